@@ -1,0 +1,103 @@
+//! How it works: `manifest.toml` describes a dataset folder: its frame (CRS and where grid space
+//! sits in it), and for each layer its pack file, texel size and tile pyramid. It is the last file a
+//! build writes, so a folder with a readable manifest is a complete dataset.
+//!
+//! Frames: grid space is metres east (x) and north (y) of `origin_m`, the CRS position of the
+//! south-west height sample. Heights are vertex samples `spacing_m` apart; cell layers (imagery,
+//! land cover) tile the DEM's pixel-area extent, which starts half a spacing south-west of it.
+
+use serde::{Deserialize, Serialize};
+
+use super::pyramid::Pyramid;
+
+pub const FORMAT_VERSION: u32 = 1;
+pub const MANIFEST_FILE: &str = "manifest.toml";
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    pub format_version: u32,
+    /// A short name for logs (the DEM file's stem, or "synthetic").
+    pub name: String,
+    pub crs: Crs,
+    /// CRS coordinates (metres) of grid sample (0, 0): the south-west height sample.
+    pub origin_m: [f64; 2],
+    pub height: HeightLayer,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imagery: Option<CellLayer>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub landcover: Option<LandcoverLayer>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Crs {
+    /// The dataset's metric CRS, as WKT, PROJ string or authority code.
+    pub definition: String,
+    /// Where it came from: the DEM's CRS, or for geographic DEMs the local frame built from it.
+    pub note: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HeightLayer {
+    pub pack: String,
+    /// Distance between level-0 samples, metres.
+    pub spacing_m: f64,
+    pub pyramid: Pyramid,
+    pub min_m: f32,
+    pub max_m: f32,
+    /// Samples that were nodata in the source and were filled.
+    pub filled_samples: u64,
+    /// A pack of the same pyramid with 1 where the source had a value, 0 where it was filled.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub valid_mask_pack: Option<String>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellLayer {
+    pub pack: String,
+    /// Texel edge at level 0, metres.
+    pub texel_m: f64,
+    pub pyramid: Pyramid,
+    /// Mips stored per tile.
+    pub mips: u32,
+    /// What the texels hold, e.g. "rgba8 srgb".
+    pub format: String,
+    /// The source file, for the record.
+    pub source: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LandcoverLayer {
+    #[serde(flatten)]
+    pub layer: CellLayer,
+    /// The classification scheme's name (e.g. "nc", "nlcd").
+    pub scheme: String,
+    /// The classes of the scheme. Codes absent here are "no class".
+    pub classes: Vec<ClassName>,
+    /// The code written where the source had no data.
+    pub nodata_code: u8,
+}
+
+impl Manifest {
+    /// CRS coordinates of the south-west corner of the DEM's pixel-area extent.
+    pub fn corner_m(&self) -> [f64; 2] {
+        let half = 0.5 * self.height.spacing_m;
+        [self.origin_m[0] - half, self.origin_m[1] - half]
+    }
+
+    /// Size of the pixel-area extent, metres.
+    pub fn extent_m(&self) -> [f64; 2] {
+        self.height.pyramid.size.map(|n| f64::from(n) * self.height.spacing_m)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClassName {
+    pub code: u8,
+    pub name: String,
+}

@@ -1,0 +1,179 @@
+//! How it works: a dataset is a folder with `manifest.toml` and one memory-mapped pack per layer
+//! (heights, their validity mask, imagery, land cover). `Dataset::open` checks the manifest and
+//! every pack's header and length up front; tile payloads are checksummed when read, so a damaged
+//! tile is an error for that tile alone and the caller decides how to degrade.
+//!
+//! Writing goes through `Staging` (atomic publication) and `layer_writer::write_layer` (one pack,
+//! tile by tile), shared by `terramp-data build` and the synthetic generator.
+
+pub mod layer_writer;
+pub mod manifest;
+pub mod pack;
+pub mod pyramid;
+pub mod staging;
+
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer};
+pub use manifest::{
+    CellLayer, ClassName, Crs, FORMAT_VERSION, HeightLayer, LandcoverLayer, MANIFEST_FILE, Manifest,
+};
+pub use pack::{Pack, PackError};
+pub use pyramid::{Pyramid, Sampling, TileId};
+pub use staging::Staging;
+
+/// Height tiles: 256 cells (257 shared-edge samples) plus a 1-sample border for normals.
+pub const HEIGHT_TILE_CELLS: u32 = 256;
+pub const HEIGHT_BORDER: u32 = 1;
+/// Imagery and land-cover tiles: 512 texels. Imagery carries an 8-texel border, enough for
+/// trilinear and anisotropic filtering down its 4 stored mips (8, 4, 2, 1 texels of border).
+pub const CELL_TILE_TEXELS: u32 = 512;
+pub const IMAGERY_BORDER: u32 = 8;
+pub const IMAGERY_MIPS: u32 = 4;
+/// Land cover is read texel by texel (nearest), so it needs no border.
+pub const LANDCOVER_BORDER: u32 = 0;
+
+#[derive(Debug, Error)]
+pub enum DatasetError {
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error(
+        "{path}: no dataset here (no {MANIFEST_FILE}); build one with `terramp-data build` or `terramp-data synth`"
+    )]
+    NotADataset { path: PathBuf },
+    #[error("{path}: bad manifest: {message}")]
+    Manifest { path: PathBuf, message: String },
+    #[error("{path}: dataset format version {found}, this build reads version {FORMAT_VERSION}; rebuild it")]
+    Version { path: PathBuf, found: u32 },
+    #[error("writing the manifest: {0}")]
+    ManifestWrite(String),
+    #[error("{path}: not a usable output folder name")]
+    BadOutput { path: PathBuf },
+    #[error(
+        "{path}: pack holds {found} tiles of {found_bytes} bytes, the manifest describes {expected} of {expected_bytes}"
+    )]
+    PackShape { path: PathBuf, found: u64, found_bytes: u64, expected: u64, expected_bytes: u64 },
+    #[error(transparent)]
+    Pack(#[from] PackError),
+}
+
+/// One layer's pack with the pyramid that addresses it.
+pub struct LayerPack {
+    pub pyramid: Pyramid,
+    pub mips: u32,
+    pack: Pack,
+}
+
+impl LayerPack {
+    fn open(
+        dir: &Path,
+        file: &str,
+        pyramid: Pyramid,
+        mips: u32,
+        texel_bytes: usize,
+    ) -> Result<Self, DatasetError> {
+        let pack = Pack::open(&dir.join(file))?;
+        let spec = LayerSpec { name: "", pyramid, mips, reduce: Reduce::Decimate };
+        let expected_bytes = (spec.tile_texels() * texel_bytes) as u64;
+        if pack.tile_count() != pyramid.tile_count() || pack.tile_bytes() != expected_bytes {
+            return Err(DatasetError::PackShape {
+                path: pack.path().to_owned(),
+                found: pack.tile_count(),
+                found_bytes: pack.tile_bytes(),
+                expected: pyramid.tile_count(),
+                expected_bytes,
+            });
+        }
+        Ok(Self { pyramid, mips, pack })
+    }
+
+    /// The tile's payload (all mips), checksum verified.
+    pub fn tile_bytes(&self, id: TileId) -> Result<&[u8], PackError> {
+        let index = self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
+            path: self.pack.path().to_owned(),
+            index: u64::MAX,
+            count: self.pack.tile_count(),
+        })?;
+        self.pack.tile(index)
+    }
+}
+
+/// An opened dataset.
+pub struct Dataset {
+    pub dir: PathBuf,
+    pub manifest: Manifest,
+    pub height: LayerPack,
+    pub imagery: Option<LayerPack>,
+    pub landcover: Option<LayerPack>,
+}
+
+impl Dataset {
+    pub fn open(dir: &Path) -> Result<Self, DatasetError> {
+        let manifest_path = dir.join(MANIFEST_FILE);
+        if !manifest_path.exists() {
+            return Err(DatasetError::NotADataset { path: dir.to_owned() });
+        }
+        let text = std::fs::read_to_string(&manifest_path)
+            .map_err(|source| DatasetError::Io { path: manifest_path.clone(), source })?;
+        let manifest: Manifest = toml::from_str(&text)
+            .map_err(|e| DatasetError::Manifest { path: manifest_path.clone(), message: e.to_string() })?;
+        if manifest.format_version != FORMAT_VERSION {
+            return Err(DatasetError::Version { path: manifest_path, found: manifest.format_version });
+        }
+        let height =
+            LayerPack::open(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?;
+        let imagery = manifest
+            .imagery
+            .as_ref()
+            .map(|l| LayerPack::open(dir, &l.pack, l.pyramid, l.mips, 4))
+            .transpose()?;
+        let landcover = manifest
+            .landcover
+            .as_ref()
+            .map(|l| LayerPack::open(dir, &l.layer.pack, l.layer.pyramid, l.layer.mips, 1))
+            .transpose()?;
+        Ok(Self { dir: dir.to_owned(), manifest, height, imagery, landcover })
+    }
+
+    /// The height tile's samples, `tile_extent`² f32 metres, south row first.
+    pub fn height_tile(&self, id: TileId) -> Result<&[f32], PackError> {
+        // Pack payloads start 4 KiB-aligned and are whole multiples of 4 bytes.
+        Ok(bytemuck::cast_slice(self.height.tile_bytes(id)?))
+    }
+
+    /// Height at grid-space position (`x_m`, `y_m`) from `level`, bilinear between samples and
+    /// clamped to the dataset. Reads at most four tiles; for camera placement and tests, not the
+    /// per-frame path.
+    pub fn height_at(&self, x_m: f64, y_m: f64, level: u32) -> Result<f64, PackError> {
+        let pyramid = &self.height.pyramid;
+        let level = level.min(pyramid.levels - 1);
+        let spacing = self.manifest.height.spacing_m * f64::from(1u32 << level);
+        let size = pyramid.size_at(level);
+        let max = [f64::from(size[0] - 1), f64::from(size[1] - 1)];
+        let (gx, gy) = ((x_m / spacing).clamp(0.0, max[0]), (y_m / spacing).clamp(0.0, max[1]));
+        let (ix, iy) = (gx.floor() as u32, gy.floor() as u32);
+        let (fx, fy) = (gx - f64::from(ix), gy - f64::from(iy));
+        let sample = |x: u32, y: u32| self.height_sample(level, x.min(size[0] - 1), y.min(size[1] - 1));
+        let (h00, h10) = (sample(ix, iy)?, sample(ix + 1, iy)?);
+        let (h01, h11) = (sample(ix, iy + 1)?, sample(ix + 1, iy + 1)?);
+        let south = h00 + (h10 - h00) * fx;
+        let north = h01 + (h11 - h01) * fx;
+        Ok(south + (north - south) * fy)
+    }
+
+    /// The stored sample (`x`, `y`) of `level`, in metres.
+    pub fn height_sample(&self, level: u32, x: u32, y: u32) -> Result<f64, PackError> {
+        let pyramid = &self.height.pyramid;
+        let tiles = pyramid.tiles_at(level);
+        let (tx, ty) = ((x / pyramid.tile).min(tiles[0] - 1), (y / pyramid.tile).min(tiles[1] - 1));
+        let tile = self.height_tile(TileId::new(level, tx, ty))?;
+        let extent = pyramid.tile_extent();
+        let (lx, ly) = (x - tx * pyramid.tile + pyramid.border, y - ty * pyramid.tile + pyramid.border);
+        Ok(f64::from(tile[(ly * extent + lx) as usize]))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,8 @@
+//! terramp amplifies real terrain on the GPU.
+//!
+//! It streams a large DEM with its aerial imagery and populates the ground with seeds chosen from
+//! a land-cover map, in the four passes of Amara, Meunier & Marsault (2007). See `DESIGN.md` in
+//! the shared folder for the architecture; `frame` reads as the list of passes.
+
+pub mod classes;
+pub mod dataset;
