@@ -120,7 +120,7 @@ where
     S: Fn(Window) -> Result<Vec<T>, String> + Sync,
 {
     let pyramid = &spec.pyramid;
-    debug_assert!(pyramid.tile_extent() % (1 << (spec.mips - 1)) == 0, "mips must halve exactly");
+    debug_assert!(pyramid.tile_extent().is_multiple_of(1 << (spec.mips - 1)), "mips must halve exactly");
     let writer = PackWriter::create(path, spec.tile_bytes::<T>(), pyramid.tile_count())?;
     progress.set_length(pyramid.tile_count());
     for level in 0..pyramid.levels {
