@@ -4,5 +4,13 @@
 //! a land-cover map, in the four passes of Amara, Meunier & Marsault (2007). See `DESIGN.md` in
 //! the shared folder for the architecture; `frame` reads as the list of passes.
 
+pub mod camera;
 pub mod classes;
+pub mod config;
 pub mod dataset;
+pub mod frame;
+pub mod gpu;
+pub mod shaders;
+pub mod streaming;
+pub mod synth;
+pub mod terrain;

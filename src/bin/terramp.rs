@@ -1,1 +1,266 @@
-fn main() {}
+//! The `terramp` command line: render a frame of a dataset, fly the demo, describe a dataset.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use glam::DVec3;
+
+use terramp::camera::Camera;
+use terramp::config::Settings;
+use terramp::dataset::Dataset;
+use terramp::frame::Renderer;
+use terramp::gpu::{Gpu, PassTiming};
+
+#[derive(Parser)]
+#[command(
+    name = "terramp",
+    version,
+    about = "GPU terrain amplification: stream a DEM with imagery and render it"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Args)]
+struct SettingsArgs {
+    /// Preset: fast, balanced or accurate.
+    #[arg(long, default_value = "balanced")]
+    preset: String,
+    /// A TOML file overriding settings (see config/default.toml for every key).
+    #[arg(long)]
+    settings: Option<PathBuf>,
+}
+
+impl SettingsArgs {
+    fn load(&self) -> Result<Settings> {
+        Ok(Settings::load(&self.preset, self.settings.as_deref())?)
+    }
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render one frame of a dataset to a PNG.
+    Render {
+        #[arg(long)]
+        dataset: PathBuf,
+        /// X,Y,Z,YAW,PITCH: position in the dataset CRS (metres; Z above the datum), compass
+        /// heading and pitch above the horizon (degrees). E.g. `--camera 636000,214000,900,0,-20`.
+        #[arg(long, allow_hyphen_values = true)]
+        camera: String,
+        /// Vertical field of view, degrees.
+        #[arg(long)]
+        fov: Option<f64>,
+        #[arg(long)]
+        width: Option<u32>,
+        #[arg(long)]
+        height: Option<u32>,
+        #[arg(long)]
+        out: PathBuf,
+        #[command(flatten)]
+        settings: SettingsArgs,
+    },
+    /// The main job on the embedded default: synthesize the default dataset if missing, then fly
+    /// over it and write the frames.
+    Demo {
+        /// Where the default dataset lives (created when missing).
+        #[arg(long, default_value = "data/default")]
+        dataset: PathBuf,
+        /// Folder for the frames.
+        #[arg(long, default_value = "out/demo")]
+        out: PathBuf,
+        #[arg(long, default_value_t = 24)]
+        frames: u32,
+        #[command(flatten)]
+        settings: SettingsArgs,
+    },
+    /// Describe a dataset: frame, extent, layers.
+    Info {
+        #[arg(long)]
+        dataset: PathBuf,
+    },
+}
+
+fn main() -> Result<()> {
+    match Cli::parse().command {
+        Command::Render { dataset, camera, fov, width, height, out, settings } => {
+            let mut settings = settings.load()?;
+            settings.render.fov_deg = fov.unwrap_or(settings.render.fov_deg);
+            settings.render.width = width.unwrap_or(settings.render.width);
+            settings.render.height = height.unwrap_or(settings.render.height);
+            let camera = Camera::parse_pose(&camera, settings.render.fov_deg, settings.render.near_m)?;
+            render_one(&dataset, settings, &camera, &out)
+        }
+        Command::Demo { dataset, out, frames, settings } => demo(&dataset, &out, frames, settings.load()?),
+        Command::Info { dataset } => info(&dataset),
+    }
+}
+
+fn open_renderer(dataset_dir: &Path, settings: Settings) -> Result<Renderer> {
+    let dataset = Dataset::open(dataset_dir)?;
+    let gpu = Gpu::new(settings.gpu.adapter)?;
+    eprintln!("terramp: adapter {}", gpu.describe());
+    Ok(Renderer::new(gpu, dataset, settings)?)
+}
+
+fn render_one(dataset_dir: &Path, settings: Settings, camera: &Camera, out: &Path) -> Result<()> {
+    let mut renderer = open_renderer(dataset_dir, settings)?;
+    let start = Instant::now();
+    let report = renderer.render(camera)?;
+    let image = renderer.read_colour()?;
+    let elapsed = start.elapsed();
+    save_png(&image, out)?;
+    let drained = renderer.profiler.drain(&renderer.gpu)?;
+    println!(
+        "{}: {} nodes, {} height + {} imagery tiles uploaded, {:.0} ms (first frame, shaders compiled on first use)",
+        out.display(),
+        report.nodes_drawn,
+        report.height.uploaded,
+        report.imagery.uploaded,
+        elapsed.as_secs_f64() * 1000.0
+    );
+    print_timings(drained.last().map(Vec::as_slice).unwrap_or(renderer.last_timings()));
+    Ok(())
+}
+
+fn save_png(image: &image::RgbaImage, out: &Path) -> Result<()> {
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+    }
+    image.save(out).with_context(|| format!("writing {}", out.display()))
+}
+
+fn print_timings(timings: &[PassTiming]) {
+    for t in timings {
+        println!("  {:<16} {:>8.2} ms  ({:?})", t.label, t.ms, t.source);
+    }
+}
+
+fn demo(dataset_dir: &Path, out: &Path, frames: u32, settings: Settings) -> Result<()> {
+    if frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    if !dataset_dir.join(terramp::dataset::MANIFEST_FILE).exists() {
+        eprintln!("terramp: no dataset at {}; synthesizing the default one", dataset_dir.display());
+        let start = Instant::now();
+        terramp::synth::synthesize(dataset_dir, &terramp::synth::SynthParams::default(), true)?;
+        eprintln!("terramp: synthesized in {:.1} s", start.elapsed().as_secs_f64());
+    }
+    let mut renderer = open_renderer(dataset_dir, settings)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let path = DemoPath::over(&renderer.dataset);
+    let mut frame_ms = Vec::new();
+    for i in 0..frames {
+        let camera = path.camera(&renderer, f64::from(i) / f64::from(frames.max(2) - 1))?;
+        let start = Instant::now();
+        let report = renderer.render(&camera)?;
+        let image = renderer.read_colour()?;
+        frame_ms.push(start.elapsed().as_secs_f64() * 1000.0);
+        let file = out.join(format!("frame_{i:04}.png"));
+        save_png(&image, &file)?;
+        println!(
+            "frame {i:>3}: {:>4} nodes, uploaded {:>3} height / {:>3} imagery tiles, {:>7.1} ms",
+            report.nodes_drawn,
+            report.height.uploaded,
+            report.imagery.uploaded,
+            frame_ms.last().copied().unwrap_or_default()
+        );
+    }
+    let drained = renderer.profiler.drain(&renderer.gpu)?;
+    println!("last frame's passes:");
+    print_timings(drained.last().map(Vec::as_slice).unwrap_or(renderer.last_timings()));
+    frame_ms.sort_by(f64::total_cmp);
+    println!(
+        "{frames} frames in {}: median {:.1} ms per frame (render + readback + PNG)",
+        out.display(),
+        frame_ms[frame_ms.len() / 2]
+    );
+    Ok(())
+}
+
+/// A straight flight across the dataset's middle, 120 m above the highest ground near the line,
+/// looking ahead and down.
+struct DemoPath {
+    start_m: DVec3,
+    end_m: DVec3,
+}
+
+impl DemoPath {
+    fn over(dataset: &Dataset) -> Self {
+        let m = &dataset.manifest;
+        let [w, h] = m.extent_m();
+        let corner = m.corner_m();
+        let at = |fx: f64, fy: f64| DVec3::new(corner[0] + fx * w, corner[1] + fy * h, 0.0);
+        Self { start_m: at(0.15, 0.2), end_m: at(0.75, 0.7) }
+    }
+
+    fn camera(&self, renderer: &Renderer, t: f64) -> Result<Camera> {
+        let m = &renderer.dataset.manifest;
+        let position = self.start_m.lerp(self.end_m, t);
+        let ahead = (self.end_m - self.start_m).normalize();
+        // Clearance over the ground below and a little ahead, so the camera never dives into a hill.
+        let mut ground_m = f64::MIN;
+        for step in 0..8 {
+            let probe = position + ahead * f64::from(step) * 40.0;
+            let grid = [probe.x - m.origin_m[0], probe.y - m.origin_m[1]];
+            ground_m = ground_m.max(renderer.dataset.height_at(grid[0], grid[1], 0)?);
+        }
+        let yaw_deg = ahead.x.atan2(ahead.y).to_degrees();
+        let r = &renderer.settings.render;
+        Ok(Camera {
+            position_m: DVec3::new(position.x, position.y, ground_m + 120.0),
+            yaw_deg,
+            pitch_deg: -12.0,
+            fov_deg: r.fov_deg,
+            near_m: r.near_m,
+        })
+    }
+}
+
+fn info(dataset_dir: &Path) -> Result<()> {
+    let dataset = Dataset::open(dataset_dir)?;
+    let m = &dataset.manifest;
+    let [w, h] = m.extent_m();
+    let corner = m.corner_m();
+    println!("{} ({})", m.name, dataset_dir.display());
+    println!("  CRS: {}", m.crs.note);
+    println!(
+        "  extent: {:.1} .. {:.1} E, {:.1} .. {:.1} N ({:.1} × {:.1} km)",
+        corner[0],
+        corner[0] + w,
+        corner[1],
+        corner[1] + h,
+        w / 1000.0,
+        h / 1000.0
+    );
+    let p = &m.height.pyramid;
+    println!(
+        "  heights: {}×{} samples at {} m, {} levels, {:.1} .. {:.1} m, {} filled",
+        p.size[0],
+        p.size[1],
+        m.height.spacing_m,
+        p.levels,
+        m.height.min_m,
+        m.height.max_m,
+        m.height.filled_samples
+    );
+    if let Some(i) = &m.imagery {
+        println!(
+            "  imagery: {}×{} texels at {} m, {} levels",
+            i.pyramid.size[0], i.pyramid.size[1], i.texel_m, i.pyramid.levels
+        );
+    }
+    if let Some(l) = &m.landcover {
+        println!(
+            "  land cover ({}, {} classes): {}×{} texels at {} m",
+            l.scheme,
+            l.classes.len(),
+            l.layer.pyramid.size[0],
+            l.layer.pyramid.size[1],
+            l.layer.texel_m
+        );
+    }
+    Ok(())
+}

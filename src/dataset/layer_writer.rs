@@ -70,7 +70,7 @@ impl Texel for [u8; 4] {
 
 /// An in-range window of a layer's level-0 grid: texels `x0..x0 + width`, `y0..y0 + height`
 /// (grid space: y grows north). Sources return texels row by row, southernmost row first.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Window {
     pub x0: u32,
     pub y0: u32,

@@ -47,7 +47,8 @@ pub struct HeightLayer {
     pub pyramid: Pyramid,
     pub min_m: f32,
     pub max_m: f32,
-    /// Samples that were nodata in the source and were filled.
+    /// Samples with no source value that were filled: voids and nodata in the source, and, for a
+    /// reprojected DEM, the grid's corners beyond the source's edge. Equals the zeros of the mask.
     pub filled_samples: u64,
     /// A pack of the same pyramid with 1 where the source had a value, 0 where it was filled.
     #[serde(default, skip_serializing_if = "Option::is_none")]

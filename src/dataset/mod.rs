@@ -105,6 +105,8 @@ pub struct Dataset {
     pub dir: PathBuf,
     pub manifest: Manifest,
     pub height: LayerPack,
+    /// 1 where the DEM had a value, 0 where it was filled; absent when nothing was filled.
+    pub valid_mask: Option<LayerPack>,
     pub imagery: Option<LayerPack>,
     pub landcover: Option<LayerPack>,
 }
@@ -124,6 +126,12 @@ impl Dataset {
         }
         let height =
             LayerPack::open(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?;
+        let valid_mask = manifest
+            .height
+            .valid_mask_pack
+            .as_ref()
+            .map(|pack| LayerPack::open(dir, pack, manifest.height.pyramid, 1, 1))
+            .transpose()?;
         let imagery = manifest
             .imagery
             .as_ref()
@@ -134,7 +142,7 @@ impl Dataset {
             .as_ref()
             .map(|l| LayerPack::open(dir, &l.layer.pack, l.layer.pyramid, l.layer.mips, 1))
             .transpose()?;
-        Ok(Self { dir: dir.to_owned(), manifest, height, imagery, landcover })
+        Ok(Self { dir: dir.to_owned(), manifest, height, valid_mask, imagery, landcover })
     }
 
     /// The height tile's samples, `tile_extent`² f32 metres, south row first.

@@ -1,0 +1,193 @@
+//! How it works: `terramp-data build` turns GeoTIFF inputs into a dataset folder.
+//!
+//! Every input is opened and checked first (`raster`), so a bad file fails before any work. The
+//! DEM then fixes the frame (`frame`): its projected CRS and grid, or a local metric frame for a
+//! DEM in degrees. Each layer is a `GridRaster` (the source as seen on the layer's grid, read
+//! directly when aligned, else warped by GDAL) and is written tile by tile by the library's
+//! `write_layer` into a staging folder: heights after a scan that finds their range and voids
+//! (`heights`, `fill`), then imagery (`imagery`) and land cover (`landcover`). The manifest is
+//! written last and the folder published atomically, so `--out` never holds half a dataset.
+
+mod fill;
+mod frame;
+mod gdal_ffi;
+mod heights;
+mod imagery;
+mod landcover;
+mod raster;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
+use terramp::dataset::{FORMAT_VERSION, Manifest, Staging};
+
+use frame::{Frame, Grid};
+use heights::{Footprint, HeightScan};
+use imagery::Imagery;
+use landcover::Landcover;
+use raster::{Access, GridRaster, Resampling, SourceRaster};
+
+/// GDAL's raster block cache: enough for a few rows of tiles, and a bound on resident memory.
+const GDAL_BLOCK_CACHE_BYTES: i64 = 64 << 20;
+
+#[derive(Debug, clap::Args)]
+pub struct BuildArgs {
+    /// The DEM: heights in metres, in a projected CRS or in geographic degrees.
+    #[arg(long)]
+    pub dem: PathBuf,
+    /// Imagery to drape over the terrain (any CRS; reprojected onto the DEM's extent).
+    #[arg(long)]
+    pub imagery: Option<PathBuf>,
+    /// Imagery bands (1-based) to use as red,green,blue, e.g. `3,2,1`; one band gives grey.
+    #[arg(long, value_delimiter = ',', requires = "imagery")]
+    pub bands: Option<Vec<usize>>,
+    /// A land-cover classification raster.
+    #[arg(long, requires = "classes")]
+    pub landcover: Option<PathBuf>,
+    /// The land cover's class table: a built-in one (`nc`, `nlcd`) or a TOML file.
+    #[arg(long, requires = "landcover")]
+    pub classes: Option<String>,
+    /// The output dataset folder (replaced atomically if it already holds a dataset).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// A short name for logs (default: the DEM file's stem).
+    #[arg(long)]
+    pub name: Option<String>,
+}
+
+pub fn run(args: &BuildArgs) -> Result<()> {
+    configure_gdal();
+    let inputs = Inputs::open(args)?;
+    let staging = Staging::begin(&args.out).with_context(|| format!("preparing {}", args.out.display()))?;
+    let progress = MultiProgress::new();
+    let name = args.name.clone().unwrap_or_else(|| file_stem(&args.dem));
+    let (manifest, scan) = write_layers(&inputs, name, &staging, &progress)?;
+    let dir = staging.commit(&manifest).with_context(|| format!("publishing {}", args.out.display()))?;
+    progress.clear().ok();
+    print_summary(&dir, &manifest, &inputs, &scan);
+    Ok(())
+}
+
+/// Every input, opened and checked before anything is written.
+struct Inputs {
+    frame: Frame,
+    dem: GridRaster,
+    footprint: Footprint,
+    imagery: Option<Imagery>,
+    landcover: Option<Landcover>,
+}
+
+impl Inputs {
+    fn open(args: &BuildArgs) -> Result<Self> {
+        let dem_source = SourceRaster::open(&args.dem, "DEM")?;
+        let frame = Frame::from_dem(&dem_source)?;
+        let imagery = args.imagery.as_deref().map(|path| Imagery::open(path, args.bands.as_deref(), &frame));
+        let landcover = match (&args.landcover, &args.classes) {
+            (Some(path), Some(classes)) => Some(Landcover::open(path, classes, &frame)?),
+            _ => None,
+        };
+        let dem = GridRaster::new(dem_source, &frame.dem_grid, &frame.srs, &[1], Resampling::Bilinear, true)?;
+        let footprint = footprint(&dem, &args.dem, &frame)?;
+        Ok(Self { imagery: imagery.transpose()?, landcover, dem, footprint, frame })
+    }
+}
+
+/// Writes every layer's pack into the staging folder; returns the dataset's manifest.
+fn write_layers(
+    inputs: &Inputs,
+    name: String,
+    staging: &Staging,
+    progress: &MultiProgress,
+) -> Result<(Manifest, HeightScan)> {
+    let scan = heights::scan(&inputs.dem, &inputs.footprint, &bar(progress, "scan DEM", "blocks"))?;
+    let height_bars = [&bar(progress, "heights", "tiles"), &bar(progress, "valid mask", "tiles")];
+    let height = heights::write(&inputs.dem, &scan, inputs.frame.dem_grid.pixel_m, staging, height_bars)?;
+    let imagery = inputs.imagery.as_ref().map(|i| i.write(staging, &bar(progress, "imagery", "tiles")));
+    let landcover =
+        inputs.landcover.as_ref().map(|l| l.write(staging, &bar(progress, "land cover", "tiles")));
+    let manifest = Manifest {
+        format_version: FORMAT_VERSION,
+        name,
+        crs: inputs.frame.crs.clone(),
+        origin_m: inputs.frame.origin_m(),
+        height,
+        imagery: imagery.transpose()?,
+        landcover: landcover.transpose()?,
+    };
+    Ok((manifest, scan))
+}
+
+/// Small block cache, and GDAL's own messages kept off stderr: its errors reach the user through
+/// the results of the calls that failed, with the file named.
+fn configure_gdal() {
+    gdal_ffi::set_block_cache_bytes(GDAL_BLOCK_CACHE_BYTES);
+    gdal::config::set_error_handler(|_, _, _| {});
+}
+
+/// How the scan tells the source's voids from the grid beyond its edge. For a warped DEM with
+/// nodata, that is the DEM warped again as if it had none: where even that is `NaN`, the grid lies
+/// beyond the source's edge.
+fn footprint(dem: &GridRaster, path: &Path, frame: &Frame) -> Result<Footprint> {
+    if dem.access == Access::Direct {
+        return Ok(Footprint::Whole);
+    }
+    let source = SourceRaster::open(path, "DEM")?;
+    if source.nodata(1)?.is_none() {
+        return Ok(Footprint::NoNodata);
+    }
+    let coverage = GridRaster::new(source, &frame.dem_grid, &frame.srs, &[1], Resampling::Bilinear, false)?;
+    Ok(Footprint::Coverage(coverage))
+}
+
+fn bar(progress: &MultiProgress, name: &str, unit: &str) -> ProgressBar {
+    let template = format!("{{prefix:>11}} {{bar:40}} {{pos}}/{{len}} {unit} {{elapsed}}");
+    let style = ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar());
+    progress.add(ProgressBar::new(0).with_style(style).with_prefix(name.to_owned()))
+}
+
+fn file_stem(path: &Path) -> String {
+    path.file_stem().map_or_else(|| "dataset".to_owned(), |s| s.to_string_lossy().into_owned())
+}
+
+fn describe_access(access: Access) -> &'static str {
+    match access {
+        Access::Direct => "copied",
+        Access::Warped => "reprojected",
+    }
+}
+
+fn describe_grid(grid: &Grid, access: Access) -> String {
+    format!("{} × {} texels of {} m, {}", grid.size[0], grid.size[1], grid.pixel_m, describe_access(access))
+}
+
+fn print_summary(dir: &Path, manifest: &Manifest, inputs: &Inputs, scan: &HeightScan) {
+    let height = &manifest.height;
+    println!("wrote {} ({})", dir.display(), manifest.name);
+    println!("  frame: {}", manifest.crs.note);
+    println!(
+        "  heights: {} × {} samples {} m apart, {} .. {} m, {}",
+        height.pyramid.size[0],
+        height.pyramid.size[1],
+        height.spacing_m,
+        height.min_m,
+        height.max_m,
+        describe_access(inputs.dem.access)
+    );
+    println!(
+        "  filled {} samples: {} voids in the source, {} beyond its edge",
+        height.filled_samples, scan.source_voids, scan.beyond_edge
+    );
+    if let Some(imagery) = &inputs.imagery {
+        let bands: Vec<String> = imagery.bands.iter().map(usize::to_string).collect();
+        println!("  imagery: {}, bands {}", describe_grid(imagery.grid(), imagery.access()), bands.join(","));
+    }
+    if let Some(landcover) = &inputs.landcover {
+        println!(
+            "  land cover: {}, scheme {}; {} texels carry codes outside the table (no class)",
+            describe_grid(landcover.grid(), landcover.access()),
+            landcover.scheme(),
+            landcover.unknown_texels()
+        );
+    }
+}

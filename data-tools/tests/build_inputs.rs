@@ -1,0 +1,138 @@
+//! `terramp-data build` on inputs made here with GDAL (no shared data needed): bad inputs fail
+//! clearly, naming the file; voids that straddle tiles are filled identically by every tile.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+
+use gdal::raster::Buffer;
+use gdal::spatial_ref::SpatialRef;
+use gdal::{DriverManager, GeoTransform};
+use support::{TempDir, build, height_image, mask_image, run_build};
+
+const NODATA: f64 = -9999.0;
+/// UTM 33N: a projected, metric CRS.
+const EPSG: u32 = 32633;
+
+/// Writes a float32 GeoTIFF of `size` heights (row by row from the north) with 25 m pixels.
+fn write_dem(path: &Path, size: [usize; 2], heights: Vec<f32>, geo_transform: GeoTransform) -> PathBuf {
+    let driver = DriverManager::get_driver_by_name("GTiff").unwrap();
+    let mut dataset = driver.create_with_band_type::<f32, _>(path, size[0], size[1], 1).unwrap();
+    dataset.set_geo_transform(&geo_transform).unwrap();
+    dataset.set_spatial_ref(&SpatialRef::from_epsg(EPSG).unwrap()).unwrap();
+    let mut band = dataset.rasterband(1).unwrap();
+    band.set_no_data_value(Some(NODATA)).unwrap();
+    band.write((0, 0), (size[0], size[1]), &mut Buffer::new((size[0], size[1]), heights)).unwrap();
+    path.to_owned()
+}
+
+const NORTH_UP: GeoTransform = [500_000.0, 25.0, 0.0, 5_000_000.0, 0.0, -25.0];
+
+/// Asserts that `build` fails, names `file` on stderr and says `what`, and leaves no output.
+fn assert_fails(args: &[&str], out: &Path, file: &str, what: &str) {
+    let output = run_build(&[args, &["--out", out.to_str().unwrap()]].concat());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{args:?} should fail");
+    assert!(stderr.contains(file), "stderr should name {file}: {stderr}");
+    assert!(stderr.to_lowercase().contains(what), "stderr should say {what:?}: {stderr}");
+    assert!(!out.exists(), "a failed build must leave nothing at {}", out.display());
+}
+
+#[test]
+fn bad_inputs_fail_naming_the_file() {
+    let tmp = TempDir::new("bad-inputs");
+    let out = tmp.path().join("out");
+    let path = |name: &str| tmp.path().join(name).to_str().unwrap().to_owned();
+
+    assert_fails(&["--dem", &path("missing.tif")], &out, "missing.tif", "no such file");
+    std::fs::write(path("empty.tif"), b"").unwrap();
+    assert_fails(&["--dem", &path("empty.tif")], &out, "empty.tif", "empty");
+    std::fs::write(path("garbage.tif"), b"this is not a TIFF at all, just some text\n".repeat(40)).unwrap();
+    assert_fails(&["--dem", &path("garbage.tif")], &out, "garbage.tif", "not a raster");
+
+    let dem = write_dem(Path::new(&path("dem.tif")), [40, 30], vec![100.0; 1200], NORTH_UP);
+    let bytes = std::fs::read(&dem).unwrap();
+    std::fs::write(path("truncated.tif"), &bytes[..bytes.len() / 2]).unwrap();
+    assert_fails(&["--dem", &path("truncated.tif")], &out, "truncated.tif", "truncated.tif");
+
+    let rotated = [500_000.0, 25.0, 3.0, 5_000_000.0, 3.0, -25.0];
+    write_dem(Path::new(&path("rotated.tif")), [40, 30], vec![100.0; 1200], rotated);
+    assert_fails(&["--dem", &path("rotated.tif")], &out, "rotated.tif", "rotated");
+
+    let dem = dem.to_str().unwrap();
+    assert_fails(
+        &["--dem", dem, "--imagery", dem, "--bands", "3,2,1"],
+        &out,
+        "dem.tif",
+        "band 3 does not exist",
+    );
+    assert_fails(
+        &["--dem", dem, "--landcover", &path("garbage.tif"), "--classes", "nc"],
+        &out,
+        "garbage.tif",
+        "land cover",
+    );
+    assert_fails(
+        &["--dem", dem, "--landcover", dem, "--classes", "no-such-table"],
+        &out,
+        "no-such-table",
+        "class table",
+    );
+}
+
+/// A sloping DEM of 700 × 600 samples with voids: one sample, a 150-sample square across the
+/// tile corner at (256, 256), a strip along the west edge and a thin diagonal scratch.
+fn holed_dem() -> (Vec<f32>, [usize; 2]) {
+    let size = [700, 600];
+    let mut heights = vec![0.0f32; size[0] * size[1]];
+    for row in 0..size[1] {
+        for col in 0..size[0] {
+            let (x, y) = (col as f32, (size[1] - 1 - row) as f32);
+            let void = (x == 90.0 && y == 400.0)
+                || ((190.0..340.0).contains(&x) && (200.0..350.0).contains(&y))
+                || x < 4.0
+                || ((500.0..600.0).contains(&x) && (x - y - 100.0).abs() < 1.5);
+            heights[row * size[0] + col] =
+                if void { NODATA as f32 } else { 500.0 + 0.8 * x - 0.3 * y + 20.0 * (x * 0.05).sin() };
+        }
+    }
+    (heights, size)
+}
+
+#[test]
+fn voids_across_tiles_are_filled_the_same_by_every_tile() {
+    let tmp = TempDir::new("holed");
+    let (source, size) = holed_dem();
+    let dem = write_dem(&tmp.path().join("holed.tif"), size, source.clone(), NORTH_UP);
+    let (dataset, stdout) = build(&tmp.path().join("out"), &["--dem", dem.to_str().unwrap()]);
+    let manifest = &dataset.manifest;
+    assert_eq!(manifest.origin_m, [500_012.5, 5_000_000.0 - 600.0 * 25.0 + 12.5]);
+    let voids = source.iter().filter(|&&h| f64::from(h) == NODATA).count() as u64;
+    assert_eq!(manifest.height.filled_samples, voids, "{stdout}");
+
+    // `height_image` checks that every tile's shared edges and borders equal their neighbours'.
+    let heights = height_image(&dataset, 0);
+    let mask = mask_image(&dataset);
+    let (lo, hi) = (manifest.height.min_m, manifest.height.max_m);
+    for (k, (&height, &valid)) in heights.iter().zip(&mask).enumerate() {
+        let (x, y) = (k % size[0], k / size[0]);
+        let truth = source[(size[1] - 1 - y) * size[0] + x];
+        assert_eq!(valid, u8::from(f64::from(truth) != NODATA), "mask at ({x}, {y})");
+        if valid == 1 {
+            assert_eq!(height, truth, "a valid sample changed at ({x}, {y})");
+        } else {
+            assert!((lo..=hi).contains(&height), "fill {height} outside {lo} .. {hi} at ({x}, {y})");
+        }
+    }
+    for level in 1..dataset.height.pyramid.levels {
+        height_image(&dataset, level);
+    }
+    // The wide void is filled smoothly: no step between neighbours steeper than the terrain's.
+    let at = |x: usize, y: usize| heights[y * size[0] + x];
+    for y in 200..350 {
+        for x in 190..340 {
+            let step = (at(x + 1, y) - at(x, y)).abs().max((at(x, y + 1) - at(x, y)).abs());
+            assert!(step < 3.0, "a step of {step} m at ({x}, {y})");
+        }
+    }
+}

@@ -1,0 +1,130 @@
+//! Helpers for the `terramp-data build` tests: the shared data, temporary folders, running the
+//! binary, reading sources with GDAL and built layers level by level.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use terramp::dataset::{Dataset, Pyramid, Sampling, TileId};
+
+/// `<workspace root>/../shared/data`, or `None` (after saying why) when it is absent. On CI its
+/// absence is a failure, never a silent skip.
+pub fn shared_data() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    if std::env::var("CI").as_deref() == Ok("true") {
+        panic!("the shared data is missing at {} (required on CI)", dir.display());
+    }
+    eprintln!("skipping: no shared data at {}", dir.display());
+    None
+}
+
+/// A temporary folder, removed when dropped.
+pub struct TempDir(PathBuf);
+
+impl TempDir {
+    pub fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("terramp-data-build-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs `terramp-data build ARGS`.
+pub fn run_build(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_terramp-data")).arg("build").args(args).output().unwrap()
+}
+
+/// Runs `terramp-data build ARGS --out OUT`, asserts success, returns the opened dataset and stdout.
+pub fn build(out: &Path, args: &[&str]) -> (Dataset, String) {
+    let output = run_build(&[args, &["--out", out.to_str().unwrap()]].concat());
+    let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+    assert!(output.status.success(), "build failed:\n{stdout}\n{stderr}");
+    (Dataset::open(out).unwrap(), stdout.into_owned())
+}
+
+/// Band 1 of a raster, row by row from the north, with its size.
+pub fn gdal_band(path: &Path) -> (Vec<f64>, [usize; 2]) {
+    let dataset = gdal::Dataset::open(path).unwrap();
+    let band = dataset.rasterband(1).unwrap();
+    let (width, height) = band.size();
+    (band.read_band_as::<f64>().unwrap().into_shape_and_vec().1, [width, height])
+}
+
+/// The source value under grid texel (`x`, `y`) of a grid that is the raster's own grid.
+pub fn north_first(values: &[f64], size: [usize; 2], x: u32, y: u32) -> f64 {
+    values[(size[1] - 1 - y as usize) * size[0] + x as usize]
+}
+
+/// One level of a layer as a whole image (south row first), each texel taken from the tile that
+/// owns it, with every stored texel of every tile checked against it: shared edges and borders
+/// must repeat their neighbour's values exactly (or the edge, replicated, beyond the layer).
+pub fn level_image<T: Copy + PartialEq + std::fmt::Debug>(
+    pyramid: &Pyramid,
+    level: u32,
+    tile: impl Fn(TileId) -> Vec<T>,
+) -> Vec<T> {
+    let size = pyramid.size_at(level);
+    let [nx, ny] = pyramid.tiles_at(level);
+    let extent = pyramid.tile_extent() as i64;
+    let border = i64::from(pyramid.border);
+    let step = i64::from(pyramid.tile);
+    let tiles: Vec<Vec<T>> = (0..ny)
+        .flat_map(|y| (0..nx).map(move |x| (x, y)))
+        .map(|(x, y)| tile(TileId::new(level, x, y)))
+        .collect();
+    let owner = |v: u32, n: u32| (i64::from(v) / step).min(i64::from(n) - 1);
+    let image: Vec<T> = (0..size[1])
+        .flat_map(|y| (0..size[0]).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let (tx, ty) = (owner(x, nx), owner(y, ny));
+            let (lx, ly) = (i64::from(x) - tx * step + border, i64::from(y) - ty * step + border);
+            tiles[(ty * i64::from(nx) + tx) as usize][(ly * extent + lx) as usize]
+        })
+        .collect();
+    let clamp = |v: i64, n: u32| v.clamp(0, i64::from(n) - 1) as usize;
+    for (index, texels) in tiles.iter().enumerate() {
+        let id = TileId::new(level, index as u32 % nx, index as u32 / nx);
+        let [x0, y0] = pyramid.tile_origin(id);
+        for j in 0..extent {
+            for i in 0..extent {
+                let expected = image[clamp(y0 + j, size[1]) * size[0] as usize + clamp(x0 + i, size[0])];
+                assert_eq!(texels[(j * extent + i) as usize], expected, "{id:?} texel ({i}, {j})");
+            }
+        }
+    }
+    image
+}
+
+/// Level `level` of the heights, checked across tile borders.
+pub fn height_image(dataset: &Dataset, level: u32) -> Vec<f32> {
+    level_image(&dataset.height.pyramid, level, |id| dataset.height_tile(id).unwrap().to_vec())
+}
+
+/// Level 0 of the validity mask pack, checked across tile borders.
+pub fn mask_image(dataset: &Dataset) -> Vec<u8> {
+    let mask = dataset.valid_mask.as_ref().expect("a validity mask pack");
+    assert_eq!(mask.pyramid.sampling, Sampling::Vertex);
+    level_image(&mask.pyramid, 0, |id| mask.tile_bytes(id).unwrap().to_vec())
+}
+
+/// The number after `label` in `text` ("filled 12 samples" → `number_before(text, " samples")`).
+pub fn number_before(text: &str, label: &str) -> u64 {
+    let end = text.find(label).unwrap_or_else(|| panic!("no {label:?} in {text}"));
+    let start = text[..end].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
+    text[start..end].parse().unwrap()
+}

@@ -1,0 +1,186 @@
+//! How it works: the camera lives in f64 in the dataset's CRS (metres east, north, height above the
+//! datum). The GPU never sees those large numbers: matrices are built for *camera-relative* world
+//! space (the camera at the origin, axes east/north/up), and every position sent to a shader is
+//! subtracted from the camera in f64 first. Depth is reversed-Z with an infinite far plane, so
+//! 0.1 m to hundreds of kilometres share one Depth32Float buffer without z-fighting.
+//!
+//! Angles: `yaw_deg` is the compass heading (0 = north, 90 = east), `pitch_deg` the elevation of
+//! the view direction above the horizon (negative looks down).
+
+use glam::{DMat4, DVec3, DVec4, Mat4};
+use thiserror::Error;
+
+#[derive(Debug, Error, PartialEq)]
+pub enum CameraError {
+    #[error("camera: {0} is not a finite number")]
+    NotFinite(&'static str),
+    #[error("camera: field of view {0}° must be between 0 and 180")]
+    Fov(f64),
+    #[error("camera: viewport {0}×{1} has no area")]
+    Viewport(u32, u32),
+    #[error("camera: `{0}` is not X,Y,Z,YAW,PITCH (five numbers: metres, metres, metres, degrees, degrees)")]
+    Parse(String),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    /// Position in the dataset CRS, metres (z: height above the datum).
+    pub position_m: DVec3,
+    pub yaw_deg: f64,
+    pub pitch_deg: f64,
+    /// Vertical field of view, degrees.
+    pub fov_deg: f64,
+    pub near_m: f64,
+}
+
+impl Camera {
+    /// Parses `X,Y,Z,YAW,PITCH` as given on the command line.
+    pub fn parse_pose(text: &str, fov_deg: f64, near_m: f64) -> Result<Self, CameraError> {
+        let values: Vec<f64> = text
+            .split(',')
+            .map(|v| v.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| CameraError::Parse(text.into()))?;
+        let [x, y, z, yaw_deg, pitch_deg] = values[..] else {
+            return Err(CameraError::Parse(text.into()));
+        };
+        let camera = Self { position_m: DVec3::new(x, y, z), yaw_deg, pitch_deg, fov_deg, near_m };
+        camera.validate()?;
+        Ok(camera)
+    }
+
+    pub fn validate(&self) -> Result<(), CameraError> {
+        let named = [
+            ("x", self.position_m.x),
+            ("y", self.position_m.y),
+            ("z", self.position_m.z),
+            ("yaw", self.yaw_deg),
+            ("pitch", self.pitch_deg),
+            ("fov", self.fov_deg),
+            ("near", self.near_m),
+        ];
+        if let Some((name, _)) = named.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(CameraError::NotFinite(name));
+        }
+        if !(self.fov_deg > 0.0 && self.fov_deg < 180.0) {
+            return Err(CameraError::Fov(self.fov_deg));
+        }
+        Ok(())
+    }
+
+    /// Unit view direction (x east, y north, z up). Pitch is clamped just short of ±90° so the
+    /// view always has a defined "up".
+    pub fn forward(&self) -> DVec3 {
+        let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.clamp(-89.99, 89.99).to_radians());
+        DVec3::new(yaw.sin() * pitch.cos(), yaw.cos() * pitch.cos(), pitch.sin())
+    }
+
+    /// View-from-world for camera-relative world space.
+    pub fn view_from_world(&self) -> DMat4 {
+        glam::dcamera::rh::view::look_to_mat4(DVec3::ZERO, self.forward(), DVec3::Z)
+    }
+
+    /// Reversed-Z, infinite-far projection.
+    pub fn clip_from_view(&self, width: u32, height: u32) -> Result<DMat4, CameraError> {
+        if width == 0 || height == 0 {
+            return Err(CameraError::Viewport(width, height));
+        }
+        let aspect = f64::from(width) / f64::from(height);
+        // wgpu clip space is DirectX-like: z in [0, 1], y up.
+        Ok(glam::dcamera::rh::proj::directx::perspective_infinite_reverse(
+            self.fov_deg.to_radians(),
+            aspect,
+            self.near_m,
+        ))
+    }
+
+    /// Clip-from-camera-relative-world, in f32 for the GPU.
+    pub fn clip_from_view_world(&self, width: u32, height: u32) -> Result<Mat4, CameraError> {
+        Ok((self.clip_from_view(width, height)? * self.view_from_world()).as_mat4())
+    }
+
+    /// Metres covered by one pixel at distance `distance_m`, for a viewport `height_px` tall.
+    pub fn metres_per_pixel(&self, distance_m: f64, height_px: u32) -> f64 {
+        2.0 * distance_m * (0.5 * self.fov_deg.to_radians()).tan() / f64::from(height_px.max(1))
+    }
+}
+
+/// The side planes and near plane of a view, in camera-relative world space, for culling.
+#[derive(Debug, Clone)]
+pub struct Frustum {
+    planes: [DVec4; 5],
+}
+
+impl Frustum {
+    /// From a reversed-Z clip matrix (Gribb & Hartmann; the far plane is at infinity, so none).
+    pub fn from_clip(clip_from_world: DMat4) -> Self {
+        let m = clip_from_world.transpose();
+        let (x, y, z, w) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
+        let planes = [w + x, w - x, w + y, w - y, w - z].map(|p| p / p.truncate().length().max(1e-300));
+        Self { planes }
+    }
+
+    /// False only when the box is certainly outside.
+    pub fn intersects_box(&self, min: DVec3, max: DVec3) -> bool {
+        self.planes.iter().all(|p| {
+            let corner = DVec3::new(
+                if p.x >= 0.0 { max.x } else { min.x },
+                if p.y >= 0.0 { max.y } else { min.y },
+                if p.z >= 0.0 { max.z } else { min.z },
+            );
+            p.truncate().dot(corner) + p.w >= 0.0
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera::parse_pose("630000,215000,500,90,-10", 60.0, 0.1).unwrap()
+    }
+
+    #[test]
+    fn headings_are_compass_bearings() {
+        let c = Camera { yaw_deg: 0.0, pitch_deg: 0.0, ..camera() };
+        assert!((c.forward() - DVec3::Y).length() < 1e-12);
+        let east = Camera { yaw_deg: 90.0, ..c };
+        assert!((east.forward() - DVec3::X).length() < 1e-12);
+        assert!(camera().forward().z < 0.0);
+    }
+
+    #[test]
+    fn reversed_z_puts_near_at_one_and_far_towards_zero() {
+        let c = Camera { yaw_deg: 0.0, pitch_deg: 0.0, ..camera() };
+        let clip = c.clip_from_view(100, 100).unwrap() * c.view_from_world();
+        let depth = |d: f64| {
+            let p = clip * DVec4::new(0.0, d, 0.0, 1.0);
+            p.z / p.w
+        };
+        assert!((depth(0.1) - 1.0).abs() < 1e-9);
+        assert!(depth(500_000.0) > 0.0 && depth(500_000.0) < 1e-6);
+        assert!(depth(1.0) > depth(2.0));
+    }
+
+    #[test]
+    fn frustum_keeps_what_is_ahead_and_drops_what_is_behind() {
+        let c = Camera { yaw_deg: 0.0, pitch_deg: 0.0, ..camera() };
+        let f = Frustum::from_clip(c.clip_from_view(100, 100).unwrap() * c.view_from_world());
+        let unit = DVec3::splat(1.0);
+        assert!(f.intersects_box(DVec3::new(0.0, 100.0, 0.0) - unit, DVec3::new(0.0, 100.0, 0.0) + unit));
+        assert!(!f.intersects_box(DVec3::new(0.0, -100.0, 0.0) - unit, DVec3::new(0.0, -100.0, 0.0) + unit));
+        assert!(
+            !f.intersects_box(DVec3::new(500.0, 100.0, 0.0) - unit, DVec3::new(500.0, 100.0, 0.0) + unit)
+        );
+    }
+
+    #[test]
+    fn bad_poses_are_errors() {
+        assert!(matches!(Camera::parse_pose("1,2,3", 60.0, 0.1), Err(CameraError::Parse(_))));
+        assert!(matches!(Camera::parse_pose("1,2,3,4,x", 60.0, 0.1), Err(CameraError::Parse(_))));
+        assert!(matches!(Camera::parse_pose("1,2,3,4,5", 180.0, 0.1), Err(CameraError::Fov(_))));
+        assert!(matches!(Camera::parse_pose("1,2,inf,4,5", 60.0, 0.1), Err(CameraError::NotFinite("z"))));
+        assert!(camera().clip_from_view(0, 10).is_err());
+    }
+}

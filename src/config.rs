@@ -1,0 +1,306 @@
+//! How it works: settings are layers of TOML merged in order: `config/default.toml` (every knob,
+//! documented; compiled in, so it is the one place defaults live), a named preset
+//! (`config/presets/*.toml`), then an optional user file. Each layer is checked against the default
+//! table before merging, so a misspelt key is reported with its full name and the file it came
+//! from; the merged table is then deserialised and range-checked, naming the key again.
+//!
+//! These are user settings. The uniforms a shader reads are separate types built from them.
+
+use std::path::Path;
+
+use serde::Deserialize;
+use thiserror::Error;
+use toml::{Table, Value};
+
+use crate::gpu::AdapterChoice;
+
+const DEFAULTS: &str = include_str!("../config/default.toml");
+pub const PRESETS: &[(&str, &str)] = &[
+    ("fast", include_str!("../config/presets/fast.toml")),
+    ("balanced", include_str!("../config/presets/balanced.toml")),
+    ("accurate", include_str!("../config/presets/accurate.toml")),
+];
+
+#[derive(Debug, Error)]
+pub enum SettingsError {
+    #[error("unknown preset `{0}`: expected fast, balanced or accurate")]
+    UnknownPreset(String),
+    #[error("{origin}: {source}")]
+    Read { origin: String, source: std::io::Error },
+    #[error("{origin}: not valid TOML: {message}")]
+    Syntax { origin: String, message: String },
+    #[error("{origin}: unknown key `{key}`")]
+    UnknownKey { origin: String, key: String },
+    #[error("{origin}: `{key}` must be {expected}")]
+    WrongType { origin: String, key: String, expected: &'static str },
+    #[error("settings: `{key}` = {value}: {rule}")]
+    OutOfRange { key: &'static str, value: String, rule: &'static str },
+    #[error("settings: {0}")]
+    Shape(String),
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Settings {
+    pub gpu: GpuSettings,
+    pub render: RenderSettings,
+    pub terrain: TerrainSettings,
+    pub imagery: ImagerySettings,
+    pub cache: CacheSettings,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GpuSettings {
+    pub adapter: AdapterChoice,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub fov_deg: f64,
+    pub near_m: f64,
+    pub sun_azimuth_deg: f64,
+    pub sun_elevation_deg: f64,
+    pub haze_half_distance_m: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TerrainSettings {
+    pub node_cells: u32,
+    pub triangle_px: f64,
+    pub morph_fraction: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImagerySettings {
+    pub lod_bias: f64,
+    pub anisotropy: u16,
+}
+
+impl ImagerySettings {
+    /// The anisotropy to use on an adapter (`software`: a CPU rasteriser), resolving 0 = automatic.
+    pub fn anisotropy_on(&self, software: bool) -> u16 {
+        match (self.anisotropy, software) {
+            (0, true) => 1,
+            (0, false) => 8,
+            (n, _) => n,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CacheSettings {
+    pub height_slots: u32,
+    pub imagery_slots: u32,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        // The compiled-in defaults are checked by a test; failing here is a build defect.
+        Self::from_layers(&[]).expect("config/default.toml is valid")
+    }
+}
+
+impl Settings {
+    /// A named preset over the defaults.
+    pub fn preset(name: &str) -> Result<Self, SettingsError> {
+        Self::load(name, None)
+    }
+
+    /// The defaults, then the preset `preset`, then the user's file if any.
+    pub fn load(preset: &str, user_file: Option<&Path>) -> Result<Self, SettingsError> {
+        let (_, preset_text) = PRESETS
+            .iter()
+            .find(|(name, _)| *name == preset)
+            .ok_or_else(|| SettingsError::UnknownPreset(preset.to_owned()))?;
+        let user = user_file
+            .map(|path| {
+                let origin = path.display().to_string();
+                std::fs::read_to_string(path)
+                    .map(|text| (origin.clone(), text))
+                    .map_err(|source| SettingsError::Read { origin, source })
+            })
+            .transpose()?;
+        let mut layers = vec![(format!("preset {preset}"), preset_text.to_string())];
+        layers.extend(user);
+        Self::from_layers(&layers)
+    }
+
+    /// The defaults overlaid with `(origin, toml text)` layers, in order.
+    pub fn from_layers(layers: &[(String, String)]) -> Result<Self, SettingsError> {
+        let mut merged = parse("config/default.toml", DEFAULTS)?;
+        let defaults = merged.clone();
+        for (origin, text) in layers {
+            let layer = parse(origin, text)?;
+            check_keys(origin, &layer, &defaults, "")?;
+            overlay(&mut merged, layer);
+        }
+        let settings =
+            Settings::deserialize(Value::Table(merged)).map_err(|e| SettingsError::Shape(e.to_string()))?;
+        settings.validate()?;
+        Ok(settings)
+    }
+
+    fn validate(&self) -> Result<(), SettingsError> {
+        let r = &self.render;
+        let t = &self.terrain;
+        let checks: [(bool, &'static str, String, &'static str); 10] = [
+            (r.width >= 1 && r.width <= 16384, "render.width", r.width.to_string(), "1 to 16384 pixels"),
+            (r.height >= 1 && r.height <= 16384, "render.height", r.height.to_string(), "1 to 16384 pixels"),
+            (
+                r.fov_deg > 0.0 && r.fov_deg < 180.0,
+                "render.fov_deg",
+                r.fov_deg.to_string(),
+                "between 0 and 180",
+            ),
+            (r.near_m > 0.0, "render.near_m", r.near_m.to_string(), "must be positive"),
+            (
+                (-90.0..=90.0).contains(&r.sun_elevation_deg),
+                "render.sun_elevation_deg",
+                r.sun_elevation_deg.to_string(),
+                "-90 to 90",
+            ),
+            (
+                t.node_cells.is_power_of_two() && (8..=256).contains(&t.node_cells),
+                "terrain.node_cells",
+                t.node_cells.to_string(),
+                "a power of two from 8 to 256",
+            ),
+            (t.triangle_px > 0.0, "terrain.triangle_px", t.triangle_px.to_string(), "must be positive"),
+            (
+                t.morph_fraction > 0.0 && t.morph_fraction < 1.0,
+                "terrain.morph_fraction",
+                t.morph_fraction.to_string(),
+                "between 0 and 1",
+            ),
+            (
+                self.imagery.anisotropy <= 16,
+                "imagery.anisotropy",
+                self.imagery.anisotropy.to_string(),
+                "0 (automatic) or 1 to 16",
+            ),
+            (
+                self.cache.height_slots >= 16 && self.cache.imagery_slots >= 16,
+                "cache",
+                format!("{:?}", self.cache),
+                "at least 16 slots per cache (the coarse levels are pinned)",
+            ),
+        ];
+        match checks.into_iter().find(|(ok, ..)| !ok) {
+            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
+            None => Ok(()),
+        }
+    }
+}
+
+fn parse(origin: &str, text: &str) -> Result<Table, SettingsError> {
+    text.parse::<Table>()
+        .map_err(|e| SettingsError::Syntax { origin: origin.to_owned(), message: e.to_string() })
+}
+
+/// Every key of `layer` must exist in `defaults`, with a table where the default has a table.
+fn check_keys(origin: &str, layer: &Table, defaults: &Table, prefix: &str) -> Result<(), SettingsError> {
+    for (key, value) in layer {
+        let full = format!("{prefix}{key}");
+        match (defaults.get(key), value) {
+            (None, _) => return Err(SettingsError::UnknownKey { origin: origin.to_owned(), key: full }),
+            (Some(Value::Table(d)), Value::Table(v)) => check_keys(origin, v, d, &format!("{full}."))?,
+            (Some(Value::Table(_)), _) => {
+                return Err(SettingsError::WrongType {
+                    origin: origin.to_owned(),
+                    key: full,
+                    expected: "a table",
+                });
+            }
+            (Some(d), v) if !same_kind(d, v) => {
+                return Err(SettingsError::WrongType {
+                    origin: origin.to_owned(),
+                    key: full,
+                    expected: kind_of(d),
+                });
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+fn same_kind(default: &Value, value: &Value) -> bool {
+    // An integer where a float is expected is what a person means by `fov_deg = 60`.
+    kind_of(default) == kind_of(value) || (default.is_float() && value.is_integer())
+}
+
+fn kind_of(value: &Value) -> &'static str {
+    match value {
+        Value::String(_) => "a string",
+        Value::Integer(_) => "an integer",
+        Value::Float(_) => "a number",
+        Value::Boolean(_) => "true or false",
+        Value::Datetime(_) => "a date",
+        Value::Array(_) => "an array",
+        Value::Table(_) => "a table",
+    }
+}
+
+fn overlay(base: &mut Table, layer: Table) {
+    for (key, value) in layer {
+        match (base.get_mut(&key), value) {
+            (Some(Value::Table(b)), Value::Table(v)) => overlay(b, v),
+            (Some(Value::Float(_)), Value::Integer(i)) => {
+                base.insert(key, Value::Float(i as f64));
+            }
+            (_, v) => {
+                base.insert(key, v);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with(text: &str) -> Result<Settings, SettingsError> {
+        Settings::from_layers(&[("test.toml".into(), text.into())])
+    }
+
+    #[test]
+    fn defaults_and_every_preset_load() {
+        let defaults = Settings::default();
+        assert_eq!(Settings::preset("balanced").unwrap(), defaults);
+        let fast = Settings::preset("fast").unwrap();
+        let accurate = Settings::preset("accurate").unwrap();
+        assert!(fast.terrain.triangle_px > defaults.terrain.triangle_px);
+        assert!(accurate.terrain.triangle_px < defaults.terrain.triangle_px);
+        assert!(matches!(Settings::preset("ludicrous"), Err(SettingsError::UnknownPreset(_))));
+    }
+
+    #[test]
+    fn user_layers_override_only_their_keys() {
+        let s = with("[render]\nwidth = 64\nfov_deg = 90\n").unwrap();
+        assert_eq!((s.render.width, s.render.fov_deg), (64, 90.0));
+        assert_eq!(s.render.height, Settings::default().render.height);
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let unknown = with("[render]\nfovv = 3.0\n").unwrap_err().to_string();
+        assert!(unknown.contains("render.fovv") && unknown.contains("test.toml"), "{unknown}");
+        let wrong = with("[render]\nwidth = \"wide\"\n").unwrap_err().to_string();
+        assert!(wrong.contains("render.width") && wrong.contains("integer"), "{wrong}");
+        let range = with("[render]\nfov_deg = 180.0\n").unwrap_err().to_string();
+        assert!(range.contains("render.fov_deg"), "{range}");
+        let cells = with("[terrain]\nnode_cells = 48\n").unwrap_err().to_string();
+        assert!(cells.contains("terrain.node_cells"), "{cells}");
+        let adapter = with("[gpu]\nadapter = \"quantum\"\n").unwrap_err().to_string();
+        assert!(adapter.contains("quantum"), "{adapter}");
+        let syntax = with("[render\n").unwrap_err().to_string();
+        assert!(syntax.contains("test.toml"), "{syntax}");
+    }
+}

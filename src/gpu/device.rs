@@ -1,0 +1,167 @@
+//! How it works: terramp renders headless, so it asks wgpu for every adapter rather than one tied
+//! to a surface, and picks by policy: a hardware GPU when there is one, else a software rasteriser
+//! (Mesa lavapipe on Linux), unless the setting or `TERRAMP_ADAPTER` forces one kind. `WGPU_BACKEND`
+//! narrows the backends as usual (CI sets `vulkan`, so a silent fallback to GL cannot hide).
+//!
+//! With no usable adapter the error says what is missing and how to install it. wgpu's default
+//! uncaptured-error handler panics; ours records the error (and prints it once), so a validation
+//! error surfaces as a `GpuError` from `Gpu::check`, never a backtrace.
+
+use std::sync::{Arc, Mutex};
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Which kind of adapter to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AdapterChoice {
+    /// A hardware GPU if there is one, else a software adapter.
+    #[default]
+    Auto,
+    Hardware,
+    Software,
+}
+
+impl AdapterChoice {
+    /// The `TERRAMP_ADAPTER` environment variable, when set, overrides the setting.
+    pub fn with_env(self) -> Result<Self, GpuError> {
+        match std::env::var("TERRAMP_ADAPTER") {
+            Err(_) => Ok(self),
+            Ok(v) => match v.to_ascii_lowercase().as_str() {
+                "auto" | "" => Ok(Self::Auto),
+                "hardware" => Ok(Self::Hardware),
+                "software" => Ok(Self::Software),
+                _ => Err(GpuError::BadChoice(v)),
+            },
+        }
+    }
+
+    fn accepts(self, device_type: wgpu::DeviceType) -> bool {
+        let software = device_type == wgpu::DeviceType::Cpu;
+        match self {
+            Self::Auto => true,
+            Self::Hardware => !software,
+            Self::Software => software,
+        }
+    }
+}
+
+pub const INSTALL_HINT: &str = "terramp needs a GPU adapter. With no GPU driver, install Mesa's software Vulkan \
+driver: `sudo apt-get install mesa-vulkan-drivers libvulkan1` (Debian/Ubuntu). Force one kind with \
+TERRAMP_ADAPTER=software|hardware, and a backend with WGPU_BACKEND=vulkan.";
+
+#[derive(Debug, Error)]
+pub enum GpuError {
+    #[error("no {wanted} GPU adapter found (adapters seen: {seen}). {INSTALL_HINT}")]
+    NoAdapter { wanted: &'static str, seen: String },
+    #[error("TERRAMP_ADAPTER={0:?}: expected auto, hardware or software")]
+    BadChoice(String),
+    #[error("the adapter {adapter} refused a device: {source}")]
+    Device { adapter: String, source: wgpu::RequestDeviceError },
+    #[error("GPU error: {0}")]
+    Validation(String),
+    #[error("waiting for the GPU: {0}")]
+    Poll(#[from] wgpu::PollError),
+    #[error("reading a GPU buffer back: {0}")]
+    Map(#[from] wgpu::BufferAsyncError),
+}
+
+/// The device terramp renders with, and what it can do.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    /// GPU timestamps can be written inside encoders (else the profiler times on the CPU).
+    pub has_timestamps: bool,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl Gpu {
+    pub fn new(choice: AdapterChoice) -> Result<Self, GpuError> {
+        let choice = choice.with_env()?;
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+        let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+        let seen: Vec<String> =
+            adapters.iter().map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend)).collect();
+        // Hardware first, then by backend preference (Vulkan before GL): the order is the policy.
+        let rank = |info: &wgpu::AdapterInfo| {
+            let kind = match info.device_type {
+                wgpu::DeviceType::DiscreteGpu => 0,
+                wgpu::DeviceType::IntegratedGpu => 1,
+                wgpu::DeviceType::VirtualGpu | wgpu::DeviceType::Other => 2,
+                wgpu::DeviceType::Cpu => 3,
+            };
+            (kind, info.backend != wgpu::Backend::Vulkan)
+        };
+        let adapter = adapters
+            .into_iter()
+            .filter(|a| choice.accepts(a.get_info().device_type))
+            .min_by_key(|a| rank(&a.get_info()))
+            .ok_or_else(|| GpuError::NoAdapter {
+                wanted: match choice {
+                    AdapterChoice::Auto => "usable",
+                    AdapterChoice::Hardware => "hardware",
+                    AdapterChoice::Software => "software",
+                },
+                seen: if seen.is_empty() { "none".into() } else { seen.join(", ") },
+            })?;
+        let info = adapter.get_info();
+        let wanted = wgpu_profiler::GpuProfiler::ALL_WGPU_TIMER_FEATURES
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+        let features = adapter.features() & wanted;
+        let has_timestamps = features
+            .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+        // Cache texture arrays and seed buffers want what the adapter has, not WebGPU's minimums.
+        let adapter_limits = adapter.limits();
+        let limits = wgpu::Limits {
+            max_texture_array_layers: adapter_limits.max_texture_array_layers.min(2048),
+            max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,
+            max_buffer_size: adapter_limits.max_buffer_size,
+            ..wgpu::Limits::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("terramp"),
+            required_features: features,
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = Arc::clone(&errors);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            let text = error.to_string();
+            eprintln!("terramp: GPU error: {text}");
+            if let Ok(mut errors) = sink.lock() {
+                errors.push(text);
+            }
+        }));
+        Ok(Self { device, queue, info, has_timestamps, errors })
+    }
+
+    /// One line naming the adapter, for logs.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {:?}, {})",
+            self.info.name, self.info.backend, self.info.device_type, self.info.driver
+        )
+    }
+
+    /// Blocks until the GPU has finished everything submitted so far.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device.poll(wgpu::PollType::wait_indefinitely())?;
+        Ok(())
+    }
+
+    /// The GPU errors raised since the last check, as one error.
+    pub fn check(&self) -> Result<(), GpuError> {
+        let mut errors = self.errors.lock().map_err(|_| GpuError::Validation("error log poisoned".into()))?;
+        if errors.is_empty() {
+            return Ok(());
+        }
+        let joined = errors.join("; ");
+        errors.clear();
+        Err(GpuError::Validation(joined))
+    }
+}

@@ -1,0 +1,161 @@
+//! How it works: every pass of a frame is recorded through `Profiler::pass`, which brackets it with
+//! GPU timestamp queries (wgpu-profiler) when the adapter can write them inside encoders. Results
+//! arrive a frame or two later, when the query buffers map, so timing never stalls the frame.
+//!
+//! Without timestamps the profiler falls back to CPU timing: it submits what was recorded before
+//! the pass, waits, then records, submits and waits for the pass alone. That serialises the frame
+//! (so it is slower), but each figure is still the pass's own wall time. CPU work (TLM analysis,
+//! uploads) is timed with `cpu` scopes either way. Timings are in milliseconds.
+
+use std::time::Instant;
+
+use wgpu_profiler::{GpuProfiler, GpuProfilerSettings, GpuTimerQueryResult};
+
+use super::{Gpu, GpuError};
+
+/// Frames whose GPU timings may be in flight at once. When one more ends, the newest pending one
+/// is dropped (as wgpu-profiler does, so the two queues stay paired): a profiler that is never
+/// read cannot grow.
+const MAX_PENDING_FRAMES: usize = 4;
+
+/// Where a timing came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeSource {
+    GpuTimestamps,
+    CpuWait,
+    Cpu,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PassTiming {
+    pub label: String,
+    pub ms: f64,
+    pub source: TimeSource,
+}
+
+pub struct Profiler {
+    timestamps: Option<GpuProfiler>,
+    /// CPU-measured timings of the frame being recorded.
+    cpu: Vec<PassTiming>,
+    /// CPU timings of frames whose GPU timings are still in flight, oldest first.
+    pending: std::collections::VecDeque<Vec<PassTiming>>,
+}
+
+impl Profiler {
+    pub fn new(gpu: &Gpu) -> Self {
+        let timestamps = if gpu.has_timestamps {
+            GpuProfiler::new(
+                &gpu.device,
+                GpuProfilerSettings { max_num_pending_frames: MAX_PENDING_FRAMES, ..Default::default() },
+            )
+            .ok()
+        } else {
+            None
+        };
+        Self { timestamps, cpu: Vec::new(), pending: Default::default() }
+    }
+
+    pub fn uses_gpu_timestamps(&self) -> bool {
+        self.timestamps.is_some()
+    }
+
+    /// Records the pass `label` into `encoder`, timed.
+    pub fn pass<R>(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        record: impl FnOnce(&mut wgpu::CommandEncoder) -> R,
+    ) -> Result<R, GpuError> {
+        if let Some(profiler) = &self.timestamps {
+            let mut scope = profiler.scope(label, encoder);
+            return Ok(record(&mut scope));
+        }
+        let new_encoder = || gpu.device.create_command_encoder(&Default::default());
+        gpu.queue.submit([std::mem::replace(encoder, new_encoder()).finish()]);
+        gpu.wait()?;
+        let start = Instant::now();
+        let result = record(encoder);
+        gpu.queue.submit([std::mem::replace(encoder, new_encoder()).finish()]);
+        gpu.wait()?;
+        self.cpu.push(PassTiming { label: label.into(), ms: ms_since(start), source: TimeSource::CpuWait });
+        Ok(result)
+    }
+
+    /// Times CPU work of the frame being recorded.
+    pub fn cpu<R>(&mut self, label: &str, work: impl FnOnce() -> R) -> R {
+        let start = Instant::now();
+        let result = work();
+        self.cpu.push(PassTiming { label: label.into(), ms: ms_since(start), source: TimeSource::Cpu });
+        result
+    }
+
+    /// Call on the frame's last encoder, just before it is submitted.
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(profiler) = &mut self.timestamps {
+            profiler.resolve_queries(encoder);
+        }
+    }
+
+    /// Call after the frame's last submit.
+    pub fn end_frame(&mut self) {
+        if self.pending.len() == MAX_PENDING_FRAMES {
+            match self.timestamps {
+                Some(_) => self.pending.pop_back(),
+                None => self.pending.pop_front(),
+            };
+        }
+        if let Some(profiler) = &mut self.timestamps {
+            // Only fails on unclosed scopes, which `pass` cannot leave behind.
+            let _ = profiler.end_frame();
+        }
+        self.pending.push_back(std::mem::take(&mut self.cpu));
+    }
+
+    /// The timings of the oldest frame whose results are all in; `None` while they are in flight.
+    pub fn finished_frame(&mut self, gpu: &Gpu) -> Option<Vec<PassTiming>> {
+        let Some(profiler) = &mut self.timestamps else {
+            return self.pending.pop_front();
+        };
+        let results = profiler.process_finished_frame(gpu.queue.get_timestamp_period())?;
+        let mut frame = self.pending.pop_front().unwrap_or_default();
+        frame.extend(flatten(&results));
+        Some(frame)
+    }
+
+    /// Waits for every frame in flight and returns their timings, oldest first.
+    pub fn drain(&mut self, gpu: &Gpu) -> Result<Vec<Vec<PassTiming>>, GpuError> {
+        let mut frames = Vec::new();
+        // Each frame's query buffers map on a poll after its work is done; a few polls suffice.
+        let mut polls_left = 8 * self.pending.len() + 8;
+        while !self.pending.is_empty() && polls_left > 0 {
+            gpu.wait()?;
+            polls_left -= 1;
+            if let Some(frame) = self.finished_frame(gpu) {
+                frames.push(frame);
+            }
+        }
+        // Frames whose timestamps never arrived keep their CPU timings.
+        frames.extend(self.pending.drain(..));
+        Ok(frames)
+    }
+}
+
+fn flatten(results: &[GpuTimerQueryResult]) -> Vec<PassTiming> {
+    results
+        .iter()
+        .filter_map(|r| {
+            let time = r.time.as_ref()?;
+            Some(PassTiming {
+                label: r.label.clone(),
+                ms: (time.end - time.start) * 1000.0,
+                source: TimeSource::GpuTimestamps,
+            })
+        })
+        .collect()
+}
+
+fn ms_since(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1000.0
+}

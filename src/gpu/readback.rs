@@ -1,0 +1,54 @@
+//! How it works: copies a 2D texture into a mappable buffer (rows padded to wgpu's 256-byte copy
+//! alignment), waits, and returns the tightly packed texels. Used for frames written to disk and
+//! for tests; the per-frame data paths never read back synchronously.
+
+use super::{Gpu, GpuError};
+
+/// The texels of mip 0 of `texture` (a 2D colour or depth texture), top row first,
+/// `texel_bytes` per texel.
+pub fn read_texture(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
+    texel_bytes: u32,
+) -> Result<Vec<u8>, GpuError> {
+    let (width, height) = (texture.width(), texture.height());
+    let row_bytes = width * texel_bytes;
+    let padded = row_bytes.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: u64::from(padded) * u64::from(height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    gpu.wait()?;
+    receiver.recv().map_err(|_| GpuError::Validation("readback callback never ran".into()))??;
+    let mapped = slice.get_mapped_range().map_err(|e| GpuError::Validation(e.to_string()))?;
+    let mut texels = Vec::with_capacity((row_bytes * height) as usize);
+    for row in mapped.chunks_exact(padded as usize) {
+        texels.extend_from_slice(&row[..row_bytes as usize]);
+    }
+    drop(mapped);
+    buffer.unmap();
+    gpu.check()?;
+    Ok(texels)
+}

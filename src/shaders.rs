@@ -1,0 +1,59 @@
+//! How it works: WGSL sources are compiled into the binary, each prefixed with a prelude generated
+//! from the Rust constants it needs, so a tile size or a capacity is written once (in Rust) and
+//! can never disagree between the CPU and the shaders. Tests validate every source with naga.
+
+use crate::dataset::{CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, Sampling};
+use crate::dataset::{IMAGERY_MIPS, Pyramid};
+
+/// Levels a page table describes at most (a 2^15-tile-wide layer).
+pub const MAX_LEVELS: u32 = 16;
+
+/// Every shader: its name (matching its Rust module) and source.
+pub const SHADERS: &[(&str, &str)] = &[("terrain", include_str!("../shaders/terrain.wgsl"))];
+
+/// The constants every shader sees, generated from their Rust definitions.
+pub fn prelude() -> String {
+    let height = Pyramid {
+        size: [1, 1],
+        tile: HEIGHT_TILE_CELLS,
+        border: HEIGHT_BORDER,
+        sampling: Sampling::Vertex,
+        levels: 1,
+    };
+    let imagery = Pyramid {
+        size: [1, 1],
+        tile: CELL_TILE_TEXELS,
+        border: IMAGERY_BORDER,
+        sampling: Sampling::Cell,
+        levels: 1,
+    };
+    let constants = [
+        ("HEIGHT_TILE_CELLS", HEIGHT_TILE_CELLS),
+        ("HEIGHT_BORDER", HEIGHT_BORDER),
+        ("HEIGHT_TILE_EXTENT", height.tile_extent()),
+        ("IMAGERY_TILE_TEXELS", CELL_TILE_TEXELS),
+        ("IMAGERY_BORDER", IMAGERY_BORDER),
+        ("IMAGERY_TILE_EXTENT", imagery.tile_extent()),
+        ("IMAGERY_MIPS", IMAGERY_MIPS),
+        ("MAX_LEVELS", MAX_LEVELS),
+    ];
+    let mut text = String::from("// Generated from Rust constants (src/shaders.rs).\n");
+    for (name, value) in constants {
+        text.push_str(&format!("const {name}: u32 = {value}u;\n"));
+    }
+    text
+}
+
+/// The full source of shader `name`: prelude, then the file.
+pub fn source(name: &str) -> Option<String> {
+    SHADERS.iter().find(|(n, _)| *n == name).map(|(_, body)| format!("{}\n{body}", prelude()))
+}
+
+/// Builds shader `name` on `device`.
+pub fn module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
+    let source = source(name).unwrap_or_else(|| panic!("no shader named {name}: add it to SHADERS"));
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    })
+}

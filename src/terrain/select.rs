@@ -1,0 +1,227 @@
+//! How it works: CDLOD node selection (Strugar 2010) over the height pyramid, on the CPU.
+//!
+//! A node of LOD `m` is a `cells`² grid whose vertices are the samples of height level `m`, so
+//! one height tile holds `(HEIGHT_TILE_CELLS / cells)`² nodes of its level. Each LOD owns a ring of
+//! distances: LOD `m` is used up to `range[m]` from the camera, chosen so that a triangle edge at
+//! the ring's far end covers `triangle_px` pixels. Walking down from the coarsest nodes, a node is
+//! drawn as is when its box lies beyond the finer LOD's range, and split otherwise; quadrants whose
+//! child would lie outside the finer range are drawn by the parent (a quadrant mask), exactly as
+//! Strugar does. Morphing starts at `morph_start[m]` and completes at `range[m]`, where the coarser
+//! LOD takes over, which is what keeps neighbouring LODs crack-free.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+
+use crate::camera::Frustum;
+use crate::dataset::{HEIGHT_BORDER, HEIGHT_TILE_CELLS, Pyramid, TileId};
+
+/// A node of the terrain quadtree: LOD `lod`, position (`x`, `y`) in nodes of that LOD.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId {
+    pub lod: u32,
+    pub x: u32,
+    pub y: u32,
+}
+
+/// A node to draw and which of its quadrants (bit `qy * 2 + qx`, south-west first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Selected {
+    pub node: NodeId,
+    pub quadrants: u8,
+}
+
+pub const ALL_QUADRANTS: u8 = 0b1111;
+
+/// The geometry of the node quadtree and its LOD rings.
+#[derive(Debug, Clone)]
+pub struct Lods {
+    pub cells: u32,
+    pub spacing_m: f64,
+    pub pyramid: Pyramid,
+    /// Per LOD: distance up to which it is drawn, and where its morph starts, metres.
+    pub range_m: Vec<f64>,
+    pub morph_start_m: Vec<f64>,
+}
+
+impl Lods {
+    /// Rings for a view whose pixel at distance `d` covers `d * metres_per_pixel_at_1m` metres.
+    pub fn new(
+        pyramid: Pyramid,
+        spacing_m: f64,
+        cells: u32,
+        metres_per_pixel_at_1m: f64,
+        triangle_px: f64,
+        morph_fraction: f64,
+    ) -> Self {
+        let levels = pyramid.levels;
+        let range_m: Vec<f64> = (0..levels)
+            .map(|lod| {
+                let cell_m = spacing_m * f64::from(1u32 << lod);
+                let node_m = cell_m * f64::from(cells);
+                if lod + 1 == levels {
+                    return f64::INFINITY;
+                }
+                // A triangle edge covers `triangle_px` pixels at the ring's end; the ring must also
+                // span a node diagonal and a half, so LODs of neighbouring nodes differ by one at most.
+                (cell_m / (triangle_px * metres_per_pixel_at_1m)).max(2.2 * node_m)
+            })
+            .collect();
+        let morph_start_m = (0..levels as usize)
+            .map(|lod| {
+                let inner = if lod == 0 { 0.0 } else { range_m[lod - 1] };
+                if range_m[lod].is_infinite() {
+                    f64::INFINITY
+                } else {
+                    (range_m[lod] * (1.0 - morph_fraction)).max(inner)
+                }
+            })
+            .collect();
+        Self { cells, spacing_m, pyramid, range_m, morph_start_m }
+    }
+
+    pub fn node_m(&self, lod: u32) -> f64 {
+        self.spacing_m * f64::from(1u32 << lod) * f64::from(self.cells)
+    }
+
+    /// Grid cells of LOD `lod` along each axis (samples − 1).
+    pub fn steps(&self, lod: u32) -> [u32; 2] {
+        self.pyramid.size_at(lod).map(|n| n.saturating_sub(1).max(1))
+    }
+
+    pub fn nodes_at(&self, lod: u32) -> [u32; 2] {
+        self.steps(lod).map(|n| n.div_ceil(self.cells))
+    }
+
+    fn nodes_per_tile(&self) -> u32 {
+        HEIGHT_TILE_CELLS / self.cells
+    }
+
+    /// The height tile that holds `node`'s samples.
+    pub fn tile_of(&self, node: NodeId) -> TileId {
+        let per = self.nodes_per_tile();
+        TileId::new(node.lod, node.x / per, node.y / per)
+    }
+
+    /// Sample (border included) of `node`'s south-west vertex within its tile.
+    pub fn sample_offset(&self, node: NodeId) -> [u32; 2] {
+        let per = self.nodes_per_tile();
+        [node.x % per, node.y % per].map(|n| n * self.cells + HEIGHT_BORDER)
+    }
+
+    /// Cells of `node` inside the dataset along each axis (the rest of its grid is clamped).
+    pub fn cells_inside(&self, node: NodeId) -> [u32; 2] {
+        let steps = self.steps(node.lod);
+        let start = [node.x, node.y].map(|n| n * self.cells);
+        [0, 1].map(|a| steps[a].saturating_sub(start[a]).min(self.cells))
+    }
+
+    /// Grid-space box of `node` (metres), with its height range.
+    fn node_box(&self, node: NodeId, height_m: [f32; 2]) -> (DVec3, DVec3) {
+        let size = self.node_m(node.lod);
+        let inside =
+            self.cells_inside(node).map(|c| f64::from(c) * self.spacing_m * f64::from(1u32 << node.lod));
+        let min = DVec3::new(f64::from(node.x) * size, f64::from(node.y) * size, f64::from(height_m[0]));
+        (min, DVec3::new(min.x + inside[0], min.y + inside[1], f64::from(height_m[1])))
+    }
+}
+
+fn distance_to_box(p: DVec3, (min, max): (DVec3, DVec3)) -> f64 {
+    (p.clamp(min, max) - p).length()
+}
+
+/// Selects the nodes to draw for a camera at `camera_grid_m` (grid space). `frustum` is in
+/// camera-relative space. `bounds` gives a node's height range.
+pub fn select(
+    lods: &Lods,
+    camera_grid_m: DVec3,
+    frustum: &Frustum,
+    bounds: &mut dyn FnMut(NodeId) -> [f32; 2],
+) -> Vec<Selected> {
+    let mut out = Vec::new();
+    let top = lods.pyramid.levels - 1;
+    let [nx, ny] = lods.nodes_at(top);
+    for y in 0..ny {
+        for x in 0..nx {
+            visit(lods, NodeId { lod: top, x, y }, camera_grid_m, frustum, bounds, &mut out);
+        }
+    }
+    out
+}
+
+/// Returns false when `node` lies beyond its own range: its parent draws that area instead.
+fn visit(
+    lods: &Lods,
+    node: NodeId,
+    camera: DVec3,
+    frustum: &Frustum,
+    bounds: &mut dyn FnMut(NodeId) -> [f32; 2],
+    out: &mut Vec<Selected>,
+) -> bool {
+    let (min, max) = lods.node_box(node, bounds(node));
+    if distance_to_box(camera, (min, max)) > lods.range_m[node.lod as usize] {
+        return false;
+    }
+    if !frustum.intersects_box(min - camera, max - camera) {
+        return true;
+    }
+    if node.lod == 0 || distance_to_box(camera, (min, max)) > lods.range_m[node.lod as usize - 1] {
+        out.push(Selected { node, quadrants: ALL_QUADRANTS });
+        return true;
+    }
+    let [nx, ny] = lods.nodes_at(node.lod - 1);
+    let mut parent_draws = 0u8;
+    for q in 0..4u8 {
+        let child =
+            NodeId { lod: node.lod - 1, x: node.x * 2 + u32::from(q & 1), y: node.y * 2 + u32::from(q >> 1) };
+        if child.x >= nx || child.y >= ny {
+            continue;
+        }
+        if !visit(lods, child, camera, frustum, bounds, out) {
+            parent_draws |= 1 << q;
+        }
+    }
+    if parent_draws != 0 {
+        out.push(Selected { node, quadrants: parent_draws });
+    }
+    true
+}
+
+/// Height ranges of nodes, computed once per node from its tile's samples.
+pub struct NodeBounds {
+    known: HashMap<NodeId, [f32; 2]>,
+    /// Used for nodes whose tile cannot be read: the whole dataset's range.
+    fallback_m: [f32; 2],
+}
+
+impl NodeBounds {
+    pub fn new(fallback_m: [f32; 2]) -> Self {
+        Self { known: HashMap::new(), fallback_m }
+    }
+
+    /// The node's height range; `tile` gives the samples of the node's height tile.
+    pub fn get<'a>(
+        &mut self,
+        lods: &Lods,
+        node: NodeId,
+        tile: impl FnOnce(TileId) -> Option<&'a [f32]>,
+    ) -> [f32; 2] {
+        if let Some(&range) = self.known.get(&node) {
+            return range;
+        }
+        let Some(samples) = tile(lods.tile_of(node)) else {
+            return self.fallback_m;
+        };
+        let extent = lods.pyramid.tile_extent() as usize;
+        let [x0, y0] = lods.sample_offset(node).map(|v| v as usize);
+        let [cx, cy] = lods.cells_inside(node).map(|c| c as usize);
+        let mut range = [f32::INFINITY, f32::NEG_INFINITY];
+        for row in samples.chunks_exact(extent).skip(y0).take(cy + 1) {
+            for &h in &row[x0..=(x0 + cx).min(extent - 1)] {
+                range = [range[0].min(h), range[1].max(h)];
+            }
+        }
+        self.known.insert(node, range);
+        range
+    }
+}

@@ -1,0 +1,69 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use terramp::config::Settings;
+use terramp::dataset::Dataset;
+use terramp::frame::Renderer;
+use terramp::gpu::{AdapterChoice, Gpu};
+
+/// Serialises dataset creation between the tests of one binary.
+static BUILD: Mutex<()> = Mutex::new(());
+
+/// A synthetic dataset of `size`² samples, built once per test run and shared.
+pub fn synth_dataset(size: u32, seed: u64) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("synth-{size}-{seed}"));
+    let _guard = BUILD.lock().unwrap_or_else(|e| e.into_inner());
+    if Dataset::open(&dir).is_err() {
+        let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
+        terramp::synth::synthesize(&dir, &params, false).unwrap();
+    }
+    dir
+}
+
+/// The software adapter tests run on (CI forces `WGPU_BACKEND=vulkan`).
+pub fn gpu() -> Gpu {
+    Gpu::new(AdapterChoice::Auto).expect("tests need a GPU adapter; install mesa-vulkan-drivers")
+}
+
+pub fn small_settings(width: u32, height: u32) -> Settings {
+    let mut settings = Settings::default();
+    settings.render.width = width;
+    settings.render.height = height;
+    settings
+}
+
+pub fn renderer(dataset: &Path, settings: Settings) -> Renderer {
+    Renderer::new(gpu(), Dataset::open(dataset).unwrap(), settings).unwrap()
+}
+
+/// `../shared/data`, or `None` outside CI when it is absent. Under CI its absence is a failure.
+pub fn shared_data() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    if dir.join("README.md").exists() {
+        return Some(dir);
+    }
+    if std::env::var("CI").is_ok_and(|v| v == "true") {
+        panic!("{} is missing: CI must run with ../shared beside the repository", dir.display());
+    }
+    eprintln!("skipping: {} is not there", dir.display());
+    None
+}
+
+/// Peak signal-to-noise ratio between two same-sized RGBA images, RGB channels, dB.
+pub fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let mut sum = 0.0f64;
+    let mut n = 0usize;
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        for c in 0..3 {
+            let d = f64::from(pa[c]) - f64::from(pb[c]);
+            sum += d * d;
+            n += 1;
+        }
+    }
+    let mse = sum / n as f64;
+    if mse == 0.0 { f64::INFINITY } else { 10.0 * (255.0f64 * 255.0 / mse).log10() }
+}

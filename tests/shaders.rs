@@ -1,0 +1,38 @@
+//! Every WGSL source (with its generated prelude) parses and validates with naga, and every GPU
+//! struct has the same size in WGSL as in Rust.
+
+use terramp::gpu::gpu_types::{TerrainNode, TerrainUniforms};
+use terramp::shaders::{SHADERS, source};
+
+fn module(name: &str) -> naga::Module {
+    let text = source(name).unwrap();
+    let module = naga::front::wgsl::parse_str(&text)
+        .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&text)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}.wgsl does not validate: {e:?}"));
+    module
+}
+
+fn wgsl_size(module: &naga::Module, name: &str) -> u32 {
+    let (_, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    ty.inner.size(module.to_ctx())
+}
+
+#[test]
+fn every_shader_validates() {
+    for (name, _) in SHADERS {
+        module(name);
+    }
+}
+
+#[test]
+fn gpu_structs_match_their_wgsl_twins() {
+    let terrain = module("terrain");
+    assert_eq!(wgsl_size(&terrain, "TerrainUniforms") as usize, size_of::<TerrainUniforms>());
+    assert_eq!(wgsl_size(&terrain, "TerrainNode") as usize, size_of::<TerrainNode>());
+}
