@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the `nc/` and `globe/` datasets with a release `terramp-data` and prints, for each, the
-# wall time, the peak resident memory (from GNU time's maximum RSS) and the dataset's size on disk.
+# Builds the `nc/` and `globe/` datasets and synthesizes the default (size 1024) dataset with a
+# release `terramp-data`, and prints, for each, the wall time, the peak resident memory (from GNU
+# time's maximum RSS) and the dataset's size on disk. SYNTH_SIZES="1024 4096" adds sizes.
 #
 # Usage: scripts/measure_build.sh [OUT_DIR]   (default: a fresh temporary folder, removed after)
 # Needs GNU time at /usr/bin/time (Debian: apt-get install time) and ../shared/data.
@@ -26,7 +27,7 @@ measure() {
     local name="$1"
     shift
     local log="$out/$name.time"
-    /usr/bin/time -v -o "$log" "$bin" build --out "$out/$name" "$@" >"$out/$name.log"
+    /usr/bin/time -v -o "$log" "$bin" "$@" --out "$out/$name" >"$out/$name.log"
     local wall rss_kib bytes
     wall="$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")"
     rss_kib="$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")"
@@ -36,6 +37,9 @@ measure() {
     sed 's/^/       /' "$out/$name.log"
 }
 
-measure nc --dem "$data/nc/elev_ned_30m.tif" --imagery "$data/nc/landsat_multiband.tif" --bands 3,2,1 \
+measure nc build --dem "$data/nc/elev_ned_30m.tif" --imagery "$data/nc/landsat_multiband.tif" --bands 3,2,1 \
     --landcover "$data/nc/landuse_r.tif" --classes nc
-measure globe --dem "$data/globe/globe_g_30arcsec.tif"
+measure globe build --dem "$data/globe/globe_g_30arcsec.tif"
+for size in ${SYNTH_SIZES:-1024}; do
+    measure "synth$size" synth --size "$size"
+done

@@ -230,13 +230,3 @@ fn bad_parameters_are_refused_before_writing() {
     assert!(matches!(synthesize(&out, &origin, false), Err(SynthError::NotFinite(..))));
     assert!(!out.exists());
 }
-
-/// `cargo test --release --test synth -- --ignored --nocapture default_size_timing`
-#[test]
-#[ignore = "timing, run by hand in release"]
-fn default_size_timing() {
-    let size = std::env::var("SYNTH_SIZE").ok().and_then(|s| s.parse().ok()).unwrap_or(1024);
-    let start = Instant::now();
-    synthesize(&temp_out("timing"), &params(size, 1), true).unwrap();
-    eprintln!("size {size}: {:.2?}", start.elapsed());
-}

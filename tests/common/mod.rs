@@ -9,17 +9,29 @@ use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::{AdapterChoice, Gpu};
 
-/// Serialises dataset creation between the tests of one binary.
-static BUILD: Mutex<()> = Mutex::new(());
+/// The synthetic datasets this test process built, by (size, seed).
+static BUILT: Mutex<Vec<(u32, u64, PathBuf)>> = Mutex::new(Vec::new());
 
-/// A synthetic dataset of `size`² samples, built once per test run and shared.
+/// A synthetic dataset of `size`² samples, built once per test process (never reused across runs,
+/// so a change to the generator is always what is tested) and shared by its tests.
 pub fn synth_dataset(size: u32, seed: u64) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("synth-{size}-{seed}"));
-    let _guard = BUILD.lock().unwrap_or_else(|e| e.into_inner());
-    if Dataset::open(&dir).is_err() {
-        let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
-        terramp::synth::synthesize(&dir, &params, false).unwrap();
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((.., dir)) = built.iter().find(|(s, r, _)| (*s, *r) == (size, seed)) {
+        return dir.clone();
     }
+    let root = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    if built.is_empty() {
+        // Earlier runs' datasets: cargo runs test binaries one after another, so none is in use.
+        for entry in std::fs::read_dir(root).into_iter().flatten().flatten() {
+            if entry.file_name().to_string_lossy().starts_with("synth-") {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+        }
+    }
+    let dir = root.join(format!("synth-{size}-{seed}-{}", std::process::id()));
+    let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
+    terramp::synth::synthesize(&dir, &params, false).unwrap();
+    built.push((size, seed, dir.clone()));
     dir
 }
 
