@@ -53,6 +53,7 @@ pub struct Settings {
 #[serde(deny_unknown_fields)]
 pub struct GpuSettings {
     pub adapter: AdapterChoice,
+    pub timestamps: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]

@@ -123,7 +123,7 @@ impl Renderer {
         let depth = target("depth", DEPTH_FORMAT, usage);
         let h = &dataset.manifest.height;
         let bounds = NodeBounds::new([h.min_m, h.max_m]);
-        let profiler = Profiler::new(&gpu);
+        let profiler = Profiler::new(&gpu, settings.gpu.timestamps);
         Ok(Self {
             gpu,
             dataset,

@@ -6,6 +6,7 @@ mod common;
 use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::frame::Renderer;
+use terramp::gpu::TimeSource;
 
 use common::{renderer, small_settings, synth_dataset};
 
@@ -119,4 +120,25 @@ fn no_adapter_is_a_clear_error_not_a_panic() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success());
     assert!(stderr.contains("mesa-vulkan-drivers") && !stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn passes_are_timed_with_timestamps_or_on_the_cpu() {
+    let dataset = synth_dataset(300, 7);
+    for timestamps in [true, false] {
+        let mut settings = small_settings(96, 64);
+        settings.gpu.timestamps = timestamps;
+        let mut r = renderer(&dataset, settings);
+        let camera = camera_over_centre(&r, 300.0, 30.0, -10.0);
+        for _ in 0..3 {
+            r.render(&camera).unwrap();
+        }
+        let frames = r.profiler.drain(&r.gpu).unwrap();
+        let last = frames.last().map(Vec::as_slice).unwrap_or(r.last_timings());
+        let terrain = last.iter().find(|t| t.label == "terrain").expect("the terrain pass is timed");
+        let expected = if timestamps && r.gpu.has_timestamps { TimeSource::GpuTimestamps } else { TimeSource::CpuWait };
+        assert_eq!(terrain.source, expected);
+        assert!(terrain.ms > 0.0 && terrain.ms.is_finite(), "{terrain:?}");
+        assert!(last.iter().any(|t| t.label == "terrain_select" && t.source == TimeSource::Cpu));
+    }
 }

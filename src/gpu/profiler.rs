@@ -43,8 +43,9 @@ pub struct Profiler {
 }
 
 impl Profiler {
-    pub fn new(gpu: &Gpu) -> Self {
-        let timestamps = if gpu.has_timestamps {
+    /// GPU timestamps when `use_timestamps` and the adapter has them, else CPU timing.
+    pub fn new(gpu: &Gpu, use_timestamps: bool) -> Self {
+        let timestamps = if use_timestamps && gpu.has_timestamps {
             GpuProfiler::new(
                 &gpu.device,
                 GpuProfilerSettings { max_num_pending_frames: MAX_PENDING_FRAMES, ..Default::default() },
