@@ -7,7 +7,7 @@ use thiserror::Error;
 
 use crate::camera::{Camera, CameraError, Frustum};
 use crate::config::Settings;
-use crate::dataset::{Dataset, IMAGERY_MIPS, PackError, Pyramid, Sampling, TileId};
+use crate::dataset::{Dataset, IMAGERY_MIPS, LayerSpec, PackError, TileId};
 use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
 use crate::gpu::readback::read_texture;
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
@@ -88,12 +88,7 @@ impl Renderer {
             None => TileCache::new(
                 device,
                 "no imagery",
-                Pyramid::new(
-                    [1, 1],
-                    crate::dataset::CELL_TILE_TEXELS,
-                    crate::dataset::IMAGERY_BORDER,
-                    Sampling::Cell,
-                ),
+                LayerSpec::imagery([1, 1]).pyramid,
                 IMAGERY_MIPS,
                 wgpu::TextureFormat::Rgba8UnormSrgb,
                 1,

@@ -2,8 +2,9 @@
 //! from the Rust constants it needs, so a tile size or a capacity is written once (in Rust) and
 //! can never disagree between the CPU and the shaders. Tests validate every source with naga.
 
-use crate::dataset::{CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, Sampling};
-use crate::dataset::{IMAGERY_MIPS, Pyramid};
+use crate::dataset::{
+    CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS, LayerSpec,
+};
 
 /// Levels a page table describes at most (a 2^15-tile-wide layer).
 pub const MAX_LEVELS: u32 = 16;
@@ -13,20 +14,8 @@ pub const SHADERS: &[(&str, &str)] = &[("terrain", include_str!("../shaders/terr
 
 /// The constants every shader sees, generated from their Rust definitions.
 pub fn prelude() -> String {
-    let height = Pyramid {
-        size: [1, 1],
-        tile: HEIGHT_TILE_CELLS,
-        border: HEIGHT_BORDER,
-        sampling: Sampling::Vertex,
-        levels: 1,
-    };
-    let imagery = Pyramid {
-        size: [1, 1],
-        tile: CELL_TILE_TEXELS,
-        border: IMAGERY_BORDER,
-        sampling: Sampling::Cell,
-        levels: 1,
-    };
+    let height = LayerSpec::heights([1, 1]).pyramid;
+    let imagery = LayerSpec::imagery([1, 1]).pyramid;
     let constants = [
         ("HEIGHT_TILE_CELLS", HEIGHT_TILE_CELLS),
         ("HEIGHT_BORDER", HEIGHT_BORDER),

@@ -136,7 +136,8 @@ fn passes_are_timed_with_timestamps_or_on_the_cpu() {
         let frames = r.profiler.drain(&r.gpu).unwrap();
         let last = frames.last().map(Vec::as_slice).unwrap_or(r.last_timings());
         let terrain = last.iter().find(|t| t.label == "terrain").expect("the terrain pass is timed");
-        let expected = if timestamps && r.gpu.has_timestamps { TimeSource::GpuTimestamps } else { TimeSource::CpuWait };
+        let expected =
+            if timestamps && r.gpu.has_timestamps { TimeSource::GpuTimestamps } else { TimeSource::CpuWait };
         assert_eq!(terrain.source, expected);
         assert!(terrain.ms > 0.0 && terrain.ms.is_finite(), "{terrain:?}");
         assert!(last.iter().any(|t| t.label == "terrain_select" && t.source == TimeSource::Cpu));

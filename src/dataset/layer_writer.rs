@@ -16,7 +16,10 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 use super::pack::{PackError, PackWriter};
-use super::pyramid::{Pyramid, TileId};
+use super::pyramid::{Pyramid, Sampling, TileId};
+use super::{
+    CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS, LANDCOVER_BORDER,
+};
 
 /// How a texel of level `l + 1` is made from the 2 × 2 texels of level `l` beneath it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -99,6 +102,29 @@ pub struct LayerSpec {
 }
 
 impl LayerSpec {
+    /// Heights: vertex samples in f32 metres, decimated so coarse samples are fine ones.
+    pub fn heights(size: [u32; 2]) -> Self {
+        let pyramid = Pyramid::new(size, HEIGHT_TILE_CELLS, HEIGHT_BORDER, Sampling::Vertex);
+        Self { name: "height", pyramid, mips: 1, reduce: Reduce::Decimate }
+    }
+
+    /// The heights' validity mask: the heights' pyramid, one u8 per sample, decimated alike.
+    pub fn valid_mask(size: [u32; 2]) -> Self {
+        Self { name: "valid mask", ..Self::heights(size) }
+    }
+
+    /// Imagery: RGBA8 sRGB texels with their mips and borders, box-filtered.
+    pub fn imagery(size: [u32; 2]) -> Self {
+        let pyramid = Pyramid::new(size, CELL_TILE_TEXELS, IMAGERY_BORDER, Sampling::Cell);
+        Self { name: "imagery", pyramid, mips: IMAGERY_MIPS, reduce: Reduce::Mean }
+    }
+
+    /// Land cover: u8 class codes, lossless at level 0, majority above.
+    pub fn landcover(size: [u32; 2]) -> Self {
+        let pyramid = Pyramid::new(size, CELL_TILE_TEXELS, LANDCOVER_BORDER, Sampling::Cell);
+        Self { name: "land cover", pyramid, mips: 1, reduce: Reduce::Mode }
+    }
+
     pub fn tile_texels(&self) -> usize {
         (0..self.mips).map(|m| (self.pyramid.mip_extent(m) as usize).pow(2)).sum()
     }

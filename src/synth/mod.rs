@@ -23,9 +23,8 @@ use thiserror::Error;
 
 use crate::classes::{ClassTable, ClassTableError};
 use crate::dataset::{
-    CELL_TILE_TEXELS, CellLayer, Crs, DatasetError, FORMAT_VERSION, HEIGHT_BORDER, HEIGHT_TILE_CELLS,
-    HeightLayer, IMAGERY_BORDER, IMAGERY_MIPS, LANDCOVER_BORDER, LandcoverLayer, LayerError, LayerSpec,
-    Manifest, Pyramid, Reduce, Sampling, Staging, Texel, Window, write_layer,
+    CellLayer, Crs, DatasetError, FORMAT_VERSION, HeightLayer, LandcoverLayer, LayerError, LayerSpec,
+    Manifest, Staging, Texel, Window, write_layer,
 };
 
 pub use colour::Painter;
@@ -108,12 +107,7 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
     let painter = Painter::new(seed, &terrain);
     let staging = Staging::begin(out)?;
 
-    let height = LayerSpec {
-        name: "height",
-        pyramid: Pyramid::new([size; 2], HEIGHT_TILE_CELLS, HEIGHT_BORDER, Sampling::Vertex),
-        mips: 1,
-        reduce: Reduce::Decimate,
-    };
+    let height = LayerSpec::heights([size; 2]);
     let range_m = Mutex::new([f32::INFINITY, f32::NEG_INFINITY]);
     let heights = |w: Window| {
         let samples =
@@ -129,14 +123,14 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
     bar.finish();
     let [min_m, max_m] = range_m.into_inner().unwrap_or_else(PoisonError::into_inner);
 
-    let imagery = cell_spec("imagery", size, IMAGERY_PER_SPACING, IMAGERY_BORDER, IMAGERY_MIPS, Reduce::Mean);
+    let imagery = LayerSpec::imagery([size * IMAGERY_PER_SPACING; 2]);
     let texel_m = spacing_m / f64::from(IMAGERY_PER_SPACING);
     let paint = |w: Window| Ok(painter.paint_window(&terrain, w, spacing_m, texel_m));
     let bar = progress_bar(progress, "imagery");
     write_layer(&staging.path(IMAGERY_PACK), &imagery, paint, &bar)?;
     bar.finish();
 
-    let landcover = cell_spec("landcover", size, LANDCOVER_PER_SPACING, LANDCOVER_BORDER, 1, Reduce::Mode);
+    let landcover = LayerSpec::landcover([size * LANDCOVER_PER_SPACING; 2]);
     let class_m = spacing_m / f64::from(LANDCOVER_PER_SPACING);
     let classify = |w: Window| Ok(cells(w, spacing_m, class_m, |x_m, y_m| terrain.ground(x_m, y_m).class));
     let bar = progress_bar(progress, "landcover");
@@ -179,22 +173,6 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
         }),
     };
     Ok(staging.commit(&manifest)?)
-}
-
-fn cell_spec(
-    name: &'static str,
-    size: u32,
-    per_spacing: u32,
-    border: u32,
-    mips: u32,
-    reduce: Reduce,
-) -> LayerSpec {
-    LayerSpec {
-        name,
-        pyramid: Pyramid::new([size * per_spacing; 2], CELL_TILE_TEXELS, border, Sampling::Cell),
-        mips,
-        reduce,
-    }
 }
 
 /// The window's texels from `f(i, j)`, south row first.

@@ -10,10 +10,7 @@ use std::sync::Mutex;
 
 use anyhow::{Context, Result, bail};
 use indicatif::ProgressBar;
-use terramp::dataset::{
-    HEIGHT_BORDER, HEIGHT_TILE_CELLS, HeightLayer, LayerSpec, Pyramid, Reduce, Sampling, Staging, Window,
-    write_layer,
-};
+use terramp::dataset::{HeightLayer, LayerSpec, Staging, Window, write_layer};
 
 use super::fill::{CoarseBuilder, VoidFill};
 use super::raster::GridRaster;
@@ -99,11 +96,6 @@ fn count_in_source(voids: &[usize], window: Window, footprint: &Footprint) -> Re
     })
 }
 
-/// The height pyramid of a grid of `size` samples.
-pub fn pyramid(size: [u32; 2]) -> Pyramid {
-    Pyramid::new(size, HEIGHT_TILE_CELLS, HEIGHT_BORDER, Sampling::Vertex)
-}
-
 /// Writes the height pack (and the validity mask pack when the DEM had voids).
 pub fn write(
     dem: &GridRaster,
@@ -112,8 +104,7 @@ pub fn write(
     staging: &Staging,
     bars: [&ProgressBar; 2],
 ) -> Result<HeightLayer> {
-    let pyramid = pyramid(dem.grid.size);
-    let spec = LayerSpec { name: "height", pyramid, mips: 1, reduce: Reduce::Decimate };
+    let spec = LayerSpec::heights(dem.grid.size);
     // The windows the height pass found void-free: the mask pass (same pyramid, so the same
     // windows) writes ones there without reading, and so warps only the windows with voids again.
     let void_free = Mutex::new(HashSet::new());
@@ -132,7 +123,7 @@ pub fn write(
     write_layer(&staging.path(HEIGHT_PACK), &spec, heights, bars[0]).context("writing the height pack")?;
     let valid_mask_pack = if scan.fill.is_some() {
         // Decimation keeps the mask exact at every level: a coarse sample is a fine one.
-        let mask_spec = LayerSpec { name: "valid mask", ..spec };
+        let mask_spec = LayerSpec::valid_mask(dem.grid.size);
         let valid = |window: Window| -> Result<Vec<u8>, String> {
             if void_free.lock().map_err(|_| "a mask thread panicked")?.contains(&window) {
                 return Ok(vec![1; (window.width * window.height) as usize]);
@@ -149,7 +140,7 @@ pub fn write(
     Ok(HeightLayer {
         pack: HEIGHT_PACK.to_owned(),
         spacing_m,
-        pyramid,
+        pyramid: spec.pyramid,
         min_m: scan.range_m[0],
         max_m: scan.range_m[1],
         // Every sample the mask marks 0: the source's voids and the grid beyond its edge alike.

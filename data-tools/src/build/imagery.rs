@@ -15,10 +15,7 @@ use std::path::Path;
 use anyhow::{Context, Result, ensure};
 use gdal::raster::{ColorInterpretation, GdalDataType};
 use indicatif::ProgressBar;
-use terramp::dataset::{
-    CELL_TILE_TEXELS, CellLayer, IMAGERY_BORDER, IMAGERY_MIPS, LayerSpec, Pyramid, Reduce, Sampling, Staging,
-    Window, write_layer,
-};
+use terramp::dataset::{CellLayer, IMAGERY_MIPS, LayerSpec, Staging, Window, write_layer};
 
 use super::frame::{Frame, Grid};
 use super::raster::{Access, GridRaster, Resampling, SourceRaster};
@@ -104,8 +101,7 @@ impl Imagery {
 
     pub fn write(&self, staging: &Staging, bar: &ProgressBar) -> Result<CellLayer> {
         let grid = self.grid();
-        let pyramid = Pyramid::new(grid.size, CELL_TILE_TEXELS, IMAGERY_BORDER, Sampling::Cell);
-        let spec = LayerSpec { name: "imagery", pyramid, mips: IMAGERY_MIPS, reduce: Reduce::Mean };
+        let spec = LayerSpec::imagery(grid.size);
         let texels = |window: Window| -> Result<Vec<[u8; 4]>, String> {
             let bands = self.raster.read(window)?;
             let mut values = vec![0.0; bands.len()];
@@ -123,7 +119,7 @@ impl Imagery {
         Ok(CellLayer {
             pack: IMAGERY_PACK.to_owned(),
             texel_m: grid.pixel_m,
-            pyramid,
+            pyramid: spec.pyramid,
             mips: IMAGERY_MIPS,
             format: "rgba8 srgb".to_owned(),
             source: self.raster.path.display().to_string(),

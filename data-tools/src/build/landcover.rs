@@ -10,10 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 use terramp::classes::ClassTable;
-use terramp::dataset::{
-    CELL_TILE_TEXELS, CellLayer, LANDCOVER_BORDER, LandcoverLayer, LayerSpec, Pyramid, Reduce, Sampling,
-    Staging, Window, write_layer,
-};
+use terramp::dataset::{CellLayer, LandcoverLayer, LayerSpec, Staging, Window, write_layer};
 
 use super::frame::{Frame, Grid};
 use super::raster::{Access, GridRaster, Resampling, SourceRaster};
@@ -55,8 +52,7 @@ impl Landcover {
 
     pub fn write(&self, staging: &Staging, bar: &ProgressBar) -> Result<LandcoverLayer> {
         let grid = self.grid();
-        let pyramid = Pyramid::new(grid.size, CELL_TILE_TEXELS, LANDCOVER_BORDER, Sampling::Cell);
-        let spec = LayerSpec { name: "land cover", pyramid, mips: 1, reduce: Reduce::Mode };
+        let spec = LayerSpec::landcover(grid.size);
         let nodata_code = self.table.nodata_code;
         let codes = |window: Window| -> Result<Vec<u8>, String> {
             let codes: Vec<u8> =
@@ -72,7 +68,7 @@ impl Landcover {
             layer: CellLayer {
                 pack: LANDCOVER_PACK.to_owned(),
                 texel_m: grid.pixel_m,
-                pyramid,
+                pyramid: spec.pyramid,
                 mips: 1,
                 format: "r8 class codes".to_owned(),
                 source: self.raster.path.display().to_string(),
