@@ -35,9 +35,20 @@ pub enum Reduce {
 /// A texel type a pack can store.
 pub trait Texel: bytemuck::Pod + Send + Sync {
     fn reduce(rule: Reduce, block: [Self; 4]) -> Self;
+
+    /// The value range recorded in the pack index for a tile of these texels, if the type has one.
+    fn range(_texels: &[Self]) -> Option<[f32; 2]> {
+        None
+    }
 }
 
 impl Texel for f32 {
+    fn range(texels: &[f32]) -> Option<[f32; 2]> {
+        let range =
+            texels.iter().fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], &v| [lo.min(v), hi.max(v)]);
+        (range[0] <= range[1]).then_some(range)
+    }
+
     fn reduce(rule: Reduce, block: [f32; 4]) -> f32 {
         match rule {
             Reduce::Decimate => block[0],
@@ -155,14 +166,17 @@ where
         ids.par_iter().try_for_each(|&id| -> Result<(), LayerError> {
             let extent = pyramid.tile_extent();
             let [x0, y0] = pyramid.tile_origin(id);
-            let mip0 = if level == 0 {
-                read_source(spec, &source, x0, y0, extent)?
+            // A coarse tile's range also spans the finer tiles it was reduced from, so it bounds
+            // every level-0 value beneath it, not only its own (decimated) samples.
+            let (mip0, range_below) = if level == 0 {
+                (read_source(spec, &source, x0, y0, extent)?, None)
             } else {
                 reduce_level_below(spec, &writer, id)?
             };
+            let range = union(T::range(&mip0), range_below);
             let payload = with_mips(spec, mip0);
             let index = pyramid.tile_index(id).unwrap_or_default();
-            writer.write_tile(index, bytemuck::cast_slice(&payload))?;
+            writer.write_tile(index, bytemuck::cast_slice(&payload), range)?;
             progress.inc(1);
             Ok(())
         })?;
@@ -210,12 +224,20 @@ where
     Ok(out)
 }
 
-/// Mip 0 of tile `id` (level ≥ 1), reduced from the level below as written in the pack.
+fn union(a: Option<[f32; 2]>, b: Option<[f32; 2]>) -> Option<[f32; 2]> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([a[0].min(b[0]), a[1].max(b[1])]),
+        (a, b) => a.or(b),
+    }
+}
+
+/// Mip 0 of tile `id` (level ≥ 1), reduced from the level below as written in the pack, with the
+/// union of the ranges of the tiles it read.
 fn reduce_level_below<T: Texel>(
     spec: &LayerSpec,
     writer: &PackWriter,
     id: TileId,
-) -> Result<Vec<T>, LayerError> {
+) -> Result<(Vec<T>, Option<[f32; 2]>), LayerError> {
     let pyramid = &spec.pyramid;
     let below = id.level - 1;
     let size_below = pyramid.size_at(below).map(i64::from);
@@ -224,7 +246,7 @@ fn reduce_level_below<T: Texel>(
     // The level-below window this tile reads: 2 × (extent + 1) texels from 2 × origin, clamped.
     let lo = [2 * x0, 2 * y0].map(|v| v.max(0));
     let hi = [0, 1].map(|a| (2 * [x0, y0][a] + 2 * extent - 1).min(size_below[a] - 1));
-    let window = read_written_window::<T>(spec, writer, below, lo, hi)?;
+    let (window, range) = read_written_window::<T>(spec, writer, below, lo, hi)?;
     let width = (hi[0] - lo[0] + 1) as usize;
     let at = |x: i64, y: i64| {
         let (x, y) = (x.clamp(0, size_below[0] - 1), y.clamp(0, size_below[1] - 1));
@@ -241,29 +263,32 @@ fn reduce_level_below<T: Texel>(
             out.push(T::reduce(spec.reduce, block));
         }
     }
-    Ok(out)
+    Ok((out, range))
 }
 
-/// Texels `lo..=hi` of `level`, gathered from the interiors of the tiles already written.
+/// Texels `lo..=hi` of `level`, gathered from the interiors of the tiles already written, with the
+/// union of those tiles' ranges.
 fn read_written_window<T: Texel>(
     spec: &LayerSpec,
     writer: &PackWriter,
     level: u32,
     lo: [i64; 2],
     hi: [i64; 2],
-) -> Result<Vec<T>, LayerError> {
+) -> Result<(Vec<T>, Option<[f32; 2]>), LayerError> {
     let pyramid = &spec.pyramid;
     let (tile, border, extent) =
         (i64::from(pyramid.tile), i64::from(pyramid.border), pyramid.tile_extent() as usize);
     let tiles = pyramid.tiles_at(level).map(i64::from);
     let width = (hi[0] - lo[0] + 1) as usize;
     let mut window = vec![T::zeroed(); width * (hi[1] - lo[1] + 1) as usize];
+    let mut range = None;
     let tile_of = |v: i64, axis: usize| (v / tile).min(tiles[axis] - 1);
     for ty in tile_of(lo[1], 1)..=tile_of(hi[1], 1) {
         for tx in tile_of(lo[0], 0)..=tile_of(hi[0], 0) {
             let id = TileId::new(level, tx as u32, ty as u32);
             let index = pyramid.tile_index(id).unwrap_or_default();
             let bytes = writer.read_tile(index)?;
+            range = union(range, writer.tile_range(index)?);
             let texels: &[T] = bytemuck::cast_slice(&bytes[..extent * extent * size_of::<T>()]);
             // The texels this tile owns: its interior; the last tile also owns the rest of the axis.
             let own_lo = [tx * tile, ty * tile];
@@ -278,7 +303,7 @@ fn read_written_window<T: Texel>(
             }
         }
     }
-    Ok(window)
+    Ok((window, range))
 }
 
 /// Mip 0 followed by its reductions, as stored in a tile payload.

@@ -89,6 +89,17 @@ impl LayerPack {
         Ok(Self { pyramid, mips, pack })
     }
 
+    /// The tile's value range from the pack index (heights: conservative min/max of every
+    /// level-0 sample under the tile), without reading the tile.
+    pub fn tile_range(&self, id: TileId) -> Result<Option<[f32; 2]>, PackError> {
+        let index = self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
+            path: self.pack.path().to_owned(),
+            index: u64::MAX,
+            count: self.pack.tile_count(),
+        })?;
+        self.pack.tile_range(index)
+    }
+
     /// The tile's payload (all mips), checksum verified.
     pub fn tile_bytes(&self, id: TileId) -> Result<&[u8], PackError> {
         let index = self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
@@ -149,6 +160,12 @@ impl Dataset {
     pub fn height_tile(&self, id: TileId) -> Result<&[f32], PackError> {
         // Pack payloads start 4 KiB-aligned and are whole multiples of 4 bytes.
         Ok(bytemuck::cast_slice(self.height.tile_bytes(id)?))
+    }
+
+    /// Conservative [min, max] of every level-0 height under tile `id`, metres; O(1).
+    pub fn height_range(&self, id: TileId) -> Result<[f32; 2], PackError> {
+        let fallback = [self.manifest.height.min_m, self.manifest.height.max_m];
+        Ok(self.height.tile_range(id)?.unwrap_or(fallback))
     }
 
     /// Height at grid-space position (`x_m`, `y_m`) from `level`, bilinear between samples and

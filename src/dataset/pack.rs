@@ -6,8 +6,12 @@
 //! header, the file length and a tile's checksum before handing its bytes out, so a truncated or
 //! bit-flipped pack is an error that names the file and the tile, never garbage on screen.
 //!
-//! Layout (little-endian): 64-byte header | `tile_count` × 8-byte index entries | padding to 4 KiB
-//! | tiles.
+//! Each index entry also carries the tile's value range (two f32, NaN when the layer has none):
+//! for heights, a conservative min/max of every level-0 sample under the tile, so culling can bound
+//! a tile's relief in O(1) without reading it. The index is checksummed in the header.
+//!
+//! Layout (little-endian): 64-byte header | `tile_count` × 16-byte index entries (crc, state,
+//! range min, range max) | padding to 4 KiB | tiles.
 
 use std::fs::File;
 use std::os::unix::fs::FileExt;
@@ -18,9 +22,9 @@ use memmap2::Mmap;
 use thiserror::Error;
 
 const MAGIC: &[u8; 8] = b"TRMPPACK";
-pub const PACK_VERSION: u32 = 1;
+pub const PACK_VERSION: u32 = 2;
 const HEADER_BYTES: u64 = 64;
-const INDEX_ENTRY_BYTES: u64 = 8;
+const INDEX_ENTRY_BYTES: u64 = 16;
 const DATA_ALIGN: u64 = 4096;
 /// Index entry state of a tile that the builder wrote.
 const TILE_PRESENT: u32 = 1;
@@ -35,6 +39,8 @@ pub enum PackError {
     Version { path: PathBuf, found: u32 },
     #[error("{path}: truncated: {actual} bytes, the header promises {expected}")]
     Truncated { path: PathBuf, expected: u64, actual: u64 },
+    #[error("{path}: the tile index is corrupt (checksum mismatch)")]
+    CorruptIndex { path: PathBuf },
     #[error("{path}: tile {index} is corrupt (checksum mismatch)")]
     Corrupt { path: PathBuf, index: u64 },
     #[error("{path}: tile {index} was never written")]
@@ -49,6 +55,7 @@ pub enum PackError {
 struct Header {
     tile_bytes: u64,
     tile_count: u64,
+    index_crc: u32,
 }
 
 impl Header {
@@ -66,6 +73,7 @@ impl Header {
         bytes[8..12].copy_from_slice(&PACK_VERSION.to_le_bytes());
         bytes[16..24].copy_from_slice(&self.tile_bytes.to_le_bytes());
         bytes[24..32].copy_from_slice(&self.tile_count.to_le_bytes());
+        bytes[32..36].copy_from_slice(&self.index_crc.to_le_bytes());
         let crc = crc32fast::hash(&bytes[0..60]);
         bytes[60..64].copy_from_slice(&crc.to_le_bytes());
         bytes
@@ -85,7 +93,7 @@ impl Header {
         if version != PACK_VERSION {
             return Err(PackError::Version { path: path.to_owned(), found: version });
         }
-        Ok(Header { tile_bytes: u64_at(16), tile_count: u64_at(24) })
+        Ok(Header { tile_bytes: u64_at(16), tile_count: u64_at(24), index_crc: u32_at(32) })
     }
 }
 
@@ -100,11 +108,24 @@ pub struct PackWriter {
     header: Header,
     /// Per tile: `present << 32 | crc`, filled as tiles land; written out by `finish`.
     index: Vec<AtomicU64>,
+    /// Per tile: the value range as two f32 bit patterns (`max << 32 | min`).
+    ranges: Vec<AtomicU64>,
+}
+
+const NO_RANGE: [f32; 2] = [f32::NAN, f32::NAN];
+
+fn pack_range([min, max]: [f32; 2]) -> u64 {
+    u64::from(max.to_bits()) << 32 | u64::from(min.to_bits())
+}
+
+fn unpack_range(bits: u64) -> Option<[f32; 2]> {
+    let range = [f32::from_bits(bits as u32), f32::from_bits((bits >> 32) as u32)];
+    (!range[0].is_nan()).then_some(range)
 }
 
 impl PackWriter {
     pub fn create(path: &Path, tile_bytes: u64, tile_count: u64) -> Result<Self, PackError> {
-        let header = Header { tile_bytes, tile_count };
+        let header = Header { tile_bytes, tile_count, index_crc: 0 };
         let file = File::options()
             .read(true)
             .write(true)
@@ -114,7 +135,8 @@ impl PackWriter {
             .map_err(io(path))?;
         file.set_len(header.file_bytes()).map_err(io(path))?;
         let index = (0..tile_count).map(|_| AtomicU64::new(0)).collect();
-        Ok(Self { file, path: path.to_owned(), header, index })
+        let ranges = (0..tile_count).map(|_| AtomicU64::new(pack_range(NO_RANGE))).collect();
+        Ok(Self { file, path: path.to_owned(), header, index, ranges })
     }
 
     pub fn path(&self) -> &Path {
@@ -136,7 +158,8 @@ impl PackWriter {
         self.header.data_offset() + index * self.header.tile_bytes
     }
 
-    pub fn write_tile(&self, index: u64, payload: &[u8]) -> Result<(), PackError> {
+    /// Writes tile `index`; `range` is its value range, if the layer has one.
+    pub fn write_tile(&self, index: u64, payload: &[u8], range: Option<[f32; 2]>) -> Result<(), PackError> {
         self.check_index(index)?;
         if payload.len() as u64 != self.header.tile_bytes {
             return Err(PackError::PayloadSize {
@@ -147,8 +170,15 @@ impl PackWriter {
         }
         self.file.write_all_at(payload, self.tile_offset(index)).map_err(io(&self.path))?;
         let entry = u64::from(TILE_PRESENT) << 32 | u64::from(crc32fast::hash(payload));
+        self.ranges[index as usize].store(pack_range(range.unwrap_or(NO_RANGE)), Ordering::Release);
         self.index[index as usize].store(entry, Ordering::Release);
         Ok(())
+    }
+
+    /// The range recorded for a tile written earlier.
+    pub fn tile_range(&self, index: u64) -> Result<Option<[f32; 2]>, PackError> {
+        self.check_index(index)?;
+        Ok(unpack_range(self.ranges[index as usize].load(Ordering::Acquire)))
     }
 
     /// Reads back a tile written earlier (the builder derives coarse levels from fine ones).
@@ -166,13 +196,15 @@ impl PackWriter {
     /// Writes the index and header, and flushes the file to disk.
     pub fn finish(self) -> Result<(), PackError> {
         let mut index = Vec::with_capacity(self.index.len() * INDEX_ENTRY_BYTES as usize);
-        for entry in &self.index {
-            let entry = entry.load(Ordering::Acquire);
+        for (entry, range) in self.index.iter().zip(&self.ranges) {
+            let (entry, range) = (entry.load(Ordering::Acquire), range.load(Ordering::Acquire));
             index.extend_from_slice(&(entry as u32).to_le_bytes());
             index.extend_from_slice(&((entry >> 32) as u32).to_le_bytes());
+            index.extend_from_slice(&range.to_le_bytes());
         }
         self.file.write_all_at(&index, HEADER_BYTES).map_err(io(&self.path))?;
-        self.file.write_all_at(&self.header.encode(), 0).map_err(io(&self.path))?;
+        let header = Header { index_crc: crc32fast::hash(&index), ..self.header };
+        self.file.write_all_at(&header.encode(), 0).map_err(io(&self.path))?;
         self.file.sync_all().map_err(io(&self.path))
     }
 }
@@ -199,6 +231,11 @@ impl Pack {
                 actual,
             });
         }
+        let index =
+            &map[HEADER_BYTES as usize..(HEADER_BYTES + header.tile_count * INDEX_ENTRY_BYTES) as usize];
+        if crc32fast::hash(index) != header.index_crc {
+            return Err(PackError::CorruptIndex { path: path.to_owned() });
+        }
         Ok(Self { map, path: path.to_owned(), header })
     }
 
@@ -214,6 +251,25 @@ impl Pack {
         self.header.tile_count
     }
 
+    fn entry(&self, index: u64) -> &[u8] {
+        let at = (HEADER_BYTES + index * INDEX_ENTRY_BYTES) as usize;
+        &self.map[at..at + INDEX_ENTRY_BYTES as usize]
+    }
+
+    /// The tile's value range (heights: conservative min/max of the level-0 samples under it), or
+    /// `None` for layers without one. Verified with the index at `open`; no payload is read.
+    pub fn tile_range(&self, index: u64) -> Result<Option<[f32; 2]>, PackError> {
+        if index >= self.header.tile_count {
+            return Err(PackError::OutOfRange {
+                path: self.path.clone(),
+                index,
+                count: self.header.tile_count,
+            });
+        }
+        let entry = self.entry(index);
+        Ok(unpack_range(u64::from_le_bytes(entry[8..16].try_into().unwrap_or([0xff; 8]))))
+    }
+
     /// The tile's payload, after checking that it was written and that its checksum holds.
     pub fn tile(&self, index: u64) -> Result<&[u8], PackError> {
         if index >= self.header.tile_count {
@@ -223,8 +279,7 @@ impl Pack {
                 count: self.header.tile_count,
             });
         }
-        let entry_at = (HEADER_BYTES + index * INDEX_ENTRY_BYTES) as usize;
-        let entry = &self.map[entry_at..entry_at + INDEX_ENTRY_BYTES as usize];
+        let entry = self.entry(index);
         let crc = u32::from_le_bytes([entry[0], entry[1], entry[2], entry[3]]);
         let state = u32::from_le_bytes([entry[4], entry[5], entry[6], entry[7]]);
         if state != TILE_PRESENT {
@@ -253,7 +308,7 @@ mod tests {
         let path = temp_path(name);
         let writer = PackWriter::create(&path, 16, 3).unwrap();
         for i in (0..3).rev() {
-            writer.write_tile(i, &[i as u8; 16]).unwrap();
+            writer.write_tile(i, &[i as u8; 16], Some([i as f32, 10.0 + i as f32])).unwrap();
         }
         assert_eq!(writer.read_tile(1).unwrap(), vec![1u8; 16]);
         writer.finish().unwrap();
@@ -269,6 +324,7 @@ mod tests {
             assert_eq!(pack.tile(i).unwrap(), &[i as u8; 16]);
         }
         assert!(matches!(pack.tile(3), Err(PackError::OutOfRange { .. })));
+        assert_eq!(pack.tile_range(2).unwrap(), Some([2.0, 12.0]));
     }
 
     #[test]
@@ -281,6 +337,15 @@ mod tests {
         let pack = Pack::open(&path).unwrap();
         assert!(pack.tile(0).is_ok());
         assert!(matches!(pack.tile(2), Err(PackError::Corrupt { index: 2, .. })));
+    }
+
+    #[test]
+    fn a_damaged_index_is_refused_at_open() {
+        let path = written_pack("index");
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes[HEADER_BYTES as usize + 9] ^= 0x01;
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(matches!(Pack::open(&path), Err(PackError::CorruptIndex { .. })));
     }
 
     #[test]
@@ -297,10 +362,11 @@ mod tests {
     fn unwritten_tiles_are_missing_not_zero() {
         let path = temp_path("missing");
         let writer = PackWriter::create(&path, 4, 2).unwrap();
-        writer.write_tile(0, &[7; 4]).unwrap();
-        assert!(matches!(writer.write_tile(0, &[7; 3]), Err(PackError::PayloadSize { .. })));
+        writer.write_tile(0, &[7; 4], None).unwrap();
+        assert!(matches!(writer.write_tile(0, &[7; 3], None), Err(PackError::PayloadSize { .. })));
         writer.finish().unwrap();
         let pack = Pack::open(&path).unwrap();
         assert!(matches!(pack.tile(1), Err(PackError::Missing { index: 1, .. })));
+        assert_eq!(pack.tile_range(0).unwrap(), None);
     }
 }

@@ -191,3 +191,23 @@ fn user_folders_are_never_replaced() {
     std::fs::write(root.join("thesis.tex"), b"precious").unwrap();
     assert!(matches!(Staging::begin(&root), Err(DatasetError::NotADataset { .. })));
 }
+
+#[test]
+fn height_ranges_bound_every_fine_sample_beneath() {
+    // A spike on an odd sample: decimation drops it from level 1, the range must not.
+    let spike = |x: u32, y: u32| if (x, y) == (13, 7) { 50_000.0 } else { height_of(x, y) };
+    let spec =
+        LayerSpec { pyramid: Pyramid::new([37, 21], 8, 1, Sampling::Vertex), ..LayerSpec::heights([37, 21]) };
+    let path = temp_dir("ranges").join("height.pack");
+    write_layer(&path, &spec, source_of(spike), &ProgressBar::hidden()).unwrap();
+    let pack = Pack::open(&path).unwrap();
+    for id in spec.pyramid.tiles() {
+        let index = spec.pyramid.tile_index(id).unwrap();
+        let [lo, hi] = pack.tile_range(index).unwrap().expect("heights have ranges");
+        assert!(tile_f32(&pack, &spec, id).iter().all(|&h| lo <= h && h <= hi), "{id:?}");
+        let span = 8 << id.level;
+        if id.level > 0 && (id.x, id.y) == (13 / span, 7 / span) {
+            assert_eq!(hi, 50_000.0, "{id:?} lies over the spike");
+        }
+    }
+}
