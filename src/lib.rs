@@ -10,6 +10,7 @@ pub mod config;
 pub mod dataset;
 pub mod frame;
 pub mod gpu;
+pub mod path;
 pub mod shaders;
 pub mod streaming;
 pub mod synth;

@@ -12,6 +12,7 @@ use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::{Gpu, PassTiming};
+use terramp::path::CameraPath;
 
 #[derive(Parser)]
 #[command(
@@ -76,6 +77,28 @@ enum Command {
         #[command(flatten)]
         settings: SettingsArgs,
     },
+    /// Fly a camera path (config/paths/*.toml) and write the frames and a log: one JSON object per
+    /// frame in `log.jsonl` (tiles needed, resident, uploaded, evicted, failed, bytes uploaded,
+    /// pass timings, process memory).
+    Fly {
+        #[arg(long)]
+        dataset: PathBuf,
+        #[arg(long)]
+        path: PathBuf,
+        #[arg(long, default_value_t = 120)]
+        frames: u32,
+        #[arg(long)]
+        out: PathBuf,
+        /// Write every Nth frame as PNG (0: none; the log always has every frame).
+        #[arg(long, default_value_t = 1)]
+        save_every: u32,
+        #[arg(long)]
+        width: Option<u32>,
+        #[arg(long)]
+        height: Option<u32>,
+        #[command(flatten)]
+        settings: SettingsArgs,
+    },
     /// Describe a dataset: frame, extent, layers.
     Info {
         #[arg(long)]
@@ -94,6 +117,12 @@ fn main() -> Result<()> {
             render_one(&dataset, settings, &camera, &out)
         }
         Command::Demo { dataset, out, frames, settings } => demo(&dataset, &out, frames, settings.load()?),
+        Command::Fly { dataset, path, frames, out, save_every, width, height, settings } => {
+            let mut settings = settings.load()?;
+            settings.render.width = width.unwrap_or(settings.render.width);
+            settings.render.height = height.unwrap_or(settings.render.height);
+            fly(&dataset, &CameraPath::load(&path)?, frames, &out, save_every, settings)
+        }
         Command::Info { dataset } => info(&dataset),
     }
 }
@@ -178,6 +207,68 @@ fn demo(dataset_dir: &Path, out: &Path, frames: u32, settings: Settings) -> Resu
         frame_ms[frame_ms.len() / 2]
     );
     Ok(())
+}
+
+fn fly(
+    dataset_dir: &Path,
+    path: &CameraPath,
+    frames: u32,
+    out: &Path,
+    save_every: u32,
+    settings: Settings,
+) -> Result<()> {
+    if frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let mut renderer = open_renderer(dataset_dir, settings)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let log_path = out.join("log.jsonl");
+    let mut log = std::io::BufWriter::new(
+        std::fs::File::create(&log_path).with_context(|| format!("creating {}", log_path.display()))?,
+    );
+    let mut frame_ms = Vec::with_capacity(frames as usize);
+    for i in 0..frames {
+        let r = &renderer.settings.render;
+        let camera = path.camera_at(f64::from(i) / f64::from(frames.max(2) - 1), r.fov_deg, r.near_m);
+        let start = Instant::now();
+        let report = renderer.render(&camera)?;
+        let save = save_every != 0 && i % save_every == 0;
+        if save {
+            save_png(&renderer.read_colour()?, &out.join(format!("frame_{i:04}.png")))?;
+        }
+        let ms = start.elapsed().as_secs_f64() * 1000.0;
+        frame_ms.push(ms);
+        let record = serde_json::json!({
+            "frame": i,
+            "camera": { "x_m": camera.position_m.x, "y_m": camera.position_m.y, "z_m": camera.position_m.z,
+                        "yaw_deg": camera.yaw_deg, "pitch_deg": camera.pitch_deg },
+            "report": report,
+            "wall_ms": ms,
+            "saved_png": save,
+            // GPU timings arrive a few frames late: these are the latest complete ones.
+            "passes": renderer.last_timings(),
+            "resident_kib": resident_kib(),
+        });
+        serde_json::to_writer(&mut log, &record)?;
+        std::io::Write::write_all(&mut log, b"\n")?;
+    }
+    std::io::Write::flush(&mut log)?;
+    frame_ms.sort_by(f64::total_cmp);
+    println!(
+        "{frames} frames, log in {}: median {:.1} ms, 95th percentile {:.1} ms per frame (render{})",
+        log_path.display(),
+        frame_ms[frame_ms.len() / 2],
+        frame_ms[(frame_ms.len() * 95 / 100).min(frame_ms.len() - 1)],
+        if save_every > 0 { " + PNG of saved frames" } else { "" }
+    );
+    Ok(())
+}
+
+/// The process's resident memory (Linux `VmRSS`), KiB.
+fn resident_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
 }
 
 /// A straight flight across the dataset's middle, 120 m above the highest ground near the line,

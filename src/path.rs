@@ -1,0 +1,134 @@
+//! How it works: a camera path is a list of keyframes in the dataset CRS (metres, height above the
+//! datum; compass heading and pitch in degrees), read from TOML (`config/paths/*.toml`). Positions
+//! follow a uniform Catmull-Rom spline through the keys, so the flight passes
+//! exactly through each key with a continuous velocity; headings turn the short way round. A
+//! flight of `n` frames samples the path at `n` evenly spaced parameters from the first key to
+//! the last.
+
+use std::path::Path;
+
+use glam::DVec3;
+use serde::Deserialize;
+use thiserror::Error;
+
+use crate::camera::Camera;
+
+#[derive(Debug, Error)]
+pub enum PathError {
+    #[error("{path}: {source}")]
+    Read { path: String, source: std::io::Error },
+    #[error("{path}: {message}")]
+    Parse { path: String, message: String },
+    #[error("{path}: a path needs at least one keyframe")]
+    Empty { path: String },
+    #[error("{path}: keyframe {index} has a value that is not a finite number")]
+    NotFinite { path: String, index: usize },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Keyframe {
+    /// Position in the dataset CRS: east, north, height above the datum, metres.
+    pub at: [f64; 3],
+    pub yaw_deg: f64,
+    pub pitch_deg: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraPath {
+    #[serde(rename = "key")]
+    pub keys: Vec<Keyframe>,
+}
+
+impl CameraPath {
+    pub fn load(path: &Path) -> Result<Self, PathError> {
+        let name = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|source| PathError::Read { path: name.clone(), source })?;
+        Self::parse(&text, &name)
+    }
+
+    pub fn parse(text: &str, name: &str) -> Result<Self, PathError> {
+        let path: CameraPath = toml::from_str(text)
+            .map_err(|e| PathError::Parse { path: name.to_owned(), message: e.to_string() })?;
+        if path.keys.is_empty() {
+            return Err(PathError::Empty { path: name.to_owned() });
+        }
+        if let Some(index) = path.keys.iter().position(|k| {
+            !(k.at.iter().all(|v| v.is_finite()) && k.yaw_deg.is_finite() && k.pitch_deg.is_finite())
+        }) {
+            return Err(PathError::NotFinite { path: name.to_owned(), index });
+        }
+        Ok(path)
+    }
+
+    /// The camera at `t` in [0, 1] along the path (clamped).
+    pub fn camera_at(&self, t: f64, fov_deg: f64, near_m: f64) -> Camera {
+        let last = self.keys.len() - 1;
+        let s = t.clamp(0.0, 1.0) * last as f64;
+        let i = (s.floor() as usize).min(last.saturating_sub(1));
+        let f = s - i as f64;
+        let key = |k: isize| self.keys[k.clamp(0, last as isize) as usize];
+        let i = i as isize;
+        let (k0, k1, k2, k3) = (key(i - 1), key(i), key(i + 1), key(i + 2));
+        let position = catmull_rom(k0.at.into(), k1.at.into(), k2.at.into(), k3.at.into(), f);
+        let turn = (k2.yaw_deg - k1.yaw_deg + 540.0).rem_euclid(360.0) - 180.0;
+        Camera {
+            position_m: position,
+            yaw_deg: (k1.yaw_deg + turn * f).rem_euclid(360.0),
+            pitch_deg: k1.pitch_deg + (k2.pitch_deg - k1.pitch_deg) * f,
+            fov_deg,
+            near_m,
+        }
+    }
+}
+
+fn catmull_rom(p0: DVec3, p1: DVec3, p2: DVec3, p3: DVec3, t: f64) -> DVec3 {
+    let (t2, t3) = (t * t, t * t * t);
+    0.5 * (2.0 * p1
+        + (p2 - p0) * t
+        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
+        + (3.0 * p1 - p0 - 3.0 * p2 + p3) * t3)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TWO_KEYS: &str = "[[key]]\nat = [0.0, 0.0, 100.0]\nyaw_deg = 350.0\npitch_deg = -10.0\n\
+                            [[key]]\nat = [1000.0, 0.0, 300.0]\nyaw_deg = 10.0\npitch_deg = -30.0\n";
+
+    #[test]
+    fn passes_through_keys_and_turns_the_short_way() {
+        let path = CameraPath::parse(TWO_KEYS, "test").unwrap();
+        let start = path.camera_at(0.0, 60.0, 0.1);
+        let end = path.camera_at(1.0, 60.0, 0.1);
+        assert_eq!(start.position_m, DVec3::new(0.0, 0.0, 100.0));
+        assert!((end.position_m - DVec3::new(1000.0, 0.0, 300.0)).length() < 1e-9);
+        let middle = path.camera_at(0.5, 60.0, 0.1);
+        assert!(
+            (middle.yaw_deg - 0.0).abs() < 1e-9 || (middle.yaw_deg - 360.0).abs() < 1e-9,
+            "{}",
+            middle.yaw_deg
+        );
+        assert!((middle.pitch_deg + 20.0).abs() < 1e-9);
+        assert!((middle.position_m.x - 500.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_single_key_is_a_still_camera() {
+        let one = "[[key]]\nat = [5.0, 6.0, 7.0]\nyaw_deg = 0.0\npitch_deg = 0.0\n";
+        let path = CameraPath::parse(one, "one").unwrap();
+        assert_eq!(path.camera_at(0.7, 60.0, 0.1).position_m, DVec3::new(5.0, 6.0, 7.0));
+    }
+
+    #[test]
+    fn bad_paths_are_clear_errors() {
+        assert!(matches!(CameraPath::parse("key = []", "empty"), Err(PathError::Empty { .. })));
+        let typo = "[[key]]\nat = [0.0, 0.0, 0.0]\nyaw = 0.0\npitch_deg = 0.0\n";
+        assert!(CameraPath::parse(typo, "typo").unwrap_err().to_string().contains("yaw"));
+        let nan = "[[key]]\nat = [nan, 0.0, 0.0]\nyaw_deg = 0.0\npitch_deg = 0.0\n";
+        assert!(matches!(CameraPath::parse(nan, "nan"), Err(PathError::NotFinite { index: 0, .. })));
+    }
+}
