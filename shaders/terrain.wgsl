@@ -1,7 +1,10 @@
 // Terrain: CDLOD nodes displaced by height tiles, shaded with imagery through a page table.
 //
 // Each instance is one node: a (cells + 1)² vertex grid whose vertices read exact samples of the
-// node's height tile (textureLoad, no filtering). Odd vertices morph onto the next coarser grid as
+// node's height tile (textureLoad, no filtering), ringed by skirts: one more row of vertices on
+// each side, hanging `skirt_m` below the edge. While a node's own tile streams in it reads its
+// finest resident ancestor (at 1/2^k samples per cell); the skirts hide the seams that leaves
+// against neighbours reading finer tiles, so a view is coarser there, never holed. Odd vertices morph onto the next coarser grid as
 // the camera recedes (Strugar 2010), reaching it exactly at the node's outer range, so nodes of
 // neighbouring LODs meet without cracks. Positions are camera-relative: the CPU subtracts in f64
 // and hands small f32 offsets to the GPU. Imagery comes from the finest resident level at or
@@ -29,10 +32,12 @@ struct TerrainNode {
     origin_rel_m: vec2<f32>,
     cell_m: f32,
     height_slot: u32,
-    sample_offset: vec2<u32>,
+    sample_offset: vec2<f32>,
     morph_start_m: f32,
     morph_end_m: f32,
     cells_inside: vec2<f32>,
+    sample_step: f32,
+    skirt_m: f32,
 }
 
 @group(0) @binding(0) var<uniform> u: TerrainUniforms;
@@ -53,14 +58,16 @@ struct VertexOut {
 
 fn height_sample(node: TerrainNode, s: vec2<i32>) -> f32 {
     let limit = i32(HEIGHT_TILE_EXTENT) - 1;
-    let at = clamp(vec2<i32>(node.sample_offset) + s, vec2<i32>(0), vec2<i32>(limit));
+    let at = clamp(s, vec2<i32>(0), vec2<i32>(limit));
     return textureLoad(height_tiles, at, i32(node.height_slot), 0).r;
 }
 
-// Height at fractional grid position `g` of the node, bilinear between its samples.
+// Height at grid position `g` of the node (fractional while morphing, or when reading an
+// ancestor tile), bilinear between the tile's samples.
 fn height_at(node: TerrainNode, g: vec2<f32>) -> f32 {
-    let base = floor(g);
-    let f = g - base;
+    let sample = node.sample_offset + g * node.sample_step;
+    let base = floor(sample);
+    let f = sample - base;
     let s = vec2<i32>(base);
     let h00 = height_sample(node, s);
     let h10 = height_sample(node, s + vec2<i32>(1, 0));
@@ -72,16 +79,20 @@ fn height_at(node: TerrainNode, g: vec2<f32>) -> f32 {
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
     let node = nodes[instance];
-    let row = u.node_cells + 1u;
-    let g = min(vec2<f32>(f32(vertex % row), f32(vertex / row)), node.cells_inside);
+    // The grid with its skirt ring: vertex (i, j) of (cells + 3)², the outer ring on the edges.
+    let row = u.node_cells + 3u;
+    let ij = vec2<f32>(f32(vertex % row), f32(vertex / row));
+    let last = f32(u.node_cells + 2u);
+    let skirt = ij.x == 0.0 || ij.y == 0.0 || ij.x == last || ij.y == last;
+    let g = min(clamp(ij - 1.0, vec2<f32>(0.0), vec2<f32>(f32(u.node_cells))), node.cells_inside);
 
-    let h = height_sample(node, vec2<i32>(g)) - u.camera_grid_m.z;
+    let h = height_at(node, g) - u.camera_grid_m.z;
     let distance = length(vec3<f32>(node.origin_rel_m + g * node.cell_m, h));
     let morph = clamp((distance - node.morph_start_m) / (node.morph_end_m - node.morph_start_m), 0.0, 1.0);
     let g_morphed = min(g - fract(g * 0.5) * 2.0 * morph, node.cells_inside);
 
     let xy = node.origin_rel_m + g_morphed * node.cell_m;
-    let z = height_at(node, g_morphed) - u.camera_grid_m.z;
+    let z = height_at(node, g_morphed) - u.camera_grid_m.z - select(0.0, node.skirt_m, skirt);
     // Central differences one (level) sample apart; the tile border makes them valid at the edges.
     let dx = height_at(node, g_morphed + vec2<f32>(1.0, 0.0)) - height_at(node, g_morphed - vec2<f32>(1.0, 0.0));
     let dy = height_at(node, g_morphed + vec2<f32>(0.0, 1.0)) - height_at(node, g_morphed - vec2<f32>(0.0, 1.0));

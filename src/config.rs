@@ -47,6 +47,7 @@ pub struct Settings {
     pub terrain: TerrainSettings,
     pub imagery: ImagerySettings,
     pub cache: CacheSettings,
+    pub tlm: TlmSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -99,6 +100,66 @@ impl ImagerySettings {
 pub struct CacheSettings {
     pub height_slots: u32,
     pub imagery_slots: u32,
+    pub loader_threads: u32,
+    pub upload_tiles_per_frame: u32,
+    pub upload_bytes_per_frame: u64,
+}
+
+/// The Tile Load Map (pass 1): camera-centred rings of cells, see `passes::tile_load_map`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TlmSettings {
+    pub cell_m: f64,
+    pub cells: u32,
+    pub max_rings: u32,
+    pub occlusion_tolerance_m: f64,
+    pub radial_lod_m: [f64; 3],
+    pub patterns: u32,
+    pub seed: u32,
+}
+
+impl TlmSettings {
+    fn validate(&self) -> Result<(), SettingsError> {
+        let max_rings = crate::passes::tile_load_map::TLM_MAX_RINGS;
+        let r = self.radial_lod_m;
+        let checks: [(bool, &'static str, String, &'static str); 6] = [
+            (
+                self.cell_m.is_finite() && self.cell_m >= 1.0,
+                "tlm.cell_m",
+                self.cell_m.to_string(),
+                "a finite number of metres, at least 1",
+            ),
+            (
+                self.cells.is_multiple_of(2) && (8..=256).contains(&self.cells),
+                "tlm.cells",
+                self.cells.to_string(),
+                "an even number from 8 to 256",
+            ),
+            (
+                (1..=max_rings).contains(&self.max_rings),
+                "tlm.max_rings",
+                self.max_rings.to_string(),
+                "1 to 16",
+            ),
+            (
+                self.occlusion_tolerance_m >= 0.0 && self.occlusion_tolerance_m.is_finite(),
+                "tlm.occlusion_tolerance_m",
+                self.occlusion_tolerance_m.to_string(),
+                "0 or more metres",
+            ),
+            (
+                r[0] > 0.0 && r[0] <= r[1] && r[1] <= r[2] && r[2].is_finite(),
+                "tlm.radial_lod_m",
+                format!("{r:?}"),
+                "three increasing positive distances, metres",
+            ),
+            ((1..=255).contains(&self.patterns), "tlm.patterns", self.patterns.to_string(), "1 to 255"),
+        ];
+        match checks.into_iter().find(|(ok, ..)| !ok) {
+            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
+            None => Ok(()),
+        }
+    }
 }
 
 impl Default for Settings {
@@ -151,7 +212,8 @@ impl Settings {
     fn validate(&self) -> Result<(), SettingsError> {
         let r = &self.render;
         let t = &self.terrain;
-        let checks: [(bool, &'static str, String, &'static str); 10] = [
+        let c = &self.cache;
+        let checks: [(bool, &'static str, String, &'static str); 13] = [
             (r.width >= 1 && r.width <= 16384, "render.width", r.width.to_string(), "1 to 16384 pixels"),
             (r.height >= 1 && r.height <= 16384, "render.height", r.height.to_string(), "1 to 16384 pixels"),
             (
@@ -192,7 +254,26 @@ impl Settings {
                 format!("{:?}", self.cache),
                 "at least 16 slots per cache (the coarse levels are pinned)",
             ),
+            (
+                (1..=64).contains(&c.loader_threads),
+                "cache.loader_threads",
+                c.loader_threads.to_string(),
+                "1 to 64 threads",
+            ),
+            (
+                c.upload_tiles_per_frame >= 1,
+                "cache.upload_tiles_per_frame",
+                c.upload_tiles_per_frame.to_string(),
+                "at least 1 tile",
+            ),
+            (
+                c.upload_bytes_per_frame >= 1 << 20,
+                "cache.upload_bytes_per_frame",
+                c.upload_bytes_per_frame.to_string(),
+                "at least 1 MiB (1048576 bytes)",
+            ),
         ];
+        self.tlm.validate()?;
         match checks.into_iter().find(|(ok, ..)| !ok) {
             Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
             None => Ok(()),

@@ -1,6 +1,10 @@
-//! How it works: `Renderer` owns the GPU resources of one dataset (caches, passes, targets) and
-//! `render` runs one frame as the list of its passes. Each step says why it is there; the
-//! mechanics live in the pass modules.
+//! How it works: `Renderer` owns the GPU resources of one dataset (caches, loader threads, passes,
+//! targets) and `render` runs one frame as the list of its steps. Each step says why it is there;
+//! the mechanics live in the pass and streaming modules. Nothing in a frame waits for the disk:
+//! tiles stream in over the following frames, and until they do their ancestors stand in.
+
+use std::sync::Arc;
+use std::time::Duration;
 
 use glam::{DVec3, Vec4};
 use thiserror::Error;
@@ -8,13 +12,17 @@ use thiserror::Error;
 use crate::camera::{Camera, CameraError, Frustum};
 use crate::config::Settings;
 use crate::dataset::{Dataset, IMAGERY_MIPS, LayerSpec, PackError, TileId};
-use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
+use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback::read_texture;
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
 use crate::shaders::MAX_LEVELS;
-use crate::streaming::{CacheStats, Footprint, TileCache, wanted_cell_tiles};
-use crate::terrain::select::{Lods, NodeBounds, Selected, select};
-use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, NodeBatches, TerrainPass};
+use crate::streaming::wants::{after_pinned, height_tiles, imagery_tiles, pinned_tiles};
+use crate::streaming::{CacheStats, LayerKind, Loader, LoaderError, TileCache, UploadBudget};
+use crate::terrain::select::{Lods, NodeBounds, select};
+use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, TerrainPass, node_batches};
+
+/// Tiles of the coarsest levels each cache keeps resident from the start, at most.
+const MAX_PINNED_TILES: usize = 64;
 
 /// Linear-RGB colour of the sky, also the haze the distance fades into.
 const SKY_LINEAR: [f64; 3] = [0.42, 0.55, 0.75];
@@ -29,6 +37,8 @@ pub enum RenderError {
     Pack(#[from] PackError),
     #[error("the dataset has {levels} imagery levels; at most {MAX_LEVELS} are supported")]
     TooManyLevels { levels: u32 },
+    #[error(transparent)]
+    Loader(#[from] LoaderError),
 }
 
 /// What one frame did, for logs and tests.
@@ -44,12 +54,16 @@ pub struct FrameReport {
 
 pub struct Renderer {
     pub gpu: Gpu,
-    pub dataset: Dataset,
+    pub dataset: Arc<Dataset>,
     pub settings: Settings,
     pub profiler: Profiler,
     terrain: TerrainPass,
     heights: TileCache,
     imagery: TileCache,
+    /// The coarsest tiles of each layer, resident from the first frame on and never evicted.
+    pinned_heights: Vec<TileId>,
+    pinned_imagery: Vec<TileId>,
+    loader: Loader,
     terrain_bindings: wgpu::BindGroup,
     bounds: NodeBounds,
     colour: wgpu::Texture,
@@ -61,11 +75,13 @@ pub struct Renderer {
 
 impl Renderer {
     pub fn new(gpu: Gpu, dataset: Dataset, settings: Settings) -> Result<Self, RenderError> {
+        let dataset = Arc::new(dataset);
         let device = &gpu.device;
         let terrain = TerrainPass::new(device, &settings, gpu.info.device_type == wgpu::DeviceType::Cpu);
         let heights = TileCache::new(
             device,
             "height cache",
+            LayerKind::Height,
             dataset.height.pyramid,
             1,
             wgpu::TextureFormat::R32Float,
@@ -78,6 +94,7 @@ impl Renderer {
             Some(layer) => TileCache::new(
                 device,
                 "imagery cache",
+                LayerKind::Imagery,
                 layer.pyramid,
                 layer.mips,
                 wgpu::TextureFormat::Rgba8UnormSrgb,
@@ -88,12 +105,29 @@ impl Renderer {
             None => TileCache::new(
                 device,
                 "no imagery",
+                LayerKind::Imagery,
                 LayerSpec::imagery([1, 1]).pyramid,
                 IMAGERY_MIPS,
                 wgpu::TextureFormat::Rgba8UnormSrgb,
                 1,
             ),
         };
+        let mut heights = heights;
+        let mut imagery = imagery;
+        // Pinned tiles load now, synchronously: they are what every later frame falls back on.
+        let pin =
+            |cache: &TileCache| pinned_tiles(cache.pyramid(), MAX_PINNED_TILES.min(cache.capacity() / 4));
+        let pinned_heights = pin(&heights);
+        heights.load_now(&gpu.queue, &pinned_heights, 0, |id| dataset.height.tile_bytes(id));
+        let pinned_imagery = match &dataset.imagery {
+            Some(layer) => {
+                let pinned = pin(&imagery);
+                imagery.load_now(&gpu.queue, &pinned, 0, |id| layer.tile_bytes(id));
+                pinned
+            }
+            None => Vec::new(),
+        };
+        let loader = Loader::new(Arc::clone(&dataset), settings.cache.loader_threads as usize)?;
         let terrain_bindings = terrain.bind_group(device, &heights, &imagery);
         let target = |label, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
@@ -127,6 +161,9 @@ impl Renderer {
             terrain,
             heights,
             imagery,
+            pinned_heights,
+            pinned_imagery,
+            loader,
             terrain_bindings,
             bounds,
             colour,
@@ -174,62 +211,43 @@ impl Renderer {
             })
         });
 
-        // Residency: the height tiles those nodes read, and the imagery their pixels ask for.
-        let frame = self.frame;
-        let (dataset, heights, imagery) = (&self.dataset, &mut self.heights, &mut self.imagery);
-        let queue = &self.gpu.queue;
-        let wanted_heights = height_tiles(&lods, &selected);
-        let wanted_imagery = self.profiler.cpu("imagery_wants", || {
+        // Streaming: ask for what this view needs, upload what arrived, within the frame's budget.
+        let wanted_heights = after_pinned(&self.pinned_heights, height_tiles(&lods, &selected));
+        let wanted_imagery = after_pinned(
+            &self.pinned_imagery,
             imagery_tiles(
-                dataset,
+                &self.dataset,
                 &lods,
                 &selected,
                 camera,
                 camera_grid_m,
                 height,
                 self.settings.imagery.lod_bias,
-            )
-        });
-        let (height_stats, imagery_stats) = self.profiler.cpu("uploads", || {
-            let height_stats =
-                heights.update(queue, &wanted_heights, frame, |id| dataset.height.tile_bytes(id));
-            let imagery_stats = match &dataset.imagery {
-                Some(layer) => imagery.update(queue, &wanted_imagery, frame, |id| layer.tile_bytes(id)),
-                None => CacheStats::default(),
-            };
-            (height_stats, imagery_stats)
-        });
-        report.height = height_stats;
-        report.imagery = imagery_stats;
-
-        // Instances: camera-relative node origins, subtracted in f64.
-        let mut batches = NodeBatches::default();
-        for s in &selected {
-            let Some(slot) = self.heights.slot_of(lods.tile_of(s.node)) else {
-                report.nodes_dropped += 1;
-                continue;
-            };
-            let size = lods.node_m(s.node.lod);
-            let lod = s.node.lod as usize;
-            let node = TerrainNode {
-                origin_rel_m: [
-                    (f64::from(s.node.x) * size - camera_grid_m.x) as f32,
-                    (f64::from(s.node.y) * size - camera_grid_m.y) as f32,
-                ],
-                cell_m: (size / f64::from(lods.cells)) as f32,
-                height_slot: slot,
-                sample_offset: lods.sample_offset(s.node),
-                morph_start_m: lods.morph_start_m[lod].min(f64::from(f32::MAX)) as f32,
-                morph_end_m: lods.range_m[lod].min(f64::from(f32::MAX)) as f32,
-                cells_inside: lods.cells_inside(s.node).map(|c| c as f32),
-            };
-            for q in 0..4 {
-                if s.quadrants & (1 << q) != 0 {
-                    batches.by_quadrant[q].push(node);
-                }
+            ),
+        );
+        let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
+        let (heights, imagery, loader) = (&mut self.heights, &mut self.imagery, &self.loader);
+        let has_imagery = self.dataset.imagery.is_some();
+        (report.height, report.imagery) = self.profiler.cpu("streaming", || {
+            let mut requests = heights.set_wanted(&wanted_heights, frame);
+            if has_imagery {
+                requests.extend(imagery.set_wanted(&wanted_imagery, frame));
             }
-        }
+            // Every frame, even with nothing new: it also cancels what is no longer wanted.
+            loader.submit(&requests);
+            let loaded = loader.try_recv_all();
+            let imagery_stats =
+                if has_imagery { imagery.upload(queue, &loaded, budget) } else { CacheStats::default() };
+            (heights.upload(queue, &loaded, budget), imagery_stats)
+        });
+
+        // Instances: each node over its own height tile, or its finest resident ancestor.
+        let (dataset, bounds) = (&self.dataset, &mut self.bounds);
+        let (batches, dropped) = node_batches(&lods, &selected, camera_grid_m, &self.heights, &mut |node| {
+            bounds.get(&lods, node, |tile| dataset.height_tile(tile).ok())
+        });
         report.nodes_drawn = batches.len();
+        report.nodes_dropped = dropped;
         let uniforms = self.uniforms(camera_grid_m, clip_from_view_world.as_mat4());
         let prepared = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
 
@@ -296,6 +314,35 @@ impl Renderer {
         uniforms
     }
 
+    /// Whether every tile the frame of `report` wanted is resident (or failed, or beyond what the
+    /// cache can hold), with nothing left loading or waiting for upload.
+    pub fn is_resolved(&self, report: &FrameReport) -> bool {
+        let done = |s: &CacheStats, cache: &TileCache| {
+            s.needed_resident + s.failed >= s.needed.min(cache.capacity()) && s.staged == 0
+        };
+        done(&report.height, &self.heights) && done(&report.imagery, &self.imagery) && self.loader.is_idle()
+    }
+
+    /// Renders `camera` frame after frame until everything it needs is resident (at most
+    /// `max_frames`), for single frames and references. Returns the last frame's report and the
+    /// number of frames it took.
+    pub fn render_resolved(
+        &mut self,
+        camera: &Camera,
+        max_frames: u32,
+    ) -> Result<(FrameReport, u32), RenderError> {
+        let mut frames = 0;
+        loop {
+            let report = self.render(camera)?;
+            frames += 1;
+            if self.is_resolved(&report) || frames >= max_frames {
+                return Ok((report, frames));
+            }
+            // The loader threads are reading: give them the core rather than spin.
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
     /// The last frame's colour, as an sRGB image.
     pub fn read_colour(&self) -> Result<image::RgbaImage, RenderError> {
         let bytes = read_texture(&self.gpu, &self.colour, wgpu::TextureAspect::All, 4)?;
@@ -309,52 +356,4 @@ impl Renderer {
         let bytes = read_texture(&self.gpu, &self.depth, wgpu::TextureAspect::DepthOnly, 4)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
-}
-
-/// The height tiles the selected nodes read, coarse first (they stand in for everything finer).
-fn height_tiles(lods: &Lods, selected: &[Selected]) -> Vec<TileId> {
-    let mut tiles: Vec<TileId> = selected.iter().map(|s| lods.tile_of(s.node)).collect();
-    tiles.sort_by(|a, b| b.level.cmp(&a.level).then(a.cmp(b)));
-    tiles.dedup();
-    tiles
-}
-
-/// The imagery tiles the selected nodes' pixels ask for.
-fn imagery_tiles(
-    dataset: &Dataset,
-    lods: &Lods,
-    selected: &[Selected],
-    camera: &Camera,
-    camera_grid_m: DVec3,
-    height_px: u32,
-    lod_bias: f64,
-) -> Vec<TileId> {
-    let (Some(layer), Some(meta)) = (&dataset.imagery, &dataset.manifest.imagery) else {
-        return Vec::new();
-    };
-    let half_spacing = 0.5 * dataset.manifest.height.spacing_m;
-    let footprints: Vec<Footprint> = selected
-        .iter()
-        .map(|s| {
-            let size = lods.node_m(s.node.lod);
-            let min = [f64::from(s.node.x) * size, f64::from(s.node.y) * size];
-            let max = [min[0] + size, min[1] + size];
-            let nearest = DVec3::new(
-                camera_grid_m.x.clamp(min[0], max[0]),
-                camera_grid_m.y.clamp(min[1], max[1]),
-                camera_grid_m.z.clamp(
-                    f64::from(dataset.manifest.height.min_m),
-                    f64::from(dataset.manifest.height.max_m),
-                ),
-            );
-            let distance_m = (nearest - camera_grid_m).length().max(camera.near_m);
-            Footprint {
-                min_m: min.map(|v| v + half_spacing),
-                max_m: max.map(|v| v + half_spacing),
-                pixel_m: camera.metres_per_pixel(distance_m, height_px),
-                distance_m,
-            }
-        })
-        .collect();
-    wanted_cell_tiles(&layer.pyramid, meta.texel_m, lod_bias, &footprints)
 }

@@ -10,7 +10,11 @@ use crate::dataset::{
 pub const MAX_LEVELS: u32 = 16;
 
 /// Every shader: its name (matching its Rust module) and source.
-pub const SHADERS: &[(&str, &str)] = &[("terrain", include_str!("../shaders/terrain.wgsl"))];
+pub const SHADERS: &[(&str, &str)] = &[
+    ("terrain", include_str!("../shaders/terrain.wgsl")),
+    ("depth_pyramid", include_str!("../shaders/depth_pyramid.wgsl")),
+    ("tile_load_map", include_str!("../shaders/tile_load_map.wgsl")),
+];
 
 /// The constants every shader sees, generated from their Rust definitions.
 pub fn prelude() -> String {
@@ -25,6 +29,11 @@ pub fn prelude() -> String {
         ("IMAGERY_TILE_EXTENT", imagery.tile_extent()),
         ("IMAGERY_MIPS", IMAGERY_MIPS),
         ("MAX_LEVELS", MAX_LEVELS),
+        ("HIZ_WORKGROUP", crate::passes::depth_pyramid::HIZ_WORKGROUP),
+        ("TLM_WORKGROUP", crate::passes::tile_load_map::TLM_WORKGROUP),
+        ("TLM_MAX_RINGS", crate::passes::tile_load_map::TLM_MAX_RINGS),
+        ("TLM_SPAN_INSIDE", crate::passes::tile_load_map::TLM_SPAN_INSIDE),
+        ("TLM_SPAN_COVERED", crate::passes::tile_load_map::TLM_SPAN_COVERED),
     ];
     let mut text = String::from("// Generated from Rust constants (src/shaders.rs).\n");
     for (name, value) in constants {

@@ -36,3 +36,13 @@ fn gpu_structs_match_their_wgsl_twins() {
     assert_eq!(wgsl_size(&terrain, "TerrainUniforms") as usize, size_of::<TerrainUniforms>());
     assert_eq!(wgsl_size(&terrain, "TerrainNode") as usize, size_of::<TerrainNode>());
 }
+
+#[test]
+fn tlm_structs_match_their_wgsl_twins() {
+    use terramp::gpu::gpu_types::{TlmCell, TlmRing, TlmSpan, TlmUniforms};
+    let tlm = module("tile_load_map");
+    assert_eq!(wgsl_size(&tlm, "TlmUniforms") as usize, size_of::<TlmUniforms>());
+    assert_eq!(wgsl_size(&tlm, "TlmRing") as usize, size_of::<TlmRing>());
+    assert_eq!(wgsl_size(&tlm, "TlmSpan") as usize, size_of::<TlmSpan>());
+    assert_eq!(wgsl_size(&tlm, "TlmCell") as usize, size_of::<TlmCell>());
+}

@@ -62,8 +62,9 @@ fn nc_renders_like_its_reference() {
     };
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     let mut renderer = Renderer::new(gpu, dataset, settings).unwrap();
-    let report = renderer.render(&camera).unwrap();
-    assert!(report.nodes_drawn > 0 && report.imagery.uploaded > 0, "{report:?}");
+    let (report, frames) = renderer.render_resolved(&camera, 200).unwrap();
+    assert!(renderer.is_resolved(&report), "not resolved after {frames} frames: {report:?}");
+    assert!(report.nodes_drawn > 0 && report.imagery.needed_resident > 0, "{report:?}");
     let image = renderer.read_colour().unwrap();
 
     // Not blank: the lower half is ground (depth written), and it is not one flat colour.

@@ -9,7 +9,7 @@ use glam::DVec3;
 
 use terramp::camera::Camera;
 use terramp::config::Settings;
-use terramp::dataset::Dataset;
+use terramp::dataset::{Dataset, DatasetError, PackError};
 use terramp::frame::Renderer;
 use terramp::gpu::{Gpu, PassTiming};
 use terramp::path::CameraPath;
@@ -137,17 +137,18 @@ fn open_renderer(dataset_dir: &Path, settings: Settings) -> Result<Renderer> {
 fn render_one(dataset_dir: &Path, settings: Settings, camera: &Camera, out: &Path) -> Result<()> {
     let mut renderer = open_renderer(dataset_dir, settings)?;
     let start = Instant::now();
-    let report = renderer.render(camera)?;
+    // One finished picture: keep rendering while tiles stream in.
+    let (report, frames) = renderer.render_resolved(camera, 500)?;
     let image = renderer.read_colour()?;
     let elapsed = start.elapsed();
     save_png(&image, out)?;
     let drained = renderer.profiler.drain(&renderer.gpu)?;
     println!(
-        "{}: {} nodes, {} height + {} imagery tiles uploaded, {:.0} ms (first frame, shaders compiled on first use)",
+        "{}: {} nodes, {} height + {} imagery tiles resident, resolved in {frames} frames, {:.0} ms (shaders compiled on first use)",
         out.display(),
         report.nodes_drawn,
-        report.height.uploaded,
-        report.imagery.uploaded,
+        report.height.needed_resident,
+        report.imagery.needed_resident,
         elapsed.as_secs_f64() * 1000.0
     );
     print_timings(drained.last().map(Vec::as_slice).unwrap_or(renderer.last_timings()));
@@ -171,11 +172,21 @@ fn demo(dataset_dir: &Path, out: &Path, frames: u32, settings: Settings) -> Resu
     if frames == 0 {
         bail!("--frames must be at least 1");
     }
-    if !dataset_dir.join(terramp::dataset::MANIFEST_FILE).exists() {
-        eprintln!("terramp: no dataset at {}; synthesizing the default one", dataset_dir.display());
-        let start = Instant::now();
-        terramp::synth::synthesize(dataset_dir, &terramp::synth::SynthParams::default(), true)?;
-        eprintln!("terramp: synthesized in {:.1} s", start.elapsed().as_secs_f64());
+    // The default dataset is ours to make: synthesize it when missing, or when it was made by a
+    // build whose format this one no longer reads.
+    match Dataset::open(dataset_dir) {
+        Ok(_) => {}
+        Err(
+            error @ (DatasetError::NotADataset { .. }
+            | DatasetError::Version { .. }
+            | DatasetError::Pack(PackError::Version { .. })),
+        ) => {
+            eprintln!("terramp: {error}; synthesizing the default dataset at {}", dataset_dir.display());
+            let start = Instant::now();
+            terramp::synth::synthesize(dataset_dir, &terramp::synth::SynthParams::default(), true)?;
+            eprintln!("terramp: synthesized in {:.1} s", start.elapsed().as_secs_f64());
+        }
+        Err(error) => return Err(error.into()),
     }
     let mut renderer = open_renderer(dataset_dir, settings)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;

@@ -35,7 +35,9 @@ pub enum PackError {
     Io { path: PathBuf, source: std::io::Error },
     #[error("{path}: not a terramp pack (bad magic or header checksum)")]
     NotAPack { path: PathBuf },
-    #[error("{path}: pack format version {found}, this build reads version {PACK_VERSION}")]
+    #[error(
+        "{path}: pack format version {found}, this build reads version {PACK_VERSION}; rebuild the dataset"
+    )]
     Version { path: PathBuf, found: u32 },
     #[error("{path}: truncated: {actual} bytes, the header promises {expected}")]
     Truncated { path: PathBuf, expected: u64, actual: u64 },

@@ -41,13 +41,100 @@ pub struct TerrainNode {
     pub origin_rel_m: [f32; 2],
     /// Distance between the node's vertices, metres.
     pub cell_m: f32,
-    /// Layer of the height cache holding the node's tile.
+    /// Layer of the height cache holding the tile the node reads (its own, or while that one
+    /// streams in, its finest resident ancestor).
     pub height_slot: u32,
-    /// Sample (border included) of the node's south-west vertex within its height tile.
-    pub sample_offset: [u32; 2],
+    /// Sample position (border included) of the node's south-west vertex in that tile.
+    pub sample_offset: [f32; 2],
     /// Vertices morph into the coarser grid between these distances from the camera, metres.
     pub morph_start_m: f32,
     pub morph_end_m: f32,
     /// Cells of the node inside the dataset; vertices beyond are clamped onto its edge.
     pub cells_inside: [f32; 2],
+    /// Tile samples per node cell: 1 for the node's own tile, 1/2^k for an ancestor k levels up.
+    pub sample_step: f32,
+    /// How far the node's skirts hang below its edges, metres.
+    pub skirt_m: f32,
+}
+
+/// One cell of the Tile Load Map, as the TLM pass writes it. WGSL: `TlmCell` in
+/// `shaders/tile_load_map.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Hash, Default)]
+pub struct TlmCell {
+    /// 0: culled (outside the dataset, covered by an inner ring, outside the frustum, occluded);
+    /// else `1 + seed pattern` in ring 0 and 1 in outer rings.
+    pub visibility: u32,
+    /// Imagery levels the cell needs: `tlod_min | tlod_max << 8` (0 without imagery).
+    pub imagery_lod: u32,
+    /// Terrain (CDLOD) LODs at the cell's nearest and farthest points: `hlod_min | hlod_max << 8`.
+    pub height_lod: u32,
+    /// Radial LOD of the land-cover quadtree and seed patterns: 0, 1, 2; 3 = inactive or culled.
+    pub radial_lod: u32,
+}
+
+/// One column (or row) of one TLM ring: everything about a cell that depends on its x (or y)
+/// alone, computed in f64 on the CPU. WGSL: `TlmSpan` in `shaders/tile_load_map.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct TlmSpan {
+    /// The column's extent clamped to the dataset, relative to the camera (lo, hi), metres.
+    pub rel_m: [f32; 2],
+    /// Height tiles it overlaps at its ring's height level: `first | last << 16`.
+    pub height_tiles: u32,
+    /// `TLM_SPAN_INSIDE` (overlaps the dataset), `TLM_SPAN_COVERED` (inside the inner ring).
+    pub flags: u32,
+}
+
+/// Per TLM ring constants. WGSL: `TlmRing` in `shaders/tile_load_map.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct TlmRing {
+    /// Global address (x, y) of the ring's south-west cell, in cells of the ring.
+    pub origin_cell: [i32; 2],
+    /// Height pyramid level whose tiles bound the heights of the ring's cells.
+    pub height_level: u32,
+    pub _pad: u32,
+}
+
+/// Per-frame constants of the TLM pass. WGSL: `TlmUniforms` in `shaders/tile_load_map.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct TlmUniforms {
+    /// Clip space from camera-relative world space (columns), as the terrain draws with.
+    pub clip_from_view_world: [[f32; 4]; 4],
+    /// Left, right, bottom, top and near planes (xyz · p + w ≥ 0 inside), camera-relative.
+    pub frustum_planes: [[f32; 4]; 5],
+    /// Camera height in grid space, metres.
+    pub camera_z_m: f32,
+    /// Near plane, metres: reversed-Z depth is `near_m / view distance`.
+    pub near_m: f32,
+    pub occlusion_tolerance_m: f32,
+    /// (metres per pixel at 1 m · 2^lod_bias / level-0 texel edge)²: distance² times this is the
+    /// squared texel footprint ratio whose halved log2 is the imagery level.
+    pub imagery_scale_sq: f32,
+    /// Squared radial LOD thresholds (3 used, the 4th is +∞), m².
+    pub radial_lod_sq_m2: [f32; 4],
+    /// Viewport (= depth target) size, pixels.
+    pub screen_px: [u32; 2],
+    /// NDC units per pixel (2 / width, 2 / height).
+    pub ndc_per_px: [f32; 2],
+    pub hiz_mips: u32,
+    /// Imagery levels (0: no imagery).
+    pub imagery_levels: u32,
+    /// Entries of `height_lod_range_m` in use (the terrain's LOD count).
+    pub height_lod_count: u32,
+    pub rings: u32,
+    /// Cells per ring side.
+    pub cells: u32,
+    /// Seed patterns P (visibility of a ring-0 cell is 1 + hash % P).
+    pub patterns: u32,
+    pub seed: u32,
+    /// Always 0: OR-ed into every product so no compiler fuses it into an FMA (see the shader).
+    pub no_fuse: u32,
+    /// The terrain's CDLOD range of each LOD (`Lods::range_m`), metres, four per vec4.
+    pub height_lod_range_m: [[f32; 4]; MAX_LEVELS as usize / 4],
+    /// Height pyramid per level: first tile index, tiles along x, tiles along y, 0.
+    pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
+    pub rings_info: [TlmRing; crate::passes::tile_load_map::TLM_MAX_RINGS as usize],
 }

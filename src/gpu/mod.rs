@@ -6,6 +6,7 @@ pub mod device;
 pub mod gpu_types;
 pub mod profiler;
 pub mod readback;
+pub mod readback_ring;
 
 pub use device::{AdapterChoice, Gpu, GpuError};
 pub use profiler::{PassTiming, Profiler, TimeSource};

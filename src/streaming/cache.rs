@@ -3,25 +3,59 @@
 //!
 //! The page table is a storage buffer with one `u32` per tile of the layer's pyramid, in the
 //! pyramid's own tile order (so a shader finds a tile's entry in O(1) from its level, x and y): 0
-//! when the tile is not resident, else its slot + 1. `update` takes the tiles a frame wants, most
-//! important first, makes as many resident as there are slots, evicting the least recently wanted
-//! tiles first, and never evicts a tile the frame wants to make room for a less important one. A
-//! tile that cannot be read (missing, corrupt) is reported once and remembered as failed: shaders
-//! fall back to its ancestor.
+//! when the tile is not resident, else its slot + 1. Only the entries that changed are written.
+//!
+//! The render thread drives it once a frame: `set_wanted` records what the frame needs (most
+//! important first) and returns the loader requests; `upload` takes what the loader read and
+//! uploads it, most important first, within the frame's upload budget. Which tile goes where, and
+//! what is evicted, is `Residency`'s policy (least recently needed first, never a needed tile for a
+//! less important one). `load_now` is the synchronous path for tools and tests: it reads every
+//! fitting tile at once, with no budget. A tile that cannot be read is remembered as failed, and
+//! shaders (and `resident_ancestor`) fall back to its finest resident ancestor.
 
-use std::collections::{HashMap, HashSet};
-
+use super::loader::{LayerKind, Loaded};
+use super::residency::{Placement, Residency};
+use crate::config::CacheSettings;
 use crate::dataset::{PackError, Pyramid, TileId};
 
-/// What one `update` did.
+/// What one frame did to a cache.
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
 pub struct CacheStats {
-    pub wanted: usize,
+    /// Distinct tiles the frame wants.
+    pub needed: usize,
     pub resident: usize,
+    /// Wanted tiles that are resident.
+    pub needed_resident: usize,
+    /// New loader requests this frame (the push list).
+    pub requested: usize,
+    /// Requested and not arrived yet.
+    pub in_flight: usize,
+    /// Arrived and waiting for a later frame's upload budget.
+    pub staged: usize,
     pub uploaded: usize,
     pub evicted: usize,
+    /// Tiles found unusable this frame (each is counted once, ever).
     pub failed: usize,
     pub bytes_uploaded: u64,
+    /// Arrivals thrown away: no longer wanted, or no slot without evicting something more needed.
+    pub dropped: usize,
+}
+
+/// How much one frame may upload to one cache. The first tile of a frame always goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UploadBudget {
+    pub tiles: usize,
+    pub bytes: u64,
+}
+
+impl UploadBudget {
+    pub const UNLIMITED: Self = Self { tiles: usize::MAX, bytes: u64::MAX };
+}
+
+impl From<&CacheSettings> for UploadBudget {
+    fn from(settings: &CacheSettings) -> Self {
+        Self { tiles: settings.upload_tiles_per_frame as usize, bytes: settings.upload_bytes_per_frame }
+    }
 }
 
 pub struct TileCache {
@@ -34,16 +68,16 @@ pub struct TileCache {
     pub view: wgpu::TextureView,
     pub page_table: wgpu::Buffer,
     page_table_cpu: Vec<u32>,
-    /// Per slot: the tile it holds and the last frame that wanted it.
-    slots: Vec<Option<(TileId, u64)>>,
-    resident: HashMap<TileId, u32>,
-    failed: HashSet<TileId>,
+    /// Page-table entries changed since the last write to the GPU.
+    dirty: Vec<u32>,
+    residency: Residency,
 }
 
 impl TileCache {
     pub fn new(
         device: &wgpu::Device,
         label: &'static str,
+        layer: LayerKind,
         pyramid: Pyramid,
         mips: u32,
         format: wgpu::TextureFormat,
@@ -69,6 +103,7 @@ impl TileCache {
             label: Some(label),
             size: (page_table_cpu.len().max(1) * 4) as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            // Zeroed by wgpu: every tile starts absent.
             mapped_at_creation: false,
         });
         let texel_bytes = format.block_copy_size(None).unwrap_or(4);
@@ -82,100 +117,154 @@ impl TileCache {
             view,
             page_table,
             page_table_cpu,
-            slots: vec![None; slots as usize],
-            resident: HashMap::new(),
-            failed: HashSet::new(),
+            dirty: Vec::new(),
+            residency: Residency::new(layer, slots, pyramid.levels),
         }
     }
 
     pub fn slot_of(&self, id: TileId) -> Option<u32> {
-        self.resident.get(&id).copied()
+        self.residency.slot_of(id)
+    }
+
+    /// The finest resident tile at or above `id`, and its slot: what to draw while `id` streams
+    /// in (or for good, if it failed).
+    pub fn resident_ancestor(&self, id: TileId) -> Option<(TileId, u32)> {
+        self.residency.resident_ancestor(id)
+    }
+
+    pub fn resident_tiles(&self) -> impl Iterator<Item = (TileId, u32)> + '_ {
+        self.residency.resident_tiles()
+    }
+
+    /// The tile could not be read (missing, corrupt) and will never be requested again.
+    pub fn is_failed(&self, id: TileId) -> bool {
+        self.residency.is_failed(id)
     }
 
     pub fn capacity(&self) -> usize {
-        self.slots.len()
+        self.residency.capacity()
+    }
+
+    pub fn layer(&self) -> LayerKind {
+        self.residency.layer()
     }
 
     pub fn format(&self) -> wgpu::TextureFormat {
         self.format
     }
 
-    /// Makes the `wanted` tiles (most important first) resident as far as the slots allow.
-    /// `read` returns a tile's payload (all mips), checksum verified.
-    pub fn update<'a>(
+    pub fn pyramid(&self) -> &Pyramid {
+        &self.pyramid
+    }
+
+    /// This frame's figures so far.
+    pub fn stats(&self) -> CacheStats {
+        self.residency.stats()
+    }
+
+    /// Bytes of one tile, all mips: what the loader must deliver.
+    pub fn tile_bytes(&self) -> usize {
+        let texel_bytes = self.texel_bytes as usize;
+        (0..self.mips).map(|mip| (self.pyramid.mip_extent(mip) as usize).pow(2) * texel_bytes).sum()
+    }
+
+    /// Starts a frame: records the tiles it needs (most important first: coarse levels first,
+    /// then nearest) and returns the requests to hand the loader (with every other cache's, in
+    /// one `Loader::submit`). A frame runs:
+    ///
+    /// ```text
+    /// let mut requests = heights.set_wanted(&wanted_heights, frame);
+    /// requests.extend(imagery.set_wanted(&wanted_imagery, frame));
+    /// loader.submit(&requests);              // every frame, even when empty: it cancels
+    /// let loaded = loader.try_recv_all();    // never waits
+    /// let height_stats = heights.upload(queue, &loaded, budget);
+    /// let imagery_stats = imagery.upload(queue, &loaded, budget);
+    /// ```
+    pub fn set_wanted(&mut self, wanted: &[TileId], frame: u64) -> Vec<super::TileRequest> {
+        self.residency.set_wanted(wanted, frame)
+    }
+
+    /// Takes the loader's results (other layers' are ignored) and uploads arrived tiles, most
+    /// important first, within `budget`; the rest wait for later frames. Returns the frame's
+    /// figures. Call after `set_wanted`, once a frame.
+    pub fn upload(&mut self, queue: &wgpu::Queue, loaded: &[Loaded], budget: UploadBudget) -> CacheStats {
+        self.residency.accept(loaded, self.tile_bytes());
+        for id in self.residency.staged_in_order() {
+            let Some(payload) = self.residency.take_staged(id, budget) else { break };
+            self.place(queue, id, &payload);
+        }
+        self.flush_page_table(queue);
+        self.stats()
+    }
+
+    /// Makes the `wanted` tiles (most important first) resident now, as far as the slots allow,
+    /// with no budget. `read` returns a tile's payload (all mips), checksum verified.
+    pub fn load_now<'a>(
         &mut self,
         queue: &wgpu::Queue,
         wanted: &[TileId],
         frame: u64,
         mut read: impl FnMut(TileId) -> Result<&'a [u8], PackError>,
     ) -> CacheStats {
-        let mut stats = CacheStats { wanted: wanted.len(), ..Default::default() };
-        let keep: Vec<TileId> =
-            wanted.iter().copied().filter(|id| !self.failed.contains(id)).take(self.slots.len()).collect();
-        for id in &keep {
-            if let Some(&slot) = self.resident.get(id) {
-                self.slots[slot as usize] = Some((*id, frame));
-            }
-        }
-        let mut table_changed = false;
-        for &id in &keep {
-            if self.resident.contains_key(&id) {
-                continue;
-            }
-            let payload = match read(id) {
-                Ok(payload) => payload,
+        let tile_bytes = self.tile_bytes();
+        for request in self.residency.set_wanted(wanted, frame) {
+            match read(request.id) {
+                Ok(payload) if payload.len() == tile_bytes => self.place(queue, request.id, payload),
+                Ok(payload) => {
+                    let id = request.id;
+                    eprintln!(
+                        "terramp: {} tile {id:?} is {} bytes, the cache expects {tile_bytes}; its ancestor stands in",
+                        self.label,
+                        payload.len()
+                    );
+                    self.residency.fail(id);
+                }
                 Err(error) => {
                     eprintln!(
-                        "terramp: {} tile {id:?} unusable, its ancestor stands in: {error}",
-                        self.label
+                        "terramp: {} tile {:?} unusable, its ancestor stands in: {error}",
+                        self.label, request.id
                     );
-                    self.failed.insert(id);
-                    stats.failed += 1;
-                    continue;
+                    self.residency.fail(request.id);
                 }
-            };
-            // Free slots first, then the least recently wanted tile this frame does not want.
-            let Some(slot) = self.victim(frame) else { break };
-            if let Some((old, _)) = self.slots[slot].take() {
-                self.resident.remove(&old);
-                self.set_entry(old, 0);
-                stats.evicted += 1;
             }
-            self.upload(queue, slot as u32, payload);
-            self.slots[slot] = Some((id, frame));
-            self.resident.insert(id, slot as u32);
-            self.set_entry(id, slot as u32 + 1);
-            table_changed = true;
-            stats.uploaded += 1;
-            stats.bytes_uploaded += payload.len() as u64;
         }
-        if table_changed || stats.evicted > 0 {
-            queue.write_buffer(&self.page_table, 0, bytemuck::cast_slice(&self.page_table_cpu));
-        }
-        stats.resident = self.resident.len();
-        stats
+        self.flush_page_table(queue);
+        self.stats()
     }
 
-    fn victim(&self, frame: u64) -> Option<usize> {
-        if let Some(free) = self.slots.iter().position(Option::is_none) {
-            return Some(free);
+    fn place(&mut self, queue: &wgpu::Queue, id: TileId, payload: &[u8]) {
+        let Some(Placement { slot, evicted }) = self.residency.claim(id, payload.len() as u64) else {
+            return;
+        };
+        if let Some(old) = evicted {
+            self.set_entry(old, 0);
         }
-        self.slots
-            .iter()
-            .enumerate()
-            .filter_map(|(i, s)| s.map(|(_, used)| (i, used)))
-            .filter(|&(_, used)| used != frame)
-            .min_by_key(|&(_, used)| used)
-            .map(|(i, _)| i)
+        self.write_tile(queue, slot, payload);
+        self.set_entry(id, slot + 1);
     }
 
     fn set_entry(&mut self, id: TileId, value: u32) {
         if let Some(index) = self.pyramid.tile_index(id) {
             self.page_table_cpu[index as usize] = value;
+            self.dirty.push(index as u32);
         }
     }
 
-    fn upload(&self, queue: &wgpu::Queue, slot: u32, payload: &[u8]) {
+    /// Writes the changed page-table entries, one write per run of neighbouring entries: a few
+    /// dozen bytes a frame, however large the pyramid.
+    fn flush_page_table(&mut self, queue: &wgpu::Queue) {
+        self.dirty.sort_unstable();
+        self.dirty.dedup();
+        let mut runs = self.dirty.chunk_by(|a, b| a + 1 == *b);
+        for run in &mut runs {
+            let (first, last) = (run[0] as usize, run[run.len() - 1] as usize);
+            let bytes: &[u8] = bytemuck::cast_slice(&self.page_table_cpu[first..=last]);
+            queue.write_buffer(&self.page_table, (first * 4) as u64, bytes);
+        }
+        self.dirty.clear();
+    }
+
+    fn write_tile(&self, queue: &wgpu::Queue, slot: u32, payload: &[u8]) {
         let mut offset = 0usize;
         for mip in 0..self.mips {
             let extent = self.pyramid.mip_extent(mip);

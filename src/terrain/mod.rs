@@ -11,12 +11,14 @@ pub mod select;
 
 use std::ops::Range;
 
+use glam::DVec3;
 use wgpu::util::DeviceExt;
 
 use crate::config::Settings;
 use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
 use crate::shaders;
 use crate::streaming::TileCache;
+use select::{Lods, NodeId, Selected};
 
 pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -260,26 +262,81 @@ impl TerrainPass {
     }
 }
 
-/// Triangles of a `cells`² grid of `(cells + 1)²` vertices, quadrant by quadrant (south-west,
-/// south-east, north-west, north-east), counter-clockwise seen from above; with each quadrant's
-/// index range. Diagonals alternate so the mesh has no directional bias.
-pub fn grid_indices(cells: u32) -> (Vec<u32>, [Range<u32>; 4]) {
-    let row = cells + 1;
-    let half = cells / 2;
-    let mut indices = Vec::with_capacity((cells * cells * 6) as usize);
-    let ranges = [(0, 0), (half, 0), (0, half), (half, half)].map(|(x0, y0)| {
-        let start = indices.len() as u32;
-        for y in y0..y0 + half {
-            for x in x0..x0 + half {
-                let (sw, se, nw, ne) =
-                    (y * row + x, y * row + x + 1, (y + 1) * row + x, (y + 1) * row + x + 1);
-                if (x + y) % 2 == 0 {
-                    indices.extend_from_slice(&[sw, se, ne, sw, ne, nw]);
-                } else {
-                    indices.extend_from_slice(&[sw, se, nw, se, ne, nw]);
-                }
+/// The instances drawing `selected` from a camera at `camera_grid_m` (grid space). A node reads its
+/// own height tile, or while that streams in, its finest resident ancestor; a node with neither
+/// (only before the pinned levels load) is dropped and counted. `bounds` gives node height ranges
+/// (the skirt depth).
+pub fn node_batches(
+    lods: &Lods,
+    selected: &[Selected],
+    camera_grid_m: DVec3,
+    heights: &TileCache,
+    bounds: &mut dyn FnMut(NodeId) -> [f32; 2],
+) -> (NodeBatches, usize) {
+    let mut batches = NodeBatches::default();
+    let mut dropped = 0;
+    for s in selected {
+        let Some((source, slot)) = heights.resident_ancestor(lods.tile_of(s.node)) else {
+            dropped += 1;
+            continue;
+        };
+        let size = lods.node_m(s.node.lod);
+        let cell_m = size / f64::from(lods.cells);
+        let [low_m, high_m] = bounds(s.node);
+        let lod = s.node.lod as usize;
+        let node = TerrainNode {
+            // Subtracted in f64: the GPU only sees offsets from the camera.
+            origin_rel_m: [
+                (f64::from(s.node.x) * size - camera_grid_m.x) as f32,
+                (f64::from(s.node.y) * size - camera_grid_m.y) as f32,
+            ],
+            cell_m: cell_m as f32,
+            height_slot: slot,
+            sample_offset: lods.sample_offset_in(s.node, source),
+            morph_start_m: lods.morph_start_m[lod].min(f64::from(f32::MAX)) as f32,
+            morph_end_m: lods.range_m[lod].min(f64::from(f32::MAX)) as f32,
+            cells_inside: lods.cells_inside(s.node).map(|c| c as f32),
+            sample_step: 1.0 / (1u32 << (source.level - s.node.lod)) as f32,
+            // Deep enough to close any seam against a neighbour reading another level.
+            skirt_m: (f64::from(high_m - low_m) + cell_m) as f32,
+        };
+        for (q, quadrant) in batches.by_quadrant.iter_mut().enumerate() {
+            if s.quadrants & (1 << q) != 0 {
+                quadrant.push(node);
             }
         }
+    }
+    (batches, dropped)
+}
+
+/// Triangles of a `cells`² grid ringed by skirts: `(cells + 3)²` vertices, the outer ring being
+/// the skirts' lower edge. Grouped quadrant by quadrant (south-west, south-east, north-west,
+/// north-east; skirts go with the quadrant they border), with each quadrant's index range. The
+/// grid is counter-clockwise seen from above with alternating diagonals (no directional bias);
+/// skirts are walls seen from either side, so they carry both windings.
+pub fn grid_indices(cells: u32) -> (Vec<u32>, [Range<u32>; 4]) {
+    let row = cells + 3;
+    let half = cells / 2;
+    // Ring cell 0 and inner cells 1..=half border the west (or south) half.
+    let side = |c: u32| usize::from(c > half);
+    let mut quadrants: [Vec<u32>; 4] = Default::default();
+    for cj in 0..cells + 2 {
+        for ci in 0..cells + 2 {
+            let (sw, se, nw, ne) =
+                (cj * row + ci, cj * row + ci + 1, (cj + 1) * row + ci, (cj + 1) * row + ci + 1);
+            let t = if (ci + cj) % 2 == 0 { [sw, se, ne, sw, ne, nw] } else { [sw, se, nw, se, ne, nw] };
+            let quadrant = &mut quadrants[side(cj) * 2 + side(ci)];
+            quadrant.extend_from_slice(&t);
+            let inner = (1..=cells).contains(&ci) && (1..=cells).contains(&cj);
+            if !inner {
+                quadrant.extend_from_slice(&[t[0], t[2], t[1], t[3], t[5], t[4]]);
+            }
+        }
+    }
+    let mut indices = Vec::with_capacity(quadrants.iter().map(Vec::len).sum());
+    let ranges = quadrants.map(|q| {
+        let start = indices.len() as u32;
+        indices.extend_from_slice(&q);
         start..indices.len() as u32
     });
     (indices, ranges)
@@ -290,16 +347,29 @@ mod tests {
     use super::*;
 
     #[test]
-    fn grid_quadrants_cover_every_cell_once() {
-        let (indices, ranges) = grid_indices(8);
-        assert_eq!(indices.len(), 8 * 8 * 6);
+    fn grid_and_skirts_cover_every_cell_once_by_quadrant() {
+        let cells = 8;
+        let row = cells + 3;
+        let (indices, ranges) = grid_indices(cells);
+        let ring_cells = (cells + 2) * (cells + 2) - cells * cells;
+        assert_eq!(indices.len() as u32, (cells * cells + 2 * ring_cells) * 6);
         assert_eq!(ranges.iter().map(|r| r.len()).sum::<usize>(), indices.len());
-        assert!(indices.iter().all(|&i| i < 81));
-        // Counter-clockwise from above (+z): positive signed area for every triangle.
-        for t in indices.chunks(3) {
-            let p = t.iter().map(|&i| ((i % 9) as i32, (i / 9) as i32)).collect::<Vec<_>>();
-            let area = (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[2].0 - p[0].0) * (p[1].1 - p[0].1);
-            assert!(area > 0, "{t:?}");
+        assert!(indices.iter().all(|&i| i < row * row));
+        // Every inner triangle is counter-clockwise from above (+z), and sits in its quadrant.
+        let inner = |i: u32| (1..=cells + 1).contains(&(i % row)) && (1..=cells + 1).contains(&(i / row));
+        for (q, range) in ranges.iter().enumerate() {
+            for t in indices[range.start as usize..range.end as usize].chunks(3) {
+                if !t.iter().all(|&i| inner(i)) {
+                    continue;
+                }
+                let p: Vec<(i32, i32)> = t.iter().map(|&i| ((i % row) as i32, (i / row) as i32)).collect();
+                let area = (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[2].0 - p[0].0) * (p[1].1 - p[0].1);
+                assert!(area > 0, "{t:?}");
+                let centre =
+                    ((p[0].0 + p[1].0 + p[2].0) as f32 / 3.0, (p[0].1 + p[1].1 + p[2].1) as f32 / 3.0);
+                let mid = 1.0 + (cells / 2) as f32;
+                assert_eq!(q, usize::from(centre.1 > mid) * 2 + usize::from(centre.0 > mid), "{t:?}");
+            }
         }
     }
 }

@@ -109,6 +109,17 @@ impl Lods {
         [node.x % per, node.y % per].map(|n| n * self.cells + HEIGHT_BORDER)
     }
 
+    /// Sample position (border included) of `node`'s south-west vertex within `source`, its own
+    /// tile or an ancestor of it, where one node cell spans 1/2^k samples (k levels up).
+    pub fn sample_offset_in(&self, node: NodeId, source: TileId) -> [f32; 2] {
+        let k = source.level - node.lod;
+        let in_level = |n: u32, tile: u32| {
+            f64::from(n * self.cells) / f64::from(1u32 << k) - f64::from(tile * HEIGHT_TILE_CELLS)
+        };
+        [in_level(node.x, source.x), in_level(node.y, source.y)]
+            .map(|v| (v + f64::from(HEIGHT_BORDER)) as f32)
+    }
+
     /// Cells of `node` inside the dataset along each axis (the rest of its grid is clamped).
     pub fn cells_inside(&self, node: NodeId) -> [u32; 2] {
         let steps = self.steps(node.lod);

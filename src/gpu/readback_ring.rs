@@ -1,0 +1,153 @@
+//! How it works: reading a GPU buffer back without stalling the frame. The ring owns a few
+//! mappable staging buffers. Each frame, `encode_copy` records a copy of the source into the next
+//! free one (tagged with the frame's index); after the frame's submit, `submitted` asks wgpu to
+//! map it. `try_take` polls the device without waiting and hands back the oldest frame whose
+//! buffer has mapped, as an owned copy, and frees its buffer. Results come in frame order, one or
+//! two frames late. When every buffer is still in flight (the GPU is that far behind), the frame's
+//! copy is skipped and counted: a late CPU reader loses a frame, never the frame rate.
+
+use std::collections::VecDeque;
+use std::sync::{Arc, OnceLock};
+
+use super::GpuError;
+
+/// Staging buffers the TLM readback rotates through: one being written by the GPU, one mapping,
+/// one being read on the CPU.
+pub const DEFAULT_SLOTS: usize = 3;
+
+/// One frame's bytes, read back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Readback {
+    /// The index the caller gave `encode_copy` for that frame.
+    pub frame: u64,
+    pub bytes: Vec<u8>,
+}
+
+impl Readback {
+    /// The bytes as `T`s (a copy; the byte count must be a multiple of `T`'s size).
+    pub fn cast<T: bytemuck::Pod>(&self) -> Vec<T> {
+        bytemuck::pod_collect_to_vec(&self.bytes)
+    }
+}
+
+type MapStatus = Arc<OnceLock<Result<(), wgpu::BufferAsyncError>>>;
+
+enum Slot {
+    Free,
+    /// A copy is recorded but its encoder is not known to be submitted yet.
+    Recorded {
+        frame: u64,
+        bytes: u64,
+    },
+    Mapping {
+        frame: u64,
+        bytes: u64,
+        status: MapStatus,
+    },
+}
+
+pub struct ReadbackRing {
+    buffers: Vec<wgpu::Buffer>,
+    slots: Vec<Slot>,
+    /// Slots holding a frame, oldest first.
+    order: VecDeque<usize>,
+    capacity_bytes: u64,
+    skipped: u64,
+}
+
+impl ReadbackRing {
+    /// `slots` staging buffers of `capacity_bytes` each.
+    pub fn new(device: &wgpu::Device, label: &str, capacity_bytes: u64, slots: usize) -> Self {
+        let capacity_bytes = capacity_bytes.next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT);
+        let buffers = (0..slots.max(1))
+            .map(|i| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(&format!("{label} readback {i}")),
+                    size: capacity_bytes,
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                })
+            })
+            .collect::<Vec<_>>();
+        let slots = buffers.iter().map(|_| Slot::Free).collect();
+        Self { buffers, slots, order: VecDeque::new(), capacity_bytes, skipped: 0 }
+    }
+
+    /// Records a copy of the first `bytes` of `source` for frame `frame` into a free staging
+    /// buffer. False (and counted) when none is free or `bytes` exceeds the capacity; the frame
+    /// is then simply not read back.
+    pub fn encode_copy(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &wgpu::Buffer,
+        bytes: u64,
+        frame: u64,
+    ) -> bool {
+        let free = self.slots.iter().position(|s| matches!(s, Slot::Free));
+        let (Some(index), true) = (free, bytes <= self.capacity_bytes && bytes.is_multiple_of(4)) else {
+            self.skipped += 1;
+            return false;
+        };
+        if bytes > 0 {
+            encoder.copy_buffer_to_buffer(source, 0, &self.buffers[index], 0, bytes);
+        }
+        self.slots[index] = Slot::Recorded { frame, bytes };
+        self.order.push_back(index);
+        true
+    }
+
+    /// Call after submitting the encoder(s) holding the copies: starts mapping them.
+    pub fn submitted(&mut self) {
+        for (slot, buffer) in self.slots.iter_mut().zip(&self.buffers) {
+            if let Slot::Recorded { frame, bytes } = *slot {
+                let status: MapStatus = Arc::default();
+                let sink = Arc::clone(&status);
+                if bytes > 0 {
+                    buffer.slice(..bytes).map_async(wgpu::MapMode::Read, move |result| {
+                        let _ = sink.set(result);
+                    });
+                } else {
+                    let _ = sink.set(Ok(()));
+                }
+                *slot = Slot::Mapping { frame, bytes, status };
+            }
+        }
+    }
+
+    /// The oldest frame whose copy has arrived, if it has; never waits for the GPU.
+    pub fn try_take(&mut self, device: &wgpu::Device) -> Result<Option<Readback>, GpuError> {
+        device.poll(wgpu::PollType::Poll)?;
+        let Some(&index) = self.order.front() else { return Ok(None) };
+        let Slot::Mapping { frame, bytes, status } = &self.slots[index] else { return Ok(None) };
+        let Some(result) = status.get() else { return Ok(None) };
+        let (frame, bytes, result) = (*frame, *bytes, result.clone());
+        self.order.pop_front();
+        self.slots[index] = Slot::Free;
+        result?;
+        if bytes == 0 {
+            return Ok(Some(Readback { frame, bytes: Vec::new() }));
+        }
+        let buffer = &self.buffers[index];
+        let copy = {
+            let mapped =
+                buffer.slice(..bytes).get_mapped_range().map_err(|e| GpuError::Validation(e.to_string()))?;
+            mapped.to_vec()
+        };
+        buffer.unmap();
+        Ok(Some(Readback { frame, bytes: copy }))
+    }
+
+    /// Frames whose copy was skipped because no staging buffer was free (or it did not fit).
+    pub fn skipped(&self) -> u64 {
+        self.skipped
+    }
+
+    /// Frames recorded and not yet taken.
+    pub fn in_flight(&self) -> usize {
+        self.order.len()
+    }
+
+    pub fn capacity_bytes(&self) -> u64 {
+        self.capacity_bytes
+    }
+}

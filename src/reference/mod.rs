@@ -1,0 +1,6 @@
+//! How it works: a CPU twin of every GPU pass whose output the CPU or the tests rely on, written
+//! shader-shaped (same structure, same f32 arithmetic in the same order), so tests can demand
+//! GPU == CPU exactly for integer outputs. The exact oracle used to measure accuracy (f64, full
+//! resolution) is separate from these twins: a twin reproduces the GPU, the oracle judges it.
+
+pub mod tile_load_map;

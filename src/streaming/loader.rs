@@ -1,0 +1,302 @@
+//! How it works: loader threads read tiles off the render thread. The render thread says, once a
+//! frame, which tiles it still needs and how much (`submit`); that list *replaces* the queue of
+//! requests not yet started, so a tile the view no longer wants is cancelled for free and a tile
+//! that became urgent moves up at once. N workers share the queue (a binary heap under a mutex,
+//! woken by a condvar) and always take the most important request left. A worker reads the tile
+//! from the dataset's memory-mapped pack, which verifies its checksum, copies it into an owned
+//! buffer (so the render thread never touches the mapping, nor a page fault) and sends it back on
+//! a channel that `try_recv_all` drains without blocking.
+//!
+//! A tile is never read twice at once: from the moment a worker takes it until the render thread
+//! drains its result it is *busy*, and a re-submission of it is skipped. A tile that cannot be
+//! read (missing, corrupt, out of range) is logged once per tile, naming the pack and the tile, and
+//! comes back as an error so the cache can remember it and let the tile's ancestor stand in.
+//! Dropping the `Loader` discards the queue and joins the workers (each finishes at most the tile
+//! it is reading).
+
+use std::cmp::{Ordering, Reverse};
+use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
+use std::thread::JoinHandle;
+
+use crossbeam_channel::{Receiver, Sender};
+use thiserror::Error;
+
+use crate::dataset::{Dataset, LayerPack, PackError, TileId};
+
+/// Which of the dataset's tile layers a request reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+pub enum LayerKind {
+    Height,
+    Imagery,
+    Landcover,
+}
+
+impl LayerKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Height => "height",
+            Self::Imagery => "imagery",
+            Self::Landcover => "landcover",
+        }
+    }
+}
+
+impl std::fmt::Display for LayerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum LoaderError {
+    #[error("starting loader thread {index}: {source}")]
+    Spawn { index: usize, source: std::io::Error },
+    #[error("the dataset has no {0} layer")]
+    NoLayer(LayerKind),
+    #[error(transparent)]
+    Pack(#[from] PackError),
+}
+
+/// One tile the render thread wants read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TileRequest {
+    pub layer: LayerKind,
+    pub id: TileId,
+    /// Lower is more important: the tile's rank in its cache's wanted list (coarse levels first,
+    /// then nearest). Ties go to heights, then imagery, then land cover, then submission order.
+    pub priority: u32,
+}
+
+/// One tile read: its payload (all mips, checksum verified), or why it could not be read.
+#[derive(Debug)]
+pub struct Loaded {
+    pub layer: LayerKind,
+    pub id: TileId,
+    pub result: Result<Arc<[u8]>, LoaderError>,
+}
+
+/// A queued request; the heap pops the smallest key (via `Reverse`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Queued {
+    priority: u32,
+    layer: LayerKind,
+    order: usize,
+    id: TileId,
+}
+
+impl Ord for Queued {
+    fn cmp(&self, other: &Self) -> Ordering {
+        (self.priority, self.layer, self.order, self.id).cmp(&(
+            other.priority,
+            other.layer,
+            other.order,
+            other.id,
+        ))
+    }
+}
+
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+#[derive(Default)]
+struct Queue {
+    pending: BinaryHeap<Reverse<Queued>>,
+    /// Taken by a worker and not yet drained by `try_recv_all`.
+    busy: HashSet<(LayerKind, TileId)>,
+    /// Workers reading right now (their results not yet sent).
+    reading: usize,
+    shutdown: bool,
+}
+
+struct Shared {
+    queue: Mutex<Queue>,
+    wake: Condvar,
+    /// Tiles already reported unusable, so each is logged once however often it is asked for.
+    reported: Mutex<HashSet<(LayerKind, TileId)>>,
+}
+
+impl Shared {
+    fn queue(&self) -> MutexGuard<'_, Queue> {
+        // A worker panicking mid-read leaves the queue consistent (it only pops and counts).
+        self.queue.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// Worker threads reading tiles from one dataset's packs.
+pub struct Loader {
+    shared: Arc<Shared>,
+    results: Receiver<Loaded>,
+    workers: Vec<JoinHandle<()>>,
+}
+
+impl Loader {
+    /// Starts `threads` workers (at least one) reading from `dataset`.
+    pub fn new(dataset: Arc<Dataset>, threads: usize) -> Result<Self, LoaderError> {
+        let shared = Arc::new(Shared {
+            queue: Mutex::new(Queue::default()),
+            wake: Condvar::new(),
+            reported: Mutex::new(HashSet::new()),
+        });
+        let (sender, results) = crossbeam_channel::unbounded();
+        let mut loader = Self { shared, results, workers: Vec::new() };
+        for index in 0..threads.max(1) {
+            let (shared, dataset, sender) = (loader.shared.clone(), dataset.clone(), sender.clone());
+            let worker = std::thread::Builder::new()
+                .name(format!("terramp-loader-{index}"))
+                .spawn(move || work(&shared, &dataset, &sender))
+                // Dropping `loader` here joins the workers already started.
+                .map_err(|source| LoaderError::Spawn { index, source })?;
+            loader.workers.push(worker);
+        }
+        Ok(loader)
+    }
+
+    /// Replaces the requests not yet started with `requests` (most important first by
+    /// `priority`). Call it once a frame with every layer's requests, even when there are none:
+    /// whatever was queued and is not in this list is cancelled. Tiles being read, or read and
+    /// not yet drained, are skipped. Never waits for a read.
+    pub fn submit(&self, requests: &[TileRequest]) {
+        let mut queue = self.shared.queue();
+        let mut best: HashMap<(LayerKind, TileId), Queued> = HashMap::with_capacity(requests.len());
+        for (order, r) in requests.iter().enumerate() {
+            if queue.busy.contains(&(r.layer, r.id)) {
+                continue;
+            }
+            let entry = Queued { priority: r.priority, layer: r.layer, order, id: r.id };
+            best.entry((r.layer, r.id)).and_modify(|q| *q = (*q).min(entry)).or_insert(entry);
+        }
+        queue.pending = best.into_values().map(Reverse).collect();
+        drop(queue);
+        self.shared.wake.notify_all();
+    }
+
+    /// Every tile read since the last call, in the order the workers finished. Never waits.
+    pub fn try_recv_all(&self) -> Vec<Loaded> {
+        let loaded: Vec<Loaded> = self.results.try_iter().collect();
+        if !loaded.is_empty() {
+            let mut queue = self.shared.queue();
+            for l in &loaded {
+                queue.busy.remove(&(l.layer, l.id));
+            }
+        }
+        loaded
+    }
+
+    /// Nothing queued and nothing being read: every result is ready for `try_recv_all`.
+    pub fn is_idle(&self) -> bool {
+        let queue = self.shared.queue();
+        queue.pending.is_empty() && queue.reading == 0
+    }
+
+    /// Requests queued and not yet started.
+    pub fn queued(&self) -> usize {
+        self.shared.queue().pending.len()
+    }
+
+    /// How many distinct tiles were reported unusable so far.
+    pub fn failures(&self) -> usize {
+        self.shared.reported.lock().unwrap_or_else(PoisonError::into_inner).len()
+    }
+
+    pub fn threads(&self) -> usize {
+        self.workers.len()
+    }
+}
+
+impl Drop for Loader {
+    fn drop(&mut self) {
+        self.shared.queue().shutdown = true;
+        self.shared.wake.notify_all();
+        for worker in self.workers.drain(..) {
+            // A worker that panicked has nothing left to clean up; the others exit on `shutdown`.
+            let _ = worker.join();
+        }
+    }
+}
+
+fn work(shared: &Shared, dataset: &Dataset, results: &Sender<Loaded>) {
+    loop {
+        let request = {
+            let mut queue = shared.queue();
+            loop {
+                if queue.shutdown {
+                    return;
+                }
+                if let Some(Reverse(request)) = queue.pending.pop() {
+                    queue.busy.insert((request.layer, request.id));
+                    queue.reading += 1;
+                    break request;
+                }
+                queue = shared.wake.wait(queue).unwrap_or_else(PoisonError::into_inner);
+            }
+        };
+        let result = read(dataset, request.layer, request.id);
+        if let Err(error) = &result {
+            report_once(shared, request.layer, request.id, error);
+        }
+        // The receiver lives as long as the `Loader`, which joins us before dropping it.
+        let _ = results.send(Loaded { layer: request.layer, id: request.id, result });
+        shared.queue().reading -= 1;
+    }
+}
+
+fn layer(dataset: &Dataset, kind: LayerKind) -> Option<&LayerPack> {
+    match kind {
+        LayerKind::Height => Some(&dataset.height),
+        LayerKind::Imagery => dataset.imagery.as_ref(),
+        LayerKind::Landcover => dataset.landcover.as_ref(),
+    }
+}
+
+/// The tile's payload, checksum verified, copied out of the mapping.
+pub fn read(dataset: &Dataset, kind: LayerKind, id: TileId) -> Result<Arc<[u8]>, LoaderError> {
+    let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
+    Ok(Arc::from(pack.tile_bytes(id)?))
+}
+
+fn report_once(shared: &Shared, kind: LayerKind, id: TileId, error: &LoaderError) {
+    let first = shared.reported.lock().unwrap_or_else(PoisonError::into_inner).insert((kind, id));
+    if first {
+        eprintln!(
+            "terramp: {kind} tile (level {}, x {}, y {}) unusable, its ancestor stands in: {error}",
+            id.level, id.x, id.y
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn queue_pops_lowest_priority_then_layer_then_order() {
+        let mut heap = BinaryHeap::new();
+        let q = |priority, layer, order| Reverse(Queued { priority, layer, order, id: TileId::new(0, 0, 0) });
+        heap.push(q(2, LayerKind::Height, 0));
+        heap.push(q(1, LayerKind::Imagery, 1));
+        heap.push(q(1, LayerKind::Height, 5));
+        heap.push(q(1, LayerKind::Height, 3));
+        let order: Vec<(u32, LayerKind, usize)> =
+            std::iter::from_fn(|| heap.pop()).map(|Reverse(q)| (q.priority, q.layer, q.order)).collect();
+        assert_eq!(
+            order,
+            [
+                (1, LayerKind::Height, 3),
+                (1, LayerKind::Height, 5),
+                (1, LayerKind::Imagery, 1),
+                (2, LayerKind::Height, 0)
+            ]
+        );
+    }
+
+    #[test]
+    fn dataset_can_be_shared_with_workers() {
+        fn send_sync<T: Send + Sync>() {}
+        send_sync::<Dataset>();
+        send_sync::<Loader>();
+    }
+}

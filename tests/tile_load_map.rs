@@ -1,0 +1,704 @@
+//! Pass 1, the Tile Load Map, on the software adapter: the ring layout covers the dataset and
+//! nests exactly, the depth pyramid equals a CPU min-reduction, the readback ring never waits and
+//! keeps frames in order, and the GPU pass equals its CPU twin bit for bit for many cameras, never
+//! culls a cell whose ground is on screen, and picks the levels an f64 computation picks.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use glam::{DMat4, DVec3, DVec4};
+use terramp::camera::Camera;
+use terramp::config::{Settings, TlmSettings};
+use terramp::dataset::{Dataset, HEIGHT_TILE_CELLS, TileId};
+use terramp::frame::Renderer;
+use terramp::gpu::gpu_types::TlmCell;
+use terramp::gpu::readback_ring::ReadbackRing;
+use terramp::gpu::{Profiler, TimeSource};
+use terramp::passes::depth_pyramid::DepthPyramid;
+use terramp::passes::tile_load_map::{
+    TileLoadMapPass, TlmFrame, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges,
+};
+use terramp::reference::tile_load_map::{HizMips, pattern_hash, tile_load_map};
+use terramp::terrain::select::Lods;
+
+use common::{gpu, renderer, small_settings, synth_dataset};
+
+/// Small rings, so a few-km synthetic dataset needs several of them.
+fn tlm_settings(cell_m: f64, cells: u32) -> TlmSettings {
+    TlmSettings { cell_m, cells, ..Settings::default().tlm }
+}
+
+struct Run {
+    layout: TlmLayout,
+    frame: TlmFrame,
+    lods: Lods,
+    ranges: Vec<[f32; 2]>,
+    hiz: HizMips,
+    gpu: Vec<TlmCell>,
+    twin: Vec<TlmCell>,
+    clip: DMat4,
+    camera_grid_m: DVec3,
+}
+
+/// Renders `camera`, then runs the depth pyramid and the TLM on its depth, and the twin.
+fn run(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]]) -> Run {
+    run_with(r, camera, ranges, None)
+}
+
+/// As `run`, but with `wall_m`, on a depth target cleared to a wall that far away instead.
+fn run_with(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]], wall_m: Option<f64>) -> Run {
+    r.render(camera).unwrap();
+    let s = r.settings.clone();
+    let (w, h) = (s.render.width, s.render.height);
+    let device = &r.gpu.device;
+    let hiz = DepthPyramid::new(device, w, h);
+    let pass = TileLoadMapPass::new(device, &s);
+    let ranges = ranges.to_vec();
+    let bindings = pass.bind_group(device, &ranges, &hiz);
+    let m = &r.dataset.manifest;
+    let camera_grid_m = camera.position_m - DVec3::new(m.origin_m[0], m.origin_m[1], 0.0);
+    let lods = Lods::new(
+        r.dataset.height.pyramid,
+        m.height.spacing_m,
+        s.terrain.node_cells,
+        camera.metres_per_pixel(1.0, h),
+        s.terrain.triangle_px,
+        s.terrain.morph_fraction,
+    );
+    let rect = TlmLayout::dataset_rect_m(&lods.pyramid, lods.spacing_m);
+    let layout = TlmLayout::new(&s.tlm, rect, [camera_grid_m.x, camera_grid_m.y]);
+    let imagery = m.imagery.as_ref().map(|i| TlmImagery {
+        texel_m: i.texel_m,
+        levels: i.pyramid.levels,
+        lod_bias: s.imagery.lod_bias,
+    });
+    let inputs = TlmInputs {
+        settings: &s.tlm,
+        layout: &layout,
+        camera,
+        camera_grid_m,
+        viewport_px: [w, h],
+        lods: &lods,
+        imagery,
+        hiz_mips: hiz.mips(),
+    };
+    let frame = pass.prepare(&r.gpu.queue, &inputs).unwrap();
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let wall = wall_m.map(|distance_m| {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("wall"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("wall"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear((camera.near_m / distance_m) as f32),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        view
+    });
+    let depth = wall.unwrap_or_else(|| r.depth_texture().create_view(&Default::default()));
+    hiz.encode(&mut encoder, &depth);
+    pass.encode(&mut encoder, &bindings, &frame);
+    r.gpu.queue.submit([encoder.finish()]);
+    let gpu_cells = pass.read_back(&r.gpu, &frame).unwrap();
+    let mips = hiz.read_back(&r.gpu).unwrap();
+    let twin = tile_load_map(&frame.uniforms, &frame.spans, &ranges, &mips);
+    let clip = camera.clip_from_view(w, h).unwrap() * camera.view_from_world();
+    Run { layout, frame, lods, ranges, hiz: mips, gpu: gpu_cells, twin, clip, camera_grid_m }
+}
+
+fn assert_gpu_equals_twin(run: &Run, what: &str) {
+    assert_eq!(run.gpu.len(), run.layout.cell_count(), "{what}");
+    let differ: Vec<_> = (0..run.gpu.len()).filter(|&i| run.gpu[i] != run.twin[i]).collect();
+    let show: Vec<_> =
+        differ.iter().take(5).map(|&i| (run.layout.cell_of(i), run.gpu[i], run.twin[i])).collect();
+    assert!(
+        differ.is_empty(),
+        "{what}: {} cells differ, e.g. (ring, x, y), GPU, twin: {show:?}",
+        differ.len()
+    );
+}
+
+fn visible(cells: &[TlmCell]) -> usize {
+    cells.iter().filter(|c| c.visibility != 0).count()
+}
+
+/// Every pixel showing ground lies in a cell the TLM keeps (no false culls), checked for points
+/// well inside a cell and within the dataset's height range (skirts hang below it).
+fn assert_no_false_culls(r: &Renderer, run: &Run, what: &str) {
+    let (w, h) = (r.settings.render.width, r.settings.render.height);
+    let depth = r.read_depth().unwrap();
+    let inverse = run.clip.inverse();
+    let [low, high] = [r.dataset.manifest.height.min_m, r.dataset.manifest.height.max_m].map(f64::from);
+    let mut checked = 0;
+    for (i, &d) in depth.iter().enumerate().filter(|(_, d)| **d > 0.0) {
+        let (px, py) = ((i as u32 % w) as f64 + 0.5, (i as u32 / w) as f64 + 0.5);
+        let ndc = DVec4::new(px / f64::from(w) * 2.0 - 1.0, 1.0 - py / f64::from(h) * 2.0, f64::from(d), 1.0);
+        let rel = inverse * ndc;
+        let p = run.camera_grid_m + rel.truncate() / rel.w;
+        if p.z < low - 1.0 || p.z > high + 1.0 {
+            continue;
+        }
+        let Some((ring, cx, cy)) = run.layout.locate([p.x, p.y]) else { continue };
+        let (min, max) = run.layout.cell_rect_m(ring, cx, cy);
+        let margin = (0..2).map(|a| (p[a] - min[a]).min(max[a] - p[a])).fold(f64::INFINITY, f64::min);
+        if margin < 1.0 {
+            continue;
+        }
+        let cell = run.gpu[run.layout.index(ring, cx, cy)];
+        assert!(
+            cell.visibility != 0,
+            "{what}: pixel ({px}, {py}) shows ground of culled cell {:?}",
+            (ring, cx, cy)
+        );
+        checked += 1;
+    }
+    assert!(checked > 0 || depth.iter().all(|&d| d == 0.0), "{what}: no pixel checked");
+}
+
+/// The union of the ranges of the height tiles the cell's column and row overlap.
+fn cell_height_range(run: &Run, ring: u32, cx: u32, cy: u32) -> [f32; 2] {
+    let u = &run.frame.uniforms;
+    let (sx, sy) = (
+        run.frame.spans[((ring * 2) * u.cells + cx) as usize],
+        run.frame.spans[((ring * 2 + 1) * u.cells + cy) as usize],
+    );
+    let level = u.height_levels[u.rings_info[ring as usize].height_level as usize];
+    let mut range = [f32::MAX, f32::MIN];
+    for ty in sy.height_tiles & 0xffff..=sy.height_tiles >> 16 {
+        for tx in sx.height_tiles & 0xffff..=sx.height_tiles >> 16 {
+            let r = run.ranges[(level[0] + ty * level[1] + tx) as usize];
+            range = [range[0].min(r[0]), range[1].max(r[1])];
+        }
+    }
+    range
+}
+
+/// Radial, imagery and terrain levels of visible cells equal an f64 computation, away from the
+/// thresholds (where f32 and f64 may round to either side).
+fn assert_levels_match_f64(r: &Renderer, run: &Run, camera: &Camera, what: &str) {
+    let s = &r.settings;
+    let mpp = camera.metres_per_pixel(1.0, s.render.height);
+    let imagery = r.dataset.manifest.imagery.as_ref();
+    let near = |d: f64, t: f64| (d - t).abs() < 1e-3 * t.max(1.0);
+    let mut checked = 0;
+    for (i, cell) in run.gpu.iter().enumerate().filter(|(_, c)| c.visibility != 0) {
+        let (ring, cx, cy) = run.layout.cell_of(i);
+        let (min, max) = run.layout.cell_rect_m(ring, cx, cy);
+        let height_m = cell_height_range(run, ring, cx, cy);
+        let lo =
+            DVec3::new(min[0].max(run.layout.dataset_min_m[0]), min[1].max(run.layout.dataset_min_m[1]), 0.0);
+        let hi =
+            DVec3::new(max[0].min(run.layout.dataset_max_m[0]), max[1].min(run.layout.dataset_max_m[1]), 0.0);
+        let lo = DVec3::new(lo.x, lo.y, f64::from(height_m[0])) - run.camera_grid_m;
+        let hi = DVec3::new(hi.x, hi.y, f64::from(height_m[1])) - run.camera_grid_m;
+        let nearest = DVec3::ZERO.clamp(lo, hi).length();
+        let farthest = lo.abs().max(hi.abs()).length();
+        let radial = s.tlm.radial_lod_m.iter().position(|&t| nearest < t).unwrap_or(3) as u32;
+        let hlod = |d: f64| run.lods.range_m.iter().position(|&range| d <= range).unwrap_or(0) as u32;
+        let tlod = |d: f64| {
+            imagery.map_or(0, |m| {
+                let level = (mpp * d / m.texel_m).log2() + s.imagery.lod_bias;
+                level.floor().clamp(0.0, f64::from(m.pyramid.levels - 1)) as u32
+            })
+        };
+        let ambiguous = s.tlm.radial_lod_m.iter().any(|&t| near(nearest, t))
+            || run.lods.range_m.iter().any(|&t| near(nearest, t) || near(farthest, t))
+            || imagery.is_some_and(|m| {
+                [nearest, farthest].iter().any(|&d| {
+                    let level = (mpp * d / m.texel_m).log2() + s.imagery.lod_bias;
+                    (level - level.round()).abs() < 1e-3
+                })
+            });
+        if ambiguous {
+            continue;
+        }
+        assert_eq!(cell.radial_lod, radial, "{what}: radial LOD of {:?} at {nearest:.1} m", (ring, cx, cy));
+        assert_eq!(
+            cell.height_lod,
+            hlod(nearest) | hlod(farthest) << 8,
+            "{what}: height LOD of {:?}",
+            (ring, cx, cy)
+        );
+        let imagery_lod = if imagery.is_some() { tlod(nearest) | tlod(farthest) << 8 } else { 0 };
+        assert_eq!(cell.imagery_lod, imagery_lod, "{what}: imagery LOD of {:?}", (ring, cx, cy));
+        if ring == 0 {
+            let g = run.layout.global_address(ring, cx, cy);
+            let pattern = pattern_hash(g.x as i32 as u32, g.y as i32 as u32, s.tlm.seed) % s.tlm.patterns;
+            assert_eq!(cell.visibility, 1 + pattern, "{what}: pattern of {g:?}");
+        } else {
+            assert_eq!(cell.visibility, 1);
+        }
+        checked += 1;
+    }
+    assert!(checked > 0 || visible(&run.gpu) == 0, "{what}: nothing checked");
+}
+
+/// Tight height ranges per height tile (what `Dataset::height_range` is to give): the level-0
+/// samples under the tile and one sample of its level beyond each edge, which meshes of that
+/// level interpolate across.
+fn tight_tile_ranges(dataset: &Dataset) -> Vec<[f32; 2]> {
+    let p = dataset.height.pyramid;
+    let ([nx, ny], cells) = (p.size, HEIGHT_TILE_CELLS);
+    let tiles = p.tiles_at(0);
+    let level0: Vec<Vec<f32>> = (0..tiles[0] * tiles[1])
+        .map(|i| dataset.height_tile(TileId::new(0, i % tiles[0], i / tiles[0])).unwrap().to_vec())
+        .collect();
+    let extent = p.tile_extent();
+    let sample = |x: u32, y: u32| {
+        let (tx, ty) = ((x / cells).min(tiles[0] - 1), (y / cells).min(tiles[1] - 1));
+        let (lx, ly) = (x - tx * cells + p.border, y - ty * cells + p.border);
+        level0[(ty * tiles[0] + tx) as usize][(ly * extent + lx) as usize]
+    };
+    p.tiles()
+        .map(|id| {
+            let step = 1u32 << id.level;
+            let span = |t: u32, n: u32| {
+                (t * cells * step).saturating_sub(step)..=((t + 1) * cells * step + step).min(n - 1)
+            };
+            let mut range = [f32::MAX, f32::MIN];
+            for y in span(id.y, ny) {
+                for x in span(id.x, nx) {
+                    let h = sample(x, y);
+                    range = [range[0].min(h), range[1].max(h)];
+                }
+            }
+            range
+        })
+        .collect()
+}
+
+/// Grid position of the highest sample of a coarse level, with its height.
+fn peak(r: &Renderer) -> DVec3 {
+    let pyramid = r.dataset.height.pyramid;
+    let level = pyramid.levels.saturating_sub(1).min(2);
+    let [nx, ny] = pyramid.size_at(level);
+    let spacing = r.dataset.manifest.height.spacing_m * f64::from(1u32 << level);
+    let mut best = DVec3::new(0.0, 0.0, f64::MIN);
+    for y in 0..ny {
+        for x in 0..nx {
+            let z = r.dataset.height_sample(level, x, y).unwrap();
+            if z > best.z {
+                best = DVec3::new(f64::from(x) * spacing, f64::from(y) * spacing, z);
+            }
+        }
+    }
+    best
+}
+
+fn camera_at(r: &Renderer, grid_m: DVec3, yaw_deg: f64, pitch_deg: f64) -> Camera {
+    let o = r.dataset.manifest.origin_m;
+    Camera {
+        position_m: grid_m + DVec3::new(o[0], o[1], 0.0),
+        yaw_deg,
+        pitch_deg,
+        fov_deg: 60.0,
+        near_m: 0.1,
+    }
+}
+
+fn ground(r: &Renderer, x: f64, y: f64) -> f64 {
+    r.dataset.height_at(x, y, 0).unwrap()
+}
+
+#[test]
+fn gpu_equals_twin_and_never_culls_what_is_on_screen() {
+    let dataset = synth_dataset(600, 3);
+    let mut settings = small_settings(160, 96);
+    settings.tlm = tlm_settings(64.0, 16);
+    let mut r = renderer(&dataset, settings);
+    let ranges = tight_tile_ranges(&r.dataset);
+    let [w, h] = r.dataset.manifest.extent_m();
+    let (cx, cy) = (0.5 * w, 0.5 * h);
+    let top = peak(&r);
+    // Low, 2.5 km from the peak, looking at it: its flanks hide the ground behind.
+    let foot = DVec3::new(top.x - 2500.0, top.y - 1200.0, 0.0);
+    let foot = DVec3::new(foot.x.clamp(50.0, w - 50.0), foot.y.clamp(50.0, h - 50.0), 0.0);
+    let to_peak = top - foot;
+    let yaw = to_peak.x.atan2(to_peak.y).to_degrees();
+    let cameras = [
+        ("high oblique", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 2500.0), 30.0, -35.0)),
+        ("low grazing", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 3.0), 200.0, -2.0)),
+        ("mountain", camera_at(&r, DVec3::new(foot.x, foot.y, ground(&r, foot.x, foot.y) + 5.0), yaw, 2.0)),
+        ("outside looking in", camera_at(&r, DVec3::new(-2000.0, -1500.0, top.z + 600.0), 50.0, -12.0)),
+        ("sky", camera_at(&r, DVec3::new(cx, cy, top.z + 30.0), 80.0, 40.0)),
+        ("low, up the slopes", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 20.0), 80.0, 25.0)),
+        ("straight down", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 800.0), 0.0, -90.0)),
+    ];
+    for (what, camera) in &cameras {
+        let run = run(&mut r, camera, &ranges);
+        assert_gpu_equals_twin(&run, what);
+        assert_no_false_culls(&r, &run, what);
+        assert_levels_match_f64(&r, &run, camera, what);
+        let culled_by_depth = {
+            let clear = HizMips {
+                levels: run.hiz.levels.iter().map(|l| vec![0.0; l.len()]).collect(),
+                ..run.hiz.clone()
+            };
+            visible(&tile_load_map(&run.frame.uniforms, &run.frame.spans, &run.ranges, &clear))
+                - visible(&run.gpu)
+        };
+        println!(
+            "{what}: {} rings, {} visible of {} cells, {culled_by_depth} occluded",
+            run.layout.rings,
+            visible(&run.gpu),
+            run.gpu.len()
+        );
+        match *what {
+            "sky" => assert_eq!(visible(&run.gpu), 0, "{what}: above the highest peak, looking up"),
+            "low, up the slopes" => {}
+            _ => assert!(visible(&run.gpu) > 0, "{what}: nothing visible"),
+        }
+        if *what == "outside looking in" {
+            assert!(run.layout.rings > 1);
+        }
+    }
+}
+
+/// A wall of depth 600 m away over the whole screen: cells beyond it (and the tolerance) go,
+/// cells before it stay, on the GPU as in the twin.
+#[test]
+fn cells_behind_a_wall_are_occluded() {
+    let dataset = synth_dataset(600, 3);
+    let mut settings = small_settings(160, 96);
+    settings.tlm = tlm_settings(64.0, 16);
+    let mut r = renderer(&dataset, settings);
+    let ranges = tight_tile_ranges(&r.dataset);
+    let [w, h] = r.dataset.manifest.extent_m();
+    let camera = camera_at(&r, DVec3::new(0.5 * w, 0.3 * h, ground(&r, 0.5 * w, 0.3 * h) + 60.0), 10.0, -6.0);
+    let (wall_m, tolerance_m) = (600.0, r.settings.tlm.occlusion_tolerance_m);
+    let open = run(&mut r, &camera, &ranges);
+    let walled = run_with(&mut r, &camera, &ranges, Some(wall_m));
+    assert_gpu_equals_twin(&walled, "wall");
+    let (mut kept, mut hidden) = (0, 0);
+    for (i, (before, after)) in
+        open.gpu.iter().zip(&walled.gpu).enumerate().filter(|(_, (b, _))| b.visibility != 0)
+    {
+        // The box's nearest view depth (w), in f64: where it is clearly before or behind the wall,
+        // the pass must agree.
+        let (ring, cx, cy) = walled.layout.cell_of(i);
+        let (min, max) = walled.layout.cell_rect_m(ring, cx, cy);
+        let z = cell_height_range(&walled, ring, cx, cy);
+        let nearest_w = (0..8)
+            .map(|c: u32| {
+                let p = DVec3::new(
+                    if c & 1 != 0 { max[0].min(walled.layout.dataset_max_m[0]) } else { min[0].max(0.0) },
+                    if c & 2 != 0 { max[1].min(walled.layout.dataset_max_m[1]) } else { min[1].max(0.0) },
+                    f64::from(z[usize::from(c & 4 != 0)]),
+                ) - walled.camera_grid_m;
+                (walled.clip * p.extend(1.0)).w
+            })
+            .fold(f64::INFINITY, f64::min);
+        if nearest_w < wall_m + tolerance_m - 1.0 {
+            assert_eq!(after, before, "cell {:?} before the wall", (ring, cx, cy));
+            kept += 1;
+        } else if nearest_w > wall_m + tolerance_m + 1.0 {
+            assert_eq!(after.visibility, 0, "cell {:?} behind the wall", (ring, cx, cy));
+            hidden += 1;
+        }
+    }
+    println!("wall: {kept} kept, {hidden} hidden");
+    assert!(kept > 0 && hidden > 0);
+}
+
+#[test]
+fn default_settings_one_ring_over_a_small_dataset() {
+    let dataset = synth_dataset(300, 7);
+    let mut r = renderer(&dataset, small_settings(160, 96));
+    let [w, h] = r.dataset.manifest.extent_m();
+    let camera =
+        camera_at(&r, DVec3::new(0.3 * w, 0.4 * h, ground(&r, 0.3 * w, 0.4 * h) + 150.0), 60.0, -15.0);
+    let ranges = height_tile_ranges(&r.dataset);
+    let run = run(&mut r, &camera, &ranges);
+    assert_eq!(run.layout.rings, 1, "a 3 km dataset fits in ring 0 (16 km)");
+    assert_gpu_equals_twin(&run, "defaults");
+    assert_no_false_culls(&r, &run, "defaults");
+    assert_levels_match_f64(&r, &run, &camera, "defaults");
+}
+
+#[test]
+fn rings_cover_the_dataset_and_nest_exactly() {
+    let settings = tlm_settings(50.0, 10);
+    let dataset = ([0.0, 0.0], [4990.0, 3000.0]);
+    for camera in [[2500.0, 1500.0], [10.0, 2999.0], [-3000.0, 8000.0], [4990.0, -0.5], [1.0e7, -3.0e6]] {
+        let layout = TlmLayout::new(&settings, dataset, camera);
+        let last = layout.rings - 1;
+        let (o, c) = (layout.ring_origin_m(last), layout.ring_cell_m(last));
+        let covers = (0..2).all(|a| o[a] <= dataset.0[a] && o[a] + 10.0 * c >= dataset.1[a]);
+        assert!(covers || layout.rings == settings.max_rings, "{camera:?}");
+        for ring in 0..layout.rings {
+            assert!(layout.origin_cell[ring as usize].iter().all(|g| g % 2 == 0));
+            // The camera is within a cell of the ring's centre.
+            let centre = (0..2).map(|a| layout.ring_origin_m(ring)[a] + 5.0 * layout.ring_cell_m(ring));
+            assert!(centre.zip(camera).all(|(m, v)| (m - v).abs() <= layout.ring_cell_m(ring)), "{camera:?}");
+            if ring == 0 {
+                continue;
+            }
+            // Ring k − 1's square is exactly the union of ring k's covered cells.
+            let (inner_min, inner_c) = (layout.ring_origin_m(ring - 1), layout.ring_cell_m(ring - 1));
+            let inner_max = inner_min.map(|v| v + 10.0 * inner_c);
+            for cy in 0..10 {
+                for cx in 0..10 {
+                    let (min, max) = layout.cell_rect_m(ring, cx, cy);
+                    let inside = (0..2).all(|a| min[a] >= inner_min[a] && max[a] <= inner_max[a]);
+                    let outside = (0..2).any(|a| min[a] >= inner_max[a] || max[a] <= inner_min[a]);
+                    assert!(inside || outside, "cell straddles the inner ring");
+                    assert_eq!(layout.is_covered(ring, cx, cy), inside);
+                }
+            }
+        }
+        // Every point of the dataset lies in exactly one uncovered cell (when the rings reach it).
+        for i in 0..40 {
+            let p = [
+                dataset.1[0] * f64::from(i) / 39.0 * 0.999 + 0.7,
+                dataset.1[1] * f64::from(i * 7 % 40) / 40.0,
+            ];
+            let Some((ring, cx, cy)) = layout.locate(p) else { continue };
+            assert!(!layout.is_covered(ring, cx, cy));
+            let (min, max) = layout.cell_rect_m(ring, cx, cy);
+            assert!((0..2).all(|a| min[a] <= p[a] && p[a] < max[a]));
+        }
+    }
+}
+
+#[test]
+fn snapping_moves_rings_two_cells_at_a_time() {
+    let settings = tlm_settings(64.0, 16);
+    let dataset = ([0.0, 0.0], [6000.0, 6000.0]);
+    let mut previous = TlmLayout::new(&settings, dataset, [3000.0, 3000.0]);
+    let mut unchanged = 0;
+    for step in 1..400 {
+        // Less than a cell each step, diagonally.
+        let camera = [3000.0 + 13.7 * f64::from(step), 3000.0 + 5.3 * f64::from(step)];
+        let layout = TlmLayout::new(&settings, dataset, camera);
+        for (now, before) in layout.origin_cell.iter().zip(&previous.origin_cell) {
+            for a in 0..2 {
+                assert!([0, 2].contains(&(now[a] - before[a])), "{step}: {now:?} after {before:?}");
+            }
+        }
+        unchanged += usize::from(layout.origin_cell[0] == previous.origin_cell[0]);
+        // A global address names the same square of ground whatever the ring's position.
+        let (min, _) = layout.cell_rect_m(1, 3, 4);
+        let g = layout.global_address(1, 3, 4);
+        assert_eq!(min, [g.x as f64 * 128.0, g.y as f64 * 128.0]);
+        previous = layout;
+    }
+    // Ring 0 re-snaps when the camera crosses a line every 2 cells (128 m): about one step in 9
+    // along x (13.7 m steps) and one in 24 along y.
+    assert!(unchanged > 300, "ring 0 must stay put while the camera moves within its snap interval");
+}
+
+#[test]
+fn tlm_settings_are_checked_and_named() {
+    let with = |text: &str| Settings::from_layers(&[("test.toml".into(), text.into())]);
+    let defaults = Settings::default().tlm;
+    assert_eq!((defaults.cell_m, defaults.cells, defaults.max_rings, defaults.patterns), (256.0, 64, 12, 16));
+    assert_eq!(defaults.radial_lod_m, [700.0, 1400.0, 3000.0]);
+    for (text, key) in [
+        ("[tlm]\ncells = 63\n", "tlm.cells"),
+        ("[tlm]\nmax_rings = 17\n", "tlm.max_rings"),
+        ("[tlm]\npatterns = 256\n", "tlm.patterns"),
+        ("[tlm]\nradial_lod_m = [700.0, 300.0, 3000.0]\n", "tlm.radial_lod_m"),
+        ("[tlm]\ncell_m = 0\n", "tlm.cell_m"),
+    ] {
+        let error = with(text).unwrap_err().to_string();
+        assert!(error.contains(key), "{error}");
+    }
+    assert_eq!(with("[tlm]\ncells = 32\n").unwrap().tlm.cells, 32);
+}
+
+#[test]
+fn pattern_hash_is_deterministic_and_spread_over_every_pattern() {
+    let patterns = 16;
+    let mut counts = vec![0u32; patterns as usize];
+    for y in -64i32..64 {
+        for x in -64i32..64 {
+            let p = pattern_hash(x as u32, y as u32, 1) % patterns;
+            assert_eq!(p, pattern_hash(x as u32, y as u32, 1) % patterns);
+            counts[p as usize] += 1;
+        }
+    }
+    let mean = 128.0 * 128.0 / f64::from(patterns);
+    assert!(counts.iter().all(|&c| (f64::from(c) - mean).abs() < 0.2 * mean), "{counts:?}");
+    // Another germ, another assignment.
+    let moved =
+        (0..256u32).filter(|&x| pattern_hash(x, 7, 1) % patterns != pattern_hash(x, 7, 2) % patterns).count();
+    assert!(moved > 200);
+}
+
+#[test]
+fn depth_pyramid_equals_a_cpu_min_reduction_at_odd_sizes() {
+    let dataset = synth_dataset(300, 7);
+    for (w, h) in [(157, 93), (33, 7), (1, 5)] {
+        let mut r = renderer(&dataset, small_settings(w, h));
+        let [ew, eh] = r.dataset.manifest.extent_m();
+        let camera =
+            camera_at(&r, DVec3::new(0.5 * ew, 0.5 * eh, ground(&r, 0.5 * ew, 0.5 * eh) + 120.0), 20.0, -8.0);
+        r.render(&camera).unwrap();
+        let hiz = DepthPyramid::new(&r.gpu.device, w, h);
+        let mut encoder = r.gpu.device.create_command_encoder(&Default::default());
+        hiz.encode(&mut encoder, &r.depth_texture().create_view(&Default::default()));
+        r.gpu.queue.submit([encoder.finish()]);
+        let gpu_mips = hiz.read_back(&r.gpu).unwrap();
+        let cpu_mips = HizMips::from_depth(&r.read_depth().unwrap(), w, h);
+        assert_eq!(gpu_mips.sizes, cpu_mips.sizes);
+        assert_eq!(gpu_mips.sizes.last(), Some(&[1, 1]));
+        assert!(gpu_mips == cpu_mips, "{w}×{h}: GPU and CPU pyramids differ");
+        // Conservative: the top texel is the farthest depth of the whole frame.
+        let depth = r.read_depth().unwrap();
+        assert_eq!(gpu_mips.levels.last().unwrap()[0], depth.iter().copied().fold(f32::INFINITY, f32::min));
+    }
+}
+
+#[test]
+fn readback_ring_never_waits_and_delivers_frames_in_order() {
+    let gpu = gpu();
+    let source = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("source"),
+        size: 1024,
+        usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut ring = ReadbackRing::new(&gpu.device, "test", 1024, 3);
+    let mut taken = Vec::new();
+    let mut slowest = Duration::ZERO;
+    // Five frames without reading: three fit, two are skipped.
+    for frame in 0..5u64 {
+        gpu.queue.write_buffer(&source, 0, bytemuck::cast_slice(&[frame as u32; 256]));
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let copied = ring.encode_copy(&mut encoder, &source, 1024, frame);
+        assert_eq!(copied, frame < 3);
+        gpu.queue.submit([encoder.finish()]);
+        ring.submitted();
+    }
+    assert_eq!((ring.skipped(), ring.in_flight()), (2, 3));
+    // Then a frame loop that reads what has arrived, never waiting.
+    for frame in 5..40u64 {
+        gpu.queue.write_buffer(&source, 0, bytemuck::cast_slice(&[frame as u32; 256]));
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        ring.encode_copy(&mut encoder, &source, 1024, frame);
+        gpu.queue.submit([encoder.finish()]);
+        ring.submitted();
+        let start = Instant::now();
+        while let Some(readback) = ring.try_take(&gpu.device).unwrap() {
+            taken.push(readback);
+        }
+        slowest = slowest.max(start.elapsed());
+    }
+    gpu.wait().unwrap();
+    while let Some(readback) = ring.try_take(&gpu.device).unwrap() {
+        taken.push(readback);
+    }
+    assert_eq!(ring.in_flight(), 0);
+    assert_eq!(taken.len() as u64 + ring.skipped(), 40);
+    assert!(taken.windows(2).all(|w| w[0].frame < w[1].frame), "frames out of order");
+    for readback in &taken {
+        assert!(
+            readback.cast::<u32>().iter().all(|&v| u64::from(v) == readback.frame),
+            "frame {}",
+            readback.frame
+        );
+    }
+    assert!(slowest < Duration::from_millis(500), "try_take took {slowest:?}");
+}
+
+/// The figure for the report: TLM and Hi-Z GPU times at 1280×720 with default settings, and the
+/// twin's CPU time. `cargo test --release --test tile_load_map -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timings_at_1280x720() {
+    let dataset = synth_dataset(1024, 5);
+    let mut r = renderer(&dataset, Settings::default());
+    let [w, h] = r.dataset.manifest.extent_m();
+    let ranges = tight_tile_ranges(&r.dataset);
+    let near = camera_at(&r, DVec3::new(0.2 * w, 0.2 * h, ground(&r, 0.2 * w, 0.2 * h) + 300.0), 45.0, -12.0);
+    // 40 km south-west of the dataset: four rings to reach it.
+    let far = camera_at(&r, DVec3::new(-40_000.0, -40_000.0, 3000.0), 45.0, -3.0);
+    for camera in [near, far] {
+        let warm = run(&mut r, &camera, &ranges);
+        assert_gpu_equals_twin(&warm, "timing");
+        let s = r.settings.clone();
+        let device = &r.gpu.device;
+        let hiz = DepthPyramid::new(device, s.render.width, s.render.height);
+        let pass = TileLoadMapPass::new(device, &s);
+        let bindings = pass.bind_group(device, &warm.ranges, &hiz);
+        let imagery = r.dataset.manifest.imagery.as_ref().map(|i| TlmImagery {
+            texel_m: i.texel_m,
+            levels: i.pyramid.levels,
+            lod_bias: s.imagery.lod_bias,
+        });
+        let inputs = TlmInputs {
+            settings: &s.tlm,
+            layout: &warm.layout,
+            camera: &camera,
+            camera_grid_m: warm.camera_grid_m,
+            viewport_px: [s.render.width, s.render.height],
+            lods: &warm.lods,
+            imagery,
+            hiz_mips: hiz.mips(),
+        };
+        let prepare_start = Instant::now();
+        pass.prepare(&r.gpu.queue, &inputs).unwrap();
+        let prepare_ms = prepare_start.elapsed().as_secs_f64() * 1000.0;
+        let mut profiler = Profiler::new(&r.gpu, true);
+        let depth = r.depth_texture().create_view(&Default::default());
+        let mut frames = Vec::new();
+        for _ in 0..12 {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            profiler.pass(&r.gpu, &mut encoder, "hiz", |e| hiz.encode(e, &depth)).unwrap();
+            profiler.pass(&r.gpu, &mut encoder, "tlm", |e| pass.encode(e, &bindings, &warm.frame)).unwrap();
+            profiler.resolve(&mut encoder);
+            r.gpu.queue.submit([encoder.finish()]);
+            profiler.end_frame();
+            r.gpu.wait().unwrap();
+            frames.extend(std::iter::from_fn(|| profiler.finished_frame(&r.gpu)));
+        }
+        frames.extend(profiler.drain(&r.gpu).unwrap());
+        println!(
+            "{} rings × {}² cells, {} visible; prepare (layout, uniforms, spans) {prepare_ms:.3} ms",
+            warm.layout.rings,
+            warm.layout.cells,
+            visible(&warm.gpu)
+        );
+        for label in ["hiz", "tlm"] {
+            let mut ms: Vec<f64> =
+                frames.iter().flatten().filter(|t| t.label == label).map(|t| t.ms).collect();
+            ms.sort_by(f64::total_cmp);
+            let source = frames.iter().flatten().find(|t| t.label == label).map(|t| t.source);
+            println!("  {label}: median {:.3} ms over {} frames ({source:?})", ms[ms.len() / 2], ms.len());
+            assert!(source.is_some_and(|s| s != TimeSource::Cpu));
+        }
+        let mut twin_ms: Vec<f64> = (0..5)
+            .map(|_| {
+                let start = Instant::now();
+                std::hint::black_box(tile_load_map(
+                    &warm.frame.uniforms,
+                    &warm.frame.spans,
+                    &warm.ranges,
+                    &warm.hiz,
+                ));
+                start.elapsed().as_secs_f64() * 1000.0
+            })
+            .collect();
+        twin_ms.sort_by(f64::total_cmp);
+        println!("  twin (CPU, one thread): median {:.3} ms", twin_ms[2]);
+    }
+}
