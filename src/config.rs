@@ -100,6 +100,7 @@ impl ImagerySettings {
 pub struct CacheSettings {
     pub height_slots: u32,
     pub imagery_slots: u32,
+    pub landcover_slots: u32,
     pub loader_threads: u32,
     pub upload_tiles_per_frame: u32,
     pub upload_bytes_per_frame: u64,
@@ -249,7 +250,9 @@ impl Settings {
                 "0 (automatic) or 1 to 16",
             ),
             (
-                self.cache.height_slots >= 16 && self.cache.imagery_slots >= 16,
+                self.cache.height_slots >= 16
+                    && self.cache.imagery_slots >= 16
+                    && self.cache.landcover_slots >= 16,
                 "cache",
                 format!("{:?}", self.cache),
                 "at least 16 slots per cache (the coarse levels are pinned)",

@@ -3,6 +3,7 @@
 //! the mechanics live in the pass and streaming modules. Nothing in a frame waits for the disk:
 //! tiles stream in over the following frames, and until they do their ancestors stand in.
 
+use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -14,9 +15,15 @@ use crate::config::Settings;
 use crate::dataset::{Dataset, IMAGERY_MIPS, LayerSpec, PackError, TileId};
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback::read_texture;
+use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
+use crate::passes::depth_pyramid::DepthPyramid;
+use crate::passes::tile_load_map::{
+    TileLoadMapPass, TlmBindings, TlmError, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges,
+};
 use crate::shaders::MAX_LEVELS;
-use crate::streaming::wants::{after_pinned, height_tiles, imagery_tiles, pinned_tiles};
+use crate::streaming::analysis::{LoadMaps, analyse};
+use crate::streaming::wants::{after_pinned, height_tiles, pinned_tiles};
 use crate::streaming::{CacheStats, LayerKind, Loader, LoaderError, TileCache, UploadBudget};
 use crate::terrain::select::{Lods, NodeBounds, select};
 use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, TerrainPass, node_batches};
@@ -39,6 +46,8 @@ pub enum RenderError {
     TooManyLevels { levels: u32 },
     #[error(transparent)]
     Loader(#[from] LoaderError),
+    #[error(transparent)]
+    Tlm(#[from] TlmError),
 }
 
 /// What one frame did, for logs and tests.
@@ -50,6 +59,14 @@ pub struct FrameReport {
     pub nodes_dropped: usize,
     pub height: CacheStats,
     pub imagery: CacheStats,
+    pub landcover: CacheStats,
+    /// The frame whose Tile Load Map drove this frame's streaming (`None` before the first one
+    /// arrives), its visible cells and the seed patterns it uses.
+    pub tlm_frame: Option<u64>,
+    pub tlm_visible_cells: usize,
+    pub tlm_patterns: usize,
+    /// TLM readbacks skipped so far because every staging buffer was still in flight.
+    pub tlm_readbacks_skipped: u64,
 }
 
 pub struct Renderer {
@@ -63,7 +80,16 @@ pub struct Renderer {
     /// The coarsest tiles of each layer, resident from the first frame on and never evicted.
     pinned_heights: Vec<TileId>,
     pinned_imagery: Vec<TileId>,
+    landcover: Option<TileCache>,
     loader: Loader,
+    depth_pyramid: DepthPyramid,
+    tlm: TileLoadMapPass,
+    tlm_bindings: TlmBindings,
+    tlm_readback: ReadbackRing,
+    /// Layouts of the TLMs in flight, by frame: a TLM is read against its own frame's layout.
+    tlm_layouts: VecDeque<(u64, TlmLayout, DVec3)>,
+    /// The latest TLM's load maps; they drive the streaming of the next frames.
+    load_maps: Option<LoadMaps>,
     terrain_bindings: wgpu::BindGroup,
     bounds: NodeBounds,
     colour: wgpu::Texture,
@@ -127,7 +153,22 @@ impl Renderer {
             }
             None => Vec::new(),
         };
+        let landcover = dataset.landcover.as_ref().map(|layer| {
+            TileCache::new(
+                device,
+                "land-cover cache",
+                LayerKind::Landcover,
+                layer.pyramid,
+                1,
+                wgpu::TextureFormat::R8Uint,
+                settings.cache.landcover_slots,
+            )
+        });
         let loader = Loader::new(Arc::clone(&dataset), settings.cache.loader_threads as usize)?;
+        let depth_pyramid = DepthPyramid::new(device, settings.render.width, settings.render.height);
+        let tlm = TileLoadMapPass::new(device, &settings);
+        let tlm_bindings = tlm.bind_group(device, &height_tile_ranges(&dataset), &depth_pyramid);
+        let tlm_readback = ReadbackRing::new(device, "tile load map", tlm.capacity_bytes(), DEFAULT_SLOTS);
         let terrain_bindings = terrain.bind_group(device, &heights, &imagery);
         let target = |label, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
@@ -163,7 +204,14 @@ impl Renderer {
             imagery,
             pinned_heights,
             pinned_imagery,
+            landcover,
             loader,
+            depth_pyramid,
+            tlm,
+            tlm_bindings,
+            tlm_readback,
+            tlm_layouts: VecDeque::new(),
+            load_maps: None,
             terrain_bindings,
             bounds,
             colour,
@@ -211,35 +259,64 @@ impl Renderer {
             })
         });
 
-        // Streaming: ask for what this view needs, upload what arrived, within the frame's budget.
-        let wanted_heights = after_pinned(&self.pinned_heights, height_tiles(&lods, &selected));
-        let wanted_imagery = after_pinned(
-            &self.pinned_imagery,
-            imagery_tiles(
-                &self.dataset,
-                &lods,
-                &selected,
-                camera,
-                camera_grid_m,
-                height,
-                self.settings.imagery.lod_bias,
-            ),
+        // Streaming: the terrain's own height tiles first, then what the latest Tile Load Map
+        // asks for; upload what arrived, within the frame's budget.
+        let maps = self.load_maps.take();
+        report.tlm_frame = maps.as_ref().map(|m| m.frame);
+        let maps = maps.unwrap_or_default();
+        let mut selected_heights = height_tiles(&lods, &selected);
+        selected_heights.extend(
+            maps.heights.iter().filter(|id| !selected_heights.contains(id)).copied().collect::<Vec<_>>(),
         );
+        let wanted_heights = after_pinned(&self.pinned_heights, selected_heights);
+        let wanted_imagery = after_pinned(&self.pinned_imagery, maps.ground.clone());
         let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
-        let (heights, imagery, loader) = (&mut self.heights, &mut self.imagery, &self.loader);
-        let has_imagery = self.dataset.imagery.is_some();
-        (report.height, report.imagery) = self.profiler.cpu("streaming", || {
+        let (heights, imagery, landcover) = (&mut self.heights, &mut self.imagery, &mut self.landcover);
+        let (loader, has_imagery) = (&self.loader, self.dataset.imagery.is_some());
+        let stats = self.profiler.cpu("streaming", || {
             let mut requests = heights.set_wanted(&wanted_heights, frame);
             if has_imagery {
                 requests.extend(imagery.set_wanted(&wanted_imagery, frame));
             }
+            if let Some(landcover) = landcover.as_mut() {
+                requests.extend(landcover.set_wanted(&maps.classification, frame));
+            }
             // Every frame, even with nothing new: it also cancels what is no longer wanted.
             loader.submit(&requests);
             let loaded = loader.try_recv_all();
-            let imagery_stats =
-                if has_imagery { imagery.upload(queue, &loaded, budget) } else { CacheStats::default() };
-            (heights.upload(queue, &loaded, budget), imagery_stats)
+            let uploads = |cache: &mut TileCache| cache.upload(queue, &loaded, budget);
+            [
+                uploads(heights),
+                if has_imagery { uploads(imagery) } else { CacheStats::default() },
+                landcover.as_mut().map(uploads).unwrap_or_default(),
+            ]
         });
+        [report.height, report.imagery, report.landcover] = stats;
+        report.tlm_visible_cells = maps.visible_cells;
+        report.tlm_patterns = maps.patterns.len();
+        self.load_maps = Some(maps);
+
+        // This frame's Tile Load Map, over rings centred on the camera.
+        let dataset_rect =
+            TlmLayout::dataset_rect_m(&self.dataset.height.pyramid, self.dataset.manifest.height.spacing_m);
+        let layout = TlmLayout::new(&self.settings.tlm, dataset_rect, [camera_grid_m.x, camera_grid_m.y]);
+        let tlm_frame = self.tlm.prepare(
+            &self.gpu.queue,
+            &TlmInputs {
+                settings: &self.settings.tlm,
+                layout: &layout,
+                camera,
+                camera_grid_m,
+                viewport_px: [width, height],
+                lods: &lods,
+                imagery: self.dataset.manifest.imagery.as_ref().map(|i| TlmImagery {
+                    texel_m: i.texel_m,
+                    levels: i.pyramid.levels,
+                    lod_bias: self.settings.imagery.lod_bias,
+                }),
+                hiz_mips: self.depth_pyramid.mips(),
+            },
+        )?;
 
         // Instances: each node over its own height tile, or its finest resident ancestor.
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
@@ -258,16 +335,53 @@ impl Renderer {
         self.profiler.pass(&self.gpu, &mut encoder, "terrain", |encoder| {
             self.terrain.encode(encoder, &self.terrain_bindings, &colour, &depth, SKY_LINEAR, &prepared)
         })?;
+        // Depth pyramid: the occluders the Tile Load Map culls against, at every scale.
+        self.profiler.pass(&self.gpu, &mut encoder, "depth_pyramid", |encoder| {
+            self.depth_pyramid.encode(encoder, &depth)
+        })?;
+        // Tile Load Map: which tiles at which levels the view needs, and the seed patterns.
+        self.profiler.pass(&self.gpu, &mut encoder, "tile_load_map", |encoder| {
+            self.tlm.encode(encoder, &self.tlm_bindings, &tlm_frame)
+        })?;
+        // Read back a frame or two late, never waiting (recorded after the last timed pass: the
+        // CPU-timing fallback submits each pass's encoder on its own).
+        if self.tlm_readback.encode_copy(
+            &mut encoder,
+            self.tlm.output(),
+            tlm_frame.output_bytes(),
+            self.frame,
+        ) {
+            self.tlm_layouts.push_back((self.frame, layout, camera_grid_m));
+        }
         self.profiler.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
+        self.tlm_readback.submitted();
         self.profiler.end_frame();
         self.gpu.device.poll(wgpu::PollType::Poll).map_err(GpuError::from)?;
+        self.analyse_arrived_tlms()?;
         while let Some(timings) = self.profiler.finished_frame(&self.gpu) {
             self.last_timings = timings;
         }
         self.gpu.check()?;
         self.frame += 1;
         Ok(report)
+    }
+
+    /// Turns every TLM that has arrived into load maps, keeping the newest.
+    fn analyse_arrived_tlms(&mut self) -> Result<(), RenderError> {
+        while let Some(readback) = self.tlm_readback.try_take(&self.gpu.device)? {
+            // Layouts of skipped or older frames are dropped on the way to this one's.
+            while self.tlm_layouts.front().is_some_and(|(frame, ..)| *frame < readback.frame) {
+                self.tlm_layouts.pop_front();
+            }
+            let Some((frame, layout, camera_grid_m)) = self.tlm_layouts.pop_front() else { continue };
+            let cells = readback.cast();
+            let dataset = &self.dataset;
+            let maps =
+                self.profiler.cpu("tlm_analysis", || analyse(frame, &layout, &cells, camera_grid_m, dataset));
+            self.load_maps = Some(maps);
+        }
+        Ok(())
     }
 
     fn uniforms(&self, camera_grid_m: DVec3, clip: glam::Mat4) -> TerrainUniforms {
@@ -320,7 +434,14 @@ impl Renderer {
         let done = |s: &CacheStats, cache: &TileCache| {
             s.needed_resident + s.failed >= s.needed.min(cache.capacity()) && s.staged == 0
         };
-        done(&report.height, &self.heights) && done(&report.imagery, &self.imagery) && self.loader.is_idle()
+        let landcover = match &self.landcover {
+            Some(cache) => done(&report.landcover, cache),
+            None => true,
+        };
+        done(&report.height, &self.heights)
+            && done(&report.imagery, &self.imagery)
+            && landcover
+            && self.loader.is_idle()
     }
 
     /// Renders `camera` frame after frame until everything it needs is resident (at most
@@ -331,11 +452,14 @@ impl Renderer {
         camera: &Camera,
         max_frames: u32,
     ) -> Result<(FrameReport, u32), RenderError> {
+        let first = self.frame;
         let mut frames = 0;
         loop {
             let report = self.render(camera)?;
             frames += 1;
-            if self.is_resolved(&report) || frames >= max_frames {
+            // Resolved only once a Tile Load Map of this very view has driven the streaming.
+            let informed = report.tlm_frame.is_some_and(|f| f >= first);
+            if (informed && self.is_resolved(&report)) || frames >= max_frames {
                 return Ok((report, frames));
             }
             // The loader threads are reading: give them the core rather than spin.

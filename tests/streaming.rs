@@ -13,8 +13,8 @@ use terramp::dataset::pack::{Pack, PackWriter};
 use terramp::dataset::{Dataset, IMAGERY_MIPS, Manifest, Pyramid, TileId};
 use terramp::gpu::Gpu;
 use terramp::streaming::{
-    CacheStats, Footprint, LayerKind, Loaded, Loader, LoaderError, TileCache, TileRequest, UploadBudget,
-    wanted_cell_tiles,
+    AreaWant, CacheStats, LayerKind, Loaded, Loader, LoaderError, TileCache, TileRequest, UploadBudget,
+    tiles_over,
 };
 
 fn open(dir: &Path) -> Arc<Dataset> {
@@ -370,8 +370,8 @@ fn camera_jump_converges_within_the_budget() {
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 16);
     let texel_m = dataset.manifest.imagery.as_ref().unwrap().texel_m;
     let view = |min: f64, max: f64| {
-        let f = Footprint { min_m: [min; 2], max_m: [max; 2], pixel_m: texel_m, distance_m: 10.0 };
-        wanted_cell_tiles(imagery.pyramid(), texel_m, 0.0, &[f])
+        let area = AreaWant { min_m: [min; 2], max_m: [max; 2], levels: [0, 0], distance_m: 10.0 };
+        tiles_over(imagery.pyramid(), texel_m * f64::from(imagery.pyramid().tile), &[area])
     };
     let (a, b) = (view(0.0, 2000.0), view(4000.0, 5900.0));
     assert!(a.len() <= 16 && b.len() <= 16 && a.iter().filter(|t| !b.contains(t)).count() >= 5);

@@ -4,6 +4,7 @@
 //! cache its wanted list, sends the resulting requests to the loader, and uploads what arrived
 //! within the frame's budget; see `TileCache::set_wanted`.
 
+pub mod analysis;
 pub mod cache;
 pub mod loader;
 mod residency;
@@ -11,4 +12,4 @@ pub mod wants;
 
 pub use cache::{CacheStats, TileCache, UploadBudget};
 pub use loader::{LayerKind, Loaded, Loader, LoaderError, TileRequest};
-pub use wants::{Footprint, wanted_cell_tiles};
+pub use wants::{AreaWant, tiles_over};
