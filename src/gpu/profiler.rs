@@ -48,7 +48,13 @@ impl Profiler {
         let timestamps = if use_timestamps && gpu.has_timestamps {
             GpuProfiler::new(
                 &gpu.device,
-                GpuProfilerSettings { max_num_pending_frames: MAX_PENDING_FRAMES, ..Default::default() },
+                GpuProfilerSettings {
+                    max_num_pending_frames: MAX_PENDING_FRAMES,
+                    // Debug groups only serve capture tools, and Mesa lavapipe 22.3 crashes in
+                    // vkCmdBeginDebugUtilsLabelEXT once compute passes share the encoder.
+                    enable_debug_groups: false,
+                    ..Default::default()
+                },
             )
             .ok()
         } else {
