@@ -18,6 +18,7 @@ use crate::gpu::readback::read_texture;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
 use crate::passes::depth_pyramid::DepthPyramid;
+use crate::passes::ground::GroundPass;
 use crate::passes::tile_load_map::{
     TileLoadMapPass, TlmBindings, TlmError, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges,
 };
@@ -26,10 +27,12 @@ use crate::streaming::analysis::{LoadMaps, analyse};
 use crate::streaming::wants::{after_pinned, height_tiles, pinned_tiles};
 use crate::streaming::{CacheStats, LayerKind, Loader, LoaderError, TileCache, UploadBudget};
 use crate::terrain::select::{Lods, NodeBounds, select};
-use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, TerrainPass, node_batches};
+use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass, node_batches};
 
-/// Tiles of the coarsest levels each cache keeps resident from the start, at most.
-const MAX_PINNED_TILES: usize = 64;
+/// Tiles of the coarsest levels each cache keeps resident from the start, at most: the three
+/// coarsest levels of a square layer (1 + 4 + 16), a fallback everywhere at a quarter of the
+/// finest pinned detail, for a few MiB.
+const MAX_PINNED_TILES: usize = 21;
 
 /// Linear-RGB colour of the sky, also the haze the distance fades into.
 const SKY_LINEAR: [f64; 3] = [0.42, 0.55, 0.75];
@@ -48,6 +51,8 @@ pub enum RenderError {
     Loader(#[from] LoaderError),
     #[error(transparent)]
     Tlm(#[from] TlmError),
+    #[error("the {layer} cache has {slots} slots; the whole layer is {tiles} tiles")]
+    DoesNotFit { layer: &'static str, tiles: u64, slots: usize },
 }
 
 /// What one frame did, for logs and tests.
@@ -75,6 +80,7 @@ pub struct Renderer {
     pub settings: Settings,
     pub profiler: Profiler,
     terrain: TerrainPass,
+    ground: GroundPass,
     heights: TileCache,
     imagery: TileCache,
     /// The coarsest tiles of each layer, resident from the first frame on and never evicted.
@@ -103,7 +109,9 @@ impl Renderer {
     pub fn new(gpu: Gpu, dataset: Dataset, settings: Settings) -> Result<Self, RenderError> {
         let dataset = Arc::new(dataset);
         let device = &gpu.device;
-        let terrain = TerrainPass::new(device, &settings, gpu.info.device_type == wgpu::DeviceType::Cpu);
+        let terrain = TerrainPass::new(device, &settings);
+        let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
+        let ground = GroundPass::new(device, &settings, software, &terrain);
         let heights = TileCache::new(
             device,
             "height cache",
@@ -169,7 +177,7 @@ impl Renderer {
         let tlm = TileLoadMapPass::new(device, &settings);
         let tlm_bindings = tlm.bind_group(device, &height_tile_ranges(&dataset), &depth_pyramid);
         let tlm_readback = ReadbackRing::new(device, "tile load map", tlm.capacity_bytes(), DEFAULT_SLOTS);
-        let terrain_bindings = terrain.bind_group(device, &heights, &imagery);
+        let terrain_bindings = terrain.bind_group(device, &heights, &imagery, ground.sampler());
         let target = |label, format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -200,6 +208,7 @@ impl Renderer {
             settings,
             profiler,
             terrain,
+            ground,
             heights,
             imagery,
             pinned_heights,
@@ -263,13 +272,14 @@ impl Renderer {
         // asks for; upload what arrived, within the frame's budget.
         let maps = self.load_maps.take();
         report.tlm_frame = maps.as_ref().map(|m| m.frame);
-        let maps = maps.unwrap_or_default();
+        let no_tlm_yet = LoadMaps::default();
+        let latest = maps.as_ref().unwrap_or(&no_tlm_yet);
         let mut selected_heights = height_tiles(&lods, &selected);
         selected_heights.extend(
-            maps.heights.iter().filter(|id| !selected_heights.contains(id)).copied().collect::<Vec<_>>(),
+            latest.heights.iter().filter(|id| !selected_heights.contains(id)).copied().collect::<Vec<_>>(),
         );
         let wanted_heights = after_pinned(&self.pinned_heights, selected_heights);
-        let wanted_imagery = after_pinned(&self.pinned_imagery, maps.ground.clone());
+        let wanted_imagery = after_pinned(&self.pinned_imagery, latest.ground.clone());
         let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
         let (heights, imagery, landcover) = (&mut self.heights, &mut self.imagery, &mut self.landcover);
         let (loader, has_imagery) = (&self.loader, self.dataset.imagery.is_some());
@@ -279,7 +289,7 @@ impl Renderer {
                 requests.extend(imagery.set_wanted(&wanted_imagery, frame));
             }
             if let Some(landcover) = landcover.as_mut() {
-                requests.extend(landcover.set_wanted(&maps.classification, frame));
+                requests.extend(landcover.set_wanted(&latest.classification, frame));
             }
             // Every frame, even with nothing new: it also cancels what is no longer wanted.
             loader.submit(&requests);
@@ -292,9 +302,9 @@ impl Renderer {
             ]
         });
         [report.height, report.imagery, report.landcover] = stats;
-        report.tlm_visible_cells = maps.visible_cells;
-        report.tlm_patterns = maps.patterns.len();
-        self.load_maps = Some(maps);
+        report.tlm_visible_cells = latest.visible_cells;
+        report.tlm_patterns = latest.patterns.len();
+        self.load_maps = maps;
 
         // This frame's Tile Load Map, over rings centred on the camera.
         let dataset_rect =
@@ -333,7 +343,7 @@ impl Renderer {
         let depth = self.depth.create_view(&Default::default());
         // Terrain and depth: the ground every later pass stands on and is occluded by.
         self.profiler.pass(&self.gpu, &mut encoder, "terrain", |encoder| {
-            self.terrain.encode(encoder, &self.terrain_bindings, &colour, &depth, SKY_LINEAR, &prepared)
+            self.terrain.encode(encoder, &self.terrain_bindings, &depth, &prepared)
         })?;
         // Depth pyramid: the occluders the Tile Load Map culls against, at every scale.
         self.profiler.pass(&self.gpu, &mut encoder, "depth_pyramid", |encoder| {
@@ -342,6 +352,11 @@ impl Renderer {
         // Tile Load Map: which tiles at which levels the view needs, and the seed patterns.
         self.profiler.pass(&self.gpu, &mut encoder, "tile_load_map", |encoder| {
             self.tlm.encode(encoder, &self.tlm_bindings, &tlm_frame)
+        })?;
+        // Ground: imagery on the surface the depth pass kept, from the finest resident level.
+        let mesh = MeshDraw { terrain: &self.terrain, bind_group: &self.terrain_bindings, nodes: &prepared };
+        self.profiler.pass(&self.gpu, &mut encoder, "ground", |encoder| {
+            self.ground.encode(encoder, mesh, &colour, &depth, SKY_LINEAR)
         })?;
         // Read back a frame or two late, never waiting (recorded after the last timed pass: the
         // CPU-timing fallback submits each pass's encoder on its own).
@@ -426,6 +441,31 @@ impl Renderer {
             uniforms.imagery_level_count = p.levels;
         }
         uniforms
+    }
+
+    /// Loads every tile of the dataset now and pins it, for all-resident reference renders. Fails
+    /// when a layer does not fit its cache.
+    pub fn pin_everything(&mut self) -> Result<(), RenderError> {
+        let everything = |cache: &TileCache, layer: &'static str| {
+            let pyramid = cache.pyramid();
+            if pyramid.tile_count() > cache.capacity() as u64 {
+                return Err(RenderError::DoesNotFit {
+                    layer,
+                    tiles: pyramid.tile_count(),
+                    slots: cache.capacity(),
+                });
+            }
+            Ok(pinned_tiles(pyramid, usize::MAX))
+        };
+        let queue = &self.gpu.queue;
+        self.pinned_heights = everything(&self.heights, "height")?;
+        self.heights
+            .load_now(queue, &self.pinned_heights, self.frame, |id| self.dataset.height.tile_bytes(id));
+        if let Some(layer) = &self.dataset.imagery {
+            self.pinned_imagery = everything(&self.imagery, "imagery")?;
+            self.imagery.load_now(queue, &self.pinned_imagery, self.frame, |id| layer.tile_bytes(id));
+        }
+        Ok(())
     }
 
     /// Whether every tile the frame of `report` wanted is resident (or failed, or beyond what the

@@ -9,11 +9,16 @@ use crate::dataset::{
 /// Levels a page table describes at most (a 2^15-tile-wide layer).
 pub const MAX_LEVELS: u32 = 16;
 
-/// Every shader: its name (matching its Rust module) and source.
-pub const SHADERS: &[(&str, &str)] = &[
-    ("terrain", include_str!("../shaders/terrain.wgsl")),
-    ("depth_pyramid", include_str!("../shaders/depth_pyramid.wgsl")),
-    ("tile_load_map", include_str!("../shaders/tile_load_map.wgsl")),
+/// Every shader: its name (matching its Rust module) and its source, as parts: shared code from
+/// `shaders/shared/` first, then the file of the same name.
+/// The terrain mesh both terrain passes draw.
+const TERRAIN_MESH: &str = include_str!("../shaders/shared/terrain_mesh.wgsl");
+
+pub const SHADERS: &[(&str, &[&str])] = &[
+    ("terrain", &[TERRAIN_MESH, include_str!("../shaders/terrain.wgsl")]),
+    ("ground", &[TERRAIN_MESH, include_str!("../shaders/ground.wgsl")]),
+    ("depth_pyramid", &[include_str!("../shaders/depth_pyramid.wgsl")]),
+    ("tile_load_map", &[include_str!("../shaders/tile_load_map.wgsl")]),
 ];
 
 /// The constants every shader sees, generated from their Rust definitions.
@@ -42,9 +47,9 @@ pub fn prelude() -> String {
     text
 }
 
-/// The full source of shader `name`: prelude, then the file.
+/// The full source of shader `name`: prelude, then its parts.
 pub fn source(name: &str) -> Option<String> {
-    SHADERS.iter().find(|(n, _)| *n == name).map(|(_, body)| format!("{}\n{body}", prelude()))
+    SHADERS.iter().find(|(n, _)| *n == name).map(|(_, parts)| format!("{}\n{}", prelude(), parts.join("\n")))
 }
 
 /// Builds shader `name` on `device`.

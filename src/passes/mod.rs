@@ -4,4 +4,5 @@
 //! inputs in `prepare`, and only records commands in `encode`; `frame.rs` calls them in order.
 
 pub mod depth_pyramid;
+pub mod ground;
 pub mod tile_load_map;

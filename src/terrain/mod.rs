@@ -1,7 +1,9 @@
-//! How it works: the terrain pass draws the CDLOD nodes chosen by `select` as instances of one
-//! grid mesh, displaced in the vertex shader by the height tiles of the height cache and shaded
-//! with imagery through the imagery cache's page table (`shaders/terrain.wgsl`). Its depth is a
-//! reversed-Z Depth32Float target that later passes read.
+//! How it works: the terrain pass (pass 0) draws the CDLOD nodes chosen by `select` as instances
+//! of one grid mesh, displaced in the vertex shader by the height tiles of the height cache
+//! (`shaders/shared/terrain_mesh.wgsl`), into a reversed-Z Depth32Float target only: the depth
+//! the Tile Load Map culls against before anything is shaded. The ground pass
+//! (`passes::ground`) then draws the same instances again, at depth-equal, to shade them; this
+//! module owns what both share: the bind group, the node instances and the mesh draw.
 //!
 //! The grid's index buffer is laid out quadrant by quadrant, so a node of which the parent draws
 //! only some quadrants (CDLOD's partial nodes) costs one instanced draw per quadrant: instances
@@ -32,7 +34,6 @@ pub struct TerrainPass {
     nodes: wgpu::Buffer,
     indices: wgpu::Buffer,
     quadrant_indices: [Range<u32>; 4],
-    sampler: wgpu::Sampler,
 }
 
 /// Node instances of one frame, grouped by quadrant.
@@ -51,14 +52,28 @@ impl NodeBatches {
     }
 }
 
+/// Everything a pass needs to draw this frame's terrain mesh.
+#[derive(Clone, Copy)]
+pub struct MeshDraw<'a> {
+    pub terrain: &'a TerrainPass,
+    pub bind_group: &'a wgpu::BindGroup,
+    pub nodes: &'a PreparedNodes,
+}
+
+impl MeshDraw<'_> {
+    /// Draws the node instances with the pipeline already set on `pass`.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        self.terrain.draw_mesh(pass, self.bind_group, self.nodes);
+    }
+}
+
 /// Instance ranges of each quadrant's draw, as uploaded.
 pub struct PreparedNodes {
     ranges: [Range<u32>; 4],
 }
 
 impl TerrainPass {
-    /// `software`: the adapter is a CPU rasteriser (decides automatic anisotropy).
-    pub fn new(device: &wgpu::Device, settings: &Settings, software: bool) -> Self {
+    pub fn new(device: &wgpu::Device, settings: &Settings) -> Self {
         let module = shaders::module(device, "terrain");
         let entry =
             |binding, ty, visibility| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
@@ -118,12 +133,7 @@ impl TerrainPass {
                 compilation_options: Default::default(),
                 buffers: &[],
             },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(COLOUR_FORMAT.into())],
-            }),
+            fragment: None,
             primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
@@ -154,23 +164,18 @@ impl TerrainPass {
             contents: bytemuck::cast_slice(&index_data),
             usage: wgpu::BufferUsages::INDEX,
         });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("imagery"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            anisotropy_clamp: settings.imagery.anisotropy_on(software),
-            ..Default::default()
-        });
-        Self { pipeline, layout, uniforms, nodes, indices, quadrant_indices, sampler }
+        Self { pipeline, layout, uniforms, nodes, indices, quadrant_indices }
     }
 
     /// The bind group over the caches; the caches are fixed for a renderer's life, so is this.
+    /// The bind group both terrain passes use: uniforms, nodes, the height cache (mesh), and the
+    /// imagery cache with its page table and sampler (ground shading).
     pub fn bind_group(
         &self,
         device: &wgpu::Device,
         heights: &TileCache,
         imagery: &TileCache,
+        imagery_sampler: &wgpu::Sampler,
     ) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("terrain"),
@@ -186,7 +191,10 @@ impl TerrainPass {
                     binding: 3,
                     resource: wgpu::BindingResource::TextureView(&imagery.view),
                 },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::Sampler(imagery_sampler),
+                },
                 wgpu::BindGroupEntry { binding: 5, resource: imagery.page_table.as_entire_binding() },
             ],
         })
@@ -213,31 +221,22 @@ impl TerrainPass {
         PreparedNodes { ranges }
     }
 
+    /// The layout of `bind_group`, for the passes that draw this mesh.
+    pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// Pass 0: the mesh into a cleared depth target, nothing else.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
-        colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
-        clear_linear: [f64; 3],
         nodes: &PreparedNodes,
     ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("terrain"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: colour,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: clear_linear[0],
-                        g: clear_linear[1],
-                        b: clear_linear[2],
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
+            color_attachments: &[],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
                 // Reversed-Z: 0 is infinitely far.
@@ -252,6 +251,16 @@ impl TerrainPass {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
+        self.draw_mesh(&mut pass, bind_group, nodes);
+    }
+
+    /// Draws this frame's node instances with the pipeline already set on `pass`.
+    pub fn draw_mesh(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        bind_group: &wgpu::BindGroup,
+        nodes: &PreparedNodes,
+    ) {
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         for (indices, instances) in self.quadrant_indices.iter().zip(&nodes.ranges) {

@@ -1,0 +1,102 @@
+// The terrain mesh, shared by the terrain (depth) and ground (shading) passes: CDLOD nodes
+// displaced by height tiles.
+//
+// Each instance is one node: a (cells + 1)² vertex grid whose vertices read exact samples of the
+// node's height tile (textureLoad, no filtering), ringed by skirts: one more row of vertices on
+// each side, hanging `skirt_m` below the edge. Odd vertices morph onto the next coarser grid as
+// the camera recedes (Strugar 2010), reaching it exactly at the node's outer range, so nodes of
+// neighbouring LODs meet without cracks. While a node's own tile streams in it reads its finest
+// resident ancestor (at 1/2^k samples per cell); the skirts hide the seams that leaves against
+// neighbours reading finer tiles, so the view is coarser there, never holed. Positions are
+// camera-relative: the CPU subtracts in f64 and hands small f32 offsets to the GPU. Both passes compute positions with this same code and
+// `@invariant`, so the ground pass can shade exactly the fragments the depth pass kept.
+
+struct TerrainUniforms {
+    clip_from_view_world: mat4x4<f32>,
+    sun_dir: vec4<f32>,
+    haze: vec4<f32>,
+    camera_grid_m: vec4<f32>,
+    height_range_m: vec2<f32>,
+    node_cells: u32,
+    has_imagery: u32,
+    imagery_frame: vec4<f32>,
+    imagery_levels: array<vec4<u32>, MAX_LEVELS>,
+    imagery_level_count: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+struct TerrainNode {
+    origin_rel_m: vec2<f32>,
+    cell_m: f32,
+    height_slot: u32,
+    sample_offset: vec2<f32>,
+    morph_start_m: f32,
+    morph_end_m: f32,
+    cells_inside: vec2<f32>,
+    sample_step: f32,
+    skirt_m: f32,
+}
+
+@group(0) @binding(0) var<uniform> u: TerrainUniforms;
+@group(0) @binding(1) var<storage, read> nodes: array<TerrainNode>;
+@group(0) @binding(2) var height_tiles: texture_2d_array<f32>;
+
+struct VertexOut {
+    @builtin(position) @invariant clip: vec4<f32>,
+    // Camera-relative position, metres.
+    @location(0) rel_m: vec3<f32>,
+    // Grid-space position (for imagery lookup), metres.
+    @location(1) grid_m: vec2<f32>,
+    @location(2) normal: vec3<f32>,
+}
+
+fn height_sample(node: TerrainNode, s: vec2<i32>) -> f32 {
+    let limit = i32(HEIGHT_TILE_EXTENT) - 1;
+    let at = clamp(s, vec2<i32>(0), vec2<i32>(limit));
+    return textureLoad(height_tiles, at, i32(node.height_slot), 0).r;
+}
+
+// Height at grid position `g` of the node (fractional while morphing, or when reading an
+// ancestor tile), bilinear between the tile's samples.
+fn height_at(node: TerrainNode, g: vec2<f32>) -> f32 {
+    let sample = node.sample_offset + g * node.sample_step;
+    let base = floor(sample);
+    let f = sample - base;
+    let s = vec2<i32>(base);
+    let h00 = height_sample(node, s);
+    let h10 = height_sample(node, s + vec2<i32>(1, 0));
+    let h01 = height_sample(node, s + vec2<i32>(0, 1));
+    let h11 = height_sample(node, s + vec2<i32>(1, 1));
+    return mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
+    let node = nodes[instance];
+    // The grid with its skirt ring: vertex (i, j) of (cells + 3)², the outer ring on the edges.
+    let row = u.node_cells + 3u;
+    let ij = vec2<f32>(f32(vertex % row), f32(vertex / row));
+    let last = f32(u.node_cells + 2u);
+    let skirt = ij.x == 0.0 || ij.y == 0.0 || ij.x == last || ij.y == last;
+    let g = min(clamp(ij - 1.0, vec2<f32>(0.0), vec2<f32>(f32(u.node_cells))), node.cells_inside);
+
+    let h = height_at(node, g) - u.camera_grid_m.z;
+    let distance = length(vec3<f32>(node.origin_rel_m + g * node.cell_m, h));
+    let morph = clamp((distance - node.morph_start_m) / (node.morph_end_m - node.morph_start_m), 0.0, 1.0);
+    let g_morphed = min(g - fract(g * 0.5) * 2.0 * morph, node.cells_inside);
+
+    let xy = node.origin_rel_m + g_morphed * node.cell_m;
+    let z = height_at(node, g_morphed) - u.camera_grid_m.z - select(0.0, node.skirt_m, skirt);
+    // Central differences one (level) sample apart; the tile border makes them valid at the edges.
+    let dx = height_at(node, g_morphed + vec2<f32>(1.0, 0.0)) - height_at(node, g_morphed - vec2<f32>(1.0, 0.0));
+    let dy = height_at(node, g_morphed + vec2<f32>(0.0, 1.0)) - height_at(node, g_morphed - vec2<f32>(0.0, 1.0));
+
+    var out: VertexOut;
+    out.rel_m = vec3<f32>(xy, z);
+    out.clip = u.clip_from_view_world * vec4<f32>(out.rel_m, 1.0);
+    out.grid_m = u.camera_grid_m.xy + xy;
+    out.normal = normalize(vec3<f32>(-dx, -dy, 2.0 * node.cell_m));
+    return out;
+}

@@ -1,0 +1,104 @@
+//! How it works: pass 2, the ground. It draws the terrain pass's node instances again, with the
+//! same vertex code (`shaders/shared/terrain_mesh.wgsl`, positions `@invariant`), at depth-equal
+//! without writing depth, so each pixel is shaded once, by the surface the depth pass kept. The
+//! shading (`shaders/ground.wgsl`) reads imagery through the imagery cache's page table from the
+//! finest resident level at or above the one the pixel's footprint asks for: a tile not loaded
+//! yet shows its ancestor, blurry, never a hole. Borders stored with each tile let trilinear and
+//! anisotropic filtering run inside one tile; gradients come from continuous coordinates, so tile
+//! edges cause no derivative spikes.
+
+use crate::config::Settings;
+use crate::shaders;
+use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass};
+
+pub struct GroundPass {
+    pipeline: wgpu::RenderPipeline,
+    sampler: wgpu::Sampler,
+}
+
+impl GroundPass {
+    /// `software`: the adapter is a CPU rasteriser (decides automatic anisotropy).
+    pub fn new(device: &wgpu::Device, settings: &Settings, software: bool, terrain: &TerrainPass) -> Self {
+        let module = shaders::module(device, "ground");
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("ground"),
+            bind_group_layouts: &[Some(terrain.bind_group_layout())],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("ground"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(COLOUR_FORMAT.into())],
+            }),
+            primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Equal),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("imagery"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            anisotropy_clamp: settings.imagery.anisotropy_on(software),
+            ..Default::default()
+        });
+        Self { pipeline, sampler }
+    }
+
+    /// The imagery sampler the terrain bind group must hold.
+    pub fn sampler(&self) -> &wgpu::Sampler {
+        &self.sampler
+    }
+
+    /// Clears `colour` to the sky and shades the ground the depth pass kept.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: MeshDraw<'_>,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        sky_linear: [f64; 3],
+    ) {
+        let [r, g, b] = sky_linear;
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("ground"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: colour,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        mesh.draw(&mut pass);
+    }
+}
