@@ -7,13 +7,12 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::Duration;
 
-use glam::{DVec3, Vec4};
+use glam::DVec3;
 use thiserror::Error;
 
 use crate::camera::{Camera, CameraError, Frustum};
 use crate::config::Settings;
 use crate::dataset::{Dataset, IMAGERY_MIPS, LayerSpec, PackError, TileId};
-use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback::read_texture;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
@@ -27,7 +26,7 @@ use crate::streaming::analysis::{LoadMaps, analyse};
 use crate::streaming::wants::{after_pinned, height_tiles, pinned_tiles};
 use crate::streaming::{CacheStats, LayerKind, Loader, LoaderError, TileCache, UploadBudget};
 use crate::terrain::select::{Lods, NodeBounds, select};
-use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass, node_batches};
+use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass, node_batches, terrain_uniforms};
 
 /// Tiles of the coarsest levels each cache keeps resident from the start, at most: the three
 /// coarsest levels of a square layer (1 + 4 + 16), a fallback everywhere at a quarter of the
@@ -335,7 +334,13 @@ impl Renderer {
         });
         report.nodes_drawn = batches.len();
         report.nodes_dropped = dropped;
-        let uniforms = self.uniforms(camera_grid_m, clip_from_view_world.as_mat4());
+        let uniforms = terrain_uniforms(
+            &self.dataset,
+            &self.settings,
+            camera_grid_m,
+            clip_from_view_world.as_mat4(),
+            SKY_LINEAR,
+        );
         let prepared = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
 
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
@@ -397,50 +402,6 @@ impl Renderer {
             self.load_maps = Some(maps);
         }
         Ok(())
-    }
-
-    fn uniforms(&self, camera_grid_m: DVec3, clip: glam::Mat4) -> TerrainUniforms {
-        let r = &self.settings.render;
-        let manifest = &self.dataset.manifest;
-        let (azimuth, elevation) = (r.sun_azimuth_deg.to_radians(), r.sun_elevation_deg.to_radians());
-        let sun =
-            DVec3::new(azimuth.sin() * elevation.cos(), azimuth.cos() * elevation.cos(), elevation.sin());
-        let half_spacing = 0.5 * manifest.height.spacing_m;
-        let mut uniforms = TerrainUniforms {
-            clip_from_view_world: clip.to_cols_array_2d(),
-            sun_dir: sun.as_vec3().extend(0.0).to_array(),
-            haze: Vec4::new(
-                SKY_LINEAR[0] as f32,
-                SKY_LINEAR[1] as f32,
-                SKY_LINEAR[2] as f32,
-                r.haze_half_distance_m as f32,
-            )
-            .to_array(),
-            camera_grid_m: camera_grid_m.as_vec3().extend(0.0).to_array(),
-            height_range_m: [manifest.height.min_m, manifest.height.max_m],
-            node_cells: self.settings.terrain.node_cells,
-            has_imagery: u32::from(self.dataset.imagery.is_some()),
-            imagery_frame: [0.0; 4],
-            imagery_levels: [[0; 4]; MAX_LEVELS as usize],
-            imagery_level_count: 1,
-            _pad: [0; 3],
-        };
-        if let (Some(layer), Some(meta)) = (&self.dataset.imagery, &manifest.imagery) {
-            let p = &layer.pyramid;
-            uniforms.imagery_frame = [
-                -half_spacing as f32,
-                -half_spacing as f32,
-                meta.texel_m as f32,
-                self.settings.imagery.lod_bias as f32,
-            ];
-            for level in 0..p.levels {
-                let [nx, ny] = p.tiles_at(level);
-                let first = p.tile_index(TileId::new(level, 0, 0)).unwrap_or_default() as u32;
-                uniforms.imagery_levels[level as usize] = [first, nx, ny, 0];
-            }
-            uniforms.imagery_level_count = p.levels;
-        }
-        uniforms
     }
 
     /// Loads every tile of the dataset now and pins it, for all-resident reference renders. Fails

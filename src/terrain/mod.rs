@@ -17,8 +17,10 @@ use glam::DVec3;
 use wgpu::util::DeviceExt;
 
 use crate::config::Settings;
+use crate::dataset::{Dataset, TileId};
 use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
 use crate::shaders;
+use crate::shaders::MAX_LEVELS;
 use crate::streaming::TileCache;
 use select::{Lods, NodeId, Selected};
 
@@ -269,6 +271,56 @@ impl TerrainPass {
             }
         }
     }
+}
+
+/// The terrain passes' uniforms for a camera at `camera_grid_m` (grid space) with `clip` the
+/// clip-from-camera-relative-world matrix; `sky_linear` is also the haze colour.
+pub fn terrain_uniforms(
+    dataset: &Dataset,
+    settings: &Settings,
+    camera_grid_m: DVec3,
+    clip: glam::Mat4,
+    sky_linear: [f64; 3],
+) -> TerrainUniforms {
+    let r = &settings.render;
+    let manifest = &dataset.manifest;
+    let (azimuth, elevation) = (r.sun_azimuth_deg.to_radians(), r.sun_elevation_deg.to_radians());
+    let sun = DVec3::new(azimuth.sin() * elevation.cos(), azimuth.cos() * elevation.cos(), elevation.sin());
+    let half_spacing = 0.5 * manifest.height.spacing_m;
+    let mut uniforms = TerrainUniforms {
+        clip_from_view_world: clip.to_cols_array_2d(),
+        sun_dir: sun.as_vec3().extend(0.0).to_array(),
+        haze: [
+            sky_linear[0] as f32,
+            sky_linear[1] as f32,
+            sky_linear[2] as f32,
+            r.haze_half_distance_m as f32,
+        ],
+        camera_grid_m: camera_grid_m.as_vec3().extend(0.0).to_array(),
+        height_range_m: [manifest.height.min_m, manifest.height.max_m],
+        node_cells: settings.terrain.node_cells,
+        has_imagery: u32::from(dataset.imagery.is_some()),
+        imagery_frame: [0.0; 4],
+        imagery_levels: [[0; 4]; MAX_LEVELS as usize],
+        imagery_level_count: 1,
+        _pad: [0; 3],
+    };
+    if let (Some(layer), Some(meta)) = (&dataset.imagery, &manifest.imagery) {
+        let p = &layer.pyramid;
+        uniforms.imagery_frame = [
+            -half_spacing as f32,
+            -half_spacing as f32,
+            meta.texel_m as f32,
+            settings.imagery.lod_bias as f32,
+        ];
+        for level in 0..p.levels {
+            let [nx, ny] = p.tiles_at(level);
+            let first = p.tile_index(TileId::new(level, 0, 0)).unwrap_or_default() as u32;
+            uniforms.imagery_levels[level as usize] = [first, nx, ny, 0];
+        }
+        uniforms.imagery_level_count = p.levels;
+    }
+    uniforms
 }
 
 /// The instances drawing `selected` from a camera at `camera_grid_m` (grid space). A node reads its
