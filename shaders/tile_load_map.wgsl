@@ -51,7 +51,10 @@ struct TlmCell {
     radial_lod: u32,
 }
 
-@group(0) @binding(0) var<uniform> u: TlmUniforms;
+// A storage binding, not a uniform one: Mesa lavapipe specialises a shader on the values of
+// uniforms that steer loops and branches and keeps every variant, and these change every frame
+// (a leak of about 0.5 MiB a frame, caught by data-tools/tests/globe_flight.rs).
+@group(0) @binding(0) var<storage, read> u: TlmUniforms;
 @group(0) @binding(1) var<storage, read> spans: array<TlmSpan>;
 @group(0) @binding(2) var<storage, read> height_ranges_m: array<vec2<f32>>;
 @group(0) @binding(3) var hiz: texture_2d<f32>;

@@ -215,7 +215,8 @@ impl TileLoadMapPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tile load map"),
             entries: &[
-                buffer(0, wgpu::BufferBindingType::Uniform),
+                // The per-frame constants are a storage buffer: see the note in the shader.
+                buffer(0, read_only),
                 buffer(1, read_only),
                 buffer(2, read_only),
                 wgpu::BindGroupLayoutEntry {
@@ -254,7 +255,7 @@ impl TileLoadMapPass {
         };
         let copy_dst = wgpu::BufferUsages::COPY_DST;
         let uniforms =
-            buffer("tlm uniforms", size_of::<TlmUniforms>() as u64, wgpu::BufferUsages::UNIFORM | copy_dst);
+            buffer("tlm uniforms", size_of::<TlmUniforms>() as u64, wgpu::BufferUsages::STORAGE | copy_dst);
         let spans_bytes = u64::from(max_rings * 2 * cells) * size_of::<TlmSpan>() as u64;
         let spans = buffer("tlm spans", spans_bytes, wgpu::BufferUsages::STORAGE | copy_dst);
         let output_bytes = u64::from(max_rings * cells * cells) * size_of::<TlmCell>() as u64;
