@@ -12,7 +12,18 @@ pub fn read_texture(
     aspect: wgpu::TextureAspect,
     texel_bytes: u32,
 ) -> Result<Vec<u8>, GpuError> {
-    let (width, height) = (texture.width(), texture.height());
+    read_texture_mip(gpu, texture, 0, aspect, texel_bytes)
+}
+
+/// The texels of mip `mip` of `texture`, top row first, `texel_bytes` per texel.
+pub fn read_texture_mip(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    mip: u32,
+    aspect: wgpu::TextureAspect,
+    texel_bytes: u32,
+) -> Result<Vec<u8>, GpuError> {
+    let (width, height) = ((texture.width() >> mip).max(1), (texture.height() >> mip).max(1));
     let row_bytes = width * texel_bytes;
     let padded = row_bytes.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -23,7 +34,7 @@ pub fn read_texture(
     });
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyTextureInfo { texture, mip_level: mip, origin: wgpu::Origin3d::ZERO, aspect },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {

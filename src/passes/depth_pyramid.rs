@@ -9,6 +9,7 @@
 //! One compute dispatch per level, each reading the level below through a view of that single
 //! mip (wgpu tracks usage per mip, so level L can be written while level L − 1 is read).
 
+use crate::gpu::readback::read_texture_mip;
 use crate::gpu::{Gpu, GpuError};
 use crate::reference::tile_load_map::HizMips;
 use crate::shaders;
@@ -196,65 +197,12 @@ impl DepthPyramid {
 
     /// Reads every level back, waiting for the GPU: for tests and tools, never the frame.
     pub fn read_back(&self, gpu: &Gpu) -> Result<HizMips, GpuError> {
-        let padded = |w: u32| (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let offsets: Vec<u64> = self
-            .sizes
-            .iter()
-            .scan(0u64, |offset, &[w, h]| {
-                let at = *offset;
-                *offset += u64::from(padded(w)) * u64::from(h);
-                Some(at)
+        let levels = (0..self.sizes.len() as u32)
+            .map(|mip| {
+                let bytes = read_texture_mip(gpu, &self.texture, mip, wgpu::TextureAspect::All, 4)?;
+                Ok(bytemuck::pod_collect_to_vec::<u8, f32>(&bytes))
             })
-            .collect();
-        let total = self.sizes.iter().map(|&[w, h]| u64::from(padded(w)) * u64::from(h)).sum();
-        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("depth pyramid readback"),
-            size: total,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        for (level, (&[w, h], &offset)) in self.sizes.iter().zip(&offsets).enumerate() {
-            encoder.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &self.texture,
-                    mip_level: level as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &buffer,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset,
-                        bytes_per_row: Some(padded(w)),
-                        rows_per_image: Some(h),
-                    },
-                },
-                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            );
-        }
-        gpu.queue.submit([encoder.finish()]);
-        let slice = buffer.slice(..);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |result| {
-            let _ = sender.send(result);
-        });
-        gpu.wait()?;
-        receiver.recv().map_err(|_| GpuError::Validation("depth pyramid readback never ran".into()))??;
-        let mapped = slice.get_mapped_range().map_err(|e| GpuError::Validation(e.to_string()))?;
-        let mut levels = Vec::with_capacity(self.sizes.len());
-        for (&[w, h], &offset) in self.sizes.iter().zip(&offsets) {
-            let mut texels = Vec::with_capacity((w * h) as usize);
-            for row in 0..u64::from(h) {
-                let start = (offset + row * u64::from(padded(w))) as usize;
-                texels
-                    .extend(bytemuck::pod_collect_to_vec::<u8, f32>(&mapped[start..start + 4 * w as usize]));
-            }
-            levels.push(texels);
-        }
-        drop(mapped);
-        buffer.unmap();
-        gpu.check()?;
+            .collect::<Result<Vec<_>, GpuError>>()?;
         Ok(HizMips { sizes: self.sizes.clone(), levels })
     }
 }
