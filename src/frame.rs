@@ -250,16 +250,7 @@ impl Renderer {
         let mut report = FrameReport { frame: self.frame, ..Default::default() };
 
         // Terrain LOD: choose the nodes whose triangles keep their target size on screen.
-        let h = &self.dataset.manifest.height;
-        let t = &self.settings.terrain;
-        let lods = Lods::new(
-            self.dataset.height.pyramid,
-            h.spacing_m,
-            t.node_cells,
-            camera.metres_per_pixel(1.0, height),
-            t.triangle_px,
-            t.morph_fraction,
-        );
+        let lods = Lods::for_view(&self.dataset, &self.settings.terrain, camera, height);
         let selected = self.profiler.cpu("terrain_select", || {
             let (dataset, bounds) = (&self.dataset, &mut self.bounds);
             select(&lods, camera_grid_m, &frustum, &mut |node| {
@@ -318,11 +309,7 @@ impl Renderer {
                 camera_grid_m,
                 viewport_px: [width, height],
                 lods: &lods,
-                imagery: self.dataset.manifest.imagery.as_ref().map(|i| TlmImagery {
-                    texel_m: i.texel_m,
-                    levels: i.pyramid.levels,
-                    lod_bias: self.settings.imagery.lod_bias,
-                }),
+                imagery: TlmImagery::of(&self.dataset, &self.settings.imagery),
                 hiz_mips: self.depth_pyramid.mips(),
             },
         )?;

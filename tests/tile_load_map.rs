@@ -58,21 +58,10 @@ fn run_with(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]], wall_m: Opti
     let bindings = pass.bind_group(device, &ranges, &hiz);
     let m = &r.dataset.manifest;
     let camera_grid_m = camera.position_m - DVec3::new(m.origin_m[0], m.origin_m[1], 0.0);
-    let lods = Lods::new(
-        r.dataset.height.pyramid,
-        m.height.spacing_m,
-        s.terrain.node_cells,
-        camera.metres_per_pixel(1.0, h),
-        s.terrain.triangle_px,
-        s.terrain.morph_fraction,
-    );
+    let lods = Lods::for_view(&r.dataset, &s.terrain, camera, h);
     let rect = TlmLayout::dataset_rect_m(&lods.pyramid, lods.spacing_m);
     let layout = TlmLayout::new(&s.tlm, rect, [camera_grid_m.x, camera_grid_m.y]);
-    let imagery = m.imagery.as_ref().map(|i| TlmImagery {
-        texel_m: i.texel_m,
-        levels: i.pyramid.levels,
-        lod_bias: s.imagery.lod_bias,
-    });
+    let imagery = TlmImagery::of(&r.dataset, &s.imagery);
     let inputs = TlmInputs {
         settings: &s.tlm,
         layout: &layout,
@@ -640,11 +629,7 @@ fn timings_at_1280x720() {
         let hiz = DepthPyramid::new(device, s.render.width, s.render.height);
         let pass = TileLoadMapPass::new(device, &s);
         let bindings = pass.bind_group(device, &warm.ranges, &hiz);
-        let imagery = r.dataset.manifest.imagery.as_ref().map(|i| TlmImagery {
-            texel_m: i.texel_m,
-            levels: i.pyramid.levels,
-            lod_bias: s.imagery.lod_bias,
-        });
+        let imagery = TlmImagery::of(&r.dataset, &s.imagery);
         let inputs = TlmInputs {
             settings: &s.tlm,
             layout: &warm.layout,

@@ -13,8 +13,9 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use crate::camera::Frustum;
-use crate::dataset::{HEIGHT_BORDER, HEIGHT_TILE_CELLS, Pyramid, TileId};
+use crate::camera::{Camera, Frustum};
+use crate::config::TerrainSettings;
+use crate::dataset::{Dataset, HEIGHT_BORDER, HEIGHT_TILE_CELLS, Pyramid, TileId};
 
 /// A node of the terrain quadtree: LOD `lod`, position (`x`, `y`) in nodes of that LOD.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -78,6 +79,19 @@ impl Lods {
             })
             .collect();
         Self { cells, spacing_m, pyramid, range_m, morph_start_m }
+    }
+
+    /// The rings of `dataset`'s terrain for `camera` in a viewport `height_px` tall, as the
+    /// terrain settings ask.
+    pub fn for_view(dataset: &Dataset, settings: &TerrainSettings, camera: &Camera, height_px: u32) -> Self {
+        Self::new(
+            dataset.height.pyramid,
+            dataset.manifest.height.spacing_m,
+            settings.node_cells,
+            camera.metres_per_pixel(1.0, height_px),
+            settings.triangle_px,
+            settings.morph_fraction,
+        )
     }
 
     pub fn node_m(&self, lod: u32) -> f64 {

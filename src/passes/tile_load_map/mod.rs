@@ -20,7 +20,7 @@ use thiserror::Error;
 use wgpu::util::DeviceExt;
 
 use crate::camera::{Camera, CameraError};
-use crate::config::{Settings, TlmSettings};
+use crate::config::{ImagerySettings, Settings, TlmSettings};
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::gpu_types::{TlmCell, TlmRing, TlmSpan, TlmUniforms};
 use crate::gpu::readback_ring::ReadbackRing;
@@ -88,6 +88,17 @@ pub struct TlmImagery {
     pub levels: u32,
     /// `imagery.lod_bias`, log2 texels.
     pub lod_bias: f64,
+}
+
+impl TlmImagery {
+    /// `dataset`'s imagery as the TLM sees it, with the imagery settings' bias; `None` without.
+    pub fn of(dataset: &Dataset, settings: &ImagerySettings) -> Option<Self> {
+        dataset.manifest.imagery.as_ref().map(|i| Self {
+            texel_m: i.texel_m,
+            levels: i.pyramid.levels,
+            lod_bias: settings.lod_bias,
+        })
+    }
 }
 
 /// What one frame's TLM is computed from.
