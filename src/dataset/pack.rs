@@ -253,35 +253,29 @@ impl Pack {
         self.header.tile_count
     }
 
-    fn entry(&self, index: u64) -> &[u8] {
+    /// Tile `index`'s index entry, or the error for a tile the pack does not hold.
+    fn entry(&self, index: u64) -> Result<&[u8], PackError> {
+        if index >= self.header.tile_count {
+            return Err(PackError::OutOfRange {
+                path: self.path.clone(),
+                index,
+                count: self.header.tile_count,
+            });
+        }
         let at = (HEADER_BYTES + index * INDEX_ENTRY_BYTES) as usize;
-        &self.map[at..at + INDEX_ENTRY_BYTES as usize]
+        Ok(&self.map[at..at + INDEX_ENTRY_BYTES as usize])
     }
 
     /// The tile's value range (heights: conservative min/max of the level-0 samples under it), or
     /// `None` for layers without one. Verified with the index at `open`; no payload is read.
     pub fn tile_range(&self, index: u64) -> Result<Option<[f32; 2]>, PackError> {
-        if index >= self.header.tile_count {
-            return Err(PackError::OutOfRange {
-                path: self.path.clone(),
-                index,
-                count: self.header.tile_count,
-            });
-        }
-        let entry = self.entry(index);
+        let entry = self.entry(index)?;
         Ok(unpack_range(u64::from_le_bytes(entry[8..16].try_into().unwrap_or([0xff; 8]))))
     }
 
     /// The tile's payload, after checking that it was written and that its checksum holds.
     pub fn tile(&self, index: u64) -> Result<&[u8], PackError> {
-        if index >= self.header.tile_count {
-            return Err(PackError::OutOfRange {
-                path: self.path.clone(),
-                index,
-                count: self.header.tile_count,
-            });
-        }
-        let entry = self.entry(index);
+        let entry = self.entry(index)?;
         let crc = u32::from_le_bytes([entry[0], entry[1], entry[2], entry[3]]);
         let state = u32::from_le_bytes([entry[4], entry[5], entry[6], entry[7]]);
         if state != TILE_PRESENT {
