@@ -10,7 +10,6 @@ use std::time::{Duration, Instant};
 use glam::{DMat4, DVec3, DVec4};
 use terramp::camera::Camera;
 use terramp::config::{Settings, TlmSettings};
-use terramp::dataset::{Dataset, HEIGHT_TILE_CELLS, TileId};
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::readback_ring::ReadbackRing;
@@ -241,40 +240,6 @@ fn assert_levels_match_f64(r: &Renderer, run: &Run, camera: &Camera, what: &str)
     assert!(checked > 0 || visible(&run.gpu) == 0, "{what}: nothing checked");
 }
 
-/// Tight height ranges per height tile (what `Dataset::height_range` is to give): the level-0
-/// samples under the tile and one sample of its level beyond each edge, which meshes of that
-/// level interpolate across.
-fn tight_tile_ranges(dataset: &Dataset) -> Vec<[f32; 2]> {
-    let p = dataset.height.pyramid;
-    let ([nx, ny], cells) = (p.size, HEIGHT_TILE_CELLS);
-    let tiles = p.tiles_at(0);
-    let level0: Vec<Vec<f32>> = (0..tiles[0] * tiles[1])
-        .map(|i| dataset.height_tile(TileId::new(0, i % tiles[0], i / tiles[0])).unwrap().to_vec())
-        .collect();
-    let extent = p.tile_extent();
-    let sample = |x: u32, y: u32| {
-        let (tx, ty) = ((x / cells).min(tiles[0] - 1), (y / cells).min(tiles[1] - 1));
-        let (lx, ly) = (x - tx * cells + p.border, y - ty * cells + p.border);
-        level0[(ty * tiles[0] + tx) as usize][(ly * extent + lx) as usize]
-    };
-    p.tiles()
-        .map(|id| {
-            let step = 1u32 << id.level;
-            let span = |t: u32, n: u32| {
-                (t * cells * step).saturating_sub(step)..=((t + 1) * cells * step + step).min(n - 1)
-            };
-            let mut range = [f32::MAX, f32::MIN];
-            for y in span(id.y, ny) {
-                for x in span(id.x, nx) {
-                    let h = sample(x, y);
-                    range = [range[0].min(h), range[1].max(h)];
-                }
-            }
-            range
-        })
-        .collect()
-}
-
 /// Grid position of the highest sample of a coarse level, with its height.
 fn peak(r: &Renderer) -> DVec3 {
     let pyramid = r.dataset.height.pyramid;
@@ -314,7 +279,7 @@ fn gpu_equals_twin_and_never_culls_what_is_on_screen() {
     let mut settings = small_settings(160, 96);
     settings.tlm = tlm_settings(64.0, 16);
     let mut r = renderer(&dataset, settings);
-    let ranges = tight_tile_ranges(&r.dataset);
+    let ranges = height_tile_ranges(&r.dataset);
     let [w, h] = r.dataset.manifest.extent_m();
     let (cx, cy) = (0.5 * w, 0.5 * h);
     let top = peak(&r);
@@ -370,7 +335,7 @@ fn cells_behind_a_wall_are_occluded() {
     let mut settings = small_settings(160, 96);
     settings.tlm = tlm_settings(64.0, 16);
     let mut r = renderer(&dataset, settings);
-    let ranges = tight_tile_ranges(&r.dataset);
+    let ranges = height_tile_ranges(&r.dataset);
     let [w, h] = r.dataset.manifest.extent_m();
     let camera = camera_at(&r, DVec3::new(0.5 * w, 0.3 * h, ground(&r, 0.5 * w, 0.3 * h) + 60.0), 10.0, -6.0);
     let (wall_m, tolerance_m) = (600.0, r.settings.tlm.occlusion_tolerance_m);
@@ -617,7 +582,7 @@ fn timings_at_1280x720() {
     let dataset = synth_dataset(1024, 5);
     let mut r = renderer(&dataset, Settings::default());
     let [w, h] = r.dataset.manifest.extent_m();
-    let ranges = tight_tile_ranges(&r.dataset);
+    let ranges = height_tile_ranges(&r.dataset);
     let near = camera_at(&r, DVec3::new(0.2 * w, 0.2 * h, ground(&r, 0.2 * w, 0.2 * h) + 300.0), 45.0, -12.0);
     // 40 km south-west of the dataset: four rings to reach it.
     let far = camera_at(&r, DVec3::new(-40_000.0, -40_000.0, 3000.0), 45.0, -3.0);
