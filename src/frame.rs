@@ -268,8 +268,8 @@ impl Renderer {
         selected_heights.extend(
             latest.heights.iter().filter(|id| !selected_heights.contains(id)).copied().collect::<Vec<_>>(),
         );
-        let wanted_heights = after_pinned(&self.pinned_heights, selected_heights);
-        let wanted_imagery = after_pinned(&self.pinned_imagery, latest.ground.clone());
+        let wanted_heights = after_pinned(&self.pinned_heights, &selected_heights);
+        let wanted_imagery = after_pinned(&self.pinned_imagery, &latest.ground);
         let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
         let (heights, imagery, landcover) = (&mut self.heights, &mut self.imagery, &mut self.landcover);
         let (loader, has_imagery) = (&self.loader, self.dataset.imagery.is_some());

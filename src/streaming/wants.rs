@@ -71,9 +71,9 @@ pub fn pinned_tiles(pyramid: &Pyramid, max_tiles: usize) -> Vec<TileId> {
 }
 
 /// `pinned` then `wants` without the pinned ones: the order a cache is asked in.
-pub fn after_pinned(pinned: &[TileId], wants: Vec<TileId>) -> Vec<TileId> {
+pub fn after_pinned(pinned: &[TileId], wants: &[TileId]) -> Vec<TileId> {
     let mut list = pinned.to_vec();
-    list.extend(wants.into_iter().filter(|id| !pinned.contains(id)));
+    list.extend(wants.iter().filter(|id| !pinned.contains(id)));
     list
 }
 
@@ -98,7 +98,7 @@ mod tests {
         assert_eq!(pinned[0], TileId::new(3, 0, 0));
         assert_eq!(pinned_tiles(&pyramid, 0), vec![TileId::new(3, 0, 0)]);
         let wants = vec![TileId::new(0, 1, 1), TileId::new(3, 0, 0)];
-        assert_eq!(after_pinned(&pinned[..1], wants), vec![TileId::new(3, 0, 0), TileId::new(0, 1, 1)]);
+        assert_eq!(after_pinned(&pinned[..1], &wants), vec![TileId::new(3, 0, 0), TileId::new(0, 1, 1)]);
     }
 
     #[test]
