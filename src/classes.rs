@@ -61,6 +61,11 @@ impl ClassTable {
         Ok(table)
     }
 
+    /// The table's codes and names, as a dataset's manifest records them.
+    pub fn names(&self) -> Vec<ClassName> {
+        self.classes.clone()
+    }
+
     pub fn contains(&self, code: u8) -> bool {
         self.classes.iter().any(|c| c.code == code)
     }

@@ -168,7 +168,7 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
         landcover: Some(LandcoverLayer {
             layer: cell_layer(LANDCOVER_PACK, class_m, &landcover, "u8 class code"),
             scheme: table.scheme,
-            classes: table.classes,
+            classes: table.names(),
             nodata_code: LANDCOVER_NODATA,
         }),
     };

@@ -74,7 +74,7 @@ impl Landcover {
                 source: self.raster.path.display().to_string(),
             },
             scheme: self.table.scheme.clone(),
-            classes: self.table.classes.clone(),
+            classes: self.table.names(),
             nodata_code,
         })
     }

@@ -1,0 +1,1 @@
+//! How it works: seed patterns. To be written.
