@@ -167,8 +167,8 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
         imagery: Some(cell_layer(IMAGERY_PACK, texel_m, &imagery, "rgba8 srgb")),
         landcover: Some(LandcoverLayer {
             layer: cell_layer(LANDCOVER_PACK, class_m, &landcover, "u8 class code"),
-            scheme: table.scheme,
             classes: table.names(),
+            scheme: table.scheme,
             nodata_code: LANDCOVER_NODATA,
         }),
     };
