@@ -1,14 +1,25 @@
 //! How it works: a land-cover class table names the codes of one classification scheme
-//! (`config/classes/*.toml`). The built-in tables are compiled in, so `--classes nlcd` works from
+//! (`config/classes/*.toml`) and what grows on each: a list of species (a model, a height range, a
+//! crown width, the altitudes and slopes it tolerates) and, per class, seed rules (a species and its
+//! density in seeds per km²). The built-in tables are compiled in, so `--classes nlcd` works from
 //! anywhere; a path to a TOML file of the same shape works too. Codes outside the table are not an
-//! error: they mean "no class" (no seeds), and the builder counts them.
+//! error: they mean "no class" (no seeds), and the builder counts them. Parsing validates the table
+//! (unique codes and species, rules naming known species, every number in range) and names the
+//! table, class and key of the first problem, so a typo never reaches the GPU.
 
 use std::path::Path;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::dataset::ClassName;
+
+/// Most species in one table (the seed-selection pass indexes them in 4 bits).
+pub const MAX_SPECIES: usize = 16;
+/// Most seed rules in one class.
+pub const MAX_SPECIES_PER_CLASS: usize = 4;
+/// Largest density a rule may ask for, seeds per km² (one seed per 10 m²).
+pub const MAX_PER_KM2: f32 = 100_000.0;
 
 const BUILTIN: &[(&str, &str)] = &[
     ("nc", include_str!("../config/classes/nc.toml")),
@@ -23,20 +34,80 @@ pub enum ClassTableError {
     Parse { origin: String, message: String },
     #[error("class table {origin}: code {code} is listed twice")]
     Duplicate { origin: String, code: u8 },
+    #[error("class table {origin}: species `{name}` is listed twice")]
+    DuplicateSpecies { origin: String, name: String },
+    #[error("class table {origin}: {count} species, at most {max} allowed", max = MAX_SPECIES)]
+    TooManySpecies { origin: String, count: usize },
+    #[error("class table {origin}: class {code} ({class}) has {count} seed rules, at most {max} allowed", max = MAX_SPECIES_PER_CLASS)]
+    TooManyRules { origin: String, code: u8, class: String, count: usize },
+    #[error("class table {origin}: class {code} ({class}), seeds.species = `{species}`: {problem}")]
+    BadRule { origin: String, code: u8, class: String, species: String, problem: &'static str },
+    #[error("class table {origin}: {place}, `{key}` = {value}: must be {rule}")]
+    OutOfRange { origin: String, place: String, key: &'static str, value: String, rule: &'static str },
 }
 
 fn builtin_names() -> String {
     BUILTIN.iter().map(|(name, _)| *name).collect::<Vec<_>>().join(", ")
 }
 
-#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SpeciesKind {
+    Tree,
+    Bush,
+    Rock,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Species {
+    pub name: String,
+    pub kind: SpeciesKind,
+    /// Model stem in ../shared/data/models (e.g. "Pine_1"), for the drawing pass.
+    pub model: String,
+    /// Range of the seed's height (its size), metres; each seed draws one from a hash.
+    pub height_m: [f32; 2],
+    /// Bounding-sphere radius per metre of height (crown width), for culling.
+    pub radius_per_height: f32,
+    /// Altitude range where it grows (the tree line), metres; default [-1e4, 1e4].
+    #[serde(default = "any_altitude_m")]
+    pub altitude_m: [f32; 2],
+    /// Steepest ground it grows on, degrees (0..90).
+    pub max_slope_deg: f32,
+}
+
+fn any_altitude_m() -> [f32; 2] {
+    [-1.0e4, 1.0e4]
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeedRule {
+    pub species: String,
+    /// Seeds per km².
+    pub per_km2: f32,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Class {
+    pub code: u8,
+    pub name: String,
+    #[serde(default)]
+    pub seeds: Vec<SeedRule>,
+}
+
+/// A manifest's class list compares equal to a table's classes when codes and names match.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClassTable {
     pub scheme: String,
     /// The code that means "no data" in the source rasters of this scheme.
     pub nodata_code: u8,
     #[serde(rename = "class")]
-    pub classes: Vec<ClassName>,
+    pub classes: Vec<Class>,
+    #[serde(default)]
+    pub species: Vec<Species>,
 }
 
 impl ClassTable {
@@ -53,27 +124,147 @@ impl ClassTable {
     pub fn parse(text: &str, origin: &str) -> Result<Self, ClassTableError> {
         let table: ClassTable = toml::from_str(text)
             .map_err(|e| ClassTableError::Parse { origin: origin.to_owned(), message: e.to_string() })?;
-        let mut codes: Vec<u8> = table.classes.iter().map(|c| c.code).collect();
-        codes.sort_unstable();
-        if let Some(pair) = codes.windows(2).find(|pair| pair[0] == pair[1]) {
-            return Err(ClassTableError::Duplicate { origin: origin.to_owned(), code: pair[0] });
-        }
+        table.validate(origin)?;
         Ok(table)
     }
 
     /// The table's codes and names, as a dataset's manifest records them.
     pub fn names(&self) -> Vec<ClassName> {
-        self.classes.clone()
+        self.classes.iter().map(|c| ClassName { code: c.code, name: c.name.clone() }).collect()
     }
 
     pub fn contains(&self, code: u8) -> bool {
         self.classes.iter().any(|c| c.code == code)
+    }
+
+    pub fn class(&self, code: u8) -> Option<&Class> {
+        self.classes.iter().find(|c| c.code == code)
+    }
+
+    pub fn species_index(&self, name: &str) -> Option<usize> {
+        self.species.iter().position(|s| s.name == name)
+    }
+
+    /// Total seeds per km² of the class (0 for unknown codes).
+    pub fn density_per_km2(&self, code: u8) -> f32 {
+        self.class(code).map_or(0.0, |c| c.seeds.iter().map(|r| r.per_km2).sum())
+    }
+
+    fn validate(&self, origin: &str) -> Result<(), ClassTableError> {
+        let origin = origin.to_owned();
+        let mut codes: Vec<u8> = self.classes.iter().map(|c| c.code).collect();
+        codes.sort_unstable();
+        if let Some(pair) = codes.windows(2).find(|pair| pair[0] == pair[1]) {
+            return Err(ClassTableError::Duplicate { origin, code: pair[0] });
+        }
+        if self.species.len() > MAX_SPECIES {
+            return Err(ClassTableError::TooManySpecies { origin, count: self.species.len() });
+        }
+        for (i, species) in self.species.iter().enumerate() {
+            if self.species[..i].iter().any(|s| s.name == species.name) {
+                return Err(ClassTableError::DuplicateSpecies { origin, name: species.name.clone() });
+            }
+            check_species(species).map_err(|(key, value, rule)| ClassTableError::OutOfRange {
+                origin: origin.clone(),
+                place: format!("species `{}`", species.name),
+                key,
+                value,
+                rule,
+            })?;
+        }
+        for class in &self.classes {
+            if class.seeds.len() > MAX_SPECIES_PER_CLASS {
+                return Err(ClassTableError::TooManyRules {
+                    origin,
+                    code: class.code,
+                    class: class.name.clone(),
+                    count: class.seeds.len(),
+                });
+            }
+            for (i, rule) in class.seeds.iter().enumerate() {
+                let bad_rule = |problem| ClassTableError::BadRule {
+                    origin: origin.clone(),
+                    code: class.code,
+                    class: class.name.clone(),
+                    species: rule.species.clone(),
+                    problem,
+                };
+                if self.species_index(&rule.species).is_none() {
+                    return Err(bad_rule("no species of that name in the table"));
+                }
+                if class.seeds[..i].iter().any(|r| r.species == rule.species) {
+                    return Err(bad_rule("the class lists this species twice"));
+                }
+                if !(0.0..=MAX_PER_KM2).contains(&rule.per_km2) {
+                    return Err(ClassTableError::OutOfRange {
+                        origin: origin.clone(),
+                        place: format!("class {} ({}), species `{}`", class.code, class.name, rule.species),
+                        key: "per_km2",
+                        value: rule.per_km2.to_string(),
+                        rule: "0 to 100000 seeds per km²",
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The first key of a species out of range: (key, value, rule).
+fn check_species(s: &Species) -> Result<(), (&'static str, String, &'static str)> {
+    let [h0, h1] = s.height_m;
+    let [a0, a1] = s.altitude_m;
+    let checks: [(bool, &'static str, String, &'static str); 4] = [
+        (
+            h0 > 0.0 && h0 <= h1 && h1.is_finite(),
+            "height_m",
+            format!("{:?}", s.height_m),
+            "[min, max] metres with 0 < min <= max",
+        ),
+        (
+            s.radius_per_height > 0.0 && s.radius_per_height.is_finite(),
+            "radius_per_height",
+            s.radius_per_height.to_string(),
+            "a positive number",
+        ),
+        (
+            a0 <= a1 && a0.is_finite() && a1.is_finite(),
+            "altitude_m",
+            format!("{:?}", s.altitude_m),
+            "[min, max] metres with min <= max",
+        ),
+        (
+            (0.0..=90.0).contains(&s.max_slope_deg),
+            "max_slope_deg",
+            s.max_slope_deg.to_string(),
+            "0 to 90 degrees",
+        ),
+    ];
+    match checks.into_iter().find(|(ok, ..)| !ok) {
+        Some((_, key, value, rule)) => Err((key, value, rule)),
+        None => Ok(()),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const SPECIES: &str = "[[species]]\nname = \"pine\"\nkind = \"tree\"\nmodel = \"Pine_1\"\n\
+        height_m = [6.0, 12.0]\nradius_per_height = 0.65\nmax_slope_deg = 40.0\n";
+
+    /// A one-class table with the pine species, `species_extra` appended to the species and
+    /// `rules` as the class's seed rules.
+    fn table(species_extra: &str, rules: &str) -> String {
+        format!(
+            "scheme = \"x\"\nnodata_code = 0\n{SPECIES}{species_extra}\n\
+             [[class]]\ncode = 5\nname = \"forest\"\nseeds = [{rules}]\n"
+        )
+    }
+
+    fn error(text: &str) -> String {
+        ClassTable::parse(text, "t.toml").unwrap_err().to_string()
+    }
 
     #[test]
     fn builtins_parse() {
@@ -82,6 +273,64 @@ mod tests {
         assert!(nc.contains(6) && !nc.contains(8));
         let nlcd = ClassTable::load("nlcd").unwrap();
         assert!(nlcd.contains(41) && nlcd.contains(95) && !nlcd.contains(255));
+        assert_eq!(nc.names()[4], ClassName { code: 5, name: "forest".into() });
+        assert_eq!(nc.names().len(), nc.classes.len());
+    }
+
+    #[test]
+    fn builtin_rules_name_known_species_and_respect_the_ecology() {
+        for name in ["nc", "nlcd"] {
+            let t = ClassTable::load(name).unwrap();
+            assert!(!t.species.is_empty() && t.species.len() <= MAX_SPECIES, "{name}");
+            for class in &t.classes {
+                for rule in &class.seeds {
+                    assert!(
+                        t.species_index(&rule.species).is_some(),
+                        "{name} {}: {}",
+                        class.code,
+                        rule.species
+                    );
+                }
+            }
+            for s in &t.species {
+                let max_slope = match s.kind {
+                    SpeciesKind::Tree => 40.0,
+                    SpeciesKind::Bush => 50.0,
+                    SpeciesKind::Rock => 70.0,
+                };
+                assert!(s.max_slope_deg <= max_slope, "{name}: {}", s.name);
+            }
+        }
+        let nc = ClassTable::load("nc").unwrap();
+        let kinds = |t: &ClassTable, code| -> Vec<SpeciesKind> {
+            let rules = &t.class(code).unwrap().seeds;
+            rules.iter().map(|r| t.species[t.species_index(&r.species).unwrap()].kind).collect()
+        };
+        assert!(nc.density_per_km2(5) >= 10_000.0, "{}", nc.density_per_km2(5));
+        assert_eq!(nc.density_per_km2(6), 0.0);
+        assert_eq!(nc.density_per_km2(200), 0.0);
+        assert!(!kinds(&nc, 1).contains(&SpeciesKind::Tree));
+        let nlcd = ClassTable::load("nlcd").unwrap();
+        for code in [11, 12, 22, 23, 24, 81, 82, 95] {
+            assert!(kinds(&nlcd, code).iter().all(|&k| k == SpeciesKind::Bush), "nlcd {code}");
+        }
+        for code in [41, 42, 43] {
+            assert!(nlcd.density_per_km2(code) >= 10_000.0, "nlcd {code}");
+        }
+        let conifer_line = nlcd.species.iter().filter(|s| s.model.starts_with("Pine"));
+        assert!(conifer_line.clone().count() > 0);
+        assert!(conifer_line.into_iter().all(|s| (3000.0..=3800.0).contains(&s.altitude_m[1])));
+    }
+
+    #[test]
+    fn a_valid_table_reads_back() {
+        let t = ClassTable::parse(&table("", "{ species = \"pine\", per_km2 = 900.0 }"), "t.toml").unwrap();
+        assert_eq!(t.species_index("pine"), Some(0));
+        assert_eq!(t.species_index("oak"), None);
+        assert_eq!(t.species[0].altitude_m, [-1.0e4, 1.0e4]);
+        assert_eq!(t.species[0].kind, SpeciesKind::Tree);
+        assert_eq!(t.density_per_km2(5), 900.0);
+        assert_eq!(t.class(5).unwrap().seeds[0].species, "pine");
     }
 
     #[test]
@@ -93,5 +342,46 @@ mod tests {
         let typo = "scheme = \"x\"\nnodata_code = 0\nclases = []\n";
         let err = ClassTable::parse(typo, "typo").unwrap_err().to_string();
         assert!(err.contains("clases"), "{err}");
+    }
+
+    #[test]
+    fn species_and_rule_errors_name_table_class_and_key() {
+        let err = error(&table(SPECIES, ""));
+        assert!(err.contains("t.toml") && err.contains("`pine` is listed twice"), "{err}");
+        let err = error(&table("", "{ species = \"oak\", per_km2 = 1.0 }"));
+        assert!(
+            err.contains("class 5 (forest)") && err.contains("`oak`") && err.contains("no species"),
+            "{err}"
+        );
+        let twice = "{ species = \"pine\", per_km2 = 1.0 }, { species = \"pine\", per_km2 = 2.0 }";
+        assert!(error(&table("", twice)).contains("twice"));
+        let err = error(&table("", "{ species = \"pine\", per_km2 = 100001.0 }"));
+        assert!(err.contains("class 5 (forest)") && err.contains("per_km2"), "{err}");
+        assert!(error(&table("", "{ species = \"pine\", per_km2 = -1.0 }")).contains("per_km2"));
+
+        let many: String =
+            (0..5).map(|i| SPECIES.replace("\"pine\"", &format!("\"p{i}\""))).collect::<Vec<_>>().join("");
+        let rules: Vec<String> = (0..5).map(|i| format!("{{ species = \"p{i}\", per_km2 = 1.0 }}")).collect();
+        let err = error(&table(&many, &rules.join(", ")));
+        assert!(err.contains("class 5 (forest)") && err.contains("5 seed rules"), "{err}");
+        let seventeen: String = (0..MAX_SPECIES)
+            .map(|i| SPECIES.replace("\"pine\"", &format!("\"q{i}\"")))
+            .collect::<Vec<_>>()
+            .join("");
+        assert!(error(&table(&seventeen, "")).contains("17 species"));
+
+        for (from, to, key) in [
+            ("height_m = [6.0, 12.0]", "height_m = [0.0, 12.0]", "height_m"),
+            ("height_m = [6.0, 12.0]", "height_m = [13.0, 12.0]", "height_m"),
+            ("radius_per_height = 0.65", "radius_per_height = 0.0", "radius_per_height"),
+            ("max_slope_deg = 40.0", "max_slope_deg = 91.0", "max_slope_deg"),
+            ("max_slope_deg = 40.0", "max_slope_deg = -1.0", "max_slope_deg"),
+            ("max_slope_deg = 40.0", "max_slope_deg = 40.0\naltitude_m = [3000.0, 100.0]", "altitude_m"),
+        ] {
+            let err = error(&table("", "").replace(from, to));
+            assert!(err.contains("species `pine`") && err.contains(key) && err.contains("t.toml"), "{err}");
+        }
+        let err = error(&table("", "").replace("kind = \"tree\"", "kind = \"fern\""));
+        assert!(err.contains("fern"), "{err}");
     }
 }

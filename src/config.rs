@@ -48,6 +48,7 @@ pub struct Settings {
     pub imagery: ImagerySettings,
     pub cache: CacheSettings,
     pub tlm: TlmSettings,
+    pub seeds: SeedSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -158,6 +159,59 @@ impl TlmSettings {
         ];
         match checks.into_iter().find(|(ok, ..)| !ok) {
             Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Seed selection (pass 3), see `config/default.toml` `[seeds]`. Whether the densest class of a
+/// dataset's table fits `seeds_per_pattern` is not checked here (the table comes with the dataset);
+/// `seeds::SeedTables` refuses a table that does not (see `max_density_per_km2`).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeedSettings {
+    pub seeds_per_pattern: u32,
+    pub capacity: u32,
+    pub frustum_epsilon: f64,
+    pub occlusion_tolerance_m: f64,
+    pub occlusion_tolerance_per_km: f64,
+    pub occlusion_refine_steps: u32,
+    pub reference_height_m: f64,
+    pub sink_fraction: f64,
+    pub ground_colour_radius_m: f64,
+    /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
+    pub class_table: String,
+}
+
+impl SeedSettings {
+    /// Most seeds per km² a class can ask for: one full pattern per ring-0 cell of `cell_m` metres.
+    pub fn max_density_per_km2(&self, cell_m: f64) -> f64 {
+        f64::from(self.seeds_per_pattern) / (cell_m * cell_m * 1e-6)
+    }
+
+    fn validate(&self) -> Result<(), SettingsError> {
+        let s = self;
+        let (any, tiny) = (f64::MAX, f64::MIN_POSITIVE);
+        let steps = s.occlusion_refine_steps;
+        if !(steps == 0 || steps.is_power_of_two() && steps <= 65536) {
+            let (key, rule) = ("seeds.occlusion_refine_steps", "0 or a power of two up to 65536");
+            return Err(SettingsError::OutOfRange { key, value: steps.to_string(), rule });
+        }
+        let ranges: [(&'static str, f64, f64, f64, &'static str); 8] = [
+            ("seeds.seeds_per_pattern", s.seeds_per_pattern.into(), 64.0, 65536.0, "64 to 65536 seeds"),
+            ("seeds.capacity", s.capacity.into(), 1.0, 16_777_216.0, "1 to 16777216 seeds"),
+            ("seeds.frustum_epsilon", s.frustum_epsilon, 0.0, 1.0, "0 to 1 (NDC units)"),
+            ("seeds.occlusion_tolerance_m", s.occlusion_tolerance_m, 0.0, any, "0 or more metres"),
+            ("seeds.occlusion_tolerance_per_km", s.occlusion_tolerance_per_km, 0.0, any, "0 or more m/km"),
+            ("seeds.reference_height_m", s.reference_height_m, tiny, any, "a positive number of metres"),
+            ("seeds.sink_fraction", s.sink_fraction, 0.0, 0.5, "0 to 0.5 of the seed's height"),
+            ("seeds.ground_colour_radius_m", s.ground_colour_radius_m, 0.0, any, "0 or more metres"),
+        ];
+        // NaN and infinities fall outside every range.
+        match ranges.into_iter().find(|(_, value, lo, hi, _)| !(*lo..=*hi).contains(value)) {
+            Some((key, value, .., rule)) => {
+                Err(SettingsError::OutOfRange { key, value: value.to_string(), rule })
+            }
             None => Ok(()),
         }
     }
@@ -277,6 +331,7 @@ impl Settings {
             ),
         ];
         self.tlm.validate()?;
+        self.seeds.validate()?;
         match checks.into_iter().find(|(ok, ..)| !ok) {
             Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
             None => Ok(()),
@@ -387,5 +442,57 @@ mod tests {
         assert!(adapter.contains("quantum"), "{adapter}");
         let syntax = with("[render\n").unwrap_err().to_string();
         assert!(syntax.contains("test.toml"), "{syntax}");
+    }
+
+    #[test]
+    fn seed_settings_are_range_checked() {
+        let s = Settings::default().seeds;
+        assert_eq!((s.seeds_per_pattern, s.capacity, s.class_table.as_str()), (2048, 262_144, ""));
+        assert!((s.max_density_per_km2(256.0) - 31_250.0).abs() < 1e-6);
+        let fast = Settings::preset("fast").unwrap().seeds;
+        let accurate = Settings::preset("accurate").unwrap().seeds;
+        assert!(
+            fast.seeds_per_pattern < s.seeds_per_pattern && s.seeds_per_pattern < accurate.seeds_per_pattern
+        );
+        assert!(accurate.occlusion_tolerance_m < s.occlusion_tolerance_m);
+        for (bad, key) in [
+            ("seeds_per_pattern = 63", "seeds.seeds_per_pattern"),
+            ("seeds_per_pattern = 65537", "seeds.seeds_per_pattern"),
+            ("capacity = 0", "seeds.capacity"),
+            ("capacity = 16777217", "seeds.capacity"),
+            ("frustum_epsilon = 1.5", "seeds.frustum_epsilon"),
+            ("frustum_epsilon = -0.1", "seeds.frustum_epsilon"),
+            ("occlusion_tolerance_m = -1.0", "seeds.occlusion_tolerance_m"),
+            ("occlusion_tolerance_per_km = -1.0", "seeds.occlusion_tolerance_per_km"),
+            ("occlusion_refine_steps = 300", "seeds.occlusion_refine_steps"),
+            ("reference_height_m = 0.0", "seeds.reference_height_m"),
+            ("sink_fraction = 0.6", "seeds.sink_fraction"),
+            ("ground_colour_radius_m = -2.0", "seeds.ground_colour_radius_m"),
+            ("class_table = 3", "seeds.class_table"),
+        ] {
+            let err = with(&format!("[seeds]\n{bad}\n")).unwrap_err().to_string();
+            assert!(err.contains(key), "{bad}: {err}");
+        }
+        let s = with("[seeds]\nclass_table = \"nlcd\"\nsink_fraction = 0\n").unwrap().seeds;
+        assert_eq!((s.class_table.as_str(), s.sink_fraction), ("nlcd", 0.0));
+    }
+
+    #[test]
+    fn builtin_class_tables_fit_every_preset() {
+        for (preset, _) in PRESETS {
+            let s = Settings::preset(preset).unwrap();
+            let max_per_km2 = s.seeds.max_density_per_km2(s.tlm.cell_m);
+            for name in ["nc", "nlcd"] {
+                let table = crate::classes::ClassTable::load(name).unwrap();
+                for class in &table.classes {
+                    let density = f64::from(table.density_per_km2(class.code));
+                    assert!(
+                        density <= max_per_km2,
+                        "{preset}: {name} {} {density} > {max_per_km2}",
+                        class.code
+                    );
+                }
+            }
+        }
     }
 }

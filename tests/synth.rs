@@ -131,7 +131,7 @@ fn classes_are_in_the_table_and_water_lies_below_the_surface() {
     let table = ClassTable::load("nc").unwrap();
     let manifest = dataset.manifest.landcover.as_ref().unwrap();
     assert_eq!((manifest.scheme.as_str(), manifest.nodata_code), ("nc", 255));
-    assert_eq!(manifest.classes, table.classes);
+    assert_eq!(manifest.classes, table.names());
     let layer = dataset.landcover.as_ref().unwrap();
     for id in layer.pyramid.tiles() {
         let tile = layer.tile_bytes(id).unwrap();
