@@ -160,17 +160,18 @@ impl Renderer {
             }
             None => Vec::new(),
         };
-        let landcover = dataset.landcover.as_ref().map(|layer| {
-            TileCache::new(
+        let landcover = match (&dataset.landcover, &dataset.manifest.landcover) {
+            (Some(layer), Some(meta)) => Some(TileCache::new(
                 device,
                 "land-cover cache",
                 LayerKind::Landcover,
                 layer.pyramid,
                 1,
-                wgpu::TextureFormat::R8Uint,
+                meta.coding.texture_format(),
                 settings.cache.landcover_slots,
-            )
-        });
+            )),
+            _ => None,
+        };
         let loader = Loader::new(Arc::clone(&dataset), settings.cache.loader_threads as usize)?;
         let depth_pyramid = DepthPyramid::new(device, settings.render.width, settings.render.height);
         let tlm = TileLoadMapPass::new(device, &settings);

@@ -1,1 +1,467 @@
-//! How it works: the LCC quadtree coding (paper § 4.1). To be written.
+//! How it works: the LCC quadtree (paper § 4.1) stores land-cover classes losslessly in 3 levels
+//! of one word type, so a class read at any level agrees with the others and seeds never pop.
+//!
+//! Texels hold *palette indices*, not raw codes: index 0 is reserved ("bare / no class"), indices
+//! 1..=n name the distinct source codes in ascending order (nodata and codes missing from the class
+//! table included, so decoding gives back every source code). Level 1 holds one index per source
+//! texel; level 0, twice as fine, repeats it on its 2 × 2 children; level 2, twice as coarse, packs
+//! the 4 level-1 indices (2x + dx, 2y + dy) it covers into one word, sub-code k = dx + 2·dy at bits
+//! [k·b, (k + 1)·b) with b = word_bits / 4. The word is the narrowest that holds the palette: 8 bits
+//! (b = 2: 3 codes, the paper's coding), 16 (15 codes) or 32 (255). All levels share it, so a
+//! dataset needs one texture format. `decode` is the whole reading rule, and the shader repeats it.
+//!
+//! Writing (`write_lcc_layer`) takes a source of codes on the level-1 grid, edge-replicated beyond
+//! it: level 1 is cut from the source tile by tile, levels 0 and 2 are derived from level 1 as
+//! written in the pack. The palette must be known first: `scan_codes` counts every code.
+
+use std::path::Path;
+
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::dataset::layer_writer::read_replicated;
+use crate::dataset::pack::PackWriter;
+use crate::dataset::{CELL_TILE_TEXELS, LANDCOVER_BORDER, LayerError, Pyramid, Sampling, TileId, Window};
+
+/// Levels of the LCC quadtree, whatever the layer's size.
+pub const LCC_LEVELS: u32 = 3;
+/// The level whose texels are the source's.
+pub const LCC_SOURCE_LEVEL: u32 = 1;
+/// Word widths, narrowest first.
+pub const LCC_WORD_BITS: [u32; 3] = [8, 16, 32];
+/// Palette index that no source texel gets: "bare ground / no class".
+pub const LCC_BARE_INDEX: u32 = 0;
+/// Side of the source windows `scan_codes` reads.
+const SCAN_WINDOW_TEXELS: u32 = 1024;
+const LAYER_NAME: &str = "land cover";
+
+#[derive(Debug, Error)]
+pub enum LccError {
+    #[error("{count} distinct land-cover codes: the widest LCC word (32 bits) holds at most 255")]
+    TooManyCodes { count: usize },
+    #[error("LCC words of {word_bits} bits: use 8, 16 or 32")]
+    WordBits { word_bits: u32 },
+    #[error("LCC palette of {count} codes does not fit {word_bits}-bit words (at most {max})")]
+    PaletteTooLong { count: usize, word_bits: u32, max: usize },
+    #[error("LCC palette is not sorted and unique: code {code} at entry {entry}")]
+    PaletteOrder { entry: usize, code: u8 },
+    #[error("land-cover code {code} is not in the LCC palette (did the source change after the scan?)")]
+    NotInPalette { code: u8 },
+}
+
+/// One dataset's LCC coding: its word width and palette.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LccCoding {
+    /// 8, 16 or 32.
+    pub word_bits: u32,
+    /// `palette[i - 1]` is the source code of palette index `i`; sorted, unique.
+    pub palette: Vec<u8>,
+}
+
+impl LccCoding {
+    /// The coding of a source holding `codes` (in any order, repeats allowed): the sorted distinct
+    /// codes as palette, in the narrowest word that holds them.
+    pub fn for_codes(codes: impl IntoIterator<Item = u8>) -> Result<Self, LccError> {
+        let mut seen = [false; 256];
+        for code in codes {
+            seen[usize::from(code)] = true;
+        }
+        let palette: Vec<u8> = (0..=u8::MAX).filter(|&c| seen[usize::from(c)]).collect();
+        let word_bits = LCC_WORD_BITS
+            .into_iter()
+            .find(|&bits| palette.len() <= max_codes(bits))
+            .ok_or(LccError::TooManyCodes { count: palette.len() })?;
+        Ok(Self { word_bits, palette })
+    }
+
+    /// Checks a coding read from a manifest.
+    pub fn validate(&self) -> Result<(), LccError> {
+        let word_bits = self.word_bits;
+        if !LCC_WORD_BITS.contains(&word_bits) {
+            return Err(LccError::WordBits { word_bits });
+        }
+        let (count, max) = (self.palette.len(), max_codes(word_bits));
+        if count > max {
+            return Err(LccError::PaletteTooLong { count, word_bits, max });
+        }
+        match self.palette.windows(2).position(|pair| pair[0] >= pair[1]) {
+            Some(entry) => Err(LccError::PaletteOrder { entry: entry + 1, code: self.palette[entry + 1] }),
+            None => Ok(()),
+        }
+    }
+
+    /// What the texels hold, for the manifest's `format`, e.g. "lcc r16 palette indices".
+    pub fn format_name(&self) -> String {
+        format!("lcc r{} palette indices", self.word_bits)
+    }
+
+    /// Bits of one level-2 sub-code.
+    pub fn sub_bits(&self) -> u32 {
+        self.word_bits / 4
+    }
+
+    pub fn word_bytes(&self) -> usize {
+        (self.word_bits / 8) as usize
+    }
+
+    /// The GPU texture format of every level's tiles.
+    pub fn texture_format(&self) -> wgpu::TextureFormat {
+        match self.word_bits {
+            8 => wgpu::TextureFormat::R8Uint,
+            16 => wgpu::TextureFormat::R16Uint,
+            _ => wgpu::TextureFormat::R32Uint,
+        }
+    }
+
+    /// The palette index of `code`, or `LCC_BARE_INDEX` (0) when the palette lacks it.
+    pub fn index_of(&self, code: u8) -> u32 {
+        self.palette.binary_search(&code).map_or(LCC_BARE_INDEX, |entry| entry as u32 + 1)
+    }
+
+    /// The source code of palette index `index`; `None` for 0 (bare) and indices past the palette.
+    pub fn code_of(&self, index: u32) -> Option<u8> {
+        let entry = usize::try_from(index).ok()?.checked_sub(1)?;
+        self.palette.get(entry).copied()
+    }
+
+    /// The level-2 word of 4 level-1 indices, `children[dx + 2·dy]`.
+    pub fn pack(&self, children: [u32; 4]) -> u32 {
+        let b = self.sub_bits();
+        debug_assert!(children.iter().all(|&c| c >> b == 0), "{children:?} do not fit {b} bits");
+        (0..4).fold(0, |word, k| word | children[k as usize] << (b * k))
+    }
+
+    /// Texel of `level` that holds level-1 (source) texel `q`: level 0 → 2q, 1 → q, 2 → q >> 1.
+    pub fn texel_of(level: u32, q: [u32; 2]) -> [u32; 2] {
+        match level {
+            0 => q.map(|v| 2 * v),
+            _ => q.map(|v| v >> (level - 1)),
+        }
+    }
+
+    /// Palette index of level-1 texel `q`, from the `word` read at `texel_of(level, q)`.
+    pub fn decode(&self, level: u32, word: u32, q: [u32; 2]) -> u32 {
+        if level < 2 {
+            return word;
+        }
+        let b = self.sub_bits();
+        let k = (q[0] & 1) + 2 * (q[1] & 1);
+        (word >> (b * k)) & ((1 << b) - 1)
+    }
+}
+
+/// Codes a word of `word_bits` can address in each level-2 sub-code (index 0 is reserved).
+fn max_codes(word_bits: u32) -> usize {
+    (1usize << (word_bits / 4)) - 1
+}
+
+/// The land-cover pyramid over a source of `source_size` texels: 3 levels, level 1 the source's.
+pub fn lcc_pyramid(source_size: [u32; 2]) -> Pyramid {
+    Pyramid {
+        size: source_size.map(|n| 2 * n.max(1)),
+        tile: CELL_TILE_TEXELS,
+        border: LANDCOVER_BORDER,
+        sampling: Sampling::Cell,
+        levels: LCC_LEVELS,
+    }
+}
+
+/// How many source texels carry each code.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CodeCounts {
+    pub texels: [u64; 256],
+}
+
+impl CodeCounts {
+    /// The codes that occur, ascending.
+    pub fn present(&self) -> impl Iterator<Item = u8> + '_ {
+        (0..=u8::MAX).filter(|&c| self.texels[usize::from(c)] > 0)
+    }
+}
+
+/// Counts every code of a source of `source_size` texels, window by window, in parallel.
+pub fn scan_codes<S>(
+    source_size: [u32; 2],
+    source: &S,
+    progress: &ProgressBar,
+) -> Result<CodeCounts, LayerError>
+where
+    S: Fn(Window) -> Result<Vec<u8>, String> + Sync,
+{
+    let blocks = source_size.map(|n| n.div_ceil(SCAN_WINDOW_TEXELS));
+    let windows: Vec<Window> = (0..blocks[1])
+        .flat_map(|by| (0..blocks[0]).map(move |bx| [bx, by].map(|b| b * SCAN_WINDOW_TEXELS)))
+        .map(|[x0, y0]| Window {
+            x0,
+            y0,
+            width: SCAN_WINDOW_TEXELS.min(source_size[0] - x0),
+            height: SCAN_WINDOW_TEXELS.min(source_size[1] - y0),
+        })
+        .collect();
+    progress.set_length(windows.len() as u64);
+    let counts = windows
+        .par_iter()
+        .map(|&window| -> Result<[u64; 256], LayerError> {
+            let codes = source(window).map_err(|message| LayerError::Source {
+                layer: LAYER_NAME,
+                window,
+                message,
+            })?;
+            let expected = window.width as usize * window.height as usize;
+            if codes.len() != expected {
+                let actual = codes.len();
+                return Err(LayerError::SourceSize { layer: LAYER_NAME, window, expected, actual });
+            }
+            let mut counts = [0u64; 256];
+            for code in codes {
+                counts[usize::from(code)] += 1;
+            }
+            progress.inc(1);
+            Ok(counts)
+        })
+        .try_reduce(|| [0; 256], |a, b| Ok(std::array::from_fn(|c| a[c] + b[c])))?;
+    Ok(CodeCounts { texels: counts })
+}
+
+/// A word type the LCC pack can store.
+trait LccWord: bytemuck::Pod + Send + Sync + Into<u32> {
+    /// `value` in this word; the caller made sure it fits.
+    fn narrow(value: u32) -> Self;
+}
+
+macro_rules! lcc_word {
+    ($($word:ty),*) => {$(
+        impl LccWord for $word {
+            fn narrow(value: u32) -> Self {
+                value as $word
+            }
+        }
+    )*};
+}
+lcc_word!(u8, u16, u32);
+
+/// Writes the 3-level LCC pack at `path` from `source`, the codes of the level-1 grid of
+/// `source_size` texels (south row first). Every code must be in `coding`'s palette. Returns the
+/// layer's pyramid.
+pub fn write_lcc_layer<S>(
+    path: &Path,
+    source_size: [u32; 2],
+    coding: &LccCoding,
+    source: S,
+    progress: &ProgressBar,
+) -> Result<Pyramid, LayerError>
+where
+    S: Fn(Window) -> Result<Vec<u8>, String> + Sync,
+{
+    coding.validate()?;
+    let writer = LccWriter { pyramid: lcc_pyramid(source_size), coding };
+    match coding.word_bits {
+        8 => writer.write::<u8, S>(path, source, progress),
+        16 => writer.write::<u16, S>(path, source, progress),
+        _ => writer.write::<u32, S>(path, source, progress),
+    }
+}
+
+struct LccWriter<'a> {
+    pyramid: Pyramid,
+    coding: &'a LccCoding,
+}
+
+impl LccWriter<'_> {
+    fn write<W: LccWord, S>(
+        &self,
+        path: &Path,
+        source: S,
+        progress: &ProgressBar,
+    ) -> Result<Pyramid, LayerError>
+    where
+        S: Fn(Window) -> Result<Vec<u8>, String> + Sync,
+    {
+        let pyramid = &self.pyramid;
+        let extent = pyramid.tile_extent();
+        let tile_bytes = (extent as usize).pow(2) * size_of::<W>();
+        let writer = PackWriter::create(path, tile_bytes as u64, pyramid.tile_count())?;
+        progress.set_length(pyramid.tile_count());
+        let mut index_of = [None; 256];
+        for (entry, &code) in self.coding.palette.iter().enumerate() {
+            index_of[usize::from(code)] = Some(entry as u32 + 1);
+        }
+        // Level 1 first, from the source; levels 0 and 2 are read back from it.
+        for level in [LCC_SOURCE_LEVEL, 0, 2] {
+            let [nx, ny] = pyramid.tiles_at(level);
+            let ids: Vec<TileId> =
+                (0..ny).flat_map(|y| (0..nx).map(move |x| TileId::new(level, x, y))).collect();
+            ids.par_iter().try_for_each(|&id| -> Result<(), LayerError> {
+                let [x0, y0] = [id.x, id.y].map(|t| t * pyramid.tile);
+                let words: Vec<u32> = match level {
+                    0 => {
+                        let fine = self.level1_block::<W>(&writer, [x0 / 2, y0 / 2], extent / 2)?;
+                        let half = (extent / 2) as usize;
+                        (0..extent as usize)
+                            .flat_map(|j| (0..extent as usize).map(move |i| (i, j)))
+                            .map(|(i, j)| fine[(j / 2) * half + i / 2])
+                            .collect()
+                    }
+                    1 => {
+                        let (origin, size) = ([x0, y0].map(i64::from), pyramid.size_at(LCC_SOURCE_LEVEL));
+                        let codes = read_replicated(LAYER_NAME, size, &source, origin, extent)?;
+                        codes
+                            .into_iter()
+                            .map(|c| index_of[usize::from(c)].ok_or(LccError::NotInPalette { code: c }))
+                            .collect::<Result<_, _>>()?
+                    }
+                    _ => self.level2_words::<W>(&writer, id)?,
+                };
+                let range = self.index_range(level, &words);
+                let payload: Vec<W> = words.into_iter().map(W::narrow).collect();
+                let index = pyramid.tile_index(id).unwrap_or_default();
+                writer.write_tile(index, bytemuck::cast_slice(&payload), range)?;
+                progress.inc(1);
+                Ok(())
+            })?;
+        }
+        writer.finish()?;
+        Ok(*pyramid)
+    }
+
+    /// The words of level-2 tile `id`, each packing the 4 level-1 texels it covers; beyond the
+    /// layer, the edge word repeats.
+    fn level2_words<W: LccWord>(&self, writer: &PackWriter, id: TileId) -> Result<Vec<u32>, LayerError> {
+        let pyramid = &self.pyramid;
+        let (extent, size) = (pyramid.tile_extent(), pyramid.size_at(2));
+        let [x0, y0] = [id.x, id.y].map(|t| t * pyramid.tile);
+        let fine = self.level1_block::<W>(writer, [2 * x0, 2 * y0], 2 * extent)?;
+        let fine_extent = 2 * extent as usize;
+        let mut words = Vec::with_capacity((extent as usize).pow(2));
+        for j in 0..extent {
+            let y = (y0 + j).min(size[1] - 1) - y0;
+            for i in 0..extent {
+                let x = (x0 + i).min(size[0] - 1) - x0;
+                let child =
+                    |dx: u32, dy: u32| fine[(2 * y + dy) as usize * fine_extent + (2 * x + dx) as usize];
+                words.push(self.coding.pack([child(0, 0), child(1, 0), child(0, 1), child(1, 1)]));
+            }
+        }
+        Ok(words)
+    }
+
+    /// Level-1 indices of the `extent`² block at `origin`, clamped to the layer, gathered from the
+    /// level-1 tiles already written.
+    fn level1_block<W: LccWord>(
+        &self,
+        writer: &PackWriter,
+        origin: [u32; 2],
+        extent: u32,
+    ) -> Result<Vec<u32>, LayerError> {
+        let pyramid = &self.pyramid;
+        let (size, tile) = (pyramid.size_at(LCC_SOURCE_LEVEL), pyramid.tile);
+        let clamp = |v: u32, axis: usize| v.min(size[axis] - 1);
+        let first = [0, 1].map(|a| clamp(origin[a], a) / tile);
+        let last = [0, 1].map(|a| clamp(origin[a] + extent - 1, a) / tile);
+        let mut tiles = Vec::new();
+        for ty in first[1]..=last[1] {
+            for tx in first[0]..=last[0] {
+                let index = pyramid.tile_index(TileId::new(LCC_SOURCE_LEVEL, tx, ty)).unwrap_or_default();
+                let words: Vec<W> = bytemuck::pod_collect_to_vec(&writer.read_tile(index)?);
+                tiles.push(words);
+            }
+        }
+        let across = (last[0] - first[0] + 1) as usize;
+        let mut block = Vec::with_capacity((extent as usize).pow(2));
+        for j in 0..extent {
+            let y = clamp(origin[1] + j, 1);
+            for i in 0..extent {
+                let x = clamp(origin[0] + i, 0);
+                let (tx, ty) = ((x / tile - first[0]) as usize, (y / tile - first[1]) as usize);
+                // Land-cover tiles have no border: a tile's words are its `tile`² texels.
+                let local = ((y % tile) * tile + x % tile) as usize;
+                block.push(tiles[ty * across + tx][local].into());
+            }
+        }
+        Ok(block)
+    }
+
+    /// The pack index range of a tile: min and max palette index under it.
+    fn index_range(&self, level: u32, words: &[u32]) -> Option<[f32; 2]> {
+        let sub_codes = if level < 2 { 1 } else { 4 };
+        let indices = words.iter().flat_map(|&w| (0..sub_codes).map(move |k| (w, [k & 1, k >> 1])));
+        let [lo, hi] = indices
+            .map(|(word, q)| self.coding.decode(level, word, q))
+            .fold([u32::MAX, 0], |[lo, hi], v| [lo.min(v), hi.max(v)]);
+        (lo <= hi).then_some([lo as f32, hi as f32])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_narrowest_word_that_holds_the_palette_is_chosen() {
+        let bits = |n: u8| LccCoding::for_codes((0..n).map(|c| c.wrapping_mul(17))).unwrap().word_bits;
+        assert_eq!([bits(1), bits(3), bits(4), bits(15), bits(16), bits(255)], [8, 8, 16, 16, 32, 32]);
+        let coding = LccCoding::for_codes([42, 7, 255, 7, 1, 42]).unwrap();
+        assert_eq!(coding, LccCoding { word_bits: 16, palette: vec![1, 7, 42, 255] });
+        assert_eq!((coding.sub_bits(), coding.word_bytes()), (4, 2));
+        assert_eq!(coding.texture_format(), wgpu::TextureFormat::R16Uint);
+        assert_eq!(coding.format_name(), "lcc r16 palette indices");
+        assert_eq!(LccCoding::for_codes([]).unwrap().word_bits, 8);
+    }
+
+    #[test]
+    fn more_than_255_codes_or_a_bad_manifest_coding_are_errors() {
+        assert!(matches!(LccCoding::for_codes(0..=u8::MAX), Err(LccError::TooManyCodes { count: 256 })));
+        let coding = |word_bits, palette: &[u8]| LccCoding { word_bits, palette: palette.to_vec() };
+        assert!(matches!(coding(12, &[1]).validate(), Err(LccError::WordBits { word_bits: 12 })));
+        assert!(matches!(coding(8, &[1, 2, 3, 4]).validate(), Err(LccError::PaletteTooLong { max: 3, .. })));
+        assert!(matches!(coding(8, &[3, 1]).validate(), Err(LccError::PaletteOrder { entry: 1, code: 1 })));
+        assert!(matches!(coding(8, &[1, 1]).validate(), Err(LccError::PaletteOrder { .. })));
+        let all: Vec<u8> = (0..255).collect();
+        assert!(coding(32, &all).validate().is_ok() && coding(16, &all).validate().is_err());
+    }
+
+    #[test]
+    fn palette_indices_start_at_one_and_name_every_code() {
+        let coding = LccCoding::for_codes([11, 90, 255]).unwrap();
+        assert_eq!([11, 90, 255, 12].map(|c| coding.index_of(c)), [1, 2, 3, LCC_BARE_INDEX]);
+        assert_eq!([0, 1, 2, 3, 4].map(|i| coding.code_of(i)), [None, Some(11), Some(90), Some(255), None]);
+    }
+
+    #[test]
+    fn packed_words_decode_to_every_child_at_every_width() {
+        for word_bits in LCC_WORD_BITS {
+            let coding = LccCoding { word_bits, palette: Vec::new() };
+            let top = (1u32 << coding.sub_bits()) - 1;
+            for pattern in 0..=top {
+                let children = [pattern, top - pattern, (pattern * 7) & top, top];
+                let word = coding.pack(children);
+                assert!(word_bits == 32 || word >> word_bits == 0, "{word_bits}: {word:#x} overflows");
+                for k in 0..4u32 {
+                    // Level-1 texel q, anywhere, whose position in its level-2 texel is k.
+                    let q = [2 * 37 + (k & 1), 2 * 11 + (k >> 1)];
+                    assert_eq!(LccCoding::texel_of(2, q), [37, 11]);
+                    assert_eq!(coding.decode(2, word, q), children[k as usize], "{word_bits} bits, k {k}");
+                }
+            }
+            assert_eq!(coding.decode(0, top, [5, 9]), top);
+            assert_eq!(coding.decode(1, top, [5, 9]), top);
+        }
+        assert_eq!([0, 1, 2].map(|level| LccCoding::texel_of(level, [5, 8])), [[10, 16], [5, 8], [2, 4]]);
+        let paper = LccCoding { word_bits: 8, palette: vec![1, 2, 3] };
+        assert_eq!(paper.pack([1, 2, 3, 0]), 0b00_11_10_01);
+    }
+
+    #[test]
+    fn three_levels_whatever_the_size() {
+        let small = lcc_pyramid([3, 1]);
+        assert_eq!(
+            (small.levels, small.size_at(0), small.size_at(1), small.size_at(2)),
+            (3, [6, 2], [3, 1], [2, 1])
+        );
+        let large = lcc_pyramid([5000, 3000]);
+        assert_eq!((large.levels, large.tiles_at(0), large.tiles_at(2)), (3, [20, 12], [5, 3]));
+    }
+}

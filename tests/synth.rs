@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use terramp::classes::ClassTable;
-use terramp::dataset::{Dataset, LayerPack, TileId};
+use terramp::dataset::{Dataset, TileId};
+use terramp::lcc::LCC_SOURCE_LEVEL;
 use terramp::synth::{IMAGERY_PACK, LANDCOVER_PACK, SynthError, SynthParams, code, synthesize};
 
 fn temp_out(name: &str) -> PathBuf {
@@ -53,20 +54,21 @@ fn level0_heights(dataset: &Dataset) -> Vec<f32> {
     out
 }
 
-/// Level-0 texels of a cell layer with one byte per texel (mip 0, interiors only).
-fn level0_cells(layer: &LayerPack) -> Vec<u8> {
+/// The land cover's source classes (LCC level 1, decoded), row by row from the south.
+fn source_classes(dataset: &Dataset) -> Vec<u8> {
+    let (layer, coding) = (dataset.landcover.as_ref().unwrap(), dataset.lcc_coding().unwrap());
     let p = layer.pyramid;
-    let (extent, border) = (p.tile_extent() as usize, p.border as usize);
-    let mut out = vec![0u8; (p.size[0] * p.size[1]) as usize];
-    let [nx, ny] = p.tiles_at(0);
+    let size = p.size_at(LCC_SOURCE_LEVEL);
+    let mut out = vec![0u8; (size[0] * size[1]) as usize];
+    let [nx, ny] = p.tiles_at(LCC_SOURCE_LEVEL);
     for ty in 0..ny {
         for tx in 0..nx {
-            let tile = layer.tile_bytes(TileId::new(0, tx, ty)).unwrap();
-            for j in 0..p.tile.min(p.size[1] - ty * p.tile) {
-                for i in 0..p.tile.min(p.size[0] - tx * p.tile) {
+            let words = dataset.landcover_words(TileId::new(LCC_SOURCE_LEVEL, tx, ty)).unwrap();
+            for j in 0..p.tile.min(size[1] - ty * p.tile) {
+                for i in 0..p.tile.min(size[0] - tx * p.tile) {
                     let (x, y) = (tx * p.tile + i, ty * p.tile + j);
-                    out[(y * p.size[0] + x) as usize] =
-                        tile[(j as usize + border) * extent + i as usize + border];
+                    let index = words[(j * p.tile + i) as usize];
+                    out[(y * size[0] + x) as usize] = coding.code_of(index).expect("a palette index");
                 }
             }
         }
@@ -132,17 +134,30 @@ fn classes_are_in_the_table_and_water_lies_below_the_surface() {
     let manifest = dataset.manifest.landcover.as_ref().unwrap();
     assert_eq!((manifest.scheme.as_str(), manifest.nodata_code), ("nc", 255));
     assert_eq!(manifest.classes, table.names());
+    let coding = dataset.lcc_coding().unwrap();
+    assert!(
+        coding.palette.iter().all(|&c| table.contains(c)),
+        "{coding:?} holds a code outside the nc table"
+    );
+    assert_eq!(coding.word_bits, if coding.palette.len() <= 3 { 8 } else { 16 });
     let layer = dataset.landcover.as_ref().unwrap();
     for id in layer.pyramid.tiles() {
-        let tile = layer.tile_bytes(id).unwrap();
-        assert!(tile.iter().all(|&c| table.contains(c)), "{id:?} holds a code outside the nc table");
+        let words = dataset.landcover_words(id).unwrap();
+        let sub_codes = if id.level == 2 { 4 } else { 1 };
+        let indices = words
+            .iter()
+            .flat_map(|&w| (0..sub_codes).map(move |k| coding.decode(id.level, w, [k & 1, k >> 1])));
+        let indices: Vec<u32> = indices.collect();
+        assert!(indices.iter().all(|&i| coding.code_of(i).is_some()), "{id:?} holds a bare or unknown index");
     }
-    let classes = level0_cells(layer);
+    let classes = source_classes(&dataset);
     let terrain = p.terrain();
-    let texel_m = manifest.layer.texel_m;
+    // Level 0's texels are half the source's.
+    let texel_m = 2.0 * manifest.layer.texel_m;
+    let size = layer.pyramid.size_at(LCC_SOURCE_LEVEL);
     let mut seen = [0usize; 8];
     for (k, &class) in classes.iter().enumerate() {
-        let (i, j) = (k as u32 % layer.pyramid.size[0], k as u32 / layer.pyramid.size[0]);
+        let (i, j) = (k as u32 % size[0], k as u32 / size[0]);
         let centre = |i: u32| (f64::from(i) + 0.5) * texel_m - 0.5 * p.spacing_m;
         let relief_m = terrain.relief(centre(i), centre(j)).v;
         assert_eq!(
@@ -184,7 +199,8 @@ fn odd_and_tiny_sizes_work() {
         let dataset = synth(&format!("size-{size}"), &params(size, 5));
         assert_eq!(dataset.height.pyramid.size, [size, size]);
         assert_eq!(dataset.imagery.as_ref().unwrap().pyramid.size, [4 * size, 4 * size]);
-        assert_eq!(dataset.landcover.as_ref().unwrap().pyramid.size, [2 * size, 2 * size]);
+        let landcover = dataset.landcover.as_ref().unwrap().pyramid;
+        assert_eq!((landcover.size_at(LCC_SOURCE_LEVEL), landcover.size), ([2 * size; 2], [4 * size; 2]));
         let heights = level0_heights(&dataset);
         let layer = &dataset.manifest.height;
         assert_eq!(layer.min_m, heights.iter().copied().fold(f32::INFINITY, f32::min));

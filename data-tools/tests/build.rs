@@ -23,6 +23,14 @@ const NC_KNOWN: [(u32, u32, f64); 5] = [
 const RAINIER_KNOWN: [(u32, u32, f64); 4] =
     [(600, 600, 1849.0), (1200, 1200, 1115.0), (150, 220, 2496.0), (900, 333, 1392.0)];
 
+/// The land cover's codes at LCC `level` (0 or 1: one code per texel), south row first, checked
+/// across tiles.
+fn lcc_codes(dataset: &Dataset, level: u32) -> Vec<u8> {
+    let (layer, coding) = (dataset.landcover.as_ref().unwrap(), dataset.lcc_coding().unwrap());
+    let words = level_image(&layer.pyramid, level, |id| dataset.landcover_words(id).unwrap());
+    words.iter().map(|&index| coding.code_of(index).expect("a palette index")).collect()
+}
+
 #[test]
 fn nc_trio_is_copied_exactly_and_tiles_agree() {
     let Some(data) = shared_data() else { return };
@@ -68,13 +76,12 @@ fn nc_trio_is_copied_exactly_and_tiles_agree() {
         height_image(&dataset, level);
     }
 
-    // Land cover is aligned (10 m on the 30 m DEM's extent): copied code for code, nodata too.
-    let landcover = dataset.landcover.as_ref().unwrap();
-    let layer = &manifest.landcover.as_ref().unwrap().layer;
-    assert_eq!((layer.texel_m, layer.pyramid.size), (10.0, [1500, 1350]));
-    let extent = layer.pyramid.tile_extent() as usize;
-    let codes =
-        level_image(&layer.pyramid, 0, |id| landcover.tile_bytes(id).unwrap()[..extent * extent].to_vec());
+    // Land cover is aligned (10 m on the 30 m DEM's extent): copied code for code, nodata too, as
+    // LCC level 1 (data-tools/tests/lcc.rs checks all 3 levels).
+    let landcover = manifest.landcover.as_ref().unwrap();
+    let layer = &landcover.layer;
+    assert_eq!((layer.texel_m, layer.pyramid.size_at(1)), (5.0, [1500, 1350]));
+    let codes = lcc_codes(&dataset, 1);
     let (source, size) = gdal_band(Path::new(&landuse));
     let mut nodata = 0;
     for (k, &code) in codes.iter().enumerate() {
@@ -220,10 +227,8 @@ fn zion_voids_and_nlcd_match_their_sources() {
         }
     }
     let layer = &manifest.landcover.as_ref().unwrap().layer;
-    assert_eq!((layer.texel_m, layer.pyramid.size), (30.0, [1176, 1434]));
-    let pack = dataset.landcover.as_ref().unwrap();
-    let extent = layer.pyramid.tile_extent() as usize;
-    let codes = level_image(&layer.pyramid, 0, |id| pack.tile_bytes(id).unwrap()[..extent * extent].to_vec());
+    assert_eq!((layer.texel_m, layer.pyramid.size_at(1)), (15.0, [1176, 1434]));
+    let codes = lcc_codes(&dataset, 1);
     let (source, size) = gdal_band(&nlcd);
     for (k, &code) in codes.iter().enumerate() {
         let (x, y) = ((k % size[0]) as u32, (k / size[0]) as u32);

@@ -355,13 +355,17 @@ fn info(dataset_dir: &Path) -> Result<()> {
         );
     }
     if let Some(l) = &m.landcover {
+        let source = l.layer.pyramid.size_at(terramp::lcc::LCC_SOURCE_LEVEL);
         println!(
-            "  land cover ({}, {} classes): {}×{} texels at {} m",
+            "  land cover ({}, {} classes): {}×{} texels at {} m, LCC quadtree of {} levels in {}-bit words, {} codes",
             l.scheme,
             l.classes.len(),
-            l.layer.pyramid.size[0],
-            l.layer.pyramid.size[1],
-            l.layer.texel_m
+            source[0],
+            source[1],
+            2.0 * l.layer.texel_m,
+            l.layer.pyramid.levels,
+            l.coding.word_bits,
+            l.coding.palette.len()
         );
     }
     Ok(())

@@ -6,8 +6,9 @@
 //! then derived from the level below it as already written in the pack (read back through the
 //! page cache, never held whole), by one `Reduce` rule per layer: heights are decimated so that a
 //! coarse sample equals the fine sample at the same place (which is what keeps LOD seams exact),
-//! imagery is box-filtered, classes take the majority. A tile's mips are reduced from its own
-//! bordered mip 0, with the same rule, so mips and coarser levels agree.
+//! imagery is box-filtered. A tile's mips are reduced from its own bordered mip 0, with the same
+//! rule, so mips and coarser levels agree. Land cover is not reduced at all: `crate::lcc` writes
+//! its lossless 3-level quadtree, cutting its source windows with the same `read_replicated`.
 
 use std::path::Path;
 
@@ -17,9 +18,8 @@ use thiserror::Error;
 
 use super::pack::{PackError, PackWriter};
 use super::pyramid::{Pyramid, Sampling, TileId};
-use super::{
-    CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS, LANDCOVER_BORDER,
-};
+use super::{CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS};
+use crate::lcc::LccError;
 
 /// How a texel of level `l + 1` is made from the 2 × 2 texels of level `l` beneath it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -28,8 +28,6 @@ pub enum Reduce {
     Decimate,
     /// Average (imagery).
     Mean,
-    /// Majority, ties to the smallest value (classes: never invent a class).
-    Mode,
 }
 
 /// A texel type a pack can store.
@@ -52,7 +50,7 @@ impl Texel for f32 {
     fn reduce(rule: Reduce, block: [f32; 4]) -> f32 {
         match rule {
             Reduce::Decimate => block[0],
-            Reduce::Mean | Reduce::Mode => block.iter().sum::<f32>() * 0.25,
+            Reduce::Mean => block.iter().sum::<f32>() * 0.25,
         }
     }
 }
@@ -62,16 +60,6 @@ impl Texel for u8 {
         match rule {
             Reduce::Decimate => block[0],
             Reduce::Mean => ((block.iter().map(|&v| u32::from(v)).sum::<u32>() + 2) / 4) as u8,
-            Reduce::Mode => {
-                let count = |v: u8| block.iter().filter(|&&w| w == v).count();
-                let mut best = block[0];
-                for &v in &block[1..] {
-                    if count(v) > count(best) || (count(v) == count(best) && v < best) {
-                        best = v;
-                    }
-                }
-                best
-            }
         }
     }
 }
@@ -100,6 +88,8 @@ pub enum LayerError {
     Source { layer: &'static str, window: Window, message: String },
     #[error("{layer}: source returned {actual} texels for window {window:?}, expected {expected}")]
     SourceSize { layer: &'static str, window: Window, expected: usize, actual: usize },
+    #[error(transparent)]
+    Lcc(#[from] LccError),
 }
 
 /// What is stored for one layer.
@@ -128,12 +118,6 @@ impl LayerSpec {
     pub fn imagery(size: [u32; 2]) -> Self {
         let pyramid = Pyramid::new(size, CELL_TILE_TEXELS, IMAGERY_BORDER, Sampling::Cell);
         Self { name: "imagery", pyramid, mips: IMAGERY_MIPS, reduce: Reduce::Mean }
-    }
-
-    /// Land cover: u8 class codes, lossless at level 0, majority above.
-    pub fn landcover(size: [u32; 2]) -> Self {
-        let pyramid = Pyramid::new(size, CELL_TILE_TEXELS, LANDCOVER_BORDER, Sampling::Cell);
-        Self { name: "land cover", pyramid, mips: 1, reduce: Reduce::Mode }
     }
 
     pub fn tile_texels(&self) -> usize {
@@ -169,7 +153,7 @@ where
             // A coarse tile's range also spans the finer tiles it was reduced from, so it bounds
             // every level-0 value beneath it, not only its own (decimated) samples.
             let (mip0, range_below) = if level == 0 {
-                (read_source(spec, &source, x0, y0, extent)?, None)
+                (read_replicated(spec.name, spec.pyramid.size, &source, [x0, y0], extent)?, None)
             } else {
                 reduce_level_below(spec, &writer, id)?
             };
@@ -185,19 +169,20 @@ where
     Ok(())
 }
 
-/// The `extent`² window at (`x0`, `y0`) of level 0, edge-replicated beyond the layer.
-fn read_source<T, S>(
-    spec: &LayerSpec,
+/// The `extent`² window at `origin` of a source grid of `size` texels (`layer` names it in
+/// errors), south row first, edge-replicated beyond the grid.
+pub(crate) fn read_replicated<T, S>(
+    layer: &'static str,
+    size: [u32; 2],
     source: &S,
-    x0: i64,
-    y0: i64,
+    [x0, y0]: [i64; 2],
     extent: u32,
 ) -> Result<Vec<T>, LayerError>
 where
-    T: Texel,
+    T: bytemuck::Pod,
     S: Fn(Window) -> Result<Vec<T>, String>,
 {
-    let size = spec.pyramid.size.map(i64::from);
+    let size = size.map(i64::from);
     let clamp = |v: i64, axis: usize| v.clamp(0, size[axis] - 1);
     let (lo, hi) = (
         [clamp(x0, 0), clamp(y0, 1)],
@@ -209,11 +194,10 @@ where
         width: (hi[0] - lo[0] + 1) as u32,
         height: (hi[1] - lo[1] + 1) as u32,
     };
-    let texels =
-        source(window).map_err(|message| LayerError::Source { layer: spec.name, window, message })?;
+    let texels = source(window).map_err(|message| LayerError::Source { layer, window, message })?;
     let expected = window.width as usize * window.height as usize;
     if texels.len() != expected {
-        return Err(LayerError::SourceSize { layer: spec.name, window, expected, actual: texels.len() });
+        return Err(LayerError::SourceSize { layer, window, expected, actual: texels.len() });
     }
     let extent = extent as usize;
     let mut out = Vec::with_capacity(extent * extent);

@@ -9,8 +9,10 @@
 use serde::{Deserialize, Serialize};
 
 use super::pyramid::Pyramid;
+use crate::lcc::LccCoding;
 
-pub const FORMAT_VERSION: u32 = 1;
+/// Version 2: land cover is the LCC quadtree of palette indices (`crate::lcc`).
+pub const FORMAT_VERSION: u32 = 2;
 pub const MANIFEST_FILE: &str = "manifest.toml";
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -70,11 +72,15 @@ pub struct CellLayer {
     pub source: String,
 }
 
+/// The land cover: an LCC quadtree (`crate::lcc`) whose `layer.pyramid` has exactly `LCC_LEVELS`
+/// levels, level 1 the source's texels; `layer.texel_m` is level 0's texel, half the source's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LandcoverLayer {
     #[serde(flatten)]
     pub layer: CellLayer,
+    /// The word width and palette of the texels: what turns a stored word back into a code.
+    pub coding: LccCoding,
     /// The classification scheme's name (e.g. "nc", "nlcd").
     pub scheme: String,
     /// The classes of the scheme. Codes absent here are "no class".

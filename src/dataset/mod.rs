@@ -3,8 +3,14 @@
 //! every pack's header and length up front; tile payloads are checksummed when read, so a damaged
 //! tile is an error for that tile alone and the caller decides how to degrade.
 //!
+//! The manifest's format version is read on its own before the rest, so a dataset of another
+//! version is reported as such (and rebuilt by whoever owns it), not as a malformed manifest.
+//! Land cover is an LCC quadtree (`crate::lcc`): its words are read back through the manifest's
+//! `LccCoding`, never as raw class codes.
+//!
 //! Writing goes through `Staging` (atomic publication) and `layer_writer::write_layer` (one pack,
-//! tile by tile), shared by `terramp-data build` and the synthetic generator.
+//! tile by tile; `lcc::write_lcc_layer` for land cover), shared by `terramp-data build` and the
+//! synthetic generator.
 
 pub mod layer_writer;
 pub mod manifest;
@@ -14,7 +20,10 @@ pub mod staging;
 
 use std::path::{Path, PathBuf};
 
+use serde::Deserialize;
 use thiserror::Error;
+
+use crate::lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
 
 pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer};
 pub use manifest::{
@@ -130,11 +139,17 @@ impl Dataset {
         }
         let text = std::fs::read_to_string(&manifest_path)
             .map_err(|source| DatasetError::Io { path: manifest_path.clone(), source })?;
-        let manifest: Manifest = toml::from_str(&text)
-            .map_err(|e| DatasetError::Manifest { path: manifest_path.clone(), message: e.to_string() })?;
-        if manifest.format_version != FORMAT_VERSION {
-            return Err(DatasetError::Version { path: manifest_path, found: manifest.format_version });
+        let bad = |message: String| DatasetError::Manifest { path: manifest_path.clone(), message };
+        // The version alone first: other versions' manifests need not parse as this one's.
+        #[derive(Deserialize)]
+        struct Version {
+            format_version: u32,
         }
+        let version: Version = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        if version.format_version != FORMAT_VERSION {
+            return Err(DatasetError::Version { path: manifest_path, found: version.format_version });
+        }
+        let manifest: Manifest = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
         let height =
             LayerPack::open(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?;
         let valid_mask = manifest
@@ -148,11 +163,22 @@ impl Dataset {
             .as_ref()
             .map(|l| LayerPack::open(dir, &l.pack, l.pyramid, l.mips, 4))
             .transpose()?;
-        let landcover = manifest
-            .landcover
-            .as_ref()
-            .map(|l| LayerPack::open(dir, &l.layer.pack, l.layer.pyramid, l.layer.mips, 1))
-            .transpose()?;
+        let landcover = match &manifest.landcover {
+            Some(l) => {
+                l.coding.validate().map_err(|e| bad(format!("land cover: {e}")))?;
+                let p = &l.layer.pyramid;
+                if p.levels != LCC_LEVELS || p.border != LANDCOVER_BORDER || l.layer.mips != 1 {
+                    let message = format!(
+                        "land cover: an LCC quadtree has {LCC_LEVELS} levels, 1 mip and no border, this one \
+                         {} levels, {} mips, a border of {}",
+                        p.levels, l.layer.mips, p.border
+                    );
+                    return Err(bad(message));
+                }
+                Some(LayerPack::open(dir, &l.layer.pack, *p, 1, l.coding.word_bytes())?)
+            }
+            None => None,
+        };
         Ok(Self { dir: dir.to_owned(), manifest, height, valid_mask, imagery, landcover })
     }
 
@@ -188,6 +214,45 @@ impl Dataset {
         Ok(south + (north - south) * fy)
     }
 
+    /// The land cover's LCC coding, if the dataset has land cover.
+    pub fn lcc_coding(&self) -> Option<&LccCoding> {
+        self.manifest.landcover.as_ref().map(|l| &l.coding)
+    }
+
+    /// Land-cover tile `id`'s words widened to u32, south row first (palette indices at levels 0
+    /// and 1, packed sub-codes at level 2: see `LccCoding::decode`). A dataset without land cover
+    /// answers `PackError::OutOfRange` with a count of 0.
+    pub fn landcover_words(&self, id: TileId) -> Result<Vec<u32>, PackError> {
+        let (layer, coding) = self.landcover_layer()?;
+        let bytes = layer.tile_bytes(id)?;
+        Ok(bytes.chunks_exact(coding.word_bytes()).map(word_of).collect())
+    }
+
+    /// Palette index of level-1 (source) texel `q`, clamped to the layer, as read from `level`
+    /// (0, 1 or 2: all agree). Reads one tile: for tests and the exact oracle, not per frame. A
+    /// dataset without land cover is bare everywhere (index 0).
+    pub fn landcover_index(&self, level: u32, q: [u32; 2]) -> Result<u32, PackError> {
+        if self.landcover.is_none() {
+            return Ok(crate::lcc::LCC_BARE_INDEX);
+        }
+        let (layer, coding) = self.landcover_layer()?;
+        let pyramid = &layer.pyramid;
+        let size = pyramid.size_at(LCC_SOURCE_LEVEL);
+        let q = [0, 1].map(|a| q[a].min(size[a] - 1));
+        let texel = LccCoding::texel_of(level, q);
+        let (tile, local) = (texel.map(|v| v / pyramid.tile), texel.map(|v| v % pyramid.tile));
+        let bytes = layer.tile_bytes(TileId::new(level, tile[0], tile[1]))?;
+        let at = (local[1] * pyramid.tile_extent() + local[0]) as usize * coding.word_bytes();
+        Ok(coding.decode(level, word_of(&bytes[at..at + coding.word_bytes()]), q))
+    }
+
+    fn landcover_layer(&self) -> Result<(&LayerPack, &LccCoding), PackError> {
+        match (&self.landcover, self.lcc_coding()) {
+            (Some(layer), Some(coding)) => Ok((layer, coding)),
+            _ => Err(PackError::OutOfRange { path: self.dir.clone(), index: u64::MAX, count: 0 }),
+        }
+    }
+
     /// The stored sample (`x`, `y`) of `level`, in metres.
     pub fn height_sample(&self, level: u32, x: u32, y: u32) -> Result<f64, PackError> {
         let pyramid = &self.height.pyramid;
@@ -198,6 +263,11 @@ impl Dataset {
         let (lx, ly) = (x - tx * pyramid.tile + pyramid.border, y - ty * pyramid.tile + pyramid.border);
         Ok(f64::from(tile[(ly * extent + lx) as usize]))
     }
+}
+
+/// A little-endian word of 1, 2 or 4 bytes, widened.
+fn word_of(bytes: &[u8]) -> u32 {
+    bytes.iter().rev().fold(0, |word, &b| word << 8 | u32::from(b))
 }
 
 #[cfg(test)]

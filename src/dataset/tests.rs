@@ -3,6 +3,7 @@ use std::path::PathBuf;
 use indicatif::ProgressBar;
 
 use super::*;
+use crate::lcc::{self, LccCoding};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("terramp-dataset-{}-{name}", std::process::id()));
@@ -94,29 +95,112 @@ fn imagery_mips_and_levels_are_consistent_box_filters() {
     }
 }
 
-#[test]
-fn classes_are_lossless_at_level_zero_and_never_invented() {
-    let spec = LayerSpec {
-        name: "landcover",
-        pyramid: Pyramid::new([50, 30], 16, 0, Sampling::Cell),
+/// Writes a staged dataset of 37 × 21 heights and an LCC land cover of `size` source texels.
+fn lcc_dataset(name: &str, size: [u32; 2], class: impl Fn(u32, u32) -> u8 + Sync) -> Dataset {
+    let out = temp_dir(name).join("ds");
+    let staging = Staging::begin(&out).unwrap();
+    let spec =
+        LayerSpec { pyramid: Pyramid::new([37, 21], 8, 1, Sampling::Vertex), ..LayerSpec::heights([37, 21]) };
+    write_layer(&staging.path("height.pack"), &spec, source_of(height_of), &ProgressBar::hidden()).unwrap();
+    let counts = lcc::scan_codes(size, &source_of(&class), &ProgressBar::hidden()).unwrap();
+    let coding = LccCoding::for_codes(counts.present()).unwrap();
+    let path = staging.path("landcover.pack");
+    let pyramid =
+        lcc::write_lcc_layer(&path, size, &coding, source_of(&class), &ProgressBar::hidden()).unwrap();
+    let layer = CellLayer {
+        pack: "landcover.pack".into(),
+        texel_m: 5.0,
+        pyramid,
         mips: 1,
-        reduce: Reduce::Mode,
+        format: coding.format_name(),
+        source: "test".into(),
     };
-    let path = temp_dir("classes").join("landcover.pack");
-    let class = |x: u32, y: u32| [11u8, 41, 42, 95][((x / 3 + y / 5) % 4) as usize];
-    write_layer(&path, &spec, source_of(class), &ProgressBar::hidden()).unwrap();
-    let pack = Pack::open(&path).unwrap();
-    for id in spec.pyramid.tiles() {
-        let tile = pack.tile(spec.pyramid.tile_index(id).unwrap()).unwrap();
-        if id.level == 0 {
-            for (k, &c) in tile.iter().enumerate() {
-                let (x, y) = (id.x * 16 + k as u32 % 16, id.y * 16 + k as u32 / 16);
-                assert_eq!(c, class(x.min(49), y.min(29)));
+    let landcover =
+        LandcoverLayer { layer, coding, scheme: "test".into(), classes: Vec::new(), nodata_code: 255 };
+    staging.commit(&Manifest { landcover: Some(landcover), ..manifest_for(&spec) }).unwrap();
+    Dataset::open(&out).unwrap()
+}
+
+#[test]
+fn lcc_levels_decode_to_the_source_codes_everywhere() {
+    // Odd sizes: level 2's last column and row pack replicated edge texels; the layer spans
+    // several tiles at levels 0 and 1, one at level 2.
+    let size = [701, 263];
+    let class = |x: u32, y: u32| [11u8, 41, 42, 95, 255][((x / 3 + y / 5 + x * y % 7) % 5) as usize];
+    let dataset = lcc_dataset("lcc", size, class);
+    let coding = dataset.lcc_coding().unwrap().clone();
+    assert_eq!((coding.word_bits, coding.palette.clone()), (16, vec![11, 41, 42, 95, 255]));
+    let layer = dataset.landcover.as_ref().unwrap();
+    let p = layer.pyramid;
+    assert_eq!(
+        (p.levels, p.size_at(1), p.tiles_at(0), p.tiles_at(2)),
+        (lcc::LCC_LEVELS, size, [3, 2], [1, 1])
+    );
+    for level in 0..lcc::LCC_LEVELS {
+        // Every stored word, padding included, through the tile reader.
+        let tile = p.tile as usize;
+        for id in (0..p.tiles_at(level)[1])
+            .flat_map(|y| (0..p.tiles_at(level)[0]).map(move |x| TileId::new(level, x, y)))
+        {
+            let words = dataset.landcover_words(id).unwrap();
+            assert_eq!(words.len(), tile * tile);
+            let range = layer.tile_range(id).unwrap().expect("land-cover tiles have an index range");
+            for (k, &word) in words.iter().enumerate() {
+                let texel = [id.x * p.tile + (k % tile) as u32, id.y * p.tile + (k / tile) as u32];
+                let texel = [0, 1].map(|a| texel[a].min(p.size_at(level)[a] - 1));
+                let expected = match level {
+                    0 => coding.index_of(class(texel[0] / 2, texel[1] / 2)),
+                    1 => coding.index_of(class(texel[0], texel[1])),
+                    _ => coding.pack([0, 1, 2, 3].map(|k| {
+                        let q = [
+                            (2 * texel[0] + (k & 1)).min(size[0] - 1),
+                            (2 * texel[1] + (k >> 1)).min(size[1] - 1),
+                        ];
+                        coding.index_of(class(q[0], q[1]))
+                    })),
+                };
+                assert_eq!(word, expected, "{id:?} texel {texel:?}");
+                for sub in 0..if level == 2 { 4 } else { 1 } {
+                    let index = coding.decode(level, word, [sub & 1, sub >> 1]) as f32;
+                    assert!(range[0] <= index && index <= range[1], "{id:?}: {index} outside {range:?}");
+                }
             }
-        } else {
-            assert!(tile.iter().all(|c| [11, 41, 42, 95].contains(c)));
+        }
+        // Every source texel, read back from each level.
+        for y in 0..size[1] {
+            for x in 0..size[0] {
+                let index = dataset.landcover_index(level, [x, y]).unwrap();
+                assert_eq!(coding.code_of(index), Some(class(x, y)), "level {level}, texel ({x}, {y})");
+            }
         }
     }
+    assert_eq!(
+        dataset.landcover_index(2, [5000, 5000]).unwrap(),
+        dataset.landcover_index(1, [700, 262]).unwrap()
+    );
+}
+
+#[test]
+fn an_lcc_layer_of_one_texel_still_has_three_levels() {
+    let dataset = lcc_dataset("lcc-one", [1, 1], |_, _| 7);
+    let coding = dataset.lcc_coding().unwrap();
+    assert_eq!((coding.word_bits, coding.palette.as_slice()), (8, &[7u8][..]));
+    for level in 0..3 {
+        assert_eq!(dataset.landcover_index(level, [0, 0]).unwrap(), 1);
+        let words = dataset.landcover_words(TileId::new(level, 0, 0)).unwrap();
+        let expected = if level == 2 { 0b01_01_01_01 } else { 1 };
+        assert!(words.iter().all(|&w| w == expected), "level {level}");
+    }
+}
+
+#[test]
+fn codes_missing_from_the_palette_are_refused() {
+    let path = temp_dir("lcc-missing").join("landcover.pack");
+    let coding = LccCoding::for_codes([1, 2]).unwrap();
+    let class = |x: u32, _| if x == 5 { 3 } else { 1 };
+    let err =
+        lcc::write_lcc_layer(&path, [9, 9], &coding, source_of(class), &ProgressBar::hidden()).unwrap_err();
+    assert!(matches!(err, LayerError::Lcc(lcc::LccError::NotInPalette { code: 3 })), "{err}");
 }
 
 #[test]
@@ -210,4 +294,31 @@ fn height_ranges_bound_every_fine_sample_beneath() {
             assert_eq!(hi, 50_000.0, "{id:?} lies over the spike");
         }
     }
+}
+
+#[test]
+fn datasets_of_another_format_version_say_so() {
+    let (path, spec) = write_heights("old-version", [37, 21]);
+    let dir = path.parent().unwrap();
+    let mut text = toml::to_string_pretty(&manifest_for(&spec)).unwrap();
+    // A version-1 land cover had no `coding`: the version must be what is reported, not that.
+    text = text.replace(&format!("format_version = {FORMAT_VERSION}"), "format_version = 1");
+    text.push_str("\n[landcover]\npack = \"landcover.pack\"\nformat = \"r8 class codes\"\n");
+    std::fs::write(dir.join(MANIFEST_FILE), text).unwrap();
+    assert!(matches!(Dataset::open(dir), Err(DatasetError::Version { found: 1, .. })));
+}
+
+#[test]
+fn a_bad_lcc_coding_is_refused_naming_the_manifest() {
+    let dataset = lcc_dataset("lcc-bad", [4, 4], |x, _| x as u8);
+    let path = dataset.dir.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("word_bits = 16", "word_bits = 12").replace("word_bits = 8", "word_bits = 12"),
+    )
+    .unwrap();
+    let err = Dataset::open(&dataset.dir).err().expect("a 12-bit coding must not open");
+    assert!(matches!(&err, DatasetError::Manifest { path: p, .. } if *p == path), "{err}");
+    assert!(err.to_string().contains("12 bits"), "{err}");
 }

@@ -8,7 +8,9 @@
 //! and a dataset of half the spacing holds the same heights at the samples the two share. Height
 //! samples sit at (i, j) · spacing; cell layers tile the pixel-area extent from half a spacing
 //! south-west, so imagery texel (i, j) is centred at ((i, j) + ½) · spacing / 4 − spacing / 2.
-//! The manifest's height range is gathered from the samples as they are written.
+//! The manifest's height range is gathered from the samples as they are written. Land cover is
+//! classified at 2 texels per spacing (the LCC quadtree's level 1): a first pass counts the codes
+//! for the palette, a second writes the 3 levels (`crate::lcc`).
 
 mod colour;
 mod noise;
@@ -26,6 +28,7 @@ use crate::dataset::{
     CellLayer, Crs, DatasetError, FORMAT_VERSION, HeightLayer, LandcoverLayer, LayerError, LayerSpec,
     Manifest, Staging, Texel, Window, write_layer,
 };
+use crate::lcc::{LccCoding, LccError, scan_codes, write_lcc_layer};
 
 pub use colour::Painter;
 pub use noise::Field;
@@ -33,7 +36,7 @@ pub use terrain::{Ground, Parcel, Terrain, code};
 
 /// Imagery texels per DEM spacing, per axis.
 pub const IMAGERY_PER_SPACING: u32 = 4;
-/// Land-cover texels per DEM spacing, per axis.
+/// Land-cover source texels (LCC level 1; level 0 has twice as many) per DEM spacing, per axis.
 pub const LANDCOVER_PER_SPACING: u32 = 2;
 /// Largest `size`: imagery is 4× finer and its texel indices must fit in u32.
 pub const MAX_SIZE: u32 = 1 << 20;
@@ -83,6 +86,8 @@ pub enum SynthError {
     Layer(#[from] LayerError),
     #[error(transparent)]
     Classes(#[from] ClassTableError),
+    #[error(transparent)]
+    Lcc(#[from] LccError),
 }
 
 pub const HEIGHT_PACK: &str = "height.pack";
@@ -130,11 +135,14 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
     write_layer(&staging.path(IMAGERY_PACK), &imagery, paint, &bar)?;
     bar.finish();
 
-    let landcover = LayerSpec::landcover([size * LANDCOVER_PER_SPACING; 2]);
+    let class_texels = [size * LANDCOVER_PER_SPACING; 2];
     let class_m = spacing_m / f64::from(LANDCOVER_PER_SPACING);
     let classify = |w: Window| Ok(cells(w, spacing_m, class_m, |x_m, y_m| terrain.ground(x_m, y_m).class));
+    let bar = progress_bar(progress, "classes");
+    let coding = LccCoding::for_codes(scan_codes(class_texels, &classify, &bar)?.present())?;
+    bar.finish();
     let bar = progress_bar(progress, "landcover");
-    write_layer(&staging.path(LANDCOVER_PACK), &landcover, classify, &bar)?;
+    let landcover = write_lcc_layer(&staging.path(LANDCOVER_PACK), class_texels, &coding, classify, &bar)?;
     bar.finish();
 
     let cell_layer = |pack: &str, texel_m: f64, spec: &LayerSpec, format: &str| CellLayer {
@@ -166,7 +174,15 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
         },
         imagery: Some(cell_layer(IMAGERY_PACK, texel_m, &imagery, "rgba8 srgb")),
         landcover: Some(LandcoverLayer {
-            layer: cell_layer(LANDCOVER_PACK, class_m, &landcover, "u8 class code"),
+            layer: CellLayer {
+                pack: LANDCOVER_PACK.into(),
+                texel_m: 0.5 * class_m,
+                pyramid: landcover,
+                mips: 1,
+                format: coding.format_name(),
+                source: format!("synthetic (seed {seed})"),
+            },
+            coding,
             classes: table.names(),
             scheme: table.scheme,
             nodata_code: LANDCOVER_NODATA,

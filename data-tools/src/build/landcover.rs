@@ -1,16 +1,19 @@
 //! How it works: land cover is copied code for code onto the DEM's extent at the source's own
 //! pixel size: directly when it is aligned with the DEM's grid, else through GDAL's warper with
 //! nearest-neighbour resampling, since blending class codes would invent classes. The source's
-//! nodata becomes the class table's `nodata_code`. Codes missing from the table are kept (they
-//! mean "no class") and counted, so a wrong `--classes` shows in the build's summary.
+//! nodata becomes the class table's `nodata_code`. Those codes are stored losslessly in the
+//! library's LCC quadtree (`terramp::lcc`), whose level 1 is this grid: a first pass over the
+//! source counts every code, which gives the palette (and so the word width) and the texels whose
+//! code is missing from the table (kept, they mean "no class", and reported, so a wrong
+//! `--classes` shows in the build's summary); a second pass writes the 3 levels.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 use terramp::classes::ClassTable;
-use terramp::dataset::{CellLayer, LandcoverLayer, LayerSpec, Staging, Window, write_layer};
+use terramp::dataset::{CellLayer, LandcoverLayer, Staging, Window};
+use terramp::lcc::{CodeCounts, LccCoding, scan_codes, write_lcc_layer};
 
 use super::frame::{Frame, Grid};
 use super::raster::{Access, GridRaster, Resampling, SourceRaster};
@@ -21,8 +24,23 @@ pub const LANDCOVER_PACK: &str = "landcover.pack";
 pub struct Landcover {
     raster: GridRaster,
     table: ClassTable,
-    /// Level-0 texels whose code is neither in the table nor its nodata code.
-    unknown_texels: AtomicU64,
+}
+
+/// What the first pass found.
+pub struct LandcoverScan {
+    pub counts: CodeCounts,
+    pub coding: LccCoding,
+}
+
+impl LandcoverScan {
+    /// Texels whose code is neither in the table nor its nodata code.
+    pub fn unknown_texels(&self, table: &ClassTable) -> u64 {
+        self.counts
+            .present()
+            .filter(|&c| c != table.nodata_code && !table.contains(c))
+            .map(|c| self.counts.texels[usize::from(c)])
+            .sum()
+    }
 }
 
 impl Landcover {
@@ -31,7 +49,7 @@ impl Landcover {
         let source = SourceRaster::open(path, "land cover")?;
         let grid = frame.cell_grid(&source)?;
         let raster = GridRaster::new(source, &grid, &frame.srs, &[1], Resampling::Nearest, true)?;
-        Ok(Self { raster, table, unknown_texels: AtomicU64::new(0) })
+        Ok(Self { raster, table })
     }
 
     pub fn grid(&self) -> &Grid {
@@ -42,40 +60,51 @@ impl Landcover {
         self.raster.access
     }
 
-    pub fn scheme(&self) -> &str {
-        &self.table.scheme
+    pub fn table(&self) -> &ClassTable {
+        &self.table
     }
 
-    pub fn unknown_texels(&self) -> u64 {
-        self.unknown_texels.load(Ordering::Relaxed)
-    }
-
-    pub fn write(&self, staging: &Staging, bar: &ProgressBar) -> Result<LandcoverLayer> {
-        let grid = self.grid();
-        let spec = LayerSpec::landcover(grid.size);
+    /// The source's codes in `window` of the grid, south row first.
+    fn codes(&self, window: Window) -> Result<Vec<u8>, String> {
         let nodata_code = self.table.nodata_code;
-        let codes = |window: Window| -> Result<Vec<u8>, String> {
-            let codes: Vec<u8> =
-                self.raster.read(window)?[0].iter().map(|&v| code_of(v, nodata_code)).collect();
-            // Level-0 windows of a borderless layer do not overlap, so each texel counts once.
-            let unknown = codes.iter().filter(|&&c| c != nodata_code && !self.table.contains(c)).count();
-            self.unknown_texels.fetch_add(unknown as u64, Ordering::Relaxed);
-            Ok(codes)
-        };
-        write_layer(&staging.path(LANDCOVER_PACK), &spec, codes, bar)
-            .context("writing the land-cover pack")?;
+        Ok(self.raster.read(window)?[0].iter().map(|&v| code_of(v, nodata_code)).collect())
+    }
+
+    /// The first pass: every code of the source, and the LCC coding they need.
+    pub fn scan(&self, bar: &ProgressBar) -> Result<LandcoverScan> {
+        let counts = scan_codes(self.grid().size, &|w| self.codes(w), bar)
+            .context("scanning the land cover's codes")?;
+        let coding = LccCoding::for_codes(counts.present())
+            .with_context(|| format!("{}: coding the land cover", self.raster.path.display()))?;
+        Ok(LandcoverScan { counts, coding })
+    }
+
+    /// The second pass: the LCC quadtree, from the coding the scan found.
+    pub fn write(
+        &self,
+        scan: &LandcoverScan,
+        staging: &Staging,
+        bar: &ProgressBar,
+    ) -> Result<LandcoverLayer> {
+        let grid = self.grid();
+        let coding = scan.coding.clone();
+        let pyramid =
+            write_lcc_layer(&staging.path(LANDCOVER_PACK), grid.size, &coding, |w| self.codes(w), bar)
+                .context("writing the land-cover pack")?;
         Ok(LandcoverLayer {
             layer: CellLayer {
                 pack: LANDCOVER_PACK.to_owned(),
-                texel_m: grid.pixel_m,
-                pyramid: spec.pyramid,
+                // Level 0 repeats each source texel on its 2 × 2 children.
+                texel_m: 0.5 * grid.pixel_m,
+                pyramid,
                 mips: 1,
-                format: "r8 class codes".to_owned(),
+                format: coding.format_name(),
                 source: self.raster.path.display().to_string(),
             },
+            coding,
             scheme: self.table.scheme.clone(),
             classes: self.table.names(),
-            nodata_code,
+            nodata_code: self.table.nodata_code,
         })
     }
 }

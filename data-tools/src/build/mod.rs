@@ -5,8 +5,9 @@
 //! DEM in degrees. Each layer is a `GridRaster` (the source as seen on the layer's grid, read
 //! directly when aligned, else warped by GDAL) and is written tile by tile by the library's
 //! `write_layer` into a staging folder: heights after a scan that finds their range and voids
-//! (`heights`, `fill`), then imagery (`imagery`) and land cover (`landcover`). The manifest is
-//! written last and the folder published atomically, so `--out` never holds half a dataset.
+//! (`heights`, `fill`), then imagery (`imagery`) and land cover (`landcover`, after a scan that
+//! finds its codes, hence its LCC palette). The manifest is written last and the folder published
+//! atomically, so `--out` never holds half a dataset.
 
 mod fill;
 mod frame;
@@ -25,7 +26,7 @@ use terramp::dataset::{FORMAT_VERSION, Manifest, Staging};
 use frame::{Frame, Grid};
 use heights::{Footprint, HeightScan};
 use imagery::Imagery;
-use landcover::Landcover;
+use landcover::{Landcover, LandcoverScan};
 use raster::{Access, GridRaster, Resampling, SourceRaster};
 
 /// GDAL's raster block cache: enough for a few rows of tiles, and a bound on resident memory.
@@ -62,10 +63,10 @@ pub fn run(args: &BuildArgs) -> Result<()> {
     let staging = Staging::begin(&args.out).with_context(|| format!("preparing {}", args.out.display()))?;
     let progress = MultiProgress::new();
     let name = args.name.clone().unwrap_or_else(|| file_stem(&args.dem));
-    let (manifest, scan) = write_layers(&inputs, name, &staging, &progress)?;
+    let (manifest, scans) = write_layers(&inputs, name, &staging, &progress)?;
     let dir = staging.commit(&manifest).with_context(|| format!("publishing {}", args.out.display()))?;
     progress.clear().ok();
-    print_summary(&dir, &manifest, &inputs, &scan);
+    print_summary(&dir, &manifest, &inputs, &scans);
     Ok(())
 }
 
@@ -93,19 +94,31 @@ impl Inputs {
     }
 }
 
+/// What the first passes over the inputs found, for the summary.
+struct Scans {
+    height: HeightScan,
+    landcover: Option<LandcoverScan>,
+}
+
 /// Writes every layer's pack into the staging folder; returns the dataset's manifest.
 fn write_layers(
     inputs: &Inputs,
     name: String,
     staging: &Staging,
     progress: &MultiProgress,
-) -> Result<(Manifest, HeightScan)> {
+) -> Result<(Manifest, Scans)> {
     let scan = heights::scan(&inputs.dem, &inputs.footprint, &bar(progress, "scan DEM", "blocks"))?;
     let height_bars = [&bar(progress, "heights", "tiles"), &bar(progress, "valid mask", "tiles")];
     let height = heights::write(&inputs.dem, &scan, inputs.frame.dem_grid.pixel_m, staging, height_bars)?;
     let imagery = inputs.imagery.as_ref().map(|i| i.write(staging, &bar(progress, "imagery", "tiles")));
-    let landcover =
-        inputs.landcover.as_ref().map(|l| l.write(staging, &bar(progress, "land cover", "tiles")));
+    let landcover = match &inputs.landcover {
+        Some(l) => {
+            let scan = l.scan(&bar(progress, "scan codes", "windows"))?;
+            Some((l.write(&scan, staging, &bar(progress, "land cover", "tiles"))?, scan))
+        }
+        None => None,
+    };
+    let (landcover, landcover_scan) = landcover.unzip();
     let manifest = Manifest {
         format_version: FORMAT_VERSION,
         name,
@@ -113,9 +126,9 @@ fn write_layers(
         origin_m: inputs.frame.origin_m(),
         height,
         imagery: imagery.transpose()?,
-        landcover: landcover.transpose()?,
+        landcover,
     };
-    Ok((manifest, scan))
+    Ok((manifest, Scans { height: scan, landcover: landcover_scan }))
 }
 
 /// Small block cache, and GDAL's own messages kept off stderr: its errors reach the user through
@@ -161,7 +174,8 @@ fn describe_grid(grid: &Grid, access: Access) -> String {
     format!("{} × {} texels of {} m, {}", grid.size[0], grid.size[1], grid.pixel_m, describe_access(access))
 }
 
-fn print_summary(dir: &Path, manifest: &Manifest, inputs: &Inputs, scan: &HeightScan) {
+fn print_summary(dir: &Path, manifest: &Manifest, inputs: &Inputs, scans: &Scans) {
+    let scan = &scans.height;
     let height = &manifest.height;
     println!("wrote {} ({})", dir.display(), manifest.name);
     println!("  frame: {}", manifest.crs.note);
@@ -182,12 +196,15 @@ fn print_summary(dir: &Path, manifest: &Manifest, inputs: &Inputs, scan: &Height
         let bands: Vec<String> = imagery.bands.iter().map(usize::to_string).collect();
         println!("  imagery: {}, bands {}", describe_grid(imagery.grid(), imagery.access()), bands.join(","));
     }
-    if let Some(landcover) = &inputs.landcover {
+    if let (Some(landcover), Some(lcc)) = (&inputs.landcover, &scans.landcover) {
+        let table = landcover.table();
         println!(
-            "  land cover: {}, scheme {}; {} texels carry codes outside the table (no class)",
+            "  land cover: {}, scheme {}; {} codes in {}-bit LCC words; {} texels carry codes outside the table (no class)",
             describe_grid(landcover.grid(), landcover.access()),
-            landcover.scheme(),
-            landcover.unknown_texels()
+            table.scheme,
+            lcc.coding.palette.len(),
+            lcc.coding.word_bits,
+            lcc.unknown_texels(table)
         );
     }
 }
