@@ -69,17 +69,6 @@ fn length_sq(v: vec3<f32>) -> f32 {
     return mul(v.x, v.x) + mul(v.y, v.y) + mul(v.z, v.z);
 }
 
-// PCG (O'Neill), as a hash.
-fn pcg(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
-fn pattern_hash(x: u32, y: u32, seed: u32) -> u32 {
-    return pcg(x ^ pcg(y ^ pcg(seed)));
-}
-
 // Union of the height ranges of the tiles a cell overlaps (at most 2 × 2).
 fn height_range(ring: u32, tiles_x: u32, tiles_y: u32) -> vec2<f32> {
     let level = u.height_levels[u.rings_info[ring].height_level];

@@ -5,6 +5,7 @@
 use crate::dataset::{
     CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS, LayerSpec,
 };
+use crate::seeds;
 
 /// Levels a page table describes at most (a 2^15-tile-wide layer).
 pub const MAX_LEVELS: u32 = 16;
@@ -13,12 +14,15 @@ pub const MAX_LEVELS: u32 = 16;
 /// `shaders/shared/` first, then the file of the same name.
 /// The terrain mesh both terrain passes draw.
 const TERRAIN_MESH: &str = include_str!("../shaders/shared/terrain_mesh.wgsl");
+/// The hashes that pick seed patterns and vary seeds.
+const HASH: &str = include_str!("../shaders/shared/hash.wgsl");
 
 pub const SHADERS: &[(&str, &[&str])] = &[
     ("terrain", &[TERRAIN_MESH, include_str!("../shaders/terrain.wgsl")]),
     ("ground", &[TERRAIN_MESH, include_str!("../shaders/ground.wgsl")]),
     ("depth_pyramid", &[include_str!("../shaders/depth_pyramid.wgsl")]),
-    ("tile_load_map", &[include_str!("../shaders/tile_load_map.wgsl")]),
+    ("tile_load_map", &[HASH, include_str!("../shaders/tile_load_map.wgsl")]),
+    ("seed_select", &[HASH, include_str!("../shaders/seed_select.wgsl")]),
 ];
 
 /// The constants every shader sees, generated from their Rust definitions.
@@ -39,11 +43,27 @@ pub fn prelude() -> String {
         ("TLM_MAX_RINGS", crate::passes::tile_load_map::TLM_MAX_RINGS),
         ("TLM_SPAN_INSIDE", crate::passes::tile_load_map::TLM_SPAN_INSIDE),
         ("TLM_SPAN_COVERED", crate::passes::tile_load_map::TLM_SPAN_COVERED),
+        ("LCC_LEVELS", crate::lcc::LCC_LEVELS),
+        ("LCC_TILE_TEXELS", CELL_TILE_TEXELS),
+        ("MAX_SPECIES_PER_CLASS", crate::classes::MAX_SPECIES_PER_CLASS as u32),
+        ("SEED_WORKGROUP", seeds::SEED_WORKGROUP),
+        ("SEED_SALT", seeds::SEED_SALT),
+        ("GROUND_SAMPLES", seeds::GROUND_SAMPLES),
+        ("SEED_COUNTERS", seeds::SEED_COUNTERS),
+        ("COUNT_SELECTED", seeds::COUNT_SELECTED),
+        ("COUNT_OVERFLOW", seeds::COUNT_OVERFLOW),
+        ("COUNT_CHECKED", seeds::COUNT_CHECKED),
+        ("COUNT_CLASS", seeds::COUNT_CLASS),
+        ("COUNT_RULE", seeds::COUNT_RULE),
+        ("COUNT_DISTANCE", seeds::COUNT_DISTANCE),
+        ("COUNT_FRUSTUM", seeds::COUNT_FRUSTUM),
+        ("COUNT_OCCLUSION", seeds::COUNT_OCCLUSION),
     ];
     let mut text = String::from("// Generated from Rust constants (src/shaders.rs).\n");
     for (name, value) in constants {
         text.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }
+    text.push_str(&format!("const OCCLUSION_FOOTPRINT_PX: i32 = {};\n", seeds::OCCLUSION_FOOTPRINT_PX));
     text
 }
 

@@ -54,6 +54,7 @@ fn a_fixed_view_converges_to_the_all_resident_picture() {
 
     let mut all = small_settings(192, 108);
     all.cache.imagery_slots = 160;
+    all.cache.landcover_slots = 160;
     let mut reference = renderer(&dataset, all);
     reference.pin_everything().unwrap();
     reference.render_resolved(&camera, 50).unwrap();

@@ -46,3 +46,15 @@ fn tlm_structs_match_their_wgsl_twins() {
     assert_eq!(wgsl_size(&tlm, "TlmSpan") as usize, size_of::<TlmSpan>());
     assert_eq!(wgsl_size(&tlm, "TlmCell") as usize, size_of::<TlmCell>());
 }
+
+#[test]
+fn seed_structs_match_their_wgsl_twins() {
+    use terramp::gpu::gpu_types::{SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms};
+    let seeds = module("seed_select");
+    assert_eq!(wgsl_size(&seeds, "SeedUniforms") as usize, size_of::<SeedUniforms>());
+    assert_eq!(wgsl_size(&seeds, "SeedCell") as usize, size_of::<SeedCell>());
+    assert_eq!(wgsl_size(&seeds, "SeedSpecies") as usize, size_of::<SeedSpecies>());
+    assert_eq!(wgsl_size(&seeds, "SeedClass") as usize, size_of::<SeedClass>());
+    assert_eq!(wgsl_size(&seeds, "SeedRecord") as usize, size_of::<SeedRecord>());
+    assert_eq!(wgsl_size(&seeds, "SeedCounters") as usize, size_of::<SeedCounters>());
+}

@@ -12,7 +12,7 @@ use terramp::config::Settings;
 use terramp::frame::Renderer;
 use terramp::gpu::{AdapterChoice, Gpu};
 
-use support::{TempDir, build, shared_data};
+use support::{TempDir, build_nc, shared_data};
 
 const REFERENCE: &str = "tests/reference/nc_240x135.png";
 /// Rasterisers differ in the last bits of filtering and coverage; a broken frame is far below this.
@@ -30,26 +30,11 @@ fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
 
 #[test]
 fn nc_renders_like_its_reference() {
-    let Some(data) = shared_data() else { return };
-    let nc = data.join("nc");
-    let arg = |f: &str| nc.join(f).to_str().unwrap().to_owned();
+    if shared_data().is_none() {
+        return;
+    }
     let dir = TempDir::new("render-nc");
-    let out = dir.path().join("nc");
-    let (dataset, _) = build(
-        &out,
-        &[
-            "--dem",
-            &arg("elev_ned_30m.tif"),
-            "--imagery",
-            &arg("landsat_multiband.tif"),
-            "--bands",
-            "3,2,1",
-            "--landcover",
-            &arg("landuse_r.tif"),
-            "--classes",
-            "nc",
-        ],
-    );
+    let dataset = build_nc(&dir.path().join("nc"));
     let mut settings = Settings::default();
     settings.render.width = 240;
     settings.render.height = 135;

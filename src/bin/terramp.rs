@@ -78,7 +78,8 @@ enum Command {
         settings: SettingsArgs,
     },
     /// Fly a camera path (config/paths/*.toml) and write the frames and a log: one JSON object per
-    /// frame in `log.jsonl` (tiles needed, resident, uploaded, evicted, failed, bytes uploaded,
+    /// frame in `log.jsonl` (tiles needed, resident, uploaded, evicted, failed, bytes uploaded;
+    /// seeds checked, selected, culled by class, rule, distance, frustum and occlusion, overflow;
     /// pass timings, process memory).
     Fly {
         #[arg(long)]

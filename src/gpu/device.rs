@@ -119,6 +119,8 @@ impl Gpu {
             max_texture_array_layers: adapter_limits.max_texture_array_layers.min(2048),
             max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,
             max_buffer_size: adapter_limits.max_buffer_size,
+            // Seed selection reads three page tables and its tables beside its outputs.
+            max_storage_buffers_per_shader_stage: adapter_limits.max_storage_buffers_per_shader_stage.min(16),
             ..wgpu::Limits::default()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

@@ -138,3 +138,168 @@ pub struct TlmUniforms {
     pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
     pub rings_info: [TlmRing; crate::passes::tile_load_map::TLM_MAX_RINGS as usize],
 }
+
+/// Per-frame constants of seed selection (pass 3). WGSL: `SeedUniforms` in
+/// `shaders/seed_select.wgsl`. Lengths are pre-divided on the CPU (f64, then rounded once) so the
+/// shader and its twin only multiply.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct SeedUniforms {
+    /// Clip space from camera-relative world space (columns), as the terrain draws with.
+    pub clip_from_view_world: [[f32; 4]; 4],
+    /// Camera height in grid space, metres.
+    pub camera_z_m: f32,
+    /// Near plane, metres: reversed-Z depth is `near_m / view distance`.
+    pub near_m: f32,
+    /// NDC tolerance of the frustum test.
+    pub frustum_epsilon: f32,
+    /// Always 0: OR-ed into every product so no compiler fuses it into an FMA.
+    pub no_fuse: u32,
+    /// For the side planes `w ± x ≥ 0` (and y), the length of `row_w ± row_x` (xyz; the larger of
+    /// the two): a sphere of radius r reaches a plane when `w ∓ x ≥ −r` times this, so with
+    /// `frustum_epsilon` 0 the test is the exact sphere–plane test.
+    pub clip_row_len: [f32; 2],
+    /// Viewport (= depth target) size, pixels.
+    pub screen_px: [u32; 2],
+    /// A summit is hidden when it lies more than `tolerance_m + per_m × distance` behind the depth.
+    pub occlusion_tolerance_m: f32,
+    pub occlusion_tolerance_per_m: f32,
+    /// 1 / the height that sees the full radial LOD distances, 1/m.
+    pub inv_reference_height_m: f32,
+    /// Fraction of its height a seed's anchor sinks below the ground.
+    pub sink_fraction: f32,
+    /// Radial LOD thresholds (3 used), metres.
+    pub radial_lod_m: [f32; 4],
+    /// A ring-0 cell's edge in level-0 height samples, in level-1 land-cover texels and in
+    /// level-0 imagery texels.
+    pub cell_in_samples: f32,
+    pub cell_in_lcc_texels: f32,
+    pub cell_in_imagery_texels: f32,
+    /// Ground-colour sampling radius, level-0 imagery texels.
+    pub ground_radius_texels: f32,
+    /// 1 / height sample spacing, 1/m (slopes).
+    pub inv_spacing_m: f32,
+    /// Seeds in each pattern, and patterns.
+    pub seeds_per_pattern: u32,
+    /// Seed records the output holds.
+    pub capacity: u32,
+    /// The world's seed number (the hash germ, as `tlm.seed`).
+    pub seed: u32,
+    /// Level-0 height samples along x and y.
+    pub height_size: [u32; 2],
+    pub height_level_count: u32,
+    /// Bits per level-2 sub-code of the land-cover coding (2, 4 or 8); 0: no land cover.
+    pub lcc_sub_bits: u32,
+    /// Level-1 land-cover texels along x and y.
+    pub lcc_size: [u32; 2],
+    pub imagery_level_count: u32,
+    /// Edge of a ring-0 cell, metres.
+    pub cell_m: f32,
+    /// Imagery level-0 texels along x and y.
+    pub imagery_size: [u32; 2],
+    /// NDC units per pixel (2 / width, 2 / height).
+    pub ndc_per_px: [f32; 2],
+    /// The camera in level-0 height samples: integer part, remainder.
+    pub camera_sample: [i32; 2],
+    pub camera_sample_frac: [f32; 2],
+    /// Most samples of the DEM march that settles a summit near a silhouette (0: no march; the
+    /// summit's own pixel decides).
+    pub refine_max_steps: u32,
+    pub _pad: [u32; 3],
+    /// Page tables per level (first entry, tiles along x, tiles along y, 0).
+    pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
+    pub lcc_levels: [[u32; 4]; 4],
+    pub imagery_levels: [[u32; 4]; MAX_LEVELS as usize],
+}
+
+/// One ring-0 TLM cell whose seeds pass 3 checks. WGSL: `SeedCell` in `shaders/seed_select.wgsl`.
+/// The cell's corner is given in each layer's own texel grid as an integer part and a remainder,
+/// so no large coordinate ever reaches f32.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct SeedCell {
+    /// South-west corner relative to the camera, metres.
+    pub rel_m: [f32; 2],
+    /// Global ring-0 address (x, y): with the rank, a seed's identity.
+    pub address: [i32; 2],
+    /// Corner in level-0 height samples: integer part, remainder.
+    pub height_sample: [i32; 2],
+    pub height_frac: [f32; 2],
+    /// Corner in level-1 land-cover texels (the source's).
+    pub lcc_texel: [i32; 2],
+    pub lcc_frac: [f32; 2],
+    /// Corner in level-0 imagery texels.
+    pub imagery_texel: [i32; 2],
+    pub imagery_frac: [f32; 2],
+    /// Its seed pattern, and the land-cover level its radial LOD asked the streaming for.
+    pub pattern: u32,
+    pub lcc_level: u32,
+    pub _pad: [u32; 2],
+}
+
+/// How a species grows, as pass 3 reads it. WGSL: `SeedSpecies`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct SeedSpecies {
+    /// Height range (min, max), metres.
+    pub height_m: [f32; 2],
+    /// Altitude range (min, max), metres.
+    pub altitude_m: [f32; 2],
+    /// tan² of the steepest slope it grows on.
+    pub max_slope_tan_sq: f32,
+    /// Bounding-sphere radius per metre of height.
+    pub radius_per_height: f32,
+    pub kind: u32,
+    pub _pad: u32,
+}
+
+/// The seeds of one land-cover palette index. WGSL: `SeedClass`. A seed of rank r is species
+/// `species[k]` for the first k with `r < rank_limit[k]` (cumulative densities × cell area), and
+/// none when r is beyond them all: thinning by rank keeps every density blue noise.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct SeedClass {
+    pub rank_limit: [f32; 4],
+    pub species: [u32; 4],
+}
+
+/// One selected seed. WGSL: `SeedRecord`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct SeedRecord {
+    /// Anchor (ground, sunk by `sink_fraction` of the height) relative to the camera, metres.
+    pub position_rel_m: [f32; 3],
+    /// The seed's height (its size), metres.
+    pub height_m: f32,
+    /// Global ring-0 cell and rank in its pattern: the seed's identity.
+    pub address: [i32; 2],
+    pub rank: u32,
+    /// `species | radial_lod << 8 | lcc_level << 12 | height_level << 16`.
+    pub species_lod: u32,
+    /// Hash bits: orientation (low 16) and colour variation (high 16).
+    pub jitter: u32,
+    /// Mean imagery colour around the seed, linear RGB as unorm8 (alpha: imagery coverage).
+    pub ground_colour: u32,
+    /// Bounding-sphere radius, metres.
+    pub radius_m: f32,
+    /// Bilinear ground height under the seed, grid space, metres (before sinking).
+    pub ground_m: f32,
+}
+
+/// What pass 3 counted. WGSL: `SeedCounters` (atomics). `selected` counts every seed that passed,
+/// overflow included; records hold `min(selected, capacity)`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default, serde::Serialize)]
+pub struct SeedCounters {
+    pub selected: u32,
+    pub overflow: u32,
+    pub checked: u32,
+    /// Culled: no class, or a class whose density leaves this rank out (or outside the dataset).
+    pub class: u32,
+    /// Culled by the species' altitude or slope rule.
+    pub rule: u32,
+    /// Beyond the radial LOD distance for its size.
+    pub distance: u32,
+    pub frustum: u32,
+    pub occlusion: u32,
+}

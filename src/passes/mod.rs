@@ -5,4 +5,5 @@
 
 pub mod depth_pyramid;
 pub mod ground;
+pub mod seed_select;
 pub mod tile_load_map;

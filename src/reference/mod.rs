@@ -3,4 +3,6 @@
 //! GPU == CPU exactly for integer outputs. The exact oracle used to measure accuracy (f64, full
 //! resolution) is separate from these twins: a twin reproduces the GPU, the oracle judges it.
 
+pub mod oracle;
+pub mod seed_select;
 pub mod tile_load_map;

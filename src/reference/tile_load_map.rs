@@ -10,6 +10,7 @@
 
 use crate::gpu::gpu_types::{TlmCell, TlmSpan, TlmUniforms};
 use crate::passes::tile_load_map::{TLM_SPAN_COVERED, TLM_SPAN_INSIDE};
+pub use crate::seeds::{pattern_hash, pcg};
 
 /// A depth pyramid on the CPU: level sizes and texels (top row first) of every level.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,18 +58,6 @@ impl HizMips {
 
 fn length_sq(v: [f32; 3]) -> f32 {
     v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-}
-
-/// PCG (O'Neill), as a hash: the shader's `pcg`.
-pub fn pcg(v: u32) -> u32 {
-    let state = v.wrapping_mul(747796405).wrapping_add(2891336453);
-    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277803737);
-    (word >> 22) ^ word
-}
-
-/// The seed-pattern hash of ring-0 cell (`x`, `y`) (global address, as two's-complement bits).
-pub fn pattern_hash(x: u32, y: u32, seed: u32) -> u32 {
-    pcg(x ^ pcg(y ^ pcg(seed)))
 }
 
 fn height_range(u: &TlmUniforms, ranges_m: &[[f32; 2]], ring: u32, tiles_x: u32, tiles_y: u32) -> [f32; 2] {

@@ -1,3 +1,194 @@
-//! How it works: seeds (paper § 4.4). To be written.
+//! How it works: the seeded world, defined once (paper § 4.4). The ground is tiled by the TLM's
+//! ring-0 cells; each cell shows one of P generic blue-noise patterns (`patterns`), picked by a
+//! hash of its global address, so a place always shows the same seeds and neighbours differ. A
+//! seed is identified by (cell address, rank in the pattern); everything random about it (its
+//! size, orientation, colour, where its ground colour is sampled) derives from one hash of that
+//! identity and the world's seed number.
+//!
+//! Which seeds grow is decided by the land-cover class under them: a class's species table gives
+//! cumulative densities, scaled by the cell's area into rank limits, and a seed of rank r becomes
+//! the first species whose limit exceeds r. Thinning by rank keeps every density blue noise and
+//! makes a class's seed count in a cell exact. `SeedTables` turns a class table and a land-cover
+//! coding into those limits, as the GPU pass, its CPU twin and the exact oracle all read them:
+//! they disagree only on visibility, never on what exists.
 
 pub mod patterns;
+
+use thiserror::Error;
+
+use crate::classes::{ClassTable, MAX_SPECIES, MAX_SPECIES_PER_CLASS, SpeciesKind};
+use crate::gpu::gpu_types::{SeedClass, SeedSpecies};
+use crate::lcc::LccCoding;
+
+/// Workgroup size of the seed-selection dispatch (handed to WGSL through the prelude).
+pub const SEED_WORKGROUP: u32 = 64;
+/// Cells one dispatch checks at most (a dispatch dimension's limit).
+pub const MAX_SEED_CELLS: u32 = 65535;
+/// Indices into `SeedCounters` (as an array of u32): where a seed's outcome is counted.
+pub const COUNT_SELECTED: u32 = 0;
+pub const COUNT_OVERFLOW: u32 = 1;
+pub const COUNT_CHECKED: u32 = 2;
+pub const COUNT_CLASS: u32 = 3;
+pub const COUNT_RULE: u32 = 4;
+pub const COUNT_DISTANCE: u32 = 5;
+pub const COUNT_FRUSTUM: u32 = 6;
+pub const COUNT_OCCLUSION: u32 = 7;
+pub const SEED_COUNTERS: u32 = 8;
+/// `SeedSpecies::kind` codes.
+pub const KIND_TREE: u32 = 0;
+pub const KIND_BUSH: u32 = 1;
+pub const KIND_ROCK: u32 = 2;
+/// Pixels around a summit's whose farthest terrain depth decides its occlusion (1: a 3 × 3
+/// block), so a summit within a pixel of a silhouette is kept.
+pub const OCCLUSION_FOOTPRINT_PX: i32 = 1;
+/// Imagery texels averaged into a seed's ground colour.
+pub const GROUND_SAMPLES: u32 = 4;
+/// Mixed into the seed hash so it never equals the pattern hash of the same cell.
+pub const SEED_SALT: u32 = 0x5eed_5eed;
+
+#[derive(Debug, Error)]
+pub enum SeedError {
+    #[error(
+        "class {code} ({name}) asks for {density_per_km2} seeds per km²; the patterns hold {max_per_km2:.0} \
+         (seeds.seeds_per_pattern / tlm.cell_m²): raise seeds.seeds_per_pattern or lower the density"
+    )]
+    TooDense { code: u8, name: String, density_per_km2: f64, max_per_km2: f64 },
+    #[error("class table {scheme}: more than {MAX_SPECIES} species")]
+    TooManySpecies { scheme: String },
+}
+
+/// PCG (O'Neill), as a hash: the shaders' `pcg`.
+pub fn pcg(v: u32) -> u32 {
+    let state = v.wrapping_mul(747796405).wrapping_add(2891336453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277803737);
+    (word >> 22) ^ word
+}
+
+/// The seed-pattern hash of ring-0 cell (`x`, `y`) (global address, as two's-complement bits).
+pub fn pattern_hash(x: u32, y: u32, seed: u32) -> u32 {
+    pcg(x ^ pcg(y ^ pcg(seed)))
+}
+
+/// The pattern ring-0 cell `address` shows, of `patterns`.
+pub fn cell_pattern(address: [i32; 2], seed: u32, patterns: u32) -> u32 {
+    pattern_hash(address[0] as u32, address[1] as u32, seed) % patterns.max(1)
+}
+
+/// The hash of seed `rank` of cell `address`: the shader's `seed_hash`.
+pub fn seed_hash(address: [i32; 2], rank: u32, seed: u32) -> u32 {
+    pcg(rank ^ pattern_hash(address[0] as u32, address[1] as u32, seed ^ SEED_SALT))
+}
+
+/// A hash as a number in [0, 1), exactly representable in f32.
+pub fn unit(hash: u32) -> f32 {
+    (hash >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The seed's height from its species and hash: the shader's `seed_height`.
+pub fn seed_height_m(species: &SeedSpecies, hash: u32) -> f32 {
+    species.height_m[0] + (species.height_m[1] - species.height_m[0]) * unit(hash)
+}
+
+/// Which species (index into the species table) seed `rank` of a cell of `class` becomes, if any.
+pub fn species_of_rank(class: &SeedClass, rank: u32) -> Option<u32> {
+    let r = rank as f32;
+    (0..MAX_SPECIES_PER_CLASS).find(|&k| r < class.rank_limit[k]).map(|k| class.species[k])
+}
+
+/// The per-dataset tables of pass 3: species, and per land-cover palette index its seeds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeedTables {
+    pub species: Vec<SeedSpecies>,
+    /// Indexed by palette index (0: bare ground, no seeds).
+    pub classes: Vec<SeedClass>,
+}
+
+impl SeedTables {
+    /// The tables for a dataset coded with `coding`, its classes grown per `table`, on patterns of
+    /// `seeds_per_pattern` seeds over cells of `cell_m`.
+    pub fn new(
+        table: &ClassTable,
+        coding: &LccCoding,
+        cell_m: f64,
+        seeds_per_pattern: u32,
+    ) -> Result<Self, SeedError> {
+        if table.species.len() > MAX_SPECIES {
+            return Err(SeedError::TooManySpecies { scheme: table.scheme.clone() });
+        }
+        let species = table
+            .species
+            .iter()
+            .map(|s| {
+                let tan = s.max_slope_deg.to_radians().tan();
+                SeedSpecies {
+                    height_m: s.height_m,
+                    altitude_m: s.altitude_m,
+                    max_slope_tan_sq: if s.max_slope_deg >= 90.0 { f32::INFINITY } else { tan * tan },
+                    radius_per_height: s.radius_per_height,
+                    kind: match s.kind {
+                        SpeciesKind::Tree => KIND_TREE,
+                        SpeciesKind::Bush => KIND_BUSH,
+                        SpeciesKind::Rock => KIND_ROCK,
+                    },
+                    _pad: 0,
+                }
+            })
+            .collect();
+        let cell_km2 = (cell_m / 1000.0).powi(2);
+        let max_per_km2 = f64::from(seeds_per_pattern) / cell_km2;
+        let mut classes = vec![SeedClass::default(); coding.palette.len() + 1];
+        for (index, entry) in classes.iter_mut().enumerate().skip(1) {
+            let Some(class) = coding.code_of(index as u32).and_then(|code| table.class(code)) else {
+                continue;
+            };
+            let mut cumulative_per_km2 = 0.0f64;
+            for (k, rule) in class.seeds.iter().enumerate().take(MAX_SPECIES_PER_CLASS) {
+                cumulative_per_km2 += f64::from(rule.per_km2);
+                entry.rank_limit[k] = (cumulative_per_km2 * cell_km2) as f32;
+                entry.species[k] = table.species_index(&rule.species).unwrap_or_default() as u32;
+            }
+            if cumulative_per_km2 > max_per_km2 {
+                return Err(SeedError::TooDense {
+                    code: class.code,
+                    name: class.name.clone(),
+                    density_per_km2: cumulative_per_km2,
+                    max_per_km2,
+                });
+            }
+        }
+        Ok(Self { species, classes })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_is_in_range_and_exact() {
+        assert_eq!(unit(0), 0.0);
+        assert!(unit(u32::MAX) < 1.0);
+        assert_eq!(unit(1 << 8), 1.0 / 16_777_216.0);
+    }
+
+    #[test]
+    fn seed_hash_depends_on_every_input() {
+        let h = seed_hash([3, -4], 17, 1);
+        assert_eq!(h, seed_hash([3, -4], 17, 1));
+        assert_ne!(h, seed_hash([4, -4], 17, 1));
+        assert_ne!(h, seed_hash([3, -3], 17, 1));
+        assert_ne!(h, seed_hash([3, -4], 18, 1));
+        assert_ne!(h, seed_hash([3, -4], 17, 2));
+    }
+
+    #[test]
+    fn rank_thinning_picks_species_by_cumulative_density() {
+        let class = SeedClass { rank_limit: [10.0, 15.5, 0.0, 0.0], species: [4, 7, 0, 0] };
+        assert_eq!(species_of_rank(&class, 0), Some(4));
+        assert_eq!(species_of_rank(&class, 9), Some(4));
+        assert_eq!(species_of_rank(&class, 10), Some(7));
+        assert_eq!(species_of_rank(&class, 15), Some(7));
+        assert_eq!(species_of_rank(&class, 16), None);
+        assert_eq!(species_of_rank(&SeedClass::default(), 0), None);
+    }
+}

@@ -12,6 +12,7 @@ use glam::DVec3;
 
 use crate::dataset::{Dataset, HEIGHT_TILE_CELLS, TileId};
 use crate::gpu::gpu_types::TlmCell;
+use crate::passes::seed_select::SeedCellRef;
 use crate::passes::tile_load_map::TlmLayout;
 
 use super::wants::{AreaWant, tiles_over};
@@ -29,6 +30,8 @@ pub struct LoadMaps {
     pub classification: Vec<TileId>,
     /// Seed patterns in use and how many cells use each, by pattern index: the PLM.
     pub patterns: Vec<(u32, u32)>,
+    /// The ring-0 cells whose seeds pass 3 checks, in TLM order.
+    pub seed_cells: Vec<SeedCellRef>,
     pub visible_cells: usize,
 }
 
@@ -51,6 +54,7 @@ pub fn analyse(
     let mut heights = Vec::new();
     let mut classification = Vec::new();
     let mut patterns = std::collections::BTreeMap::<u32, u32>::new();
+    let mut seed_cells = Vec::new();
     let mut visible_cells = 0;
     for (index, cell) in cells.iter().enumerate().take(layout.cell_count()) {
         if cell.visibility == 0 {
@@ -74,7 +78,16 @@ pub fn analyse(
         heights.push(AreaWant { min_m, max_m, levels: lods(cell.height_lod), distance_m });
         if ring == 0 && cell.radial_lod < RADIAL_INACTIVE {
             classification.push(in_cell_layer([cell.radial_lod; 2]));
-            *patterns.entry(cell.visibility - 1).or_default() += 1;
+            // Seeds stand on the finest heights, whatever the mesh draws there.
+            heights.push(AreaWant { min_m, max_m, levels: [0, 0], distance_m });
+            let pattern = cell.visibility - 1;
+            *patterns.entry(pattern).or_default() += 1;
+            let address = layout.global_address(0, cx, cy);
+            seed_cells.push(SeedCellRef {
+                address: [address.x, address.y],
+                pattern,
+                radial_lod: cell.radial_lod,
+            });
         }
     }
     let height_tile_m = f64::from(HEIGHT_TILE_CELLS) * manifest.height.spacing_m;
@@ -96,6 +109,7 @@ pub fn analyse(
             _ => Vec::new(),
         },
         patterns: patterns.into_iter().collect(),
+        seed_cells,
         visible_cells,
     }
 }

@@ -122,6 +122,12 @@ impl TileCache {
         }
     }
 
+    /// The page table as last written to the GPU (`slot + 1` per tile, 0 when absent): for CPU
+    /// twins of the passes that read it.
+    pub fn page_table_entries(&self) -> &[u32] {
+        &self.page_table_cpu
+    }
+
     pub fn slot_of(&self, id: TileId) -> Option<u32> {
         self.residency.slot_of(id)
     }

@@ -57,6 +57,32 @@ pub fn build(out: &Path, args: &[&str]) -> (Dataset, String) {
     (Dataset::open(out).unwrap(), stdout.into_owned())
 }
 
+/// Builds `nc/`'s co-registered trio (DEM, Landsat true colour, land use) into `out`.
+pub fn build_nc(out: &Path) -> Dataset {
+    let nc = shared_data().expect("../shared/data").join("nc");
+    let arg = |f: &str| nc.join(f).to_str().unwrap().to_owned();
+    let args = [
+        ["--dem", &arg("elev_ned_30m.tif")],
+        ["--imagery", &arg("landsat_multiband.tif")],
+        ["--bands", "3,2,1"],
+        ["--landcover", &arg("landuse_r.tif")],
+        ["--classes", "nc"],
+    ];
+    build(out, &args.concat()).0
+}
+
+/// Builds `zion/`'s reprojected DEM and NLCD land cover (no imagery) into `out`.
+pub fn build_zion(out: &Path) -> Dataset {
+    let zion = shared_data().expect("../shared/data").join("zion");
+    let arg = |f: &str| zion.join(f).to_str().unwrap().to_owned();
+    let args = [
+        ["--dem", &arg("dem_utm12n_30m.tif")],
+        ["--landcover", &arg("nlcd_utm12n_30m.tif")],
+        ["--classes", "nlcd"],
+    ];
+    build(out, &args.concat()).0
+}
+
 /// Band 1 of a raster, row by row from the north, with its size.
 pub fn gdal_band(path: &Path) -> (Vec<f64>, [usize; 2]) {
     let dataset = gdal::Dataset::open(path).unwrap();

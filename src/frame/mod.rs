@@ -5,7 +5,6 @@
 
 use std::collections::VecDeque;
 use std::sync::Arc;
-use std::time::Duration;
 
 use glam::DVec3;
 use thiserror::Error;
@@ -13,11 +12,11 @@ use thiserror::Error;
 use crate::camera::{Camera, CameraError, Frustum};
 use crate::config::Settings;
 use crate::dataset::{Dataset, IMAGERY_MIPS, LayerSpec, PackError, TileId};
-use crate::gpu::readback::read_texture;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
 use crate::passes::depth_pyramid::DepthPyramid;
 use crate::passes::ground::GroundPass;
+use crate::passes::seed_select::SeedSources;
 use crate::passes::tile_load_map::{
     TileLoadMapPass, TlmBindings, TlmError, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges,
 };
@@ -27,6 +26,11 @@ use crate::streaming::wants::{after_pinned, height_tiles, pinned_tiles};
 use crate::streaming::{CacheStats, LayerKind, Loader, LoaderError, TileCache, UploadBudget};
 use crate::terrain::select::{Lods, NodeBounds, select};
 use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass, node_batches, terrain_uniforms};
+
+mod seeds;
+mod tools;
+
+pub use seeds::SeedReport;
 
 /// Tiles of the coarsest levels each cache keeps resident from the start, at most: the three
 /// coarsest levels of a square layer (1 + 4 + 16), a fallback everywhere at a quarter of the
@@ -50,6 +54,12 @@ pub enum RenderError {
     Loader(#[from] LoaderError),
     #[error(transparent)]
     Tlm(#[from] TlmError),
+    #[error(transparent)]
+    ClassTable(#[from] crate::classes::ClassTableError),
+    #[error(transparent)]
+    Seeds(#[from] crate::seeds::SeedError),
+    #[error("seeds.capacity = {capacity} records does not fit one GPU buffer binding here (at most {max})")]
+    SeedCapacity { capacity: u32, max: u32 },
     #[error("the {layer} cache has {slots} slots; the whole layer is {tiles} tiles")]
     DoesNotFit { layer: &'static str, tiles: u64, slots: usize },
 }
@@ -71,6 +81,12 @@ pub struct FrameReport {
     pub tlm_patterns: usize,
     /// TLM readbacks skipped so far because every staging buffer was still in flight.
     pub tlm_readbacks_skipped: u64,
+    /// Ring-0 cells whose seeds this frame checks (and how many beyond the dispatch limit were
+    /// left out).
+    pub seed_cells: usize,
+    pub seed_cells_dropped: usize,
+    /// Pass 3's counters of the latest frame whose counters have arrived (a frame or two old).
+    pub seeds: Option<SeedReport>,
 }
 
 pub struct Renderer {
@@ -85,7 +101,11 @@ pub struct Renderer {
     /// The coarsest tiles of each layer, resident from the first frame on and never evicted.
     pinned_heights: Vec<TileId>,
     pinned_imagery: Vec<TileId>,
+    /// Land-cover tiles pinned by `pin_everything` (none otherwise: seeds only live near the camera).
+    pinned_landcover: Vec<TileId>,
     landcover: Option<TileCache>,
+    /// Pass 3 and what it needs; `None` without land cover.
+    seeds: Option<seeds::SeedStage>,
     loader: Loader,
     depth_pyramid: DepthPyramid,
     tlm: TileLoadMapPass,
@@ -199,6 +219,15 @@ impl Renderer {
             | wgpu::TextureUsages::COPY_SRC;
         let colour = target("colour", COLOUR_FORMAT, usage);
         let depth = target("depth", DEPTH_FORMAT, usage);
+        let seeds = match &landcover {
+            Some(landcover) => {
+                let depth_view = depth.create_view(&Default::default());
+                let sources =
+                    SeedSources { heights: &heights, landcover, imagery: &imagery, depth: &depth_view };
+                seeds::SeedStage::new(device, &dataset, &settings, &sources)?
+            }
+            None => None,
+        };
         let h = &dataset.manifest.height;
         let bounds = NodeBounds::new([h.min_m, h.max_m]);
         let profiler = Profiler::new(&gpu, settings.gpu.timestamps);
@@ -213,7 +242,9 @@ impl Renderer {
             imagery,
             pinned_heights,
             pinned_imagery,
+            pinned_landcover: Vec::new(),
             landcover,
+            seeds,
             loader,
             depth_pyramid,
             tlm,
@@ -271,6 +302,7 @@ impl Renderer {
         );
         let wanted_heights = after_pinned(&self.pinned_heights, &selected_heights);
         let wanted_imagery = after_pinned(&self.pinned_imagery, &latest.ground);
+        let wanted_landcover = after_pinned(&self.pinned_landcover, &latest.classification);
         let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
         let (heights, imagery, landcover) = (&mut self.heights, &mut self.imagery, &mut self.landcover);
         let (loader, has_imagery) = (&self.loader, self.dataset.imagery.is_some());
@@ -280,7 +312,7 @@ impl Renderer {
                 requests.extend(imagery.set_wanted(&wanted_imagery, frame));
             }
             if let Some(landcover) = landcover.as_mut() {
-                requests.extend(landcover.set_wanted(&latest.classification, frame));
+                requests.extend(landcover.set_wanted(&wanted_landcover, frame));
             }
             // Every frame, even with nothing new: it also cancels what is no longer wanted.
             loader.submit(&requests);
@@ -351,6 +383,15 @@ impl Renderer {
         self.profiler.pass(&self.gpu, &mut encoder, "ground", |encoder| {
             self.ground.encode(encoder, mesh, &colour, &depth, SKY_LINEAR)
         })?;
+        // Seed selection: the seeds of the cells the latest TLM found near and visible.
+        if let Some(stage) = self.seeds.as_mut() {
+            let cells = self.load_maps.as_ref().map_or(&[][..], |m| &m.seed_cells[..]);
+            let inputs = seeds::seed_inputs(&self.settings, &self.dataset, camera, camera_grid_m, cells);
+            let frame = stage.prepare(&self.gpu, &inputs)?;
+            report.seed_cells = frame.cells.len();
+            report.seed_cells_dropped = frame.cells_dropped;
+            self.profiler.pass(&self.gpu, &mut encoder, "seed_select", |encoder| stage.encode(encoder))?;
+        }
         // Read back a frame or two late, never waiting (recorded after the last timed pass: the
         // CPU-timing fallback submits each pass's encoder on its own).
         if self.tlm_readback.encode_copy(
@@ -361,12 +402,22 @@ impl Renderer {
         ) {
             self.tlm_layouts.push_back((self.frame, layout, camera_grid_m));
         }
+        if let Some(stage) = self.seeds.as_mut() {
+            stage.encode_readback(&mut encoder, self.frame);
+        }
         self.profiler.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
         self.tlm_readback.submitted();
+        if let Some(stage) = self.seeds.as_mut() {
+            stage.submitted();
+        }
         self.profiler.end_frame();
         self.gpu.device.poll(wgpu::PollType::Poll).map_err(GpuError::from)?;
         self.analyse_arrived_tlms()?;
+        if let Some(stage) = self.seeds.as_mut() {
+            stage.collect(&self.gpu.device)?;
+            report.seeds = stage.latest;
+        }
         while let Some(timings) = self.profiler.finished_frame(&self.gpu) {
             self.last_timings = timings;
         }
@@ -390,83 +441,5 @@ impl Renderer {
             self.load_maps = Some(maps);
         }
         Ok(())
-    }
-
-    /// Loads every tile of the dataset now and pins it, for all-resident reference renders. Fails
-    /// when a layer does not fit its cache.
-    pub fn pin_everything(&mut self) -> Result<(), RenderError> {
-        let everything = |cache: &TileCache, layer: &'static str| {
-            let pyramid = cache.pyramid();
-            if pyramid.tile_count() > cache.capacity() as u64 {
-                return Err(RenderError::DoesNotFit {
-                    layer,
-                    tiles: pyramid.tile_count(),
-                    slots: cache.capacity(),
-                });
-            }
-            Ok(pinned_tiles(pyramid, usize::MAX))
-        };
-        let queue = &self.gpu.queue;
-        self.pinned_heights = everything(&self.heights, "height")?;
-        self.heights
-            .load_now(queue, &self.pinned_heights, self.frame, |id| self.dataset.height.tile_bytes(id));
-        if let Some(layer) = &self.dataset.imagery {
-            self.pinned_imagery = everything(&self.imagery, "imagery")?;
-            self.imagery.load_now(queue, &self.pinned_imagery, self.frame, |id| layer.tile_bytes(id));
-        }
-        Ok(())
-    }
-
-    /// Whether every tile the frame of `report` wanted is resident (or failed, or beyond what the
-    /// cache can hold), with nothing left loading or waiting for upload.
-    pub fn is_resolved(&self, report: &FrameReport) -> bool {
-        let done = |s: &CacheStats, cache: &TileCache| {
-            s.needed_resident + s.failed >= s.needed.min(cache.capacity()) && s.staged == 0
-        };
-        let landcover = match &self.landcover {
-            Some(cache) => done(&report.landcover, cache),
-            None => true,
-        };
-        done(&report.height, &self.heights)
-            && done(&report.imagery, &self.imagery)
-            && landcover
-            && self.loader.is_idle()
-    }
-
-    /// Renders `camera` frame after frame until everything it needs is resident (at most
-    /// `max_frames`), for single frames and references. Returns the last frame's report and the
-    /// number of frames it took.
-    pub fn render_resolved(
-        &mut self,
-        camera: &Camera,
-        max_frames: u32,
-    ) -> Result<(FrameReport, u32), RenderError> {
-        let first = self.frame;
-        let mut frames = 0;
-        loop {
-            let report = self.render(camera)?;
-            frames += 1;
-            // Resolved only once a Tile Load Map of this very view has driven the streaming.
-            let informed = report.tlm_frame.is_some_and(|f| f >= first);
-            if (informed && self.is_resolved(&report)) || frames >= max_frames {
-                return Ok((report, frames));
-            }
-            // The loader threads are reading: give them the core rather than spin.
-            std::thread::sleep(Duration::from_millis(2));
-        }
-    }
-
-    /// The last frame's colour, as an sRGB image.
-    pub fn read_colour(&self) -> Result<image::RgbaImage, RenderError> {
-        let bytes = read_texture(&self.gpu, &self.colour, wgpu::TextureAspect::All, 4)?;
-        let (w, h) = (self.colour.width(), self.colour.height());
-        image::RgbaImage::from_raw(w, h, bytes)
-            .ok_or_else(|| RenderError::Gpu(GpuError::Validation("readback size mismatch".into())))
-    }
-
-    /// The last frame's depth (reversed-Z: 1 at the near plane, 0 for the sky), top row first.
-    pub fn read_depth(&self) -> Result<Vec<f32>, RenderError> {
-        let bytes = read_texture(&self.gpu, &self.depth, wgpu::TextureAspect::DepthOnly, 4)?;
-        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 }

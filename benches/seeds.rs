@@ -1,0 +1,106 @@
+//! Seeds checked per second by pass 3 (seed selection) for about 100 k, 1 M and 4 M checked seeds
+//! per frame, and its CPU twin's rate on the same input in the same run. The default synthetic
+//! dataset (10 km) is pinned whole, one resolved frame gives the depth, then pass 3 alone runs over
+//! a square block of ring-0 cells around the camera (4096 seeds each). Prints a table; run with
+//! `WGPU_BACKEND=vulkan cargo bench --bench seeds`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::DVec3;
+use terramp::camera::Camera;
+use terramp::config::Settings;
+use terramp::dataset::Dataset;
+use terramp::frame::Renderer;
+use terramp::gpu::{AdapterChoice, Gpu};
+use terramp::passes::seed_select::SeedCellRef;
+use terramp::seeds::cell_pattern;
+
+const SEEDS_PER_PATTERN: u32 = 4096;
+const GPU_RUNS: usize = 7;
+
+fn main() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("bench-default");
+    if Dataset::open(&dir).is_err() {
+        terramp::synth::synthesize(&dir, &terramp::synth::SynthParams::default(), false).expect("synthesize");
+    }
+    let dataset = Dataset::open(&dir).expect("open");
+    let mut settings = Settings::default();
+    settings.seeds.seeds_per_pattern = SEEDS_PER_PATTERN;
+    settings.seeds.capacity = 1 << 21;
+    settings.tlm.radial_lod_m = [3000.0, 6000.0, 12000.0];
+    let tiles = |p: Option<&terramp::dataset::LayerPack>| p.map_or(1, |l| l.pyramid.tile_count() as u32);
+    settings.cache.height_slots = tiles(Some(&dataset.height)).max(16);
+    settings.cache.imagery_slots = tiles(dataset.imagery.as_ref()).max(16);
+    settings.cache.landcover_slots = tiles(dataset.landcover.as_ref()).max(16);
+    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter");
+    println!("adapter: {}", gpu.describe());
+    let mut r = Renderer::new(gpu, dataset, settings).expect("renderer");
+    r.pin_everything().expect("the dataset fits its caches");
+    let m = &r.dataset.manifest;
+    let [w, h] = m.extent_m();
+    let centre = [0.5 * w, 0.5 * h];
+    let ground = r.dataset.height_at(centre[0], centre[1], 0).expect("height");
+    let camera = Camera {
+        position_m: DVec3::new(m.origin_m[0] + centre[0], m.origin_m[1] + centre[1], ground + 150.0),
+        yaw_deg: 30.0,
+        pitch_deg: -20.0,
+        fov_deg: 60.0,
+        near_m: 0.1,
+    };
+    r.render_resolved(&camera, 30).expect("render");
+    let cell_m = r.settings.tlm.cell_m;
+    let (seed, patterns) = (r.settings.tlm.seed, r.settings.tlm.patterns);
+    println!(
+        "{:>10} {:>7} {:>10} {:>12} {:>14} {:>12} {:>14} {:>7}",
+        "checked", "cells", "selected", "gpu ms", "gpu seeds/s", "twin ms", "twin seeds/s", "ratio"
+    );
+    for target in [100_000u64, 1_000_000, 4_000_000] {
+        let side = ((target as f64 / f64::from(SEEDS_PER_PATTERN)).sqrt().round() as i64).max(1);
+        let camera_cell = centre.map(|v| (v / cell_m).floor() as i64);
+        let cells: Vec<SeedCellRef> = (0..side * side)
+            .map(|k| {
+                let address = [camera_cell[0] - side / 2 + k % side, camera_cell[1] - side / 2 + k / side];
+                let distance_m = (((address[0] as f64 + 0.5) * cell_m - centre[0])
+                    .hypot((address[1] as f64 + 0.5) * cell_m - centre[1]))
+                .max(0.0);
+                let radial_lod =
+                    r.settings.tlm.radial_lod_m.iter().filter(|&&t| distance_m >= t).count() as u32;
+                SeedCellRef {
+                    address,
+                    pattern: cell_pattern([address[0] as i32, address[1] as i32], seed, patterns),
+                    radial_lod: radial_lod.min(2),
+                }
+            })
+            .collect();
+        let checked = cells.len() as u64 * u64::from(SEEDS_PER_PATTERN);
+        r.run_seed_select(&camera, &cells).expect("warm-up");
+        let mut gpu_ms: Vec<f64> = (0..GPU_RUNS)
+            .map(|_| {
+                let start = Instant::now();
+                r.run_seed_select(&camera, &cells).expect("seed select");
+                start.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        gpu_ms.sort_by(f64::total_cmp);
+        let gpu_ms = gpu_ms[GPU_RUNS / 2];
+        let (_, counters) = r.read_seeds().expect("read back").expect("land cover");
+        let snapshot = r.seed_snapshot().expect("snapshot").expect("land cover");
+        let start = Instant::now();
+        let (_, twin) = terramp::reference::seed_select::seed_select(&snapshot.inputs());
+        let twin_ms = start.elapsed().as_secs_f64() * 1e3;
+        assert_eq!(twin, counters, "the twin disagrees with the GPU");
+        let rate = |ms: f64| checked as f64 / (ms * 1e-3);
+        println!(
+            "{:>10} {:>7} {:>10} {:>12.2} {:>14.3e} {:>12.1} {:>14.3e} {:>7.1}",
+            checked,
+            cells.len(),
+            counters.selected,
+            gpu_ms,
+            rate(gpu_ms),
+            twin_ms,
+            rate(twin_ms),
+            twin_ms / gpu_ms
+        );
+    }
+}

@@ -1,0 +1,470 @@
+// Pass 3, seed selection (Amara et al. 2007, § 4.4): one invocation per seed of each active
+// ring-0 cell's pattern (workgroups along x cover a pattern, one row of workgroups per cell).
+// A seed is placed on the finest resident height level (bilinear, identical whatever the mesh
+// LOD), given a class by the LCC quadtree (any resident level: the coding makes them agree), a
+// species by its rank, checked against its species' altitude and slope rules, sized by its hash,
+// cut at the radial LOD distance for its size, culled by frustum (bounding sphere, NDC tolerance)
+// and by occlusion (its summit against the terrain's depth, with a tolerance growing with
+// distance), and written out with its ground colour from the imagery around it.
+//
+// Exactness: the CPU twin (`reference/seed_select.rs`) must take the same decisions, so the
+// shader avoids division and transcendental functions, and every product goes through `mul`,
+// which no compiler can fuse into an FMA. Large coordinates never reach f32: each cell's corner
+// comes as an integer texel plus a remainder in every layer's own grid.
+//
+// Output: records are appended per workgroup (one global atomic per workgroup); their order
+// varies between runs, their identity (cell address, rank) does not. Records beyond `capacity`
+// are not written and are counted as overflow.
+
+struct SeedUniforms {
+    clip_from_view_world: mat4x4<f32>,
+    camera_z_m: f32,
+    near_m: f32,
+    frustum_epsilon: f32,
+    no_fuse: u32,
+    clip_row_len: vec2<f32>,
+    screen_px: vec2<u32>,
+    occlusion_tolerance_m: f32,
+    occlusion_tolerance_per_m: f32,
+    inv_reference_height_m: f32,
+    sink_fraction: f32,
+    radial_lod_m: vec4<f32>,
+    cell_in_samples: f32,
+    cell_in_lcc_texels: f32,
+    cell_in_imagery_texels: f32,
+    ground_radius_texels: f32,
+    inv_spacing_m: f32,
+    seeds_per_pattern: u32,
+    capacity: u32,
+    seed: u32,
+    height_size: vec2<u32>,
+    height_level_count: u32,
+    lcc_sub_bits: u32,
+    lcc_size: vec2<u32>,
+    imagery_level_count: u32,
+    cell_m: f32,
+    imagery_size: vec2<u32>,
+    ndc_per_px: vec2<f32>,
+    camera_sample: vec2<i32>,
+    camera_sample_frac: vec2<f32>,
+    refine_max_steps: u32,
+    _pad: array<u32, 3>,
+    height_levels: array<vec4<u32>, MAX_LEVELS>,
+    lcc_levels: array<vec4<u32>, 4>,
+    imagery_levels: array<vec4<u32>, MAX_LEVELS>,
+}
+
+struct SeedCell {
+    rel_m: vec2<f32>,
+    address: vec2<i32>,
+    height_sample: vec2<i32>,
+    height_frac: vec2<f32>,
+    lcc_texel: vec2<i32>,
+    lcc_frac: vec2<f32>,
+    imagery_texel: vec2<i32>,
+    imagery_frac: vec2<f32>,
+    pattern: u32,
+    lcc_level: u32,
+    _pad: vec2<u32>,
+}
+
+struct SeedSpecies {
+    height_m: vec2<f32>,
+    altitude_m: vec2<f32>,
+    max_slope_tan_sq: f32,
+    radius_per_height: f32,
+    kind: u32,
+    _pad: u32,
+}
+
+struct SeedClass {
+    rank_limit: vec4<f32>,
+    species: vec4<u32>,
+}
+
+struct SeedRecord {
+    position_rel_m: vec3<f32>,
+    height_m: f32,
+    address: vec2<i32>,
+    rank: u32,
+    species_lod: u32,
+    jitter: u32,
+    ground_colour: u32,
+    radius_m: f32,
+    ground_m: f32,
+}
+
+struct SeedCounters {
+    count: array<atomic<u32>, SEED_COUNTERS>,
+}
+
+// Per-frame constants in a storage buffer, not a uniform buffer: see tile_load_map.wgsl.
+@group(0) @binding(0) var<storage, read> u: SeedUniforms;
+@group(0) @binding(1) var<storage, read> cells: array<SeedCell>;
+@group(0) @binding(2) var<storage, read> patterns: array<vec2<f32>>;
+@group(0) @binding(3) var<storage, read> species_table: array<SeedSpecies>;
+@group(0) @binding(4) var<storage, read> class_table: array<SeedClass>;
+@group(0) @binding(5) var<storage, read> height_page_table: array<u32>;
+@group(0) @binding(6) var height_tiles: texture_2d_array<f32>;
+@group(0) @binding(7) var<storage, read> lcc_page_table: array<u32>;
+@group(0) @binding(8) var lcc_tiles: texture_2d_array<u32>;
+@group(0) @binding(9) var<storage, read> imagery_page_table: array<u32>;
+@group(0) @binding(10) var imagery_tiles: texture_2d_array<f32>;
+@group(0) @binding(11) var depth: texture_depth_2d;
+@group(0) @binding(12) var<storage, read_write> records: array<SeedRecord>;
+@group(0) @binding(13) var<storage, read_write> counters: SeedCounters;
+
+var<workgroup> wg_count: array<atomic<u32>, SEED_COUNTERS>;
+var<workgroup> wg_base: u32;
+
+// a · b, correctly rounded and never fused into a following add.
+fn mul(a: f32, b: f32) -> f32 {
+    return bitcast<f32>(bitcast<u32>(a * b) | u.no_fuse);
+}
+
+fn seed_hash(address: vec2<i32>, rank: u32) -> u32 {
+    return pcg(rank ^ pattern_hash(bitcast<u32>(address.x), bitcast<u32>(address.y), u.seed ^ SEED_SALT));
+}
+
+fn unit(hash: u32) -> f32 {
+    return f32(hash >> 8u) * (1.0 / 16777216.0);
+}
+
+// A position in a layer's texel grid: integer texel and remainder in [0, 1).
+struct GridPos {
+    texel: vec2<i32>,
+    frac: vec2<f32>,
+}
+
+fn grid_pos(corner: vec2<i32>, corner_frac: vec2<f32>, pos_unit: vec2<f32>, cell_in_texels: f32) -> GridPos {
+    let t = corner_frac + vec2<f32>(mul(pos_unit.x, cell_in_texels), mul(pos_unit.y, cell_in_texels));
+    let whole = floor(t);
+    return GridPos(corner + vec2<i32>(whole), t - whole);
+}
+
+// Clip position of camera-relative `p`, product by product.
+fn to_clip(p: vec3<f32>) -> vec4<f32> {
+    let m = u.clip_from_view_world;
+    var clip: vec4<f32>;
+    for (var r = 0; r < 4; r += 1) {
+        clip[r] = mul(m[0][r], p.x) + mul(m[1][r], p.y) + mul(m[2][r], p.z) + m[3][r];
+    }
+    return clip;
+}
+
+struct Ground {
+    height_m: f32,
+    // Height change per metre east and north.
+    gradient: vec2<f32>,
+    level: u32,
+    found: bool,
+}
+
+// Bilinear height at `p` (level-0 samples) from the finest resident level.
+fn ground_at(p: GridPos) -> Ground {
+    let s0 = vec2<u32>(p.texel);
+    var level = 0u;
+    var slot = 0u;
+    var tile = vec2<u32>(0u);
+    loop {
+        let info = u.height_levels[level];
+        tile = min((s0 >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
+        slot = height_page_table[info.x + tile.y * info.y + tile.x];
+        if slot != 0u || level + 1u >= u.height_level_count {
+            break;
+        }
+        level += 1u;
+    }
+    if slot == 0u {
+        return Ground(0.0, vec2<f32>(0.0), level, false);
+    }
+    let s = s0 >> vec2<u32>(level);
+    let local = vec2<i32>(s - tile * HEIGHT_TILE_CELLS + HEIGHT_BORDER);
+    let layer = i32(slot - 1u);
+    let h00 = textureLoad(height_tiles, local, layer, 0).r;
+    let h10 = textureLoad(height_tiles, local + vec2<i32>(1, 0), layer, 0).r;
+    let h01 = textureLoad(height_tiles, local + vec2<i32>(0, 1), layer, 0).r;
+    let h11 = textureLoad(height_tiles, local + vec2<i32>(1, 1), layer, 0).r;
+    // The remainder at this level: the dropped low bits plus the level-0 remainder, scaled by a
+    // power of two (exact).
+    let mask = (1u << level) - 1u;
+    let scale = ldexp(1.0, -i32(level));
+    let f = vec2<f32>(mul(f32(s0.x & mask) + p.frac.x, scale), mul(f32(s0.y & mask) + p.frac.y, scale));
+    let south = h00 + mul(h10 - h00, f.x);
+    let north = h01 + mul(h11 - h01, f.x);
+    let height_m = south + mul(north - south, f.y);
+    let dx = (h10 - h00) + mul((h11 - h01) - (h10 - h00), f.y);
+    let dy = (h01 - h00) + mul((h11 - h10) - (h01 - h00), f.x);
+    let per_m = mul(scale, u.inv_spacing_m);
+    return Ground(height_m, vec2<f32>(mul(dx, per_m), mul(dy, per_m)), level, true);
+}
+
+// Palette index of level-1 land-cover texel `q`, read from `wanted` or, while that streams in,
+// another resident level (they all decode to the same class); 0xffffffff when none is resident.
+fn class_at(q: vec2<u32>, wanted: u32) -> vec2<u32> {
+    for (var n = 0u; n < LCC_LEVELS; n += 1u) {
+        let level = (wanted + n) % LCC_LEVELS;
+        var texel = q >> vec2<u32>(1u);
+        if level == 0u {
+            texel = q << vec2<u32>(1u);
+        } else if level == 1u {
+            texel = q;
+        }
+        let info = u.lcc_levels[level];
+        let tile = min(texel / LCC_TILE_TEXELS, info.yz - 1u);
+        let slot = lcc_page_table[info.x + tile.y * info.y + tile.x];
+        if slot != 0u {
+            let word = textureLoad(lcc_tiles, vec2<i32>(texel - tile * LCC_TILE_TEXELS), i32(slot - 1u), 0).x;
+            if level != 2u {
+                return vec2<u32>(word, level);
+            }
+            let shift = u.lcc_sub_bits * ((q.x & 1u) + 2u * (q.y & 1u));
+            return vec2<u32>((word >> shift) & ((1u << u.lcc_sub_bits) - 1u), level);
+        }
+    }
+    return vec2<u32>(0xffffffffu, 0u);
+}
+
+// Linear colour of level-0 imagery texel `t` from the finest resident level (alpha 0: none).
+fn imagery_texel(t: vec2<u32>) -> vec4<f32> {
+    var level = 0u;
+    loop {
+        let info = u.imagery_levels[level];
+        let texel = t >> vec2<u32>(level);
+        let tile = min(texel / IMAGERY_TILE_TEXELS, info.yz - 1u);
+        let slot = imagery_page_table[info.x + tile.y * info.y + tile.x];
+        if slot != 0u {
+            let local = vec2<i32>(texel - tile * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
+            return textureLoad(imagery_tiles, local, i32(slot - 1u), 0);
+        }
+        if level + 1u >= u.imagery_level_count {
+            return vec4<f32>(0.0);
+        }
+        level += 1u;
+    }
+    return vec4<f32>(0.0);
+}
+
+// Mean imagery colour at GROUND_SAMPLES hashed points within the ground radius of `p`.
+fn ground_colour(p: GridPos, hash: u32) -> u32 {
+    if u.imagery_level_count == 0u {
+        return 0u;
+    }
+    var sum = vec4<f32>(0.0);
+    var h = hash;
+    let last = vec2<i32>(u.imagery_size) - 1;
+    for (var k = 0u; k < GROUND_SAMPLES; k += 1u) {
+        h = pcg(h);
+        let offset = vec2<f32>(mul(unit(h) * 2.0 - 1.0, u.ground_radius_texels),
+                               mul(unit(pcg(h)) * 2.0 - 1.0, u.ground_radius_texels));
+        let texel = clamp(p.texel + vec2<i32>(floor(p.frac + offset)), vec2<i32>(0), last);
+        sum += imagery_texel(vec2<u32>(texel));
+    }
+    return pack4x8unorm(sum * (1.0 / f32(GROUND_SAMPLES)));
+}
+
+// Pixel column holding clip-space x at distance w (x / w in NDC): a first guess by division,
+// settled by exact comparisons against the pixel edges (`step` NDC units apart).
+fn pixel_of(x: f32, w: f32, n: u32, step: f32) -> u32 {
+    let guess = clamp((x / w * 0.5 + 0.5) * f32(n), 0.0, f32(n - 1u));
+    var i = u32(guess);
+    for (var k = 0; k < 4; k += 1) {
+        if i > 0u && x < mul(mul(f32(i), step) - 1.0, w) {
+            i -= 1u;
+        } else if i + 1u < n && x >= mul(mul(f32(i + 1u), step) - 1.0, w) {
+            i += 1u;
+        }
+    }
+    return i;
+}
+
+// Whether the DEM (finest resident heights, bilinear) rises above the segment from the eye to
+// camera-relative `summit_rel` anywhere: samples at least every half height spacing (a power of two
+// of them, at most `refine_max_steps`), positions by products only, so the twin agrees exactly.
+fn dem_blocks(summit_rel: vec3<f32>) -> bool {
+    let length_sq = mul(summit_rel.x, summit_rel.x) + mul(summit_rel.y, summit_rel.y);
+    let wanted_sq = mul(mul(length_sq, 4.0), mul(u.inv_spacing_m, u.inv_spacing_m));
+    var steps = 2u;
+    while steps < u.refine_max_steps && f32(steps * steps) < wanted_sq {
+        steps *= 2u;
+    }
+    let dt = ldexp(1.0, -i32(countTrailingZeros(steps)));
+    let last = vec2<i32>(u.height_size) - 1;
+    for (var k = 1u; k < steps; k += 1u) {
+        let t = mul(f32(k), dt);
+        let p = vec3<f32>(mul(summit_rel.x, t), mul(summit_rel.y, t), mul(summit_rel.z, t));
+        let sample = grid_pos(u.camera_sample, u.camera_sample_frac, p.xy, u.inv_spacing_m);
+        if any(sample.texel < vec2<i32>(0)) || any(sample.texel > last) {
+            continue;
+        }
+        let ground = ground_at(sample);
+        if ground.found && ground.height_m > p.z + u.camera_z_m {
+            return true;
+        }
+    }
+    return false;
+}
+
+// The seed's fate: a counter index (COUNT_SELECTED when kept) and its record.
+struct Outcome {
+    count: u32,
+    record: SeedRecord,
+}
+
+fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
+    var out: Outcome;
+    out.count = COUNT_CLASS;
+    let pos_unit = patterns[cell.pattern * u.seeds_per_pattern + rank];
+    // Outside the dataset there is no class.
+    let sample = grid_pos(cell.height_sample, cell.height_frac, pos_unit, u.cell_in_samples);
+    if any(sample.texel < vec2<i32>(0)) || any(sample.texel > vec2<i32>(u.height_size) - 1) || u.lcc_sub_bits == 0u {
+        return out;
+    }
+    let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);
+    let q = vec2<u32>(clamp(lcc.texel, vec2<i32>(0), vec2<i32>(u.lcc_size) - 1));
+    let found = class_at(q, cell.lcc_level);
+    if found.x >= arrayLength(&class_table) {
+        return out;
+    }
+    let seeds = class_table[found.x];
+    var k = 0u;
+    while k < MAX_SPECIES_PER_CLASS && !(f32(rank) < seeds.rank_limit[k]) {
+        k += 1u;
+    }
+    if k == MAX_SPECIES_PER_CLASS {
+        return out;
+    }
+    let species_index = seeds.species[k];
+    let species = species_table[species_index];
+
+    out.count = COUNT_RULE;
+    let ground = ground_at(sample);
+    let slope_sq = mul(ground.gradient.x, ground.gradient.x) + mul(ground.gradient.y, ground.gradient.y);
+    if !ground.found || ground.height_m < species.altitude_m.x || ground.height_m > species.altitude_m.y
+        || slope_sq > species.max_slope_tan_sq {
+        return out;
+    }
+
+    let hash = seed_hash(cell.address, rank);
+    let height_m = species.height_m.x + mul(species.height_m.y - species.height_m.x, unit(hash));
+    let rel_xy = cell.rel_m + vec2<f32>(mul(pos_unit.x, u.cell_m), mul(pos_unit.y, u.cell_m));
+    let ground_rel_m = ground.height_m - u.camera_z_m;
+
+    // Radial LOD: thresholds shrink with the seed's size below the reference height.
+    out.count = COUNT_DISTANCE;
+    let distance_sq = mul(rel_xy.x, rel_xy.x) + mul(rel_xy.y, rel_xy.y) + mul(ground_rel_m, ground_rel_m);
+    let size_scale = min(1.0, mul(height_m, u.inv_reference_height_m));
+    var lod = 0u;
+    loop {
+        if lod >= 3u {
+            return out;
+        }
+        let reach = mul(u.radial_lod_m[lod], size_scale);
+        if distance_sq < mul(reach, reach) {
+            break;
+        }
+        lod += 1u;
+    }
+
+    // Frustum: the bounding sphere, centred half-way up, against the NDC square grown by ε.
+    out.count = COUNT_FRUSTUM;
+    let sink_m = mul(height_m, u.sink_fraction);
+    let base_rel_m = ground_rel_m - sink_m;
+    let radius_m = mul(height_m, species.radius_per_height);
+    let centre = to_clip(vec3<f32>(rel_xy, base_rel_m + mul(height_m, 0.5)));
+    if centre.w < -radius_m {
+        return out;
+    }
+    let grown = mul(1.0 + u.frustum_epsilon, centre.w);
+    if abs(centre.x) > grown + mul(radius_m, u.clip_row_len.x)
+        || abs(centre.y) > grown + mul(radius_m, u.clip_row_len.y) {
+        return out;
+    }
+
+    // Occlusion: the summit's distance against the terrain depth around it (the nearest edge
+    // pixels when it is off screen), with the tolerance the coarse far mesh needs.
+    out.count = COUNT_OCCLUSION;
+    let summit = to_clip(vec3<f32>(rel_xy, base_rel_m + height_m));
+    if summit.w > u.near_m {
+        let px = vec2<i32>(i32(pixel_of(summit.x, summit.w, u.screen_px.x, u.ndc_per_px.x)),
+                           i32(pixel_of(-summit.y, summit.w, u.screen_px.y, u.ndc_per_px.y)));
+        // The terrain around the summit's pixel decides, unless it disagrees with itself: then
+        // the summit sits within a pixel of a silhouette, which the mesh and the pixel grid are
+        // both too coarse to place, and a march over the DEM settles it.
+        var farthest = 1.0;
+        var nearest = 0.0;
+        let last = vec2<i32>(u.screen_px) - 1;
+        for (var dy = -OCCLUSION_FOOTPRINT_PX; dy <= OCCLUSION_FOOTPRINT_PX; dy += 1) {
+            for (var dx = -OCCLUSION_FOOTPRINT_PX; dx <= OCCLUSION_FOOTPRINT_PX; dx += 1) {
+                let d = textureLoad(depth, clamp(px + vec2<i32>(dx, dy), vec2<i32>(0), last), 0);
+                farthest = min(farthest, d);
+                nearest = max(nearest, d);
+            }
+        }
+        let tolerance_m = u.occlusion_tolerance_m + mul(u.occlusion_tolerance_per_m, summit.w);
+        let behind_m = summit.w - tolerance_m;
+        var hidden = mul(behind_m, farthest) > u.near_m;
+        if !hidden && mul(behind_m, nearest) > u.near_m {
+            if u.refine_max_steps == 0u {
+                hidden = mul(behind_m, textureLoad(depth, px, 0)) > u.near_m;
+            } else {
+                hidden = dem_blocks(vec3<f32>(rel_xy, base_rel_m + height_m));
+            }
+        }
+        if hidden {
+            return out;
+        }
+    }
+
+    out.count = COUNT_SELECTED;
+    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
+    out.record = SeedRecord(
+        vec3<f32>(rel_xy, base_rel_m),
+        height_m,
+        cell.address,
+        rank,
+        species_index | (lod << 8u) | (found.y << 12u) | (ground.level << 16u),
+        pcg(hash),
+        ground_colour(imagery, hash),
+        radius_m,
+        ground.height_m,
+    );
+    return out;
+}
+
+@compute @workgroup_size(SEED_WORKGROUP)
+fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    if lane < SEED_COUNTERS {
+        atomicStore(&wg_count[lane], 0u);
+    }
+    workgroupBarrier();
+    let rank = group.x * SEED_WORKGROUP + lane;
+    var outcome: Outcome;
+    var local = 0u;
+    if rank < u.seeds_per_pattern {
+        atomicAdd(&wg_count[COUNT_CHECKED], 1u);
+        outcome = select_seed(cells[group.y], rank);
+        local = atomicAdd(&wg_count[outcome.count], 1u);
+    }
+    workgroupBarrier();
+    if lane == 0u {
+        let kept = atomicLoad(&wg_count[COUNT_SELECTED]);
+        let base = atomicAdd(&counters.count[COUNT_SELECTED], kept);
+        wg_base = base;
+        let room = select(0u, u.capacity - base, base < u.capacity);
+        let overflow = kept - min(kept, room);
+        if overflow != 0u {
+            atomicAdd(&counters.count[COUNT_OVERFLOW], overflow);
+        }
+        for (var c = COUNT_CHECKED; c < SEED_COUNTERS; c += 1u) {
+            let n = atomicLoad(&wg_count[c]);
+            if n != 0u {
+                atomicAdd(&counters.count[c], n);
+            }
+        }
+    }
+    let base = workgroupUniformLoad(&wg_base);
+    if rank < u.seeds_per_pattern && outcome.count == COUNT_SELECTED && base + local < u.capacity {
+        records[base + local] = outcome.record;
+    }
+}

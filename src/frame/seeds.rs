@@ -1,0 +1,144 @@
+//! How it works: the renderer's seed stage. A dataset with land cover gets, once, its species
+//! tables (from the class table its scheme names, or `seeds.class_table`), the P generic patterns
+//! and pass 3's pipeline bound to the caches and the depth target. Each frame it feeds pass 3 the
+//! ring-0 cells of the latest Tile Load Map and reads pass 3's counters back through a staging
+//! ring, never waiting: the counters a frame reports are a frame or two old.
+
+use std::collections::VecDeque;
+
+use glam::DVec3;
+
+use crate::camera::Camera;
+use crate::classes::ClassTable;
+use crate::config::Settings;
+use crate::dataset::Dataset;
+use crate::gpu::gpu_types::SeedCounters;
+use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
+use crate::gpu::{Gpu, GpuError};
+use crate::passes::seed_select::{SeedCellRef, SeedFrame, SeedInputs, SeedSelectPass, SeedSources};
+use crate::seeds::SeedTables;
+use crate::seeds::patterns::SeedPatterns;
+
+use super::RenderError;
+
+/// Pass 3's counters for one frame, as the frame log records them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SeedReport {
+    /// The frame these counters are from.
+    pub frame: u64,
+    pub cells: u32,
+    #[serde(flatten)]
+    pub counters: SeedCounters,
+}
+
+pub(super) struct SeedStage {
+    pub tables: SeedTables,
+    pub patterns: SeedPatterns,
+    pub pass: SeedSelectPass,
+    pub bind_group: wgpu::BindGroup,
+    counters_ring: ReadbackRing,
+    /// Frames (and their cell counts) whose counters are in flight, oldest first.
+    in_flight: VecDeque<(u64, u32)>,
+    /// The last frame's inputs, for the twin.
+    pub last_frame: Option<SeedFrame>,
+    pub latest: Option<SeedReport>,
+}
+
+impl SeedStage {
+    /// The stage for `dataset`, or `None` when it has no land cover (nothing to grow seeds from).
+    pub fn new(
+        device: &wgpu::Device,
+        dataset: &Dataset,
+        settings: &Settings,
+        sources: &SeedSources,
+    ) -> Result<Option<Self>, RenderError> {
+        let Some(landcover) = &dataset.manifest.landcover else { return Ok(None) };
+        let name = match settings.seeds.class_table.as_str() {
+            "" => landcover.scheme.as_str(),
+            name => name,
+        };
+        let record_bytes = size_of::<crate::gpu::gpu_types::SeedRecord>() as u64;
+        let max_bytes = device.limits().max_storage_buffer_binding_size;
+        if u64::from(settings.seeds.capacity) * record_bytes > max_bytes {
+            return Err(RenderError::SeedCapacity {
+                capacity: settings.seeds.capacity,
+                max: (max_bytes / record_bytes) as u32,
+            });
+        }
+        let table = ClassTable::load(name)?;
+        let seeds_per_pattern = settings.seeds.seeds_per_pattern;
+        let tables = SeedTables::new(&table, &landcover.coding, settings.tlm.cell_m, seeds_per_pattern)?;
+        let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds_per_pattern, settings.tlm.seed);
+        let pass = SeedSelectPass::new(device, settings, &patterns, &tables);
+        let bind_group = pass.bind_group(device, sources);
+        let counters_ring =
+            ReadbackRing::new(device, "seed counters", size_of::<SeedCounters>() as u64, DEFAULT_SLOTS);
+        Ok(Some(Self {
+            tables,
+            patterns,
+            pass,
+            bind_group,
+            counters_ring,
+            in_flight: VecDeque::new(),
+            last_frame: None,
+            latest: None,
+        }))
+    }
+
+    /// Uploads this frame's cells.
+    pub fn prepare(&mut self, gpu: &Gpu, inputs: &SeedInputs) -> Result<&SeedFrame, RenderError> {
+        let frame = self.pass.prepare(&gpu.queue, inputs)?;
+        Ok(self.last_frame.insert(frame))
+    }
+
+    /// Records pass 3, then the copy of its counters (after the last timed pass: see `render`).
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(frame) = &self.last_frame {
+            self.pass.encode(encoder, &self.bind_group, frame);
+        }
+    }
+
+    pub fn encode_readback(&mut self, encoder: &mut wgpu::CommandEncoder, frame: u64) {
+        let bytes = size_of::<SeedCounters>() as u64;
+        if self.counters_ring.encode_copy(encoder, self.pass.counters(), bytes, frame) {
+            let cells = self.last_frame.as_ref().map_or(0, |f| f.cells.len() as u32);
+            self.in_flight.push_back((frame, cells));
+        }
+    }
+
+    pub fn submitted(&mut self) {
+        self.counters_ring.submitted();
+    }
+
+    /// Takes every counter readback that has arrived, keeping the newest.
+    pub fn collect(&mut self, device: &wgpu::Device) -> Result<(), GpuError> {
+        while let Some(readback) = self.counters_ring.try_take(device)? {
+            while self.in_flight.front().is_some_and(|(frame, _)| *frame < readback.frame) {
+                self.in_flight.pop_front();
+            }
+            let Some((frame, cells)) = self.in_flight.pop_front() else { continue };
+            if let Some(&counters) = readback.cast::<SeedCounters>().first() {
+                self.latest = Some(SeedReport { frame, cells, counters });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The inputs of a frame's seed selection.
+pub(super) fn seed_inputs<'a>(
+    settings: &'a Settings,
+    dataset: &'a Dataset,
+    camera: &'a Camera,
+    camera_grid_m: DVec3,
+    cells: &'a [SeedCellRef],
+) -> SeedInputs<'a> {
+    SeedInputs {
+        settings,
+        dataset,
+        camera,
+        camera_grid_m,
+        viewport_px: [settings.render.width, settings.render.height],
+        cells,
+    }
+}

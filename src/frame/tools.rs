@@ -1,0 +1,151 @@
+//! How it works: what tools and tests ask of a renderer besides frames: all-resident references,
+//! rendering a view until it has streamed in, and blocking readbacks of the targets and the seeds.
+//! None of it is on the per-frame path.
+
+use std::time::Duration;
+
+use crate::gpu::GpuError;
+use crate::gpu::readback::read_texture;
+use crate::streaming::wants::pinned_tiles;
+use crate::streaming::{CacheStats, TileCache};
+
+use super::{FrameReport, RenderError, Renderer};
+use crate::camera::Camera;
+use crate::gpu::gpu_types::{SeedCounters, SeedRecord};
+use crate::passes::seed_select::SeedCellRef;
+use crate::reference::seed_select::{SeedSnapshot, seed_select, snapshot_caches};
+use crate::seeds::SeedTables;
+use crate::seeds::patterns::SeedPatterns;
+
+impl Renderer {
+    /// Loads every tile of the dataset now (heights, imagery, land cover) and pins it, for
+    /// all-resident reference renders. Fails when a layer does not fit its cache.
+    pub fn pin_everything(&mut self) -> Result<(), RenderError> {
+        let everything = |cache: &TileCache, layer: &'static str| {
+            let pyramid = cache.pyramid();
+            if pyramid.tile_count() > cache.capacity() as u64 {
+                return Err(RenderError::DoesNotFit {
+                    layer,
+                    tiles: pyramid.tile_count(),
+                    slots: cache.capacity(),
+                });
+            }
+            Ok(pinned_tiles(pyramid, usize::MAX))
+        };
+        let queue = &self.gpu.queue;
+        self.pinned_heights = everything(&self.heights, "height")?;
+        self.heights
+            .load_now(queue, &self.pinned_heights, self.frame, |id| self.dataset.height.tile_bytes(id));
+        if let Some(layer) = &self.dataset.imagery {
+            self.pinned_imagery = everything(&self.imagery, "imagery")?;
+            self.imagery.load_now(queue, &self.pinned_imagery, self.frame, |id| layer.tile_bytes(id));
+        }
+        if let (Some(layer), Some(cache)) = (&self.dataset.landcover, self.landcover.as_mut()) {
+            self.pinned_landcover = everything(cache, "land-cover")?;
+            cache.load_now(queue, &self.pinned_landcover, self.frame, |id| layer.tile_bytes(id));
+        }
+        Ok(())
+    }
+
+    /// Whether every tile the frame of `report` wanted is resident (or failed, or beyond what the
+    /// cache can hold), with nothing left loading or waiting for upload.
+    pub fn is_resolved(&self, report: &FrameReport) -> bool {
+        let done = |s: &CacheStats, cache: &TileCache| {
+            s.needed_resident + s.failed >= s.needed.min(cache.capacity()) && s.staged == 0
+        };
+        let landcover = match &self.landcover {
+            Some(cache) => done(&report.landcover, cache),
+            None => true,
+        };
+        done(&report.height, &self.heights)
+            && done(&report.imagery, &self.imagery)
+            && landcover
+            && self.loader.is_idle()
+    }
+
+    /// Renders `camera` frame after frame until everything it needs is resident (at most
+    /// `max_frames`), for single frames and references. Returns the last frame's report and the
+    /// number of frames it took.
+    pub fn render_resolved(
+        &mut self,
+        camera: &Camera,
+        max_frames: u32,
+    ) -> Result<(FrameReport, u32), RenderError> {
+        let first = self.frame;
+        let mut frames = 0;
+        loop {
+            let report = self.render(camera)?;
+            frames += 1;
+            // Resolved only once a Tile Load Map of this very view has driven the streaming.
+            let informed = report.tlm_frame.is_some_and(|f| f >= first);
+            if (informed && self.is_resolved(&report)) || frames >= max_frames {
+                return Ok((report, frames));
+            }
+            // The loader threads are reading: give them the core rather than spin.
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    /// The last frame's colour, as an sRGB image.
+    pub fn read_colour(&self) -> Result<image::RgbaImage, RenderError> {
+        let bytes = read_texture(&self.gpu, &self.colour, wgpu::TextureAspect::All, 4)?;
+        let (w, h) = (self.colour.width(), self.colour.height());
+        image::RgbaImage::from_raw(w, h, bytes)
+            .ok_or_else(|| RenderError::Gpu(GpuError::Validation("readback size mismatch".into())))
+    }
+
+    /// The last frame's depth (reversed-Z: 1 at the near plane, 0 for the sky), top row first.
+    pub fn read_depth(&self) -> Result<Vec<f32>, RenderError> {
+        let bytes = read_texture(&self.gpu, &self.depth, wgpu::TextureAspect::DepthOnly, 4)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// The seeded world of this renderer: species tables and patterns (`None` without land cover).
+    pub fn seed_world(&self) -> Option<(&SeedTables, &SeedPatterns)> {
+        self.seeds.as_ref().map(|s| (&s.tables, &s.patterns))
+    }
+
+    /// The last frame's seeds as pass 3 wrote them, with its counters, waiting for the GPU
+    /// (`None` without land cover). Records come in no particular order.
+    pub fn read_seeds(&self) -> Result<Option<(Vec<SeedRecord>, SeedCounters)>, RenderError> {
+        let Some(stage) = &self.seeds else { return Ok(None) };
+        Ok(Some(stage.pass.read_back(&self.gpu)?))
+    }
+
+    /// What pass 3 read in the last frame (its cells, the resident tiles, the depth), for its
+    /// twin; `None` without land cover or before a first frame.
+    pub fn seed_snapshot(&self) -> Result<Option<SeedSnapshot>, RenderError> {
+        let (Some(stage), Some(landcover)) = (&self.seeds, &self.landcover) else { return Ok(None) };
+        let Some(frame) = &stage.last_frame else { return Ok(None) };
+        let caches = snapshot_caches(&self.dataset, &self.heights, landcover, &self.imagery)?;
+        Ok(Some(SeedSnapshot {
+            frame: frame.clone(),
+            patterns_unit: stage.patterns.positions_unit.clone(),
+            tables: stage.tables.clone(),
+            caches,
+            depth: self.read_depth()?,
+        }))
+    }
+
+    /// Pass 3 replayed by its CPU twin over the last frame's inputs, in canonical order.
+    pub fn seed_twin(&self) -> Result<Option<(Vec<SeedRecord>, SeedCounters)>, RenderError> {
+        Ok(self.seed_snapshot()?.map(|snapshot| seed_select(&snapshot.inputs())))
+    }
+
+    /// Runs pass 3 alone over `cells` seen from `camera`, against the caches and depth as the last
+    /// frame left them, and waits for it: for benchmarks, which choose how many seeds to check.
+    /// `read_seeds` then reads its output.
+    pub fn run_seed_select(&mut self, camera: &Camera, cells: &[SeedCellRef]) -> Result<(), RenderError> {
+        let Some(stage) = self.seeds.as_mut() else { return Ok(()) };
+        let origin = self.dataset.manifest.origin_m;
+        let camera_grid_m = camera.position_m - glam::DVec3::new(origin[0], origin[1], 0.0);
+        let inputs = super::seeds::seed_inputs(&self.settings, &self.dataset, camera, camera_grid_m, cells);
+        stage.prepare(&self.gpu, &inputs)?;
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        stage.encode(&mut encoder);
+        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.wait()?;
+        self.gpu.check()?;
+        Ok(())
+    }
+}

@@ -1,0 +1,323 @@
+//! How it works: the exact oracle of seed visibility, what the accuracy of pass 3 is measured
+//! against (CPU, f64, full resolution, no tolerance). It owes the GPU nothing: it enumerates the
+//! seeds itself, every seed of every ring-0 cell within reach of the camera, and judges each in the
+//! GPU pass's order of culls (class, rule, distance, frustum, occlusion), but exactly. The seeded
+//! world (patterns, hashes, rank thinning, sizes) is the shared definition in `crate::seeds`.
+//!
+//! The ground is the bilinear surface of the level-0 height samples (sample (i, j) at grid
+//! (i·spacing, j·spacing)); a seed's slope is that patch's gradient (the patch of the cell whose
+//! floor holds the point). Its class is the level-1 land-cover texel under it, the land-cover grid
+//! starting half a spacing south-west of grid space's origin. Its bounding sphere (centred half-way
+//! up its sunk trunk) must reach the inner side of each of the five planes of the view (left,
+//! right, bottom, top, near). Occlusion is exact: the eye→summit segment (bar its last 1e-6) must
+//! never pass strictly below the bilinear surface. The walk visits the DEM cells the segment's
+//! horizontal projection crosses, in order (2D DDA, each crossing's parameter computed directly,
+//! so no error accumulates); in a cell the surface along the segment is a quadratic in the
+//! parameter and the segment's height linear, so their difference is checked at the interval's
+//! ends and at the quadratic's vertex. Outside the dataset there is no terrain; an eye below the
+//! surface sees nothing.
+//!
+//! Speed: the level-0 heights around the camera are copied once into a dense window and the
+//! land-cover tiles under it decoded once; cells are judged in parallel (rayon). The result is
+//! deterministic: visible seeds sorted by (cell address, rank), counts summed.
+
+mod ground;
+
+use glam::{DMat4, DVec2, DVec3, DVec4};
+use rayon::prelude::*;
+use thiserror::Error;
+
+use crate::camera::{Camera, CameraError};
+use crate::config::Settings;
+use crate::dataset::{Dataset, PackError};
+use crate::gpu::gpu_types::SeedSpecies;
+use crate::seeds::patterns::SeedPatterns;
+use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, species_of_rank};
+use ground::{DemWindow, LandcoverTiles};
+
+/// The fraction of an eye→summit segment, at the summit's end, the occlusion test ignores.
+pub const SEGMENT_END_SKIP: f64 = 1e-6;
+
+#[derive(Debug, Error)]
+pub enum OracleError {
+    #[error("oracle: {0}")]
+    Camera(#[from] CameraError),
+    #[error("oracle: {0}")]
+    Pack(#[from] PackError),
+    #[error(
+        "oracle: the patterns hold {count} patterns of {seeds_per_pattern} seeds in {positions} positions; \
+         tlm.patterns asks for {wanted}"
+    )]
+    Patterns { count: u32, seeds_per_pattern: u32, positions: usize, wanted: u32 },
+    #[error("oracle: ring-0 cell ({0}, {1}) has no 32-bit address (tlm.cell_m too small for this dataset)")]
+    Address(i64, i64),
+}
+
+/// What the oracle reads.
+pub struct OracleInputs<'a> {
+    pub dataset: &'a Dataset,
+    /// Reads `tlm.cell_m`, `tlm.patterns`, `tlm.seed`, `tlm.radial_lod_m`,
+    /// `seeds.reference_height_m` and `seeds.sink_fraction`.
+    pub settings: &'a Settings,
+    pub tables: &'a SeedTables,
+    /// The ranks judged per cell are `patterns.seeds_per_pattern`.
+    pub patterns: &'a SeedPatterns,
+    /// `position_m` in CRS metres; grid space is that minus (`origin_m`, 0).
+    pub camera: &'a Camera,
+    pub viewport_px: [u32; 2],
+}
+
+/// A visible seed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OracleSeed {
+    /// Global ring-0 cell address.
+    pub address: [i64; 2],
+    pub rank: u32,
+    /// Index into `SeedTables::species`.
+    pub species: u32,
+    pub position_grid_m: [f64; 2],
+    /// The bilinear ground height under the seed (its anchor sinks below it).
+    pub ground_m: f64,
+    pub height_m: f64,
+    /// 0, 1 or 2: the first `tlm.radial_lod_m` threshold (scaled by size) the seed is within.
+    pub radial_lod: u32,
+}
+
+/// Seeds judged, and where each went: every candidate lands in exactly one other field.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct OracleCounts {
+    pub candidates: u64,
+    pub class: u64,
+    pub rule: u64,
+    pub distance: u64,
+    pub frustum: u64,
+    pub occlusion: u64,
+    pub visible: u64,
+}
+
+impl OracleCounts {
+    fn add(&mut self, o: &Self) {
+        self.candidates += o.candidates;
+        self.class += o.class;
+        self.rule += o.rule;
+        self.distance += o.distance;
+        self.frustum += o.frustum;
+        self.occlusion += o.occlusion;
+        self.visible += o.visible;
+    }
+}
+
+/// The visible seeds of the view, sorted by (address, rank), and the counts of every fate.
+pub fn visible_seeds(inputs: &OracleInputs) -> Result<(Vec<OracleSeed>, OracleCounts), OracleError> {
+    let &OracleInputs { dataset, settings, patterns, camera, viewport_px, .. } = inputs;
+    camera.validate()?;
+    let clip = camera.clip_from_view(viewport_px[0], viewport_px[1])? * camera.view_from_world();
+    let spp = patterns.seeds_per_pattern;
+    if patterns.count < settings.tlm.patterns.max(1)
+        || patterns.positions_unit.len() != patterns.count as usize * spp as usize
+    {
+        return Err(OracleError::Patterns {
+            count: patterns.count,
+            seeds_per_pattern: spp,
+            positions: patterns.positions_unit.len(),
+            wanted: settings.tlm.patterns,
+        });
+    }
+    let manifest = &dataset.manifest;
+    let spacing_m = manifest.height.spacing_m;
+    let extent_m = dataset.height.pyramid.size.map(|n| f64::from(n.max(1) - 1) * spacing_m);
+    let eye = camera.position_m - DVec3::new(manifest.origin_m[0], manifest.origin_m[1], 0.0);
+    let cell_m = settings.tlm.cell_m;
+    let reach_m = settings.tlm.radial_lod_m.iter().fold(0.0f64, |a, &b| a.max(b));
+
+    // Ring-0 cells overlapping the height rectangle whose square comes within reach.
+    let range = |c: f64, a: usize| {
+        let last = (extent_m[a] / cell_m).floor();
+        let lo = ((c - reach_m) / cell_m).floor().max(0.0);
+        let hi = ((c + reach_m) / cell_m).floor().min(last);
+        (lo as i64, hi as i64)
+    };
+    let ((x0, x1), (y0, y1)) = (range(eye.x, 0), range(eye.y, 1));
+    let mut cells = Vec::new();
+    for gy in y0..=y1 {
+        for gx in x0..=x1 {
+            let gap = |g: i64, c: f64| (g as f64 * cell_m - c).max(c - (g + 1) as f64 * cell_m).max(0.0);
+            if DVec2::new(gap(gx, eye.x), gap(gy, eye.y)).length() < reach_m {
+                cells.push([gx, gy]);
+            }
+        }
+    }
+    if cells.is_empty() {
+        return Ok((Vec::new(), OracleCounts::default()));
+    }
+    let region_min = [x0 as f64 * cell_m, y0 as f64 * cell_m];
+    let region_max =
+        [((x1 + 1) as f64 * cell_m).min(extent_m[0]), ((y1 + 1) as f64 * cell_m).min(extent_m[1])];
+    let dem = DemWindow::load(dataset, region_min, region_max)?;
+    let landcover = LandcoverTiles::load(dataset, region_min, region_max)?;
+    let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= extent_m[0] && p.y <= extent_m[1];
+    // An eye below the ground sees nothing (every seed reaching the occlusion test is hidden).
+    let eye_underground = inside(eye.truncate()) && eye.z < dem.ground(eye.truncate()).0;
+    let view = View { inputs, dem, landcover, planes: frustum_planes(clip), eye, eye_underground, extent_m };
+    let judged: Vec<(Vec<OracleSeed>, OracleCounts)> =
+        cells.par_iter().map(|&address| view.cell(address)).collect::<Result<_, _>>()?;
+    let mut counts = OracleCounts::default();
+    let mut seeds = Vec::with_capacity(judged.iter().map(|(s, _)| s.len()).sum());
+    for (cell_seeds, cell_counts) in judged {
+        seeds.extend(cell_seeds);
+        counts.add(&cell_counts);
+    }
+    seeds.sort_by_key(|s| (s.address, s.rank));
+    Ok((seeds, counts))
+}
+
+/// Whether the segment eye→target (grid space, metres) clears the full-resolution DEM: it never
+/// passes strictly below the bilinear surface where the dataset has terrain. The last
+/// `SEGMENT_END_SKIP` of the segment, at the target's end, is ignored.
+pub fn segment_clears_dem(
+    dataset: &Dataset,
+    eye_grid_m: DVec3,
+    target_grid_m: DVec3,
+) -> Result<bool, PackError> {
+    Ok(segment_min_clearance_m(dataset, eye_grid_m, target_grid_m, true)? >= 0.0)
+}
+
+/// The least height of the segment above the surface (∞ where it meets no terrain); with `stop`,
+/// any negative value as soon as one is found.
+fn segment_min_clearance_m(
+    dataset: &Dataset,
+    eye: DVec3,
+    target: DVec3,
+    stop: bool,
+) -> Result<f64, PackError> {
+    let (lo, hi) = (eye.min(target), eye.max(target));
+    let dem = DemWindow::load(dataset, [lo.x, lo.y], [hi.x, hi.y])?;
+    Ok(dem.min_clearance_m(eye, target, 1.0 - SEGMENT_END_SKIP, stop))
+}
+
+/// The five planes (left, right, bottom, top, near; unit normals pointing inside) of a reversed-Z,
+/// infinite-far clip matrix over camera-relative space (Gribb & Hartmann, as `Frustum`).
+fn frustum_planes(clip_from_world: DMat4) -> [DVec4; 5] {
+    let m = clip_from_world.transpose();
+    let (x, y, z, w) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
+    [w + x, w - x, w + y, w - y, w - z].map(|p| p / p.truncate().length().max(1e-300))
+}
+
+/// A seed's fate.
+enum Fate {
+    Class,
+    Rule,
+    Distance,
+    Frustum,
+    Occlusion,
+    Visible(OracleSeed),
+}
+
+struct View<'a> {
+    inputs: &'a OracleInputs<'a>,
+    dem: DemWindow,
+    landcover: LandcoverTiles,
+    planes: [DVec4; 5],
+    eye: DVec3,
+    eye_underground: bool,
+    extent_m: [f64; 2],
+}
+
+impl View<'_> {
+    fn cell(&self, address: [i64; 2]) -> Result<(Vec<OracleSeed>, OracleCounts), OracleError> {
+        let i32_address = match address.map(i32::try_from) {
+            [Ok(x), Ok(y)] => [x, y],
+            _ => return Err(OracleError::Address(address[0], address[1])),
+        };
+        let tlm = &self.inputs.settings.tlm;
+        let spp = self.inputs.patterns.seeds_per_pattern;
+        let pattern = cell_pattern(i32_address, tlm.seed, tlm.patterns);
+        let positions = &self.inputs.patterns.positions_unit[(pattern * spp) as usize..][..spp as usize];
+        let mut counts = OracleCounts { candidates: u64::from(spp), ..Default::default() };
+        let mut seeds = Vec::new();
+        for (rank, &[ux, uy]) in (0..spp).zip(positions) {
+            let position = DVec2::new(
+                address[0] as f64 * tlm.cell_m + f64::from(ux) * tlm.cell_m,
+                address[1] as f64 * tlm.cell_m + f64::from(uy) * tlm.cell_m,
+            );
+            match self.seed(address, i32_address, rank, position)? {
+                Fate::Class => counts.class += 1,
+                Fate::Rule => counts.rule += 1,
+                Fate::Distance => counts.distance += 1,
+                Fate::Frustum => counts.frustum += 1,
+                Fate::Occlusion => counts.occlusion += 1,
+                Fate::Visible(seed) => {
+                    counts.visible += 1;
+                    seeds.push(seed);
+                }
+            }
+        }
+        Ok((seeds, counts))
+    }
+
+    fn seed(
+        &self,
+        address: [i64; 2],
+        i32_address: [i32; 2],
+        rank: u32,
+        p: DVec2,
+    ) -> Result<Fate, OracleError> {
+        let OracleInputs { dataset, settings, tables, .. } = *self.inputs;
+        if !(p.x >= 0.0 && p.y >= 0.0 && p.x <= self.extent_m[0] && p.y <= self.extent_m[1]) {
+            return Ok(Fate::Class);
+        }
+        let index = self.landcover.index(dataset, p)?;
+        let found = tables.classes.get(index as usize).and_then(|class| species_of_rank(class, rank));
+        let Some((species_index, species)) = found.and_then(|k| Some((k, tables.species.get(k as usize)?)))
+        else {
+            return Ok(Fate::Class);
+        };
+        let (ground_m, gradient) = self.dem.ground(p);
+        let altitude = species.altitude_m.map(f64::from);
+        if !(ground_m >= altitude[0] && ground_m <= altitude[1])
+            || gradient.length_squared() > f64::from(species.max_slope_tan_sq)
+        {
+            return Ok(Fate::Rule);
+        }
+        let seeds = &settings.seeds;
+        let height_m = f64::from(seed_height_m(species, seed_hash(i32_address, rank, settings.tlm.seed)));
+        let rel = DVec3::new(p.x, p.y, ground_m) - self.eye;
+        let distance_m = rel.length();
+        let scale = (height_m / seeds.reference_height_m).min(1.0);
+        let radial = settings.tlm.radial_lod_m;
+        if distance_m >= radial[2] * scale {
+            return Ok(Fate::Distance);
+        }
+        let radial_lod = radial.iter().position(|&r| distance_m < r * scale).unwrap_or(2) as u32;
+        if !self.in_frustum(species, rel, height_m) {
+            return Ok(Fate::Frustum);
+        }
+        let summit = DVec3::new(p.x, p.y, ground_m - seeds.sink_fraction * height_m + height_m);
+        if self.eye_underground
+            || self.dem.min_clearance_m(self.eye, summit, 1.0 - SEGMENT_END_SKIP, true) < 0.0
+        {
+            return Ok(Fate::Occlusion);
+        }
+        Ok(Fate::Visible(OracleSeed {
+            address,
+            rank,
+            species: species_index,
+            position_grid_m: [p.x, p.y],
+            ground_m,
+            height_m,
+            radial_lod,
+        }))
+    }
+
+    /// Whether the bounding sphere of a seed whose ground point is `ground_rel_m` from the eye
+    /// reaches inside every plane of the view.
+    fn in_frustum(&self, species: &SeedSpecies, ground_rel_m: DVec3, height_m: f64) -> bool {
+        let sink_fraction = self.inputs.settings.seeds.sink_fraction;
+        let centre = ground_rel_m + DVec3::Z * (height_m * (0.5 - sink_fraction));
+        let radius_m = height_m * f64::from(species.radius_per_height);
+        self.planes.iter().all(|plane| plane.truncate().dot(centre) + plane.w >= -radius_m)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,269 @@
+use std::path::PathBuf;
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use indicatif::ProgressBar;
+
+use super::*;
+use crate::classes::ClassTable;
+use crate::dataset::{
+    Crs, FORMAT_VERSION, HeightLayer, LayerSpec, Manifest, Pyramid, Reduce, Sampling, Staging, Window,
+    write_layer,
+};
+use crate::seeds::pcg;
+use crate::synth::{SynthParams, synthesize};
+
+fn temp_out(name: &str) -> PathBuf {
+    let root = std::env::temp_dir().join(format!("terramp-oracle-{}", std::process::id()));
+    std::fs::create_dir_all(&root).unwrap();
+    root.join(name)
+}
+
+/// A dataset of `size`² heights `height(i, j)`, `spacing_m` apart, in tiles of 8 cells (so a
+/// segment crosses several), without land cover.
+fn dem(name: &str, size: u32, spacing_m: f64, height: impl Fn(u32, u32) -> f32 + Sync) -> Dataset {
+    let staging = Staging::begin(&temp_out(name)).unwrap();
+    let spec = LayerSpec {
+        name: "height",
+        pyramid: Pyramid::new([size; 2], 8, 1, Sampling::Vertex),
+        mips: 1,
+        reduce: Reduce::Decimate,
+    };
+    let source = |w: Window| {
+        let rows = w.y0..w.y0 + w.height;
+        Ok::<_, String>(
+            rows.flat_map(|y| (w.x0..w.x0 + w.width).map(move |x| (x, y)))
+                .map(|(x, y)| height(x, y))
+                .collect(),
+        )
+    };
+    write_layer(&staging.path("height.pack"), &spec, source, &ProgressBar::hidden()).unwrap();
+    let manifest = Manifest {
+        format_version: FORMAT_VERSION,
+        name: "oracle test".into(),
+        crs: Crs { definition: "LOCAL".into(), note: "test".into() },
+        origin_m: [500_000.0, 4_000_000.0],
+        height: HeightLayer {
+            pack: "height.pack".into(),
+            spacing_m,
+            pyramid: spec.pyramid,
+            min_m: -1000.0,
+            max_m: 1000.0,
+            filled_samples: 0,
+            valid_mask_pack: None,
+        },
+        imagery: None,
+        landcover: None,
+    };
+    Dataset::open(&staging.commit(&manifest).unwrap()).unwrap()
+}
+
+fn clears(dataset: &Dataset, eye: [f64; 3], target: [f64; 3]) -> bool {
+    segment_clears_dem(dataset, DVec3::from(eye), DVec3::from(target)).unwrap()
+}
+
+/// A stream of numbers in [0, 1).
+fn random(state: &mut u32) -> f64 {
+    *state = pcg(*state);
+    f64::from(*state) / 4_294_967_296.0
+}
+
+#[test]
+fn the_window_reads_every_sample_and_the_bilinear_surface() {
+    let height = |i: u32, j: u32| (pcg(i * 131 + j) % 1000) as f32 * 0.1;
+    let ds = dem("window", 29, 7.5, height);
+    let dem = DemWindow::load(&ds, [0.0, 0.0], [210.0, 210.0]).unwrap();
+    let mut state = 9;
+    for _ in 0..500 {
+        let p = DVec2::new(random(&mut state) * 210.0, random(&mut state) * 210.0);
+        let (ground_m, gradient) = dem.ground(p);
+        assert!((ground_m - ds.height_at(p.x, p.y, 0).unwrap()).abs() < 1e-9, "{p}");
+        let e = 1e-6;
+        let slope_x =
+            (ds.height_at(p.x + e, p.y, 0).unwrap() - ds.height_at(p.x - e, p.y, 0).unwrap()) / (2.0 * e);
+        // Away from cell edges (where the gradient jumps) it is the surface's derivative.
+        if ((p.x / 7.5).fract() - 0.5).abs() < 0.49 {
+            assert!((gradient.x - slope_x).abs() < 1e-5, "{p}: {gradient} against {slope_x}");
+        }
+    }
+}
+
+#[test]
+fn segments_over_a_flat_plane() {
+    let ds = dem("flat", 17, 10.0, |_, _| 100.0);
+    assert!(clears(&ds, [5.0, 5.0, 101.0], [150.0, 120.0, 105.0]));
+    assert!(clears(&ds, [5.0, 5.0, 100.0], [150.0, 5.0, 100.0]), "touching is not passing below");
+    assert!(!clears(&ds, [5.0, 5.0, 101.0], [150.0, 120.0, 99.0]), "dips below before its end");
+    assert!(!clears(&ds, [5.0, 5.0, 99.0], [150.0, 120.0, 120.0]), "eye below the ground");
+    assert!(clears(&ds, [-50.0, 5.0, 50.0], [-10.0, 150.0, 50.0]), "no terrain beyond the dataset");
+    assert!(!clears(&ds, [-50.0, 80.0, 90.0], [100.0, 80.0, 110.0]), "enters the dataset below ground");
+    assert!(clears(&ds, [80.0, 80.0, 150.0], [80.0, 80.0, 100.5]), "vertical, above");
+    assert!(!clears(&ds, [80.0, 80.0, 150.0], [80.0, 80.0, 50.0]), "vertical, through");
+    // The last 1e-6 of the segment is ignored: a target a hair under the ground.
+    assert!(clears(&ds, [5.0, 5.0, 200.0], [150.0, 120.0, 100.0 - 1e-5]));
+    assert!(!clears(&ds, [5.0, 5.0, 200.0], [150.0, 120.0, 100.0 - 1e-3]));
+}
+
+const RIDGE_M: f32 = 50.0;
+
+/// Row 16 raised to `RIDGE_M` from column 4 to 20, flat 0 elsewhere.
+fn ridge(i: u32, j: u32) -> f32 {
+    if j == 16 && (4..=20).contains(&i) { RIDGE_M } else { 0.0 }
+}
+
+#[test]
+fn a_ridge_between_samples_is_caught() {
+    let s = 10.0;
+    let ds = dem("ridge", 32, s, ridge);
+    let h = f64::from(RIDGE_M);
+    // Across the ridge between two of its samples.
+    assert!(!clears(&ds, [55.0, 100.0, h - 5.0], [55.0, 220.0, h - 5.0]));
+    assert!(clears(&ds, [55.0, 100.0, h + 0.5], [55.0, 220.0, h + 0.5]));
+    // Past the ridge's end, along the anti-diagonal of cell (20, 16): every sample and every cell
+    // edge the segment passes is at 0, but inside that cell the surface bulges to h/4.
+    let along = |z: f64| clears(&ds, [22.0 * s, 15.0 * s, z], [19.0 * s, 18.0 * s, z]);
+    assert!(!along(h / 8.0));
+    assert!(!along(h / 4.0 - 0.01));
+    assert!(along(h / 4.0 + 0.01));
+}
+
+/// The least height above the bilinear surface of `ridge` along the segment, sampled every 1e-4.
+fn brute_min_clearance(eye: DVec3, target: DVec3, s: f64) -> f64 {
+    let size = 32u32;
+    let extent = f64::from(size - 1) * s;
+    let surface = |x: f64, y: f64| {
+        if !(0.0..=extent).contains(&x) || !(0.0..=extent).contains(&y) {
+            return None;
+        }
+        let (gx, gy) = (x / s, y / s);
+        let (i, j) = ((gx.floor() as u32).min(size - 2), (gy.floor() as u32).min(size - 2));
+        let (u, v) = (gx - f64::from(i), gy - f64::from(j));
+        let h = |a, b| f64::from(ridge(a, b));
+        Some(
+            h(i, j) * (1.0 - u) * (1.0 - v)
+                + h(i + 1, j) * u * (1.0 - v)
+                + h(i, j + 1) * (1.0 - u) * v
+                + h(i + 1, j + 1) * u * v,
+        )
+    };
+    let t_end = 1.0 - SEGMENT_END_SKIP;
+    (0..10_000).map(|k| f64::from(k) * 1e-4).chain([t_end]).fold(f64::INFINITY, |least, t| {
+        let p = eye + (target - eye) * t;
+        surface(p.x, p.y).map_or(least, |h| least.min(p.z - h))
+    })
+}
+
+#[test]
+fn the_exact_walk_agrees_with_brute_force_on_random_segments() {
+    let s = 10.0;
+    let ds = dem("ridge-random", 32, s, ridge);
+    let dem = DemWindow::load(&ds, [0.0, 0.0], [310.0, 310.0]).unwrap();
+    let (mut state, mut occluded) = (3u32, 0);
+    for n in 0..1000 {
+        let mut point = |z_lo: f64, z_hi: f64| {
+            let (x, y) = (random(&mut state) * 390.0 - 40.0, random(&mut state) * 390.0 - 40.0);
+            DVec3::new(x, y, z_lo + random(&mut state) * (z_hi - z_lo))
+        };
+        // Half the segments stay above the flat ground, so only the ridge can hide them.
+        let (z_lo, z_hi) = if n % 2 == 0 { (0.5, 65.0) } else { (-5.0, 65.0) };
+        let (eye, target) = (point(z_lo, z_hi), point(z_lo, z_hi));
+        let exact = dem.min_clearance_m(eye, target, 1.0 - SEGMENT_END_SKIP, false);
+        let brute = brute_min_clearance(eye, target, s);
+        // Samples are points of the segment: none is below the exact least; and between two
+        // samples the clearance changes by at most its steepest rate times the step.
+        let d = target - eye;
+        let rate = d.z.abs() + f64::from(RIDGE_M) / s * 2f64.sqrt() * d.truncate().length();
+        assert!(exact <= brute + 1e-9, "segment {n}: exact {exact} above a sample {brute}");
+        if brute.is_finite() {
+            assert!(brute - exact <= rate * 1e-4 + 1e-9, "segment {n}: exact {exact}, sampled {brute}");
+        }
+        // Brute force could only disagree within a step's change of 0, or over the dataset for less
+        // than a step: none of these segments is that close a call.
+        let close = exact.abs() <= rate * 1e-4 || brute.is_infinite() != exact.is_infinite();
+        assert_eq!(exact < 0.0, brute < 0.0, "segment {n}: exact {exact}, sampled {brute} (close: {close})");
+        assert_eq!(exact < 0.0, !segment_clears_dem(&ds, eye, target).unwrap(), "segment {n}");
+        occluded += usize::from(exact < 0.0);
+    }
+    assert!((200..=800).contains(&occluded), "{occluded} of 1000 occluded: the test says little");
+}
+
+/// The synthetic dataset of `size`² samples (10 m), built once per test process.
+fn synthetic(size: u32) -> Dataset {
+    static BUILT: OnceLock<std::sync::Mutex<Vec<(u32, PathBuf)>>> = OnceLock::new();
+    let mut built = BUILT.get_or_init(Default::default).lock().unwrap();
+    let dir = match built.iter().find(|(n, _)| *n == size) {
+        Some((_, dir)) => dir.clone(),
+        None => {
+            let params =
+                SynthParams { size, seed: 3, origin_m: [630_000.0, 215_000.0], ..Default::default() };
+            let dir = synthesize(&temp_out(&format!("synth-{size}")), &params, false).unwrap();
+            built.push((size, dir.clone()));
+            dir
+        }
+    };
+    Dataset::open(&dir).unwrap()
+}
+
+/// Runs the oracle on `dataset` from grid point (x, y), `above_m` over the ground, looking along
+/// `yaw_deg` and `pitch_deg`.
+fn run(dataset: &Dataset, pose: [f64; 5], viewport_px: [u32; 2]) -> (Vec<OracleSeed>, OracleCounts) {
+    let settings = Settings::default();
+    let landcover = dataset.manifest.landcover.as_ref().unwrap();
+    let table = ClassTable::load(&landcover.scheme).unwrap();
+    let spp = settings.seeds.seeds_per_pattern;
+    let tables = SeedTables::new(&table, &landcover.coding, settings.tlm.cell_m, spp).unwrap();
+    let patterns = SeedPatterns::generate(settings.tlm.patterns, spp, settings.tlm.seed);
+    let [x, y, above_m, yaw_deg, pitch_deg] = pose;
+    let origin = dataset.manifest.origin_m;
+    let z = dataset.height_at(x, y, 0).unwrap() + above_m;
+    let position_m = DVec3::new(origin[0] + x, origin[1] + y, z);
+    let camera = Camera { position_m, yaw_deg, pitch_deg, fov_deg: 60.0, near_m: 0.1 };
+    let inputs = OracleInputs {
+        dataset,
+        settings: &settings,
+        tables: &tables,
+        patterns: &patterns,
+        camera: &camera,
+        viewport_px,
+    };
+    visible_seeds(&inputs).unwrap()
+}
+
+#[test]
+fn the_oracle_is_deterministic_and_accounts_for_every_seed() {
+    let ds = synthetic(160);
+    let pose = [795.0, 795.0, 40.0, 30.0, -8.0];
+    let (seeds, counts) = run(&ds, pose, [400, 250]);
+    assert_eq!(run(&ds, pose, [400, 250]), (seeds.clone(), counts));
+    let c = counts;
+    assert_eq!(c.class + c.rule + c.distance + c.frustum + c.occlusion + c.visible, c.candidates);
+    assert_eq!(c.visible, seeds.len() as u64);
+    assert!(c.visible > 0 && c.frustum > 0, "{c:?}");
+    assert!(seeds.windows(2).all(|w| (w[0].address, w[0].rank) < (w[1].address, w[1].rank)));
+    let origin = ds.manifest.origin_m;
+    let z = ds.height_at(pose[0], pose[1], 0).unwrap() + pose[2];
+    let eye = DVec3::new(pose[0], pose[1], z);
+    let sink = Settings::default().seeds.sink_fraction;
+    for seed in seeds.iter().step_by(97) {
+        assert!(seed.radial_lod <= 2);
+        let [x, y] = seed.position_grid_m;
+        assert!((seed.ground_m - ds.height_at(x, y, 0).unwrap()).abs() < 1e-9);
+        let summit = DVec3::new(x, y, seed.ground_m + (1.0 - sink) * seed.height_m);
+        assert!(segment_clears_dem(&ds, eye, summit).unwrap(), "{seed:?} (origin {origin:?})");
+    }
+    // From under the ground nothing is visible.
+    let (seeds, counts) = run(&ds, [795.0, 795.0, -1.0, 30.0, -8.0], [400, 250]);
+    assert!(seeds.is_empty() && counts.visible == 0 && counts.occlusion > 0, "{counts:?}");
+}
+
+/// The oracle's cost on a typical view: `cargo test --lib oracle_runtime -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn oracle_runtime_on_a_typical_view() {
+    let ds = synthetic(1024);
+    for pose in [[5115.0, 5115.0, 30.0, 30.0, -5.0], [3000.0, 4000.0, 150.0, 120.0, -12.0]] {
+        let start = Instant::now();
+        let (seeds, counts) = run(&ds, pose, [1280, 720]);
+        eprintln!("pose {pose:?}: {} visible in {:.2?}: {counts:?}", seeds.len(), start.elapsed());
+    }
+}

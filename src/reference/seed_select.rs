@@ -1,0 +1,481 @@
+//! How it works: the CPU twin of `shaders/seed_select.wgsl`, function for function. It reads what
+//! the GPU pass reads — the frame's uniforms and cells, the patterns, the species tables, each
+//! cache's page table with the texels of its resident slots, and the terrain depth — and decides
+//! every seed with the same f32 arithmetic in the same order (products are plain `a * b`: Rust
+//! never fuses them unasked). It returns the kept records in a canonical order (cell by cell,
+//! rank by rank) and the same counters; the GPU's records come in a varying order, so tests
+//! compare them as sets keyed by (cell address, rank).
+
+use std::collections::HashMap;
+
+use crate::classes::MAX_SPECIES_PER_CLASS;
+use crate::dataset::{Dataset, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, PackError, TileId};
+use crate::gpu::gpu_types::{SeedCell, SeedCounters, SeedRecord, SeedUniforms};
+use crate::lcc::LCC_LEVELS;
+use crate::passes::seed_select::SeedFrame;
+use crate::seeds::{GROUND_SAMPLES, SeedTables, pcg, seed_hash, unit};
+use crate::streaming::TileCache;
+
+const LCC_TILE_TEXELS: u32 = crate::dataset::CELL_TILE_TEXELS;
+const IMAGERY_TILE_TEXELS: u32 = crate::dataset::CELL_TILE_TEXELS;
+
+/// One cache as the shader sees it: the page table, and the texels (mip 0, border included) of
+/// each resident slot.
+#[derive(Debug, Clone, Default)]
+pub struct TwinCache<T> {
+    pub page_table: Vec<u32>,
+    /// Edge of a slot's mip 0, texels.
+    pub extent: u32,
+    pub slots: HashMap<u32, Vec<T>>,
+}
+
+impl<T: Copy> TwinCache<T> {
+    /// A snapshot of `cache`, the texels of each resident tile from `texels` (mip 0 first).
+    pub fn of(
+        cache: &TileCache,
+        mut texels: impl FnMut(TileId) -> Result<Vec<T>, PackError>,
+    ) -> Result<Self, PackError> {
+        let mut slots = HashMap::new();
+        for (id, slot) in cache.resident_tiles() {
+            slots.insert(slot, texels(id)?);
+        }
+        Ok(Self {
+            page_table: cache.page_table_entries().to_vec(),
+            extent: cache.pyramid().tile_extent(),
+            slots,
+        })
+    }
+
+    fn load(&self, slot: u32, x: u32, y: u32) -> T {
+        // The GPU's out-of-range loads are undefined; the shader never makes one, nor may the twin.
+        self.slots[&slot][(y * self.extent + x) as usize]
+    }
+}
+
+/// Everything pass 3 reads, on the CPU.
+pub struct SeedTwinInputs<'a> {
+    pub frame: &'a SeedFrame,
+    pub patterns_unit: &'a [[f32; 2]],
+    pub tables: &'a SeedTables,
+    pub heights: &'a TwinCache<f32>,
+    pub landcover: &'a TwinCache<u32>,
+    /// Imagery texels as stored: RGBA8, sRGB-encoded.
+    pub imagery: &'a TwinCache<[u8; 4]>,
+    /// Terrain depth (reversed-Z), top row first.
+    pub depth: &'a [f32],
+}
+
+/// Everything pass 3 read in one frame, owned: what `Renderer::seed_snapshot` captures.
+pub struct SeedSnapshot {
+    pub frame: SeedFrame,
+    pub patterns_unit: Vec<[f32; 2]>,
+    pub tables: SeedTables,
+    pub caches: TwinCaches,
+    pub depth: Vec<f32>,
+}
+
+impl SeedSnapshot {
+    pub fn inputs(&self) -> SeedTwinInputs<'_> {
+        SeedTwinInputs {
+            frame: &self.frame,
+            patterns_unit: &self.patterns_unit,
+            tables: &self.tables,
+            heights: &self.caches.heights,
+            landcover: &self.caches.landcover,
+            imagery: &self.caches.imagery,
+            depth: &self.depth,
+        }
+    }
+}
+
+/// Snapshots of the three caches pass 3 reads.
+pub struct TwinCaches {
+    pub heights: TwinCache<f32>,
+    pub landcover: TwinCache<u32>,
+    pub imagery: TwinCache<[u8; 4]>,
+}
+
+/// Builds the three cache snapshots of a renderer's caches over `dataset`.
+pub fn snapshot_caches(
+    dataset: &Dataset,
+    heights: &TileCache,
+    landcover: &TileCache,
+    imagery: &TileCache,
+) -> Result<TwinCaches, PackError> {
+    let heights = TwinCache::of(heights, |id| dataset.height_tile(id).map(<[f32]>::to_vec))?;
+    let landcover = TwinCache::of(landcover, |id| dataset.landcover_words(id))?;
+    let extent = imagery.pyramid().tile_extent() as usize;
+    let imagery = match &dataset.imagery {
+        Some(layer) => TwinCache::of(imagery, |id| {
+            let bytes = layer.tile_bytes(id)?;
+            Ok(bytes[..extent * extent * 4].chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
+        })?,
+        None => TwinCache {
+            page_table: imagery.page_table_entries().to_vec(),
+            extent: extent as u32,
+            ..Default::default()
+        },
+    };
+    Ok(TwinCaches { heights, landcover, imagery })
+}
+
+/// The seeds pass 3 keeps, cell by cell and rank by rank, and its counters (with overflow as the
+/// GPU counts it when records beyond `capacity` are dropped).
+pub fn seed_select(inputs: &SeedTwinInputs) -> (Vec<SeedRecord>, SeedCounters) {
+    let u = &inputs.frame.uniforms;
+    let mut counts = [0u32; crate::seeds::SEED_COUNTERS as usize];
+    let mut records = Vec::new();
+    for cell in &inputs.frame.cells {
+        for rank in 0..u.seeds_per_pattern {
+            counts[crate::seeds::COUNT_CHECKED as usize] += 1;
+            match select_seed(inputs, cell, rank) {
+                Ok(record) => {
+                    counts[crate::seeds::COUNT_SELECTED as usize] += 1;
+                    records.push(record);
+                }
+                Err(count) => counts[count as usize] += 1,
+            }
+        }
+    }
+    let kept = records.len().min(u.capacity as usize);
+    counts[crate::seeds::COUNT_OVERFLOW as usize] = (records.len() - kept) as u32;
+    let counters: SeedCounters = bytemuck::cast(counts);
+    (records, counters)
+}
+
+struct GridPos {
+    texel: [i32; 2],
+    frac: [f32; 2],
+}
+
+fn grid_pos(corner: [i32; 2], corner_frac: [f32; 2], pos_unit: [f32; 2], cell_in_texels: f32) -> GridPos {
+    let t = [corner_frac[0] + pos_unit[0] * cell_in_texels, corner_frac[1] + pos_unit[1] * cell_in_texels];
+    let whole = t.map(f32::floor);
+    GridPos {
+        texel: [corner[0] + whole[0] as i32, corner[1] + whole[1] as i32],
+        frac: [t[0] - whole[0], t[1] - whole[1]],
+    }
+}
+
+fn to_clip(u: &SeedUniforms, p: [f32; 3]) -> [f32; 4] {
+    let m = &u.clip_from_view_world;
+    std::array::from_fn(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r])
+}
+
+struct Ground {
+    height_m: f32,
+    gradient: [f32; 2],
+    level: u32,
+}
+
+fn ground_at(u: &SeedUniforms, heights: &TwinCache<f32>, p: &GridPos) -> Option<Ground> {
+    let s0 = p.texel.map(|v| v as u32);
+    let mut level = 0;
+    let (mut slot, mut tile);
+    loop {
+        let info = u.height_levels[level as usize];
+        tile = [
+            ((s0[0] >> level) / HEIGHT_TILE_CELLS).min(info[1] - 1),
+            ((s0[1] >> level) / HEIGHT_TILE_CELLS).min(info[2] - 1),
+        ];
+        slot = heights.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize];
+        if slot != 0 || level + 1 >= u.height_level_count {
+            break;
+        }
+        level += 1;
+    }
+    if slot == 0 {
+        return None;
+    }
+    let s = s0.map(|v| v >> level);
+    let local = [
+        s[0] - tile[0] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
+        s[1] - tile[1] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
+    ];
+    let load = |dx: u32, dy: u32| heights.load(slot - 1, local[0] + dx, local[1] + dy);
+    let (h00, h10, h01, h11) = (load(0, 0), load(1, 0), load(0, 1), load(1, 1));
+    let mask = (1u32 << level) - 1;
+    let scale = 1.0 / (1u32 << level) as f32;
+    let f = [((s0[0] & mask) as f32 + p.frac[0]) * scale, ((s0[1] & mask) as f32 + p.frac[1]) * scale];
+    let south = h00 + (h10 - h00) * f[0];
+    let north = h01 + (h11 - h01) * f[0];
+    let height_m = south + (north - south) * f[1];
+    let dx = (h10 - h00) + ((h11 - h01) - (h10 - h00)) * f[1];
+    let dy = (h01 - h00) + ((h11 - h10) - (h01 - h00)) * f[0];
+    let per_m = scale * u.inv_spacing_m;
+    Some(Ground { height_m, gradient: [dx * per_m, dy * per_m], level })
+}
+
+fn class_at(u: &SeedUniforms, landcover: &TwinCache<u32>, q: [u32; 2], wanted: u32) -> Option<(u32, u32)> {
+    (0..LCC_LEVELS).find_map(|n| {
+        let level = (wanted + n) % LCC_LEVELS;
+        let texel = match level {
+            0 => q.map(|v| v << 1),
+            1 => q,
+            _ => q.map(|v| v >> 1),
+        };
+        let info = u.lcc_levels[level as usize];
+        let tile =
+            [(texel[0] / LCC_TILE_TEXELS).min(info[1] - 1), (texel[1] / LCC_TILE_TEXELS).min(info[2] - 1)];
+        let slot = landcover.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize];
+        (slot != 0).then(|| {
+            let word = landcover.load(
+                slot - 1,
+                texel[0] - tile[0] * LCC_TILE_TEXELS,
+                texel[1] - tile[1] * LCC_TILE_TEXELS,
+            );
+            if level != 2 {
+                return (word, level);
+            }
+            let shift = u.lcc_sub_bits * ((q[0] & 1) + 2 * (q[1] & 1));
+            ((word >> shift) & ((1 << u.lcc_sub_bits) - 1), level)
+        })
+    })
+}
+
+/// sRGB-encoded byte to linear, as the GPU decodes an sRGB texel.
+fn srgb_to_linear(byte: u8) -> f32 {
+    let c = f64::from(byte) / 255.0;
+    (if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }) as f32
+}
+
+fn imagery_texel(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, t: [u32; 2]) -> [f32; 4] {
+    for level in 0..u.imagery_level_count {
+        let info = u.imagery_levels[level as usize];
+        let texel = t.map(|v| v >> level);
+        let tile = [
+            (texel[0] / IMAGERY_TILE_TEXELS).min(info[1] - 1),
+            (texel[1] / IMAGERY_TILE_TEXELS).min(info[2] - 1),
+        ];
+        let slot = imagery.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize];
+        if slot != 0 {
+            let local = [0, 1].map(|a| texel[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
+            let rgba = imagery.load(slot - 1, local[0], local[1]);
+            return [
+                srgb_to_linear(rgba[0]),
+                srgb_to_linear(rgba[1]),
+                srgb_to_linear(rgba[2]),
+                f32::from(rgba[3]) / 255.0,
+            ];
+        }
+    }
+    [0.0; 4]
+}
+
+fn ground_colour(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, hash: u32) -> u32 {
+    if u.imagery_level_count == 0 {
+        return 0;
+    }
+    let mut sum = [0.0f32; 4];
+    let mut h = hash;
+    let last = u.imagery_size.map(|n| n as i32 - 1);
+    for _ in 0..GROUND_SAMPLES {
+        h = pcg(h);
+        let offset = [
+            (unit(h) * 2.0 - 1.0) * u.ground_radius_texels,
+            (unit(pcg(h)) * 2.0 - 1.0) * u.ground_radius_texels,
+        ];
+        let texel: [u32; 2] = std::array::from_fn(|a| {
+            (p.texel[a] + (p.frac[a] + offset[a]).floor() as i32).clamp(0, last[a]) as u32
+        });
+        let colour = imagery_texel(u, imagery, texel);
+        for c in 0..4 {
+            sum[c] += colour[c];
+        }
+    }
+    let mean = sum.map(|c| c * (1.0 / GROUND_SAMPLES as f32));
+    // WGSL's pack4x8unorm.
+    mean.iter()
+        .enumerate()
+        .fold(0, |word, (c, v)| word | (((v.clamp(0.0, 1.0) * 255.0).round() as u32) << (8 * c)))
+}
+
+/// The shader's `dem_blocks`: whether the DEM rises above the segment from the eye to `target`.
+fn dem_blocks(u: &SeedUniforms, heights: &TwinCache<f32>, target: [f32; 3]) -> bool {
+    let length_sq = target[0] * target[0] + target[1] * target[1];
+    let wanted_sq = (length_sq * 4.0) * (u.inv_spacing_m * u.inv_spacing_m);
+    let mut steps = 2u32;
+    while steps < u.refine_max_steps && ((steps * steps) as f32) < wanted_sq {
+        steps *= 2;
+    }
+    let dt = 1.0 / steps as f32;
+    let last = u.height_size.map(|n| n as i32 - 1);
+    (1..steps).any(|k| {
+        let t = k as f32 * dt;
+        let p = target.map(|v| v * t);
+        let sample = grid_pos(u.camera_sample, u.camera_sample_frac, [p[0], p[1]], u.inv_spacing_m);
+        let inside = (0..2).all(|a| sample.texel[a] >= 0 && sample.texel[a] <= last[a]);
+        inside && ground_at(u, heights, &sample).is_some_and(|g| g.height_m > p[2] + u.camera_z_m)
+    })
+}
+
+/// Pixel column holding clip-space x at distance w: the shader's `pixel_of`.
+fn pixel_of(x: f32, w: f32, n: u32, step: f32) -> u32 {
+    let guess = ((x / w * 0.5 + 0.5) * n as f32).clamp(0.0, (n - 1) as f32);
+    let mut i = guess as u32;
+    for _ in 0..4 {
+        if i > 0 && x < (i as f32 * step - 1.0) * w {
+            i -= 1;
+        } else if i + 1 < n && x >= ((i + 1) as f32 * step - 1.0) * w {
+            i += 1;
+        }
+    }
+    i
+}
+
+fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<SeedRecord, u32> {
+    use crate::seeds::{COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_RULE};
+    let u = &inputs.frame.uniforms;
+    let pos_unit = inputs.patterns_unit[(cell.pattern * u.seeds_per_pattern + rank) as usize];
+    let sample = grid_pos(cell.height_sample, cell.height_frac, pos_unit, u.cell_in_samples);
+    let size = u.height_size.map(|n| n as i32 - 1);
+    if sample.texel.iter().any(|&v| v < 0)
+        || sample.texel[0] > size[0]
+        || sample.texel[1] > size[1]
+        || u.lcc_sub_bits == 0
+    {
+        return Err(COUNT_CLASS);
+    }
+    let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);
+    let q: [u32; 2] = std::array::from_fn(|a| lcc.texel[a].clamp(0, u.lcc_size[a] as i32 - 1) as u32);
+    let (index, lcc_level) = class_at(u, inputs.landcover, q, cell.lcc_level).ok_or(COUNT_CLASS)?;
+    let seeds = inputs.tables.classes.get(index as usize).ok_or(COUNT_CLASS)?;
+    let k = (0..MAX_SPECIES_PER_CLASS).find(|&k| (rank as f32) < seeds.rank_limit[k]).ok_or(COUNT_CLASS)?;
+    let species_index = seeds.species[k];
+    let species = &inputs.tables.species[species_index as usize];
+
+    let ground = ground_at(u, inputs.heights, &sample).ok_or(COUNT_RULE)?;
+    let slope_sq = ground.gradient[0] * ground.gradient[0] + ground.gradient[1] * ground.gradient[1];
+    if ground.height_m < species.altitude_m[0]
+        || ground.height_m > species.altitude_m[1]
+        || slope_sq > species.max_slope_tan_sq
+    {
+        return Err(COUNT_RULE);
+    }
+
+    let hash = seed_hash(cell.address, rank, u.seed);
+    let height_m = species.height_m[0] + (species.height_m[1] - species.height_m[0]) * unit(hash);
+    let rel_xy = [cell.rel_m[0] + pos_unit[0] * u.cell_m, cell.rel_m[1] + pos_unit[1] * u.cell_m];
+    let ground_rel_m = ground.height_m - u.camera_z_m;
+
+    let distance_sq = rel_xy[0] * rel_xy[0] + rel_xy[1] * rel_xy[1] + ground_rel_m * ground_rel_m;
+    let size_scale = (height_m * u.inv_reference_height_m).min(1.0);
+    let lod = (0..3u32)
+        .find(|&lod| {
+            let reach = u.radial_lod_m[lod as usize] * size_scale;
+            distance_sq < reach * reach
+        })
+        .ok_or(COUNT_DISTANCE)?;
+
+    let sink_m = height_m * u.sink_fraction;
+    let base_rel_m = ground_rel_m - sink_m;
+    let radius_m = height_m * species.radius_per_height;
+    let centre = to_clip(u, [rel_xy[0], rel_xy[1], base_rel_m + height_m * 0.5]);
+    if centre[3] < -radius_m {
+        return Err(COUNT_FRUSTUM);
+    }
+    let grown = (1.0 + u.frustum_epsilon) * centre[3];
+    if centre[0].abs() > grown + radius_m * u.clip_row_len[0]
+        || centre[1].abs() > grown + radius_m * u.clip_row_len[1]
+    {
+        return Err(COUNT_FRUSTUM);
+    }
+
+    let summit = to_clip(u, [rel_xy[0], rel_xy[1], base_rel_m + height_m]);
+    if summit[3] > u.near_m {
+        let px = pixel_of(summit[0], summit[3], u.screen_px[0], u.ndc_per_px[0]);
+        let py = pixel_of(-summit[1], summit[3], u.screen_px[1], u.ndc_per_px[1]);
+        let reach = crate::seeds::OCCLUSION_FOOTPRINT_PX;
+        let (mut farthest, mut nearest) = (1.0f32, 0.0f32);
+        let depth_at = |x: i32, y: i32| {
+            let x = x.clamp(0, u.screen_px[0] as i32 - 1) as u32;
+            let y = y.clamp(0, u.screen_px[1] as i32 - 1) as u32;
+            inputs.depth[(y * u.screen_px[0] + x) as usize]
+        };
+        for dy in -reach..=reach {
+            for dx in -reach..=reach {
+                let d = depth_at(px as i32 + dx, py as i32 + dy);
+                farthest = farthest.min(d);
+                nearest = nearest.max(d);
+            }
+        }
+        let tolerance_m = u.occlusion_tolerance_m + u.occlusion_tolerance_per_m * summit[3];
+        let behind_m = summit[3] - tolerance_m;
+        let mut hidden = behind_m * farthest > u.near_m;
+        if !hidden && behind_m * nearest > u.near_m {
+            hidden = if u.refine_max_steps == 0 {
+                behind_m * depth_at(px as i32, py as i32) > u.near_m
+            } else {
+                dem_blocks(u, inputs.heights, [rel_xy[0], rel_xy[1], base_rel_m + height_m])
+            };
+        }
+        if hidden {
+            return Err(COUNT_OCCLUSION);
+        }
+    }
+
+    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
+    Ok(SeedRecord {
+        position_rel_m: [rel_xy[0], rel_xy[1], base_rel_m],
+        height_m,
+        address: cell.address,
+        rank,
+        species_lod: species_index | (lod << 8) | (lcc_level << 12) | (ground.level << 16),
+        jitter: pcg(hash),
+        ground_colour: ground_colour(u, inputs.imagery, &imagery, hash),
+        radius_m,
+        ground_m: ground.height_m,
+    })
+}
+
+/// How two seed sets differ, keyed by identity (cell address, rank).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SeedComparison {
+    pub common: usize,
+    /// In the twin's set, not in the GPU's; and the reverse.
+    pub only_twin: Vec<([i32; 2], u32)>,
+    pub only_gpu: Vec<([i32; 2], u32)>,
+    /// Common seeds whose species, LOD, levels or jitter differ.
+    pub mismatched: Vec<([i32; 2], u32)>,
+    /// Largest difference of position, height, radius or ground height, metres.
+    pub max_length_error_m: f32,
+    /// Largest difference of a ground-colour channel, in 1/255.
+    pub max_colour_error: u32,
+}
+
+impl SeedComparison {
+    pub fn of(gpu: &[SeedRecord], twin: &[SeedRecord]) -> Self {
+        let key = |r: &SeedRecord| (r.address, r.rank);
+        let gpu_by_key: HashMap<_, _> = gpu.iter().map(|r| (key(r), r)).collect();
+        let twin_keys: std::collections::HashSet<_> = twin.iter().map(key).collect();
+        let mut out = Self::default();
+        for t in twin {
+            let Some(g) = gpu_by_key.get(&key(t)) else {
+                out.only_twin.push(key(t));
+                continue;
+            };
+            out.common += 1;
+            if (g.species_lod, g.jitter) != (t.species_lod, t.jitter) {
+                out.mismatched.push(key(t));
+            }
+            let lengths = [
+                (g.position_rel_m[0], t.position_rel_m[0]),
+                (g.position_rel_m[1], t.position_rel_m[1]),
+                (g.position_rel_m[2], t.position_rel_m[2]),
+                (g.height_m, t.height_m),
+                (g.radius_m, t.radius_m),
+                (g.ground_m, t.ground_m),
+            ];
+            for (a, b) in lengths {
+                out.max_length_error_m = out.max_length_error_m.max((a - b).abs());
+            }
+            for c in 0..4 {
+                let channel = |w: u32| (w >> (8 * c)) & 0xff;
+                out.max_colour_error =
+                    out.max_colour_error.max(channel(g.ground_colour).abs_diff(channel(t.ground_colour)));
+            }
+        }
+        out.only_gpu = gpu.iter().map(key).filter(|k| !twin_keys.contains(k)).collect();
+        out
+    }
+}

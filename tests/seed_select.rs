@@ -1,0 +1,166 @@
+//! Pass 3 on a synthetic dataset: the GPU equals its CPU twin, runs and paths agree, seeds sit on
+//! the DEM, and a too-small output is flagged without corrupting what it keeps.
+
+mod common;
+
+use glam::DVec3;
+use terramp::camera::Camera;
+use terramp::frame::Renderer;
+use terramp::gpu::gpu_types::SeedRecord;
+use terramp::reference::seed_select::SeedComparison;
+
+const SIZE: u32 = 1024;
+
+fn camera_at(r: &Renderer, fx: f64, fy: f64, up_m: f64, yaw_deg: f64, pitch_deg: f64) -> Camera {
+    let m = &r.dataset.manifest;
+    let [w, h] = m.extent_m();
+    let grid = [fx * w, fy * h];
+    let ground = r.dataset.height_at(grid[0], grid[1], 0).unwrap();
+    Camera {
+        position_m: DVec3::new(m.origin_m[0] + grid[0], m.origin_m[1] + grid[1], ground + up_m),
+        yaw_deg,
+        pitch_deg,
+        fov_deg: 60.0,
+        near_m: 0.1,
+    }
+}
+
+fn cameras(r: &Renderer) -> Vec<Camera> {
+    vec![
+        camera_at(r, 0.3, 0.3, 40.0, 35.0, -10.0),
+        camera_at(r, 0.6, 0.5, 300.0, 200.0, -25.0),
+        camera_at(r, 0.5, 0.7, 3.0, 290.0, 2.0),
+    ]
+}
+
+fn sorted(mut records: Vec<SeedRecord>) -> Vec<SeedRecord> {
+    records.sort_by_key(|r| (r.address, r.rank));
+    records
+}
+
+#[test]
+fn gpu_seed_selection_equals_its_cpu_twin() {
+    let dataset = common::synth_dataset(SIZE, 7);
+    let mut r = common::renderer(&dataset, common::small_settings(320, 180));
+    for (i, camera) in cameras(&r).iter().enumerate() {
+        r.render_resolved(camera, 60).unwrap();
+        let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
+        let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
+        let diff = SeedComparison::of(&gpu, &twin);
+        println!(
+            "view {i}: {} seeds ({} checked), {} common, max length error {:.2e} m, colour {}/255",
+            twin.len(),
+            twin_counters.checked,
+            diff.common,
+            diff.max_length_error_m,
+            diff.max_colour_error
+        );
+        assert!(twin_counters.checked > 0 && !twin.is_empty(), "view {i} checks no seeds: {twin_counters:?}");
+        assert_eq!(gpu_counters, twin_counters, "view {i}");
+        assert!(diff.only_gpu.is_empty() && diff.only_twin.is_empty(), "view {i}: {diff:?}");
+        assert!(diff.mismatched.is_empty(), "view {i}: {:?}", diff.mismatched);
+        // Same f32 operations in the same order: positions agree to the bit; colours decode
+        // sRGB texels (the driver's table against the formula) and may round one step apart.
+        assert_eq!(diff.max_length_error_m, 0.0, "view {i}");
+        assert!(diff.max_colour_error <= 1, "view {i}: {}", diff.max_colour_error);
+    }
+}
+
+#[test]
+fn seeds_sit_on_the_bilinear_dem() {
+    let dataset = common::synth_dataset(SIZE, 7);
+    let mut r = common::renderer(&dataset, common::small_settings(320, 180));
+    let camera = cameras(&r)[0];
+    r.render_resolved(&camera, 60).unwrap();
+    let (records, _) = r.read_seeds().unwrap().unwrap();
+    assert!(records.len() > 100, "{} seeds", records.len());
+    let origin = r.dataset.manifest.origin_m;
+    let camera_grid = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
+    let mut worst_m = 0.0f64;
+    for record in &records {
+        let x = camera_grid.x + f64::from(record.position_rel_m[0]);
+        let y = camera_grid.y + f64::from(record.position_rel_m[1]);
+        let exact_m = r.dataset.height_at(x, y, 0).unwrap();
+        worst_m = worst_m.max((f64::from(record.ground_m) - exact_m).abs());
+        assert_eq!(record.species_lod >> 16, 0, "a seed stood on a coarse height level");
+    }
+    println!("{} seeds, largest base error {:.2} mm", records.len(), worst_m * 1000.0);
+    assert!(worst_m <= 0.01, "a seed's base is {worst_m} m off the DEM");
+}
+
+#[test]
+fn seeds_are_the_same_in_every_run_and_after_any_path() {
+    let dataset = common::synth_dataset(SIZE, 7);
+    let settings = common::small_settings(320, 180);
+    let seeds_after = |path: &[Camera]| {
+        let mut r = common::renderer(&dataset, settings.clone());
+        for camera in &path[..path.len() - 1] {
+            r.render(camera).unwrap();
+        }
+        r.render_resolved(path.last().unwrap(), 60).unwrap();
+        sorted(r.read_seeds().unwrap().unwrap().0)
+    };
+    let probe = common::renderer(&dataset, settings.clone());
+    let [a, b, end] = <[Camera; 3]>::try_from(cameras(&probe)).unwrap();
+    drop(probe);
+    let direct = seeds_after(&[end]);
+    assert!(!direct.is_empty());
+    assert_eq!(direct, seeds_after(&[end]), "two runs differ");
+    assert_eq!(direct, seeds_after(&[a, b, end]), "a path through other views changes the seeds");
+}
+
+#[test]
+fn overflow_is_flagged_counted_and_keeps_valid_records() {
+    let dataset = common::synth_dataset(SIZE, 7);
+    let mut settings = common::small_settings(320, 180);
+    let mut full = common::renderer(&dataset, settings.clone());
+    let camera = cameras(&full)[0];
+    full.render_resolved(&camera, 60).unwrap();
+    let (all, all_counters) = full.read_seeds().unwrap().unwrap();
+    drop(full);
+    let capacity = (all.len() / 3).max(1) as u32;
+    settings.seeds.capacity = capacity;
+    let mut small = common::renderer(&dataset, settings);
+    small.render_resolved(&camera, 60).unwrap();
+    let (kept, counters) = small.read_seeds().unwrap().unwrap();
+    assert_eq!(counters.selected, all_counters.selected);
+    assert_eq!(kept.len(), capacity as usize);
+    assert_eq!(counters.overflow, all_counters.selected - capacity);
+    let diff = SeedComparison::of(&kept, &all);
+    assert!(diff.only_gpu.is_empty() && diff.mismatched.is_empty(), "{diff:?}");
+    assert_eq!(diff.common, kept.len());
+    let (_, twin_counters) = small.seed_twin().unwrap().unwrap();
+    assert_eq!(twin_counters, counters);
+}
+
+#[test]
+fn the_fly_log_counts_seeds_per_frame() {
+    let dataset = common::synth_dataset(SIZE, 7);
+    let out = std::env::temp_dir().join(format!("terramp-fly-seeds-{}", std::process::id()));
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/paths/default.toml");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_terramp"))
+        .args(["fly", "--frames", "10", "--save-every", "0", "--width", "160", "--height", "90", "--dataset"])
+        .arg(&dataset)
+        .arg("--path")
+        .arg(&path)
+        .arg("--out")
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let log = std::fs::read_to_string(out.join("log.jsonl")).unwrap();
+    let per_pattern = u64::from(terramp::config::Settings::default().seeds.seeds_per_pattern);
+    let mut counted = 0;
+    for line in log.lines() {
+        let record: serde_json::Value = serde_json::from_str(line).unwrap();
+        let Some(seeds) = record["report"]["seeds"].as_object() else { continue };
+        counted += 1;
+        let n = |key: &str| seeds[key].as_u64().unwrap_or_else(|| panic!("no `{key}` in {seeds:?}"));
+        let culled = n("class") + n("rule") + n("distance") + n("frustum") + n("occlusion");
+        assert_eq!(n("checked"), n("selected") + culled, "{seeds:?}");
+        assert_eq!(n("checked"), n("cells") * per_pattern, "{seeds:?}");
+        assert_eq!(n("overflow"), 0);
+    }
+    assert!(counted >= 5, "only {counted} of 10 frames report seed counters:\n{log}");
+    let _ = std::fs::remove_dir_all(&out);
+}
