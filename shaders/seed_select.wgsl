@@ -48,7 +48,8 @@ struct SeedUniforms {
     camera_sample: vec2<i32>,
     camera_sample_frac: vec2<f32>,
     refine_max_steps: u32,
-    _pad: array<u32, 3>,
+    active_ranks: u32,
+    _pad: array<u32, 2>,
     height_levels: array<vec4<u32>, MAX_LEVELS>,
     lcc_levels: array<vec4<u32>, 4>,
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
@@ -441,8 +442,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let rank = group.x * SEED_WORKGROUP + lane;
     var outcome: Outcome;
     var local = 0u;
-    if rank < u.seeds_per_pattern {
-        atomicAdd(&wg_count[COUNT_CHECKED], 1u);
+    if rank < u.active_ranks {
         outcome = select_seed(cells[group.y], rank);
         local = atomicAdd(&wg_count[outcome.count], 1u);
     }
@@ -456,7 +456,9 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         if overflow != 0u {
             atomicAdd(&counters.count[COUNT_OVERFLOW], overflow);
         }
-        for (var c = COUNT_CHECKED; c < SEED_COUNTERS; c += 1u) {
+        let checked = min(SEED_WORKGROUP, u.active_ranks - group.x * SEED_WORKGROUP);
+        atomicAdd(&counters.count[COUNT_CHECKED], checked);
+        for (var c = COUNT_CHECKED + 1u; c < SEED_COUNTERS; c += 1u) {
             let n = atomicLoad(&wg_count[c]);
             if n != 0u {
                 atomicAdd(&counters.count[c], n);
@@ -464,7 +466,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         }
     }
     let base = workgroupUniformLoad(&wg_base);
-    if rank < u.seeds_per_pattern && outcome.count == COUNT_SELECTED && base + local < u.capacity {
+    if rank < u.active_ranks && outcome.count == COUNT_SELECTED && base + local < u.capacity {
         records[base + local] = outcome.record;
     }
 }

@@ -386,7 +386,9 @@ impl Renderer {
         // Seed selection: the seeds of the cells the latest TLM found near and visible.
         if let Some(stage) = self.seeds.as_mut() {
             let cells = self.load_maps.as_ref().map_or(&[][..], |m| &m.seed_cells[..]);
-            let inputs = seeds::seed_inputs(&self.settings, &self.dataset, camera, camera_grid_m, cells);
+            let ranks = stage.tables.active_ranks();
+            let inputs =
+                seeds::seed_inputs(&self.settings, &self.dataset, camera, camera_grid_m, cells, ranks);
             let frame = stage.prepare(&self.gpu, &inputs)?;
             report.seed_cells = frame.cells.len();
             report.seed_cells_dropped = frame.cells_dropped;

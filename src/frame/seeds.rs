@@ -26,7 +26,9 @@ use super::RenderError;
 pub struct SeedReport {
     /// The frame these counters are from.
     pub frame: u64,
+    /// Cells checked, and ranks checked in each (`checked = cells × ranks`).
     pub cells: u32,
+    pub ranks: u32,
     #[serde(flatten)]
     pub counters: SeedCounters,
 }
@@ -37,8 +39,8 @@ pub(super) struct SeedStage {
     pub pass: SeedSelectPass,
     pub bind_group: wgpu::BindGroup,
     counters_ring: ReadbackRing,
-    /// Frames (and their cell counts) whose counters are in flight, oldest first.
-    in_flight: VecDeque<(u64, u32)>,
+    /// Frames (with their cells and ranks) whose counters are in flight, oldest first.
+    in_flight: VecDeque<(u64, u32, u32)>,
     /// The last frame's inputs, for the twin.
     pub last_frame: Option<SeedFrame>,
     pub latest: Option<SeedReport>,
@@ -101,8 +103,9 @@ impl SeedStage {
     pub fn encode_readback(&mut self, encoder: &mut wgpu::CommandEncoder, frame: u64) {
         let bytes = size_of::<SeedCounters>() as u64;
         if self.counters_ring.encode_copy(encoder, self.pass.counters(), bytes, frame) {
-            let cells = self.last_frame.as_ref().map_or(0, |f| f.cells.len() as u32);
-            self.in_flight.push_back((frame, cells));
+            let (cells, ranks) =
+                self.last_frame.as_ref().map_or((0, 0), |f| (f.cells.len() as u32, f.uniforms.active_ranks));
+            self.in_flight.push_back((frame, cells, ranks));
         }
     }
 
@@ -113,12 +116,12 @@ impl SeedStage {
     /// Takes every counter readback that has arrived, keeping the newest.
     pub fn collect(&mut self, device: &wgpu::Device) -> Result<(), GpuError> {
         while let Some(readback) = self.counters_ring.try_take(device)? {
-            while self.in_flight.front().is_some_and(|(frame, _)| *frame < readback.frame) {
+            while self.in_flight.front().is_some_and(|(frame, ..)| *frame < readback.frame) {
                 self.in_flight.pop_front();
             }
-            let Some((frame, cells)) = self.in_flight.pop_front() else { continue };
+            let Some((frame, cells, ranks)) = self.in_flight.pop_front() else { continue };
             if let Some(&counters) = readback.cast::<SeedCounters>().first() {
-                self.latest = Some(SeedReport { frame, cells, counters });
+                self.latest = Some(SeedReport { frame, cells, ranks, counters });
             }
         }
         Ok(())
@@ -132,6 +135,7 @@ pub(super) fn seed_inputs<'a>(
     camera: &'a Camera,
     camera_grid_m: DVec3,
     cells: &'a [SeedCellRef],
+    active_ranks: u32,
 ) -> SeedInputs<'a> {
     SeedInputs {
         settings,
@@ -140,5 +144,6 @@ pub(super) fn seed_inputs<'a>(
         camera_grid_m,
         viewport_px: [settings.render.width, settings.render.height],
         cells,
+        active_ranks,
     }
 }

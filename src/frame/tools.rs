@@ -139,7 +139,9 @@ impl Renderer {
         let Some(stage) = self.seeds.as_mut() else { return Ok(()) };
         let origin = self.dataset.manifest.origin_m;
         let camera_grid_m = camera.position_m - glam::DVec3::new(origin[0], origin[1], 0.0);
-        let inputs = super::seeds::seed_inputs(&self.settings, &self.dataset, camera, camera_grid_m, cells);
+        let ranks = stage.tables.active_ranks();
+        let inputs =
+            super::seeds::seed_inputs(&self.settings, &self.dataset, camera, camera_grid_m, cells, ranks);
         stage.prepare(&self.gpu, &inputs)?;
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         stage.encode(&mut encoder);

@@ -205,7 +205,9 @@ pub struct SeedUniforms {
     /// Most samples of the DEM march that settles a summit near a silhouette (0: no march; the
     /// summit's own pixel decides).
     pub refine_max_steps: u32,
-    pub _pad: [u32; 3],
+    /// Ranks checked per cell: none beyond the densest class's last rank limit grows anything.
+    pub active_ranks: u32,
+    pub _pad: [u32; 2],
     /// Page tables per level (first entry, tiles along x, tiles along y, 0).
     pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
     pub lcc_levels: [[u32; 4]; 4],

@@ -41,6 +41,8 @@ pub struct SeedInputs<'a> {
     pub camera_grid_m: DVec3,
     pub viewport_px: [u32; 2],
     pub cells: &'a [SeedCellRef],
+    /// Ranks worth checking (`SeedTables::active_ranks`).
+    pub active_ranks: u32,
 }
 
 /// One frame's uniforms and cells: what the shader reads, and what the twin replays.
@@ -120,7 +122,8 @@ impl SeedFrame {
             camera_sample: [0; 2],
             camera_sample_frac: [0.0; 2],
             refine_max_steps: seeds.occlusion_refine_steps,
-            _pad: [0; 3],
+            active_ranks: inputs.active_ranks.min(seeds.seeds_per_pattern),
+            _pad: [0; 2],
             height_levels: level_table(&dataset.height.pyramid),
             lcc_levels: [[0; 4]; 4],
             imagery_levels: [[0; 4]; MAX_LEVELS as usize],
@@ -186,7 +189,7 @@ impl SeedFrame {
 
     /// Seeds this frame checks.
     pub fn checked(&self) -> u64 {
-        self.cells.len() as u64 * u64::from(self.uniforms.seeds_per_pattern)
+        self.cells.len() as u64 * u64::from(self.uniforms.active_ranks)
     }
 }
 
@@ -200,7 +203,6 @@ pub struct SeedSelectPass {
     classes: wgpu::Buffer,
     records: wgpu::Buffer,
     counters: wgpu::Buffer,
-    seeds_per_pattern: u32,
     capacity: u32,
 }
 
@@ -321,7 +323,6 @@ impl SeedSelectPass {
                 size_of::<SeedCounters>() as u64,
                 storage_usage | copy_dst | wgpu::BufferUsages::COPY_SRC,
             ),
-            seeds_per_pattern: patterns.seeds_per_pattern,
             capacity,
         }
     }
@@ -384,7 +385,7 @@ impl SeedSelectPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.dispatch_workgroups(
-            self.seeds_per_pattern.div_ceil(SEED_WORKGROUP),
+            frame.uniforms.active_ranks.div_ceil(SEED_WORKGROUP),
             frame.cells.len() as u32,
             1,
         );

@@ -126,7 +126,7 @@ pub fn seed_select(inputs: &SeedTwinInputs) -> (Vec<SeedRecord>, SeedCounters) {
     let mut counts = [0u32; crate::seeds::SEED_COUNTERS as usize];
     let mut records = Vec::new();
     for cell in &inputs.frame.cells {
-        for rank in 0..u.seeds_per_pattern {
+        for rank in 0..u.active_ranks {
             counts[crate::seeds::COUNT_CHECKED as usize] += 1;
             match select_seed(inputs, cell, rank) {
                 Ok(record) => {

@@ -158,6 +158,13 @@ impl SeedTables {
         }
         Ok(Self { species, classes })
     }
+
+    /// Ranks below which some class grows a seed: the rest of every pattern is culled by class
+    /// whatever the map says, so pass 3 need not check it.
+    pub fn active_ranks(&self) -> u32 {
+        let limit = self.classes.iter().flat_map(|c| c.rank_limit).fold(0.0f32, f32::max);
+        limit.ceil() as u32
+    }
 }
 
 #[cfg(test)]
