@@ -249,7 +249,7 @@ impl Dataset {
     fn landcover_layer(&self) -> Result<(&LayerPack, &LccCoding), PackError> {
         match (&self.landcover, self.lcc_coding()) {
             (Some(layer), Some(coding)) => Ok((layer, coding)),
-            _ => Err(PackError::OutOfRange { path: self.dir.clone(), index: u64::MAX, count: 0 }),
+            _ => Err(PackError::NoLayer { path: self.dir.clone(), layer: "land-cover" }),
         }
     }
 

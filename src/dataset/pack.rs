@@ -51,6 +51,8 @@ pub enum PackError {
     OutOfRange { path: PathBuf, index: u64, count: u64 },
     #[error("{path}: tile payload is {actual} bytes, the pack stores {expected}")]
     PayloadSize { path: PathBuf, expected: u64, actual: u64 },
+    #[error("{path}: the dataset has no {layer} layer")]
+    NoLayer { path: PathBuf, layer: &'static str },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

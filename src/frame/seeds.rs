@@ -93,13 +93,15 @@ impl SeedStage {
         Ok(self.last_frame.insert(frame))
     }
 
-    /// Records pass 3, then the copy of its counters (after the last timed pass: see `render`).
+    /// Records pass 3 over the cells `prepare` uploaded.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder) {
         if let Some(frame) = &self.last_frame {
             self.pass.encode(encoder, &self.bind_group, frame);
         }
     }
 
+    /// Records the copy of pass 3's counters into the staging ring (after the last timed pass:
+    /// the CPU-timing fallback submits each pass on its own), unless every slot is in flight.
     pub fn encode_readback(&mut self, encoder: &mut wgpu::CommandEncoder, frame: u64) {
         let bytes = size_of::<SeedCounters>() as u64;
         if self.counters_ring.encode_copy(encoder, self.pass.counters(), bytes, frame) {
@@ -109,6 +111,7 @@ impl SeedStage {
         }
     }
 
+    /// Tells the ring its copy was submitted.
     pub fn submitted(&mut self) {
         self.counters_ring.submitted();
     }
