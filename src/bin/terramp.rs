@@ -1,4 +1,5 @@
-//! The `terramp` command line: render a frame of a dataset, fly the demo, describe a dataset.
+//! The `terramp` command line: render a frame of a dataset, fly the demo or a path, profile the
+//! passes, describe a dataset.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -13,6 +14,7 @@ use terramp::dataset::{Dataset, DatasetError, PackError};
 use terramp::frame::Renderer;
 use terramp::gpu::{Gpu, PassTiming};
 use terramp::path::CameraPath;
+use terramp::profile::{Meta, Summary};
 
 #[derive(Parser)]
 #[command(
@@ -100,6 +102,39 @@ enum Command {
         #[command(flatten)]
         settings: SettingsArgs,
     },
+    /// Time every pass along a camera path: after warm-up frames, the median and 95th percentile
+    /// of each GPU pass (timestamp queries) and of the CPU work, seeds checked and selected per
+    /// frame, frames per second; printed as a table like the paper's Table 1, optionally as JSON
+    /// and as a Chrome trace (chrome://tracing, Perfetto).
+    Profile {
+        #[arg(long)]
+        dataset: PathBuf,
+        /// Camera path (config/paths/*.toml). Default: config/paths/default.toml on a synthetic
+        /// dataset that holds all its keyframes (the default one), else an orbit around the centre.
+        #[arg(long)]
+        path: Option<PathBuf>,
+        /// Profiled frames, spread evenly along the path.
+        #[arg(long, default_value_t = 240)]
+        frames: u32,
+        /// Frames rendered first, unprofiled, at the path's start (caches fill, shaders compile).
+        #[arg(long, default_value_t = 30)]
+        warmup: u32,
+        #[arg(long)]
+        width: Option<u32>,
+        #[arg(long)]
+        height: Option<u32>,
+        /// Write the figures as JSON (schema in the `terramp::profile::summary` docs).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write a Chrome trace (Trace Event Format JSON) of the profiled frames.
+        #[arg(long)]
+        trace: Option<PathBuf>,
+        /// Write one JSON object per frame (warm-up included), as `fly` does in `log.jsonl`.
+        #[arg(long)]
+        log: Option<PathBuf>,
+        #[command(flatten)]
+        settings: SettingsArgs,
+    },
     /// Describe a dataset: frame, extent, layers.
     Info {
         #[arg(long)]
@@ -124,8 +159,78 @@ fn main() -> Result<()> {
             settings.render.height = height.unwrap_or(settings.render.height);
             fly(&dataset, &CameraPath::load(&path)?, frames, &out, save_every, settings)
         }
+        Command::Profile { dataset, path, frames, warmup, width, height, json, trace, log, settings } => {
+            let outputs = ProfileOutputs { json, trace, log };
+            profile(&dataset, path.as_deref(), frames, warmup, (width, height), &settings, &outputs)
+        }
         Command::Info { dataset } => info(&dataset),
     }
+}
+
+struct ProfileOutputs {
+    json: Option<PathBuf>,
+    trace: Option<PathBuf>,
+    log: Option<PathBuf>,
+}
+
+fn profile(
+    dataset_dir: &Path,
+    path: Option<&Path>,
+    frames: u32,
+    warmup: u32,
+    (width, height): (Option<u32>, Option<u32>),
+    settings_args: &SettingsArgs,
+    outputs: &ProfileOutputs,
+) -> Result<()> {
+    if frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let mut settings = settings_args.load()?;
+    settings.render.width = width.unwrap_or(settings.render.width);
+    settings.render.height = height.unwrap_or(settings.render.height);
+    let dataset = Dataset::open(dataset_dir)?;
+    let (path, path_name) = match path {
+        Some(file) => (CameraPath::load(file)?, file.display().to_string()),
+        None => terramp::profile::default_path(&dataset)?,
+    };
+    let gpu = Gpu::new(settings.gpu.adapter)?;
+    let adapter = gpu.describe();
+    eprintln!("terramp: adapter {adapter}");
+    let mut renderer = Renderer::new(gpu, dataset, settings)?;
+    let (timing, timing_note) = terramp::profile::timing_of(&renderer);
+    let mut log = match &outputs.log {
+        Some(file) => Some(std::io::BufWriter::new(
+            std::fs::File::create(file).with_context(|| format!("creating {}", file.display()))?,
+        )),
+        None => None,
+    };
+    eprintln!("terramp: {warmup} warm-up frames, then {frames} profiled frames along {path_name}");
+    let log_writer = log.as_mut().map(|w| w as &mut dyn std::io::Write);
+    let recording = terramp::profile::fly(&mut renderer, &path, warmup, frames, log_writer)?;
+    if let Some(log) = log.as_mut() {
+        std::io::Write::flush(log)?;
+    }
+    let s = &renderer.settings.render;
+    let meta = Meta {
+        adapter,
+        timing,
+        timing_note,
+        resolution: [s.width, s.height],
+        preset: settings_args.preset.clone(),
+        settings: settings_args.settings.as_ref().map(|f| f.display().to_string()),
+        dataset: dataset_dir.display().to_string(),
+        path: path_name,
+        warmup,
+    };
+    let summary = Summary::new(&recording, meta);
+    print!("{}", terramp::profile::table::render(&summary));
+    if let Some(file) = &outputs.json {
+        std::fs::write(file, summary.to_json()).with_context(|| format!("writing {}", file.display()))?;
+    }
+    if let Some(file) = &outputs.trace {
+        terramp::profile::trace::write(file, &recording, &summary.meta)?;
+    }
+    Ok(())
 }
 
 fn open_renderer(dataset_dir: &Path, settings: Settings) -> Result<Renderer> {

@@ -6,6 +6,10 @@
 //! the pass, waits, then records, submits and waits for the pass alone. That serialises the frame
 //! (so it is slower), but each figure is still the pass's own wall time. CPU work (TLM analysis,
 //! uploads) is timed with `cpu` scopes either way. Timings are in milliseconds.
+//!
+//! Each frame is numbered by the `end_frame` calls before it. `keep_history` makes the profiler
+//! also keep every finished frame with its number and each scope's start (on the GPU's timestamp
+//! clock, or on the profiler's own CPU clock, `now_ms`), for `terramp profile` and its traces.
 
 use std::time::Instant;
 
@@ -34,12 +38,38 @@ pub struct PassTiming {
     pub source: TimeSource,
 }
 
+/// A timing and when it started: for `GpuTimestamps`, on the GPU's timestamp clock (its origin is
+/// the driver's); else on the profiler's CPU clock (`Profiler::now_ms`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScopeTiming {
+    pub timing: PassTiming,
+    pub start_ms: f64,
+}
+
+/// Every scope of one frame, in the order they were recorded (CPU scopes first).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FrameTimings {
+    /// `end_frame` calls before this frame's.
+    pub frame: u64,
+    pub scopes: Vec<ScopeTiming>,
+}
+
+impl FrameTimings {
+    fn timings(&self) -> Vec<PassTiming> {
+        self.scopes.iter().map(|s| s.timing.clone()).collect()
+    }
+}
+
 pub struct Profiler {
     timestamps: Option<GpuProfiler>,
+    /// The origin of the CPU clock.
+    epoch: Instant,
     /// CPU-measured timings of the frame being recorded.
-    cpu: Vec<PassTiming>,
+    cpu: FrameTimings,
     /// CPU timings of frames whose GPU timings are still in flight, oldest first.
-    pending: std::collections::VecDeque<Vec<PassTiming>>,
+    pending: std::collections::VecDeque<FrameTimings>,
+    /// Finished frames, kept while `keep_history` is on.
+    history: Option<Vec<FrameTimings>>,
 }
 
 impl Profiler {
@@ -60,11 +90,37 @@ impl Profiler {
         } else {
             None
         };
-        Self { timestamps, cpu: Vec::new(), pending: Default::default() }
+        Self {
+            timestamps,
+            epoch: Instant::now(),
+            cpu: FrameTimings::default(),
+            pending: Default::default(),
+            history: None,
+        }
     }
 
     pub fn uses_gpu_timestamps(&self) -> bool {
         self.timestamps.is_some()
+    }
+
+    /// Now on the profiler's CPU clock, ms.
+    pub fn now_ms(&self) -> f64 {
+        ms_since(self.epoch)
+    }
+
+    /// The number of the frame being recorded (`end_frame` calls so far).
+    pub fn frame(&self) -> u64 {
+        self.cpu.frame
+    }
+
+    /// Starts (or stops and forgets) keeping every finished frame for `take_history`.
+    pub fn keep_history(&mut self, keep: bool) {
+        self.history = keep.then(Vec::new);
+    }
+
+    /// The frames finished since the last call, oldest first (none unless `keep_history`).
+    pub fn take_history(&mut self) -> Vec<FrameTimings> {
+        self.history.as_mut().map(std::mem::take).unwrap_or_default()
     }
 
     /// Records the pass `label` into `encoder`, timed.
@@ -86,7 +142,7 @@ impl Profiler {
         let result = record(encoder);
         gpu.queue.submit([std::mem::replace(encoder, new_encoder()).finish()]);
         gpu.wait()?;
-        self.cpu.push(PassTiming { label: label.into(), ms: ms_since(start), source: TimeSource::CpuWait });
+        self.push_cpu(label, start, TimeSource::CpuWait);
         Ok(result)
     }
 
@@ -94,8 +150,14 @@ impl Profiler {
     pub fn cpu<R>(&mut self, label: &str, work: impl FnOnce() -> R) -> R {
         let start = Instant::now();
         let result = work();
-        self.cpu.push(PassTiming { label: label.into(), ms: ms_since(start), source: TimeSource::Cpu });
+        self.push_cpu(label, start, TimeSource::Cpu);
         result
+    }
+
+    fn push_cpu(&mut self, label: &str, start: Instant, source: TimeSource) {
+        let start_ms = start.saturating_duration_since(self.epoch).as_secs_f64() * 1000.0;
+        let timing = PassTiming { label: label.into(), ms: ms_since(start), source };
+        self.cpu.scopes.push(ScopeTiming { timing, start_ms });
     }
 
     /// Call on the frame's last encoder, just before it is submitted.
@@ -117,18 +179,30 @@ impl Profiler {
             // Only fails on unclosed scopes, which `pass` cannot leave behind.
             let _ = profiler.end_frame();
         }
-        self.pending.push_back(std::mem::take(&mut self.cpu));
+        let next = FrameTimings { frame: self.cpu.frame + 1, scopes: Vec::new() };
+        self.pending.push_back(std::mem::replace(&mut self.cpu, next));
     }
 
     /// The timings of the oldest frame whose results are all in; `None` while they are in flight.
     pub fn finished_frame(&mut self, gpu: &Gpu) -> Option<Vec<PassTiming>> {
-        let Some(profiler) = &mut self.timestamps else {
-            return self.pending.pop_front();
+        let frame = match &mut self.timestamps {
+            None => self.pending.pop_front()?,
+            Some(profiler) => {
+                let results = profiler.process_finished_frame(gpu.queue.get_timestamp_period())?;
+                let mut frame = self.pending.pop_front().unwrap_or_default();
+                frame.scopes.extend(flatten(&results));
+                frame
+            }
         };
-        let results = profiler.process_finished_frame(gpu.queue.get_timestamp_period())?;
-        let mut frame = self.pending.pop_front().unwrap_or_default();
-        frame.extend(flatten(&results));
-        Some(frame)
+        Some(self.finished(frame))
+    }
+
+    fn finished(&mut self, frame: FrameTimings) -> Vec<PassTiming> {
+        let timings = frame.timings();
+        if let Some(history) = &mut self.history {
+            history.push(frame);
+        }
+        timings
     }
 
     /// Waits for every frame in flight and returns their timings, oldest first.
@@ -144,21 +218,24 @@ impl Profiler {
             }
         }
         // Frames whose timestamps never arrived keep their CPU timings.
-        frames.extend(self.pending.drain(..));
+        while let Some(frame) = self.pending.pop_front() {
+            frames.push(self.finished(frame));
+        }
         Ok(frames)
     }
 }
 
-fn flatten(results: &[GpuTimerQueryResult]) -> Vec<PassTiming> {
+fn flatten(results: &[GpuTimerQueryResult]) -> Vec<ScopeTiming> {
     results
         .iter()
         .filter_map(|r| {
             let time = r.time.as_ref()?;
-            Some(PassTiming {
+            let timing = PassTiming {
                 label: r.label.clone(),
                 ms: (time.end - time.start) * 1000.0,
                 source: TimeSource::GpuTimestamps,
-            })
+            };
+            Some(ScopeTiming { timing, start_ms: time.start * 1000.0 })
         })
         .collect()
 }

@@ -1,0 +1,262 @@
+//! How it works: `Summary::new` reduces a `Recording` to the figures of the table and of the JSON.
+//! Per label, a frame's sample is the sum of that label's scopes in the frame (a CPU scope such as
+//! the TLM analysis may run twice in a frame, or not at all); the label's statistics are over the
+//! profiled frames where it ran (`samples` says how many). Rows come in frame order: a label first
+//! seen in a later frame is placed after the label it followed there. GPU passes come first,
+//! then CPU work. Totals sum each frame's GPU passes and its CPU work. Frames per second come
+//! from the wall times: the median's reciprocal, and frames over total time. Seeds per frame are
+//! medians over the profiled frames whose counters arrived.
+//!
+//! The JSON (`--json`) is this struct, serialised:
+//! ```text
+//! { "schema": "terramp-profile/1", "adapter": str, "timing": "gpu_timestamps" | "cpu_wait",
+//!   "timing_note": str, "resolution": [w, h], "preset": str, "settings": str | null,
+//!   "dataset": str, "path": str,
+//!   "frames": { "warmup", "profiled", "first", "last", "with_gpu_timings": int },
+//!   "fps": { "median", "mean": float },
+//!   "passes": [ { "label": str, "source": "gpu_timestamps" | "cpu_wait" | "cpu",
+//!                 "median_ms", "p95_ms", "mean_ms", "max_ms": float, "samples": int } ],
+//!   "totals": { "gpu": stat | null, "cpu": stat | null, "frame_wall": stat | null },
+//!   "seeds": { "frames": int, "checked_median": float | null, "selected_median": float | null,
+//!              "overflow_frames": int,
+//!              "per_frame": [ { "frame", "cells", "ranks", "checked", "selected", "overflow" } ] } }
+//! ```
+//! where a stat is `{ "median_ms", "p95_ms", "mean_ms", "max_ms", "samples" }`.
+
+use std::collections::HashMap;
+
+use serde::Serialize;
+
+use super::stats::{Stat, median};
+use super::{Recording, SeedSample};
+use crate::gpu::TimeSource;
+
+/// The version of the JSON layout.
+pub const SCHEMA: &str = "terramp-profile/1";
+
+/// What was profiled, and how.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Meta {
+    pub adapter: String,
+    /// How GPU passes were timed.
+    pub timing: TimeSource,
+    /// Why, in words (for the table).
+    pub timing_note: String,
+    pub resolution: [u32; 2],
+    pub preset: String,
+    /// The settings file, if one overrode the preset.
+    pub settings: Option<String>,
+    pub dataset: String,
+    /// The camera path file, or a description of the generated one.
+    pub path: String,
+    pub warmup: u32,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Frames {
+    pub warmup: u32,
+    pub profiled: usize,
+    pub first: Option<u64>,
+    pub last: Option<u64>,
+    /// Profiled frames whose GPU timings arrived.
+    pub with_gpu_timings: usize,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Fps {
+    /// 1000 / the median frame wall time.
+    pub median: f64,
+    /// Frames / their total wall time.
+    pub mean: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PassStats {
+    pub label: String,
+    pub source: TimeSource,
+    #[serde(flatten)]
+    pub stat: Stat,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Totals {
+    pub gpu: Option<Stat>,
+    pub cpu: Option<Stat>,
+    pub frame_wall: Option<Stat>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Seeds {
+    /// Profiled frames whose counters arrived.
+    pub frames: usize,
+    pub checked_median: Option<f64>,
+    pub selected_median: Option<f64>,
+    /// Frames whose output buffer overflowed.
+    pub overflow_frames: usize,
+    pub per_frame: Vec<SeedSample>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    pub schema: &'static str,
+    #[serde(flatten)]
+    pub meta: Meta,
+    pub frames: Frames,
+    pub fps: Option<Fps>,
+    pub passes: Vec<PassStats>,
+    pub totals: Totals,
+    pub seeds: Seeds,
+}
+
+impl Summary {
+    pub fn new(recording: &Recording, meta: Meta) -> Self {
+        let mut order: Vec<(String, TimeSource)> = Vec::new();
+        let mut samples: HashMap<String, Vec<f64>> = HashMap::new();
+        let (mut gpu_totals, mut cpu_totals) = (Vec::new(), Vec::new());
+        for (_, scopes) in recording.profiled_scopes() {
+            let mut previous: Option<usize> = None;
+            let mut sums: Vec<(&str, f64)> = Vec::new();
+            for scope in scopes {
+                let t = &scope.timing;
+                let at = match order.iter().position(|(label, _)| *label == t.label) {
+                    Some(at) => at,
+                    None => {
+                        let at = previous.map_or(0, |p| p + 1);
+                        order.insert(at, (t.label.clone(), t.source));
+                        at
+                    }
+                };
+                previous = Some(at);
+                match sums.iter_mut().find(|(label, _)| *label == t.label) {
+                    Some((_, sum)) => *sum += t.ms,
+                    None => sums.push((&t.label, t.ms)),
+                }
+            }
+            for &(label, ms) in &sums {
+                samples.entry(label.to_owned()).or_default().push(ms);
+            }
+            let total = |gpu: bool| {
+                let ms = scopes.iter().filter(|s| (s.timing.source != TimeSource::Cpu) == gpu);
+                let ms: Vec<f64> = ms.map(|s| s.timing.ms).collect();
+                (!ms.is_empty()).then(|| ms.iter().sum::<f64>())
+            };
+            gpu_totals.extend(total(true));
+            cpu_totals.extend(total(false));
+        }
+        // GPU passes first, then CPU work; frame order within each (the sort is stable).
+        order.sort_by_key(|(_, source)| *source == TimeSource::Cpu);
+        let passes = order
+            .into_iter()
+            .filter_map(|(label, source)| {
+                let stat = Stat::of(samples.get(&label)?)?;
+                Some(PassStats { label, source, stat })
+            })
+            .collect();
+        let wall: Vec<f64> = recording.frames.iter().map(|f| f.wall_ms).collect();
+        let frame_wall = Stat::of(&wall);
+        let total_s = wall.iter().sum::<f64>() / 1000.0;
+        let fps = frame_wall
+            .filter(|s| s.median_ms > 0.0 && total_s > 0.0)
+            .map(|s| Fps { median: 1000.0 / s.median_ms, mean: wall.len() as f64 / total_s });
+        let per_frame: Vec<SeedSample> = recording.profiled_seeds().copied().collect();
+        let seeds = Seeds {
+            frames: per_frame.len(),
+            checked_median: median(&per_frame.iter().map(|s| f64::from(s.checked)).collect::<Vec<_>>()),
+            selected_median: median(&per_frame.iter().map(|s| f64::from(s.selected)).collect::<Vec<_>>()),
+            overflow_frames: per_frame.iter().filter(|s| s.overflow > 0).count(),
+            per_frame,
+        };
+        let frames = Frames {
+            warmup: meta.warmup,
+            profiled: recording.frames.len(),
+            first: recording.frames.first().map(|f| f.frame),
+            last: recording.frames.last().map(|f| f.frame),
+            with_gpu_timings: gpu_totals.len(),
+        };
+        Self {
+            schema: SCHEMA,
+            meta,
+            frames,
+            fps,
+            passes,
+            totals: Totals { gpu: Stat::of(&gpu_totals), cpu: Stat::of(&cpu_totals), frame_wall },
+            seeds,
+        }
+    }
+
+    /// The pretty-printed JSON of `--json`.
+    pub fn to_json(&self) -> String {
+        // A struct of strings, numbers and options: serialising it cannot fail.
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+}
+
+#[cfg(test)]
+pub(crate) fn test_meta() -> Meta {
+    Meta {
+        adapter: "test adapter".into(),
+        timing: TimeSource::GpuTimestamps,
+        timing_note: "GPU timestamp queries".into(),
+        resolution: [160, 90],
+        preset: "balanced".into(),
+        settings: None,
+        dataset: "data/test".into(),
+        path: "config/paths/default.toml".into(),
+        warmup: 10,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::test_data::recording;
+
+    #[test]
+    fn passes_in_frame_order_gpu_first_with_known_statistics() {
+        let summary = Summary::new(&recording(), test_meta());
+        let labels: Vec<&str> = summary.passes.iter().map(|p| p.label.as_str()).collect();
+        assert_eq!(labels, ["terrain", "tile_load_map", "seed_select", "streaming"]);
+        let terrain = &summary.passes[0];
+        // 4, 5, 6, 7 ms: the warm-up frame's 50 ms is left out.
+        assert_eq!((terrain.stat.median_ms, terrain.stat.p95_ms, terrain.stat.samples), (5.5, 7.0, 4));
+        assert_eq!(summary.passes[2].stat.samples, 3);
+        assert_eq!(summary.passes[3].source, TimeSource::Cpu);
+        let gpu = summary.totals.gpu.unwrap();
+        assert_eq!((gpu.median_ms, gpu.samples), (9.5, 4)); // 5, 9, 10, 11
+        let fps = summary.fps.unwrap();
+        assert_eq!((fps.median, fps.mean), (50.0, 50.0));
+        assert_eq!(summary.frames.first, Some(10));
+        assert_eq!(summary.frames.with_gpu_timings, 4);
+    }
+
+    #[test]
+    fn seeds_are_medians_over_profiled_frames() {
+        let summary = Summary::new(&recording(), test_meta());
+        assert_eq!(summary.seeds.frames, 4);
+        assert_eq!(summary.seeds.checked_median, Some(10.0));
+        assert_eq!(summary.seeds.selected_median, Some(1.5));
+        assert!(summary.seeds.per_frame.iter().all(|s| s.frame >= 10));
+    }
+
+    #[test]
+    fn json_has_the_documented_fields() {
+        let json: serde_json::Value =
+            serde_json::from_str(&Summary::new(&recording(), test_meta()).to_json()).expect("valid JSON");
+        for key in ["schema", "adapter", "timing", "resolution", "preset", "dataset", "path", "frames", "fps"]
+        {
+            assert!(json.get(key).is_some(), "no {key} in {json}");
+        }
+        let pass = &json["passes"][0];
+        assert_eq!(pass["label"], "terrain");
+        assert_eq!(pass["source"], "gpu_timestamps");
+        assert!(pass["median_ms"].as_f64().is_some() && pass["p95_ms"].as_f64().is_some());
+        assert_eq!(json["seeds"]["per_frame"].as_array().map(Vec::len), Some(4));
+        assert_eq!(json["timing"], "gpu_timestamps");
+    }
+
+    #[test]
+    fn an_empty_recording_summarises_to_nothing() {
+        let summary = Summary::new(&Recording::default(), test_meta());
+        assert!(summary.passes.is_empty() && summary.fps.is_none() && summary.seeds.checked_median.is_none());
+    }
+}
