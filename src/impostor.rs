@@ -1,1 +1,182 @@
-//! How it works: impostors (billboard clouds baked from glTF models). To be written.
+//! How it works: an impostor is everything the seed-drawing pass (pass 4) needs to draw one model
+//! (a tree, a bush, a rock) at any distance: the real mesh up close and, further out, a *billboard
+//! cloud* at three levels of detail: a few textured planes fitted to the model (Décoret et al.
+//! 2003, Fuhrmann et al. 2005), whose atlas holds the geometry near each plane rendered
+//! orthographically onto it. `terramp-data bake` makes impostors from glTF models; [`load`] reads
+//! one back, ready for upload: plane vertices and indices ([`ImpostorLod::vertices`]), atlas texels
+//! per mip, mesh vertices, indices and materials.
+//!
+//! Model space is the glTF's: metres, +Y up, the model's base at y = 0. On disk, one folder per
+//! model, `DIR/<model>/`:
+//! - `impostor.toml`, the manifest ([`manifest::Manifest`], `format_version` first): the bounding
+//!   sphere, the alpha cutoff, per LOD the fit tolerance ε, the atlas (size, mip count, one PNG per
+//!   mip) and the planes (4 corners in model space, counter-clockwise seen from the side the
+//!   normal points to, and the plane's atlas rectangle as uv min/max), the mesh's submeshes and
+//!   materials.
+//! - `lod{L}_mip{M}.png`: LOD L's atlas, mip M. RGBA8, colour in sRGB, **straight** (not
+//!   premultiplied) alpha. Colour is the unlit base colour (texture × factor): shading, ground
+//!   colour follow-up and cross-fades are the draw pass's, as in the paper's FS4. Draw with an alpha test at `alpha_cutoff` (or alpha to coverage). Texels
+//!   that no geometry covers carry the colour of the nearest covered texel (dilation), so bilinear
+//!   filtering never darkens edges. Mips are box-filtered in linear light weighted by alpha, and
+//!   each plane's alpha is rescaled per mip so that the fraction of its texels passing the cutoff
+//!   stays that of mip 0 (Castaño's coverage-preserving mips): distant leaves neither vanish nor
+//!   bloat. Every rectangle starts and ends on a multiple of 2^(mips-1) texels, with at least that
+//!   many empty texels between rectangles, so no mip mixes two planes. uv (0, 0) is the top-left
+//!   corner of the image's top-left texel; corner 0 of a plane (its bottom-left) sits at
+//!   (`uv_min.x`, `uv_max.y`).
+//! - `mesh.bin` ([`mesh_file`]): the real mesh, vertices ([`MeshVertex`]) then `u32` indices,
+//!   with a checksum; `material{K}_mip{M}.png`: material K's base-colour texture, same conventions
+//!   as the atlases (alpha-masked leaf textures get coverage-preserving mips too).
+//!
+//! [`save`] writes a model's folder beside its final place and renames it into place, so a folder
+//! is either the previous complete impostor or the new one. A folder of another format version is
+//! reported as such ([`ImpostorError::Version`]): bake it again.
+
+pub mod manifest;
+pub mod mesh_file;
+pub mod mips;
+mod store;
+
+use std::path::PathBuf;
+
+use bytemuck::{Pod, Zeroable};
+use thiserror::Error;
+
+pub use manifest::{AlphaMode, BoundingSphere, Plane, Submesh};
+pub use mips::{MipChain, TexelRect, build_mip_chain, mip_size};
+pub use store::{load, models, save};
+
+/// The on-disk format's version: a reader refuses any other.
+pub const FORMAT_VERSION: u32 = 1;
+/// The manifest's name inside a model's folder.
+pub const MANIFEST_FILE: &str = "impostor.toml";
+/// The real mesh's name inside a model's folder.
+pub const MESH_FILE: &str = "mesh.bin";
+
+#[derive(Debug, Error)]
+pub enum ImpostorError {
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}: malformed impostor manifest: {source}")]
+    Manifest { path: PathBuf, source: Box<toml::de::Error> },
+    #[error(
+        "{path}: impostor format version {found}, this build reads version {expected}: bake the model again"
+    )]
+    Version { path: PathBuf, found: u32, expected: u32 },
+    #[error("{path}: {source}")]
+    Image { path: PathBuf, source: image::ImageError },
+    #[error("{path}: {reason}")]
+    Invalid { path: PathBuf, reason: String },
+    #[error("impostor {name:?}: {reason}")]
+    Inconsistent { name: String, reason: String },
+    #[error("writing an impostor manifest: {0}")]
+    ManifestWrite(String),
+}
+
+/// One model, everything a draw pass needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Impostor {
+    /// The model's name (its folder's name: the glTF file's stem).
+    pub name: String,
+    /// Encloses every vertex of the mesh, in model space; its centre is at mid-height.
+    pub bounding_sphere: BoundingSphere,
+    /// Atlas texels with alpha below this are not part of the model.
+    pub alpha_cutoff: f32,
+    /// The billboard clouds, finest first (17, 8 and 2 planes by default).
+    pub lods: Vec<ImpostorLod>,
+    /// The real mesh, for close-up drawing.
+    pub mesh: Mesh,
+}
+
+/// One level of detail: a billboard cloud.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImpostorLod {
+    /// The fit's tolerance: every triangle drawn on a plane lies within this of it, except the
+    /// few the planes could not cover, which go to the nearest plane.
+    pub epsilon_m: f32,
+    pub planes: Vec<Plane>,
+    /// RGBA8 sRGB, straight alpha, one level per mip.
+    pub atlas: MipChain,
+}
+
+/// A billboard-cloud vertex, as the draw pass uploads it: 4 per plane, in the order of
+/// [`Plane::corners_model_m`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct PlaneVertex {
+    pub position_model_m: [f32; 3],
+    /// The plane's front normal (the atlas image reads correctly from this side).
+    pub normal_model: [f32; 3],
+    pub uv_atlas: [f32; 2],
+}
+
+impl ImpostorLod {
+    /// Four vertices per plane, planes in order.
+    pub fn vertices(&self) -> Vec<PlaneVertex> {
+        self.planes
+            .iter()
+            .flat_map(|plane| {
+                let uvs = plane.corner_uvs();
+                (0..4).map(move |k| PlaneVertex {
+                    position_model_m: plane.corners_model_m[k],
+                    normal_model: plane.normal_model,
+                    uv_atlas: uvs[k],
+                })
+            })
+            .collect()
+    }
+
+    /// Two triangles per plane (counter-clockwise from the front) into [`Self::vertices`]. Draw
+    /// without culling: a billboard is seen from both sides.
+    pub fn indices(&self) -> Vec<u32> {
+        (0..self.planes.len() as u32).flat_map(|p| [0, 1, 2, 0, 2, 3].map(|k| 4 * p + k)).collect()
+    }
+}
+
+/// A mesh vertex (`mesh.bin` stores these as they are, 32 bytes each).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct MeshVertex {
+    pub position_model_m: [f32; 3],
+    pub normal_model: [f32; 3],
+    /// Base-colour texture coordinates ((0, 0) at the image's top left, repeating).
+    pub uv: [f32; 2],
+}
+
+/// The real mesh: one vertex buffer, one index buffer, one submesh per material.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mesh {
+    pub vertices: Vec<MeshVertex>,
+    /// Triangle lists, counter-clockwise front faces.
+    pub indices: Vec<u32>,
+    pub submeshes: Vec<Submesh>,
+    pub materials: Vec<Material>,
+}
+
+impl Mesh {
+    /// Triangle `t`'s material index.
+    pub fn material_of_triangle(&self, t: usize) -> Option<u32> {
+        let index = (3 * t) as u32;
+        self.submeshes
+            .iter()
+            .find(|s| (s.first_index..s.first_index + s.index_count).contains(&index))
+            .map(|s| s.material)
+    }
+}
+
+/// A glTF metallic-roughness material reduced to what foliage and rocks use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Linear RGBA, multiplied with the texture.
+    pub base_color_factor: [f32; 4],
+    pub alpha_mode: AlphaMode,
+    /// For [`AlphaMode::Mask`]: texels below this alpha are cut out.
+    pub alpha_cutoff: f32,
+    pub double_sided: bool,
+    /// RGBA8 sRGB, straight alpha, with mips; `None` for a plain colour.
+    pub texture: Option<MipChain>,
+}
+
+#[cfg(test)]
+mod tests;

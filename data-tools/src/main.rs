@@ -1,7 +1,8 @@
-//! `terramp-data`: builds terramp datasets from GeoTIFF (`build`) and synthesizes stress datasets
-//! (`synth`). GDAL does the reading and reprojection here, and only here: the runtime crate reads
-//! nothing but its own packs.
+//! `terramp-data`: builds terramp datasets from GeoTIFF (`build`), synthesizes stress datasets
+//! (`synth`) and bakes impostors from glTF models (`bake`). GDAL does the reading and
+//! reprojection here, and only here: the runtime crate reads nothing but its own packs.
 
+mod bake;
 mod build;
 
 use std::path::PathBuf;
@@ -32,11 +33,14 @@ enum Command {
         #[arg(long, default_value_t = terramp::synth::SynthParams::default().seed)]
         seed: u64,
     },
+    /// Bake impostors (billboard clouds at 3 LODs, atlases with mips, the mesh) from glTF models.
+    Bake(bake::BakeArgs),
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Build(args) => build::run(&args),
+        Command::Bake(args) => bake::run(&args),
         Command::Synth { size, out, seed } => {
             let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
             let dir = terramp::synth::synthesize(&out, &params, true)?;

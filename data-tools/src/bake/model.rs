@@ -1,0 +1,184 @@
+//! How it works: reads a glTF model (`.glb`, or `.gltf` with its buffers and images beside it)
+//! into terramp's impostor [`Mesh`]: every triangle primitive of the default scene, node
+//! transforms applied (normals by the inverse transpose, winding flipped under a mirroring
+//! transform), grouped into one submesh per material. Materials keep what foliage and rocks use:
+//! the base-colour factor and texture (decoded by `image`: PNG and JPEG; coverage-preserving mips
+//! for alpha-masked ones), the alpha mode and cutoff, double-sidedness. Missing normals are
+//! computed from the faces; missing texture coordinates are 0.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use glam::{Mat3, Mat4, Vec3};
+use terramp::impostor::{AlphaMode, Material, Mesh, MeshVertex, MipChain, Submesh, build_mip_chain};
+
+/// The mesh of the model at `path`.
+pub fn load(path: &Path) -> Result<Mesh> {
+    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let gltf = gltf::Gltf::from_slice(&bytes)
+        .with_context(|| format!("{}: not a valid glTF model", path.display()))?;
+    read(&gltf, path).with_context(|| format!("{}: unusable glTF model", path.display()))
+}
+
+fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh> {
+    let beside = |uri: &str| -> Result<Vec<u8>> {
+        if uri.starts_with("data:") {
+            bail!("embedded data URIs are not supported: use a .glb");
+        }
+        let file = path.parent().unwrap_or(Path::new(".")).join(uri);
+        std::fs::read(&file).with_context(|| format!("reading {}", file.display()))
+    };
+    let mut buffers = Vec::new();
+    for buffer in gltf.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => gltf.blob.clone().context("the binary chunk is missing")?,
+            gltf::buffer::Source::Uri(uri) => beside(uri)?,
+        };
+        if data.len() < buffer.length() {
+            bail!("buffer {} holds {} bytes, {} declared", buffer.index(), data.len(), buffer.length());
+        }
+        buffers.push(data);
+    }
+    let mut materials: Vec<Material> = Vec::new();
+    let mut tex_coords: Vec<u32> = Vec::new();
+    for material in gltf.materials() {
+        let pbr = material.pbr_metallic_roughness();
+        let alpha_mode = match material.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask | gltf::material::AlphaMode::Blend => AlphaMode::Mask,
+        };
+        let alpha_cutoff = material.alpha_cutoff().unwrap_or(0.5);
+        let texture = match pbr.base_color_texture() {
+            Some(info) => {
+                tex_coords.push(info.tex_coord());
+                let image = info.texture().source();
+                let cutoff = (alpha_mode == AlphaMode::Mask).then_some(alpha_cutoff);
+                Some(
+                    decode_image(&image, &buffers, &beside, cutoff)
+                        .with_context(|| format!("image {}", image.index()))?,
+                )
+            }
+            None => {
+                tex_coords.push(0);
+                None
+            }
+        };
+        materials.push(Material {
+            name: material.name().map_or_else(|| format!("material{}", materials.len()), str::to_owned),
+            base_color_factor: pbr.base_color_factor(),
+            alpha_mode,
+            alpha_cutoff,
+            double_sided: material.double_sided(),
+            texture,
+        });
+    }
+    let default_material = materials.len();
+    let mut vertices = Vec::new();
+    let mut by_material: Vec<Vec<u32>> = vec![Vec::new(); materials.len() + 1];
+    let scene = gltf.default_scene().or_else(|| gltf.scenes().next()).context("the file has no scene")?;
+    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        stack.extend(node.children().map(|c| (c, world)));
+        let Some(mesh) = node.mesh() else { continue };
+        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
+        let mirrored = Mat3::from_mat4(world).determinant() < 0.0;
+        for primitive in mesh.primitives() {
+            if primitive.mode() != gltf::mesh::Mode::Triangles {
+                eprintln!("{}: skipping a {:?} primitive (triangles only)", path.display(), primitive.mode());
+                continue;
+            }
+            let material = primitive.material().index().unwrap_or(default_material);
+            let set = tex_coords.get(material).copied().unwrap_or(0);
+            let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+            let positions: Vec<Vec3> = reader
+                .read_positions()
+                .context("a primitive without positions")?
+                .map(|p| world.transform_point3(Vec3::from(p)))
+                .collect();
+            let base = vertices.len() as u32;
+            let mut indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..positions.len() as u32).collect(),
+            };
+            if !indices.len().is_multiple_of(3) || indices.iter().any(|&i| i as usize >= positions.len()) {
+                bail!("mesh {}: bad triangle indices", mesh.index());
+            }
+            if mirrored {
+                indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
+            }
+            let normals: Vec<Vec3> = match reader.read_normals() {
+                Some(n) => n.map(|n| (normal_matrix * Vec3::from(n)).normalize_or_zero()).collect(),
+                None => face_normals(&positions, &indices),
+            };
+            let mut uvs: Vec<[f32; 2]> =
+                reader.read_tex_coords(set).map(|t| t.into_f32().collect()).unwrap_or_default();
+            uvs.resize(positions.len(), [0.0; 2]);
+            vertices.extend(positions.iter().zip(&normals).zip(&uvs).map(|((p, n), uv)| MeshVertex {
+                position_model_m: p.to_array(),
+                normal_model: n.to_array(),
+                uv: *uv,
+            }));
+            by_material[material].extend(indices.iter().map(|i| base + i));
+        }
+    }
+    if by_material[default_material].is_empty() {
+        by_material.pop();
+    } else {
+        materials.push(Material {
+            name: "default".into(),
+            base_color_factor: [1.0; 4],
+            alpha_mode: AlphaMode::Opaque,
+            alpha_cutoff: 0.5,
+            double_sided: false,
+            texture: None,
+        });
+    }
+    let mut indices = Vec::new();
+    let mut submeshes = Vec::new();
+    for (material, list) in by_material.iter().enumerate().filter(|(_, l)| !l.is_empty()) {
+        let first_index = indices.len() as u32;
+        indices.extend_from_slice(list);
+        submeshes.push(Submesh { material: material as u32, first_index, index_count: list.len() as u32 });
+    }
+    if indices.is_empty() {
+        bail!("no triangles");
+    }
+    Ok(Mesh { vertices, indices, submeshes, materials })
+}
+
+/// Area-weighted vertex normals of a triangle list.
+fn face_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            normals[i as usize] += n;
+        }
+    }
+    normals.into_iter().map(Vec3::normalize_or_zero).collect()
+}
+
+/// An image as RGBA8 with a full mip chain.
+fn decode_image(
+    image: &gltf::Image,
+    buffers: &[Vec<u8>],
+    beside: &dyn Fn(&str) -> Result<Vec<u8>>,
+    alpha_cutoff: Option<f32>,
+) -> Result<MipChain> {
+    let bytes = match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let buffer = buffers.get(view.buffer().index()).context("no such buffer")?;
+            buffer
+                .get(view.offset()..view.offset() + view.length())
+                .context("view outside its buffer")?
+                .to_vec()
+        }
+        gltf::image::Source::Uri { uri, .. } => beside(uri)?,
+    };
+    let rgba = image::load_from_memory(&bytes).context("decoding")?.into_rgba8();
+    let size = [rgba.width(), rgba.height()];
+    let mip_count = 32 - size[0].max(size[1]).leading_zeros();
+    Ok(build_mip_chain(rgba.into_raw(), size, mip_count, alpha_cutoff, &[]))
+}

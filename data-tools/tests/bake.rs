@@ -1,0 +1,137 @@
+//! `terramp-data bake` on the shared models: three LODs of 17, 8 and 2 planes each, every plane
+//! with something in its atlas rectangle down to the last mip, a bounding sphere holding every
+//! vertex of the glTF, and `terramp::impostor::load` reading it all back.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use support::{TempDir, shared_data};
+use terramp::impostor::{Impostor, MipChain, Plane};
+
+fn bake(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_terramp-data")).arg("bake").args(args).output().unwrap()
+}
+
+/// Every vertex position of the glTF at `path`, node transforms applied.
+fn gltf_positions(path: &Path) -> Vec<glam::Vec3> {
+    let gltf = gltf::Gltf::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let blob = gltf.blob.clone().unwrap();
+    let mut positions = Vec::new();
+    let mut stack: Vec<(gltf::Node, glam::Mat4)> =
+        gltf.default_scene().unwrap().nodes().map(|n| (n, glam::Mat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        let world = parent * glam::Mat4::from_cols_array_2d(&node.transform().matrix());
+        stack.extend(node.children().map(|c| (c, world)));
+        for primitive in node.mesh().iter().flat_map(|m| m.primitives()) {
+            let reader = primitive.reader(|_| Some(&blob));
+            positions.extend(reader.read_positions().unwrap().map(|p| world.transform_point3(p.into())));
+        }
+    }
+    positions
+}
+
+/// Texels of `level` inside `plane`'s atlas rectangle with alpha above `alpha`.
+fn texels_in(atlas: &MipChain, level: u32, plane: &Plane, alpha: u8) -> usize {
+    let [w, h] = atlas.level_size(level);
+    let x = |u: f32| ((u * w as f32).round() as usize).min(w as usize);
+    let y = |v: f32| ((v * h as f32).round() as usize).min(h as usize);
+    let texels = &atlas.levels[level as usize];
+    (y(plane.uv_min[1])..y(plane.uv_max[1]))
+        .flat_map(|row| (x(plane.uv_min[0])..x(plane.uv_max[0])).map(move |col| row * w as usize + col))
+        .filter(|&i| texels[4 * i + 3] > alpha)
+        .count()
+}
+
+fn check(impostor: &Impostor, glb: &Path) {
+    let name = &impostor.name;
+    let counts: Vec<usize> = impostor.lods.iter().map(|l| l.planes.len()).collect();
+    assert_eq!(counts, [17, 8, 2], "{name}");
+    for (l, lod) in impostor.lods.iter().enumerate() {
+        assert_eq!(lod.atlas.size, [256, 256], "{name} LOD {l}");
+        assert_eq!(lod.atlas.mip_count(), 3, "{name} LOD {l}");
+        assert!(lod.epsilon_m > 0.0 && lod.epsilon_m <= impostor.bounding_sphere.radius_m, "{name} LOD {l}");
+        assert_eq!(lod.vertices().len(), 4 * lod.planes.len());
+        for (p, plane) in lod.planes.iter().enumerate() {
+            assert!(plane.uv_min[0] < plane.uv_max[0] && plane.uv_min[1] < plane.uv_max[1], "{name} {l}/{p}");
+            // Something is drawn on every plane, and alpha-aware mips keep it to the last level.
+            assert!(texels_in(&lod.atlas, 0, plane, 0) > 0, "{name} LOD {l} plane {p}: empty");
+            let last = lod.atlas.mip_count() - 1;
+            assert!(
+                texels_in(&lod.atlas, last, plane, 127) > 0,
+                "{name} LOD {l} plane {p}: vanishes at mip {last}"
+            );
+            // The quad's corners stay near the model (a plane is framed on what it draws).
+            let sphere = impostor.bounding_sphere;
+            for corner in plane.corners_model_m {
+                let d = glam::Vec3::from(corner).distance(sphere.centre_model_m.into());
+                assert!(d < 2.0 * sphere.radius_m, "{name} LOD {l} plane {p}: corner {corner:?}");
+            }
+        }
+        for (p, a) in lod.planes.iter().enumerate() {
+            for b in &lod.planes[p + 1..] {
+                let apart = a.uv_max[0] <= b.uv_min[0]
+                    || b.uv_max[0] <= a.uv_min[0]
+                    || a.uv_max[1] <= b.uv_min[1]
+                    || b.uv_max[1] <= a.uv_min[1];
+                assert!(apart, "{name} LOD {l}: atlas rectangles overlap");
+            }
+        }
+    }
+    let positions = gltf_positions(glb);
+    assert_eq!(impostor.mesh.vertices.len(), positions.len(), "{name}");
+    let sphere = impostor.bounding_sphere;
+    let (low, high) =
+        positions.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    for p in positions {
+        assert!(sphere.contains(p.to_array()), "{name}: {p} outside {sphere:?}");
+    }
+    // Centred at mid-height, as the paper's seeds expect.
+    assert!((sphere.centre_model_m[1] - 0.5 * (low + high)).abs() < 1e-3, "{name}: {sphere:?}");
+    assert_eq!(impostor.mesh.submeshes.len(), impostor.mesh.materials.len(), "{name}");
+}
+
+#[test]
+fn baking_every_model_gives_three_lods_with_their_planes_and_non_empty_atlases() {
+    let Some(data) = shared_data() else { return };
+    let mut models: Vec<PathBuf> = std::fs::read_dir(data.join("models"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .collect();
+    models.sort();
+    assert!(!models.is_empty(), "no .glb in {}", data.join("models").display());
+    let out = TempDir::new("bake");
+    let mut args: Vec<&str> = models.iter().flat_map(|m| ["--model", m.to_str().unwrap()]).collect();
+    args.extend(["--out", out.path().to_str().unwrap(), "--texels", "256"]);
+    let output = bake(&args);
+    let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+    assert!(output.status.success(), "bake failed:\n{stdout}\n{stderr}");
+    assert!(stdout.contains(&format!("baked {} models", models.len())), "{stdout}");
+    let mut names = Vec::new();
+    for glb in &models {
+        let name = glb.file_stem().unwrap().to_str().unwrap();
+        let impostor = terramp::impostor::load(out.path(), name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(impostor.name, name);
+        check(&impostor, glb);
+        names.push(name.to_owned());
+    }
+    assert_eq!(terramp::impostor::models(out.path()).unwrap(), names);
+}
+
+#[test]
+fn missing_and_corrupt_models_are_named() {
+    let dir = TempDir::new("bake-errors");
+    let missing = dir.path().join("Nothing.glb");
+    let output = bake(&["--model", missing.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("Nothing.glb"), "{stderr}");
+    let corrupt = dir.path().join("Broken.glb");
+    std::fs::write(&corrupt, b"glTF\x02\x00\x00\x00 this is not a model").unwrap();
+    let output = bake(&["--model", corrupt.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    assert!(stderr.contains("Broken.glb") && stderr.contains("not a valid glTF"), "{stderr}");
+    assert!(!dir.path().join("Broken").exists(), "nothing written for a failed model");
+}

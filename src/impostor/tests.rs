@@ -1,0 +1,135 @@
+use std::path::PathBuf;
+
+use super::*;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("terramp-impostor-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// A 16 × 8 atlas: a disc of opaque texels in each half, the rest transparent.
+fn atlas() -> Vec<u8> {
+    (0..8u32)
+        .flat_map(|y| (0..16u32).map(move |x| (x, y)))
+        .flat_map(|(x, y)| {
+            let (cx, cy) = ((x % 8) as f32 - 3.5, y as f32 - 3.5);
+            let inside = cx * cx + cy * cy < 9.0;
+            [200, (x * 10) as u8, 50, if inside { 255 } else { 0 }]
+        })
+        .collect()
+}
+
+fn sample() -> Impostor {
+    let plane = |x: f32| Plane {
+        corners_model_m: [[x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], [x + 1.0, 1.0, 0.0], [x, 1.0, 0.0]],
+        normal_model: [0.0, 0.0, 1.0],
+        uv_min: [x / 2.0, 0.0],
+        uv_max: [x / 2.0 + 0.5, 1.0],
+    };
+    let rects =
+        [TexelRect { x: 0, y: 0, width: 8, height: 8 }, TexelRect { x: 8, y: 0, width: 8, height: 8 }];
+    let vertex =
+        |p: [f32; 3]| MeshVertex { position_model_m: p, normal_model: [0.0, 0.0, 1.0], uv: [p[0], p[1]] };
+    Impostor {
+        name: "Quads".into(),
+        bounding_sphere: BoundingSphere { centre_model_m: [1.0, 0.5, 0.0], radius_m: 1.2 },
+        alpha_cutoff: 0.5,
+        lods: vec![ImpostorLod {
+            epsilon_m: 0.1,
+            planes: vec![plane(0.0), plane(1.0)],
+            atlas: build_mip_chain(atlas(), [16, 8], 3, Some(0.5), &rects),
+        }],
+        mesh: Mesh {
+            vertices: vec![vertex([0.0, 0.0, 0.0]), vertex([2.0, 0.0, 0.0]), vertex([2.0, 1.0, 0.0])],
+            indices: vec![0, 1, 2],
+            submeshes: vec![Submesh { material: 0, first_index: 0, index_count: 3 }],
+            materials: vec![Material {
+                name: "Leaves".into(),
+                base_color_factor: [1.0, 0.5, 0.25, 1.0],
+                alpha_mode: AlphaMode::Mask,
+                alpha_cutoff: 0.5,
+                double_sided: true,
+                texture: Some(build_mip_chain(atlas(), [16, 8], 5, Some(0.5), &[])),
+            }],
+        },
+    }
+}
+
+#[test]
+fn saved_impostors_load_back_identical() {
+    let dir = temp_dir("roundtrip");
+    let impostor = sample();
+    let folder = save(&dir, &impostor).unwrap();
+    assert_eq!(folder, dir.join("Quads"));
+    assert_eq!(load(&dir, "Quads").unwrap(), impostor);
+    assert_eq!(models(&dir).unwrap(), vec!["Quads".to_string()]);
+    // Saving again replaces the folder whole.
+    save(&dir, &impostor).unwrap();
+    assert_eq!(load(&dir, "Quads").unwrap(), impostor);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn other_versions_and_damaged_meshes_are_named() {
+    let dir = temp_dir("damaged");
+    let folder = save(&dir, &sample()).unwrap();
+    let manifest = folder.join(MANIFEST_FILE);
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    std::fs::write(&manifest, text.replace("format_version = 1", "format_version = 99")).unwrap();
+    let error = load(&dir, "Quads").unwrap_err();
+    assert!(matches!(error, ImpostorError::Version { found: 99, .. }), "{error}");
+    std::fs::write(&manifest, text).unwrap();
+    let mesh = folder.join(MESH_FILE);
+    let mut bytes = std::fs::read(&mesh).unwrap();
+    let last = bytes.len() - 5;
+    bytes[last] ^= 0xff;
+    std::fs::write(&mesh, &bytes).unwrap();
+    let error = load(&dir, "Quads").unwrap_err().to_string();
+    assert!(error.contains("mesh.bin") && error.contains("checksum"), "{error}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn plane_vertices_follow_the_corners_and_their_atlas_rectangles() {
+    let lod = &sample().lods[0];
+    let vertices = lod.vertices();
+    assert_eq!(vertices.len(), 8);
+    assert_eq!(lod.indices(), vec![0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7]);
+    // Corner 0 is the bottom left: the atlas rectangle's left column, bottom row.
+    assert_eq!(vertices[4].position_model_m, [1.0, 0.0, 0.0]);
+    assert_eq!(vertices[4].uv_atlas, [0.5, 1.0]);
+    assert_eq!(vertices[6].uv_atlas, [1.0, 0.0]);
+}
+
+#[test]
+fn mips_keep_alpha_tested_coverage_and_dilate_colour() {
+    // A sparse checker of single opaque texels: plain averaging would give alpha 0.25 everywhere,
+    // which fails a 0.5 test, so the foliage would vanish one mip down.
+    let size = [32u32, 32u32];
+    let level0: Vec<u8> = (0..size[0] * size[1])
+        .flat_map(|i| {
+            let (x, y) = (i % size[0], i / size[0]);
+            let on = x % 2 == 0 && y % 2 == 0;
+            [40, 160, 40, if on { 255 } else { 0 }]
+        })
+        .collect();
+    let chain = build_mip_chain(level0, size, 4, Some(0.5), &[]);
+    assert_eq!(chain.mip_count(), 4);
+    for (m, level) in chain.levels.iter().enumerate() {
+        let [w, h] = chain.level_size(m as u32);
+        assert_eq!(level.len(), (4 * w * h) as usize);
+        let passing = level.chunks_exact(4).filter(|t| t[3] >= 128).count() as f32 / (w * h) as f32;
+        assert!(m == 0 || passing > 0.2, "mip {m}: coverage {passing}");
+        // Every texel, covered or not, carries the foliage colour: no black fringes.
+        assert!(level.chunks_exact(4).all(|t| t[1] > 120 && t[0] < 80), "mip {m}");
+    }
+}
+
+#[test]
+fn bounding_spheres_hold_their_points() {
+    let points = [[0.0, 0.0, 0.0], [1.0, 4.0, -1.0], [-2.0, 8.0, 0.5], [0.3, 2.0, 3.0]];
+    let sphere = BoundingSphere::enclosing(points);
+    assert_eq!(sphere.centre_model_m[1], 4.0, "centred at mid-height");
+    assert!(points.iter().all(|&p| sphere.contains(p)));
+}
