@@ -12,9 +12,10 @@
 // which no compiler can fuse into an FMA. Large coordinates never reach f32: each cell's corner
 // comes as an integer texel plus a remainder in every layer's own grid.
 //
-// Output: records are appended per workgroup (one global atomic per workgroup); their order
-// varies between runs, their identity (cell address, rank) does not. Records beyond `capacity`
-// are not written and are counted as overflow.
+// Output: a workgroup numbers its survivors by a ballot (rank order, every run), claims room with
+// one global atomic (where it lands varies), writes them with their draw-group keys, and notes
+// where in its fixed block-table entry: read in table order, records come in the twin's order
+// (compaction keeps it). Records beyond `capacity` are not written and are counted as overflow.
 
 struct SeedUniforms {
     clip_from_view_world: mat4x4<f32>,
@@ -114,8 +115,11 @@ struct SeedCounters {
 @group(0) @binding(11) var depth: texture_depth_2d;
 @group(0) @binding(12) var<storage, read_write> records: array<SeedRecord>;
 @group(0) @binding(13) var<storage, read_write> counters: SeedCounters;
+@group(0) @binding(14) var<storage, read_write> keys: array<u32>;
+@group(0) @binding(15) var<storage, read_write> blocks: array<SeedBlock>;
 
 var<workgroup> wg_count: array<atomic<u32>, SEED_COUNTERS>;
+var<workgroup> wg_kept: array<atomic<u32>, BALLOT_WORDS>;
 var<workgroup> wg_base: u32;
 
 // a · b, correctly rounded and never fused into a following add.
@@ -306,10 +310,11 @@ fn dem_blocks(summit_rel: vec3<f32>) -> bool {
     return false;
 }
 
-// The seed's fate: a counter index (COUNT_SELECTED when kept) and its record.
+// The seed's fate: a counter index (COUNT_SELECTED when kept), its record and draw group.
 struct Outcome {
     count: u32,
     record: SeedRecord,
+    key: u32,
 }
 
 fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
@@ -418,6 +423,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     }
 
     out.count = COUNT_SELECTED;
+    out.key = species_index * SEED_LODS + lod;
     let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     out.record = SeedRecord(
         vec3<f32>(rel_xy, base_rel_m),
@@ -434,28 +440,43 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
 }
 
 @compute @workgroup_size(SEED_WORKGROUP)
-fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>,
+        @builtin(local_invocation_index) lane: u32) {
     if lane < SEED_COUNTERS {
         atomicStore(&wg_count[lane], 0u);
+    }
+    if lane < BALLOT_WORDS {
+        atomicStore(&wg_kept[lane], 0u);
     }
     workgroupBarrier();
     let rank = group.x * SEED_WORKGROUP + lane;
     var outcome: Outcome;
-    var local = 0u;
     if rank < u.active_ranks {
         outcome = select_seed(cells[group.y], rank);
-        local = atomicAdd(&wg_count[outcome.count], 1u);
+        if outcome.count == COUNT_SELECTED {
+            atomicOr(&wg_kept[lane / 32u], 1u << (lane % 32u));
+        } else {
+            atomicAdd(&wg_count[outcome.count], 1u);
+        }
     }
     workgroupBarrier();
+    var kept_mask: array<u32, BALLOT_WORDS>;
+    for (var w = 0u; w < BALLOT_WORDS; w += 1u) {
+        kept_mask[w] = atomicLoad(&wg_kept[w]);
+    }
     if lane == 0u {
-        let kept = atomicLoad(&wg_count[COUNT_SELECTED]);
-        let base = atomicAdd(&counters.count[COUNT_SELECTED], kept);
-        wg_base = base;
-        let room = select(0u, u.capacity - base, base < u.capacity);
-        let overflow = kept - min(kept, room);
-        if overflow != 0u {
-            atomicAdd(&counters.count[COUNT_OVERFLOW], overflow);
+        let kept = ballot_count(kept_mask);
+        var block = SeedBlock(0u, 0u);
+        if kept != 0u {
+            let base = atomicAdd(&counters.count[COUNT_SELECTED], kept);
+            block.count = min(kept, select(0u, u.capacity - base, base < u.capacity));
+            block.offset = select(0u, base, block.count != 0u);
+            if block.count != kept {
+                atomicAdd(&counters.count[COUNT_OVERFLOW], kept - block.count);
+            }
+            wg_base = base;
         }
+        blocks[group.y * groups.x + group.x] = block;
         let checked = min(SEED_WORKGROUP, u.active_ranks - group.x * SEED_WORKGROUP);
         atomicAdd(&counters.count[COUNT_CHECKED], checked);
         for (var c = COUNT_CHECKED + 1u; c < SEED_COUNTERS; c += 1u) {
@@ -466,7 +487,9 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         }
     }
     let base = workgroupUniformLoad(&wg_base);
-    if rank < u.active_ranks && outcome.count == COUNT_SELECTED && base + local < u.capacity {
-        records[base + local] = outcome.record;
+    let index = base + ballot_below(kept_mask, lane);
+    if rank < u.active_ranks && outcome.count == COUNT_SELECTED && index < u.capacity {
+        records[index] = outcome.record;
+        keys[index] = outcome.key;
     }
 }

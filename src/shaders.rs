@@ -5,6 +5,7 @@
 use crate::dataset::{
     CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS, LayerSpec,
 };
+use crate::passes::compact;
 use crate::seeds;
 
 /// Levels a page table describes at most (a 2^15-tile-wide layer).
@@ -16,13 +17,16 @@ pub const MAX_LEVELS: u32 = 16;
 const TERRAIN_MESH: &str = include_str!("../shaders/shared/terrain_mesh.wgsl");
 /// The hashes that pick seed patterns and vary seeds.
 const HASH: &str = include_str!("../shaders/shared/hash.wgsl");
+/// How pass 3 hands its survivors to compaction: the block table's entries and lane ballots.
+const BLOCKS: &str = include_str!("../shaders/shared/blocks.wgsl");
 
 pub const SHADERS: &[(&str, &[&str])] = &[
     ("terrain", &[TERRAIN_MESH, include_str!("../shaders/terrain.wgsl")]),
     ("ground", &[TERRAIN_MESH, include_str!("../shaders/ground.wgsl")]),
     ("depth_pyramid", &[include_str!("../shaders/depth_pyramid.wgsl")]),
     ("tile_load_map", &[HASH, include_str!("../shaders/tile_load_map.wgsl")]),
-    ("seed_select", &[HASH, include_str!("../shaders/seed_select.wgsl")]),
+    ("seed_select", &[HASH, BLOCKS, include_str!("../shaders/seed_select.wgsl")]),
+    ("compact", &[BLOCKS, include_str!("../shaders/compact.wgsl")]),
 ];
 
 /// The constants every shader sees, generated from their Rust definitions.
@@ -58,6 +62,11 @@ pub fn prelude() -> String {
         ("COUNT_DISTANCE", seeds::COUNT_DISTANCE),
         ("COUNT_FRUSTUM", seeds::COUNT_FRUSTUM),
         ("COUNT_OCCLUSION", seeds::COUNT_OCCLUSION),
+        ("BALLOT_WORDS", seeds::BALLOT_WORDS),
+        ("SEED_LODS", seeds::SEED_LODS),
+        ("SEED_GROUPS", seeds::SEED_GROUPS),
+        ("COMPACT_WORKGROUP", compact::COMPACT_WORKGROUP),
+        ("COMPACT_CHUNK", compact::COMPACT_CHUNK),
     ];
     let mut text = String::from("// Generated from Rust constants (src/shaders.rs).\n");
     for (name, value) in constants {

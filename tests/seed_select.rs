@@ -1,5 +1,7 @@
-//! Pass 3 on a synthetic dataset: the GPU equals its CPU twin, runs and paths agree, seeds sit on
-//! the DEM, and a too-small output is flagged without corrupting what it keeps.
+//! Pass 3 on a synthetic dataset: the GPU equals its CPU twin (read in block-table order, in the
+//! same order too), runs and paths agree, seeds sit on the DEM, a too-small output is flagged
+//! without corrupting what it keeps, and compaction's draw order is the same in every run and
+//! equals its twin's.
 
 mod common;
 
@@ -8,6 +10,7 @@ use terramp::camera::Camera;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::reference::seed_select::SeedComparison;
+use terramp::seeds::{SEED_GROUPS, seed_group};
 
 const SIZE: u32 = 1024;
 
@@ -63,7 +66,68 @@ fn gpu_seed_selection_equals_its_cpu_twin() {
         // sRGB texels (the driver's table against the formula) and may round one step apart.
         assert_eq!(diff.max_length_error_m, 0.0, "view {i}");
         assert!(diff.max_colour_error <= 1, "view {i}: {}", diff.max_colour_error);
+        // Read in block-table order, the GPU's records come in the twin's order, whatever order
+        // the blocks landed in; the block tables agree entry for entry.
+        let output = r.read_seed_output().unwrap().unwrap();
+        let (twin_output, _) = r.compact_twin().unwrap().unwrap();
+        assert_eq!(identities(&output.in_block_order()), identities(&twin), "view {i}");
+        let counts = |o: &terramp::passes::seed_select::SeedOutput| {
+            o.blocks.iter().map(|b| b.count).collect::<Vec<_>>()
+        };
+        assert_eq!(counts(&output), counts(&twin_output), "view {i}");
+        assert_eq!(output.keys.len(), output.records.len());
     }
+}
+
+/// Who each seed is, in order: cell, rank and what it grows into.
+fn identities(records: &[SeedRecord]) -> Vec<([i32; 2], u32, u32)> {
+    records.iter().map(|r| (r.address, r.rank, r.species_lod)).collect()
+}
+
+#[test]
+fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
+    let dataset = common::synth_dataset(SIZE, 7);
+    let settings = common::small_settings(320, 180);
+    let probe = common::renderer(&dataset, settings.clone());
+    let camera = cameras(&probe)[0];
+    drop(probe);
+    let run = || {
+        let mut r = common::renderer(&dataset, settings.clone());
+        r.render_resolved(&camera, 60).unwrap();
+        let output = r.read_seed_output().unwrap().unwrap();
+        let compacted = r.read_compacted().unwrap().unwrap();
+        // Compaction's twin over the GPU's own block table: the same permutation, bit for bit.
+        let twin_of_gpu = terramp::reference::compact::compact(&output.keys, &output.blocks, &[]).unwrap();
+        assert_eq!(compacted, twin_of_gpu);
+        (r, output, compacted)
+    };
+    let (r, output, compacted) = run();
+    let drawn = compacted.gather(&output.records);
+    assert!(drawn.len() > 100, "{} seeds drawn", drawn.len());
+    assert_eq!(drawn.len(), output.records.len());
+    // Each group's slots hold its seeds.
+    for (g, args) in compacted.args.iter().enumerate() {
+        let slots = args.first_instance as usize..(args.first_instance + args.instance_count) as usize;
+        for s in &drawn[slots] {
+            assert_eq!(seed_group(s.species_lod & 0xff, (s.species_lod >> 8) & 0xf), g as u32);
+        }
+    }
+    assert_eq!(compacted.args.len(), SEED_GROUPS as usize);
+
+    // A second run: where the records landed may differ, the seeds in draw order may not.
+    let (_, output_b, compacted_b) = run();
+    let bytes = |records: &[SeedRecord]| bytemuck::cast_slice::<SeedRecord, u8>(records).to_vec();
+    assert_eq!(bytes(&compacted_b.gather(&output_b.records)), bytes(&drawn), "two runs draw differently");
+    assert_eq!(compacted_b.args, compacted.args);
+
+    // The twins of pass 3 and compaction: the same draws, the same seeds in the same slots.
+    let (twin_output, twin) = r.compact_twin().unwrap().unwrap();
+    let twin_drawn = twin.gather(&twin_output.records);
+    assert_eq!(twin.args, compacted.args);
+    assert_eq!(identities(&twin_drawn), identities(&drawn));
+    let diff = SeedComparison::of(&drawn, &twin_drawn);
+    assert_eq!(diff.max_length_error_m, 0.0);
+    assert!(diff.max_colour_error <= 1, "{}", diff.max_colour_error);
 }
 
 #[test]
@@ -131,6 +195,11 @@ fn overflow_is_flagged_counted_and_keeps_valid_records() {
     assert_eq!(diff.common, kept.len());
     let (_, twin_counters) = small.seed_twin().unwrap().unwrap();
     assert_eq!(twin_counters, counters);
+    // Compaction draws exactly what was kept, as its twin does over the same block table.
+    let output = small.read_seed_output().unwrap().unwrap();
+    let compacted = small.read_compacted().unwrap().unwrap();
+    assert_eq!(compacted.drawn(), capacity as usize);
+    assert_eq!(compacted, terramp::reference::compact::compact(&output.keys, &output.blocks, &[]).unwrap());
 }
 
 #[test]

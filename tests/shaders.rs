@@ -58,3 +58,30 @@ fn seed_structs_match_their_wgsl_twins() {
     assert_eq!(wgsl_size(&seeds, "SeedRecord") as usize, size_of::<SeedRecord>());
     assert_eq!(wgsl_size(&seeds, "SeedCounters") as usize, size_of::<SeedCounters>());
 }
+
+#[test]
+fn compaction_structs_match_their_wgsl_twins() {
+    use terramp::gpu::gpu_types::{CompactParams, SeedBlock, SeedDrawArgs};
+    let compact = module("compact");
+    assert_eq!(wgsl_size(&compact, "CompactParams") as usize, size_of::<CompactParams>());
+    assert_eq!(wgsl_size(&compact, "SeedDrawArgs") as usize, size_of::<SeedDrawArgs>());
+    assert_eq!(wgsl_size(&compact, "SeedBlock") as usize, size_of::<SeedBlock>());
+    assert_eq!(wgsl_size(&module("seed_select"), "SeedBlock") as usize, size_of::<SeedBlock>());
+    // The draw pass hands the arguments to wgpu as they are.
+    assert_eq!(size_of::<SeedDrawArgs>(), size_of::<wgpu::util::DrawIndexedIndirectArgs>());
+    let args = SeedDrawArgs {
+        index_count: 1,
+        instance_count: 2,
+        first_index: 3,
+        base_vertex: -4,
+        first_instance: 5,
+    };
+    let wgpu_args = wgpu::util::DrawIndexedIndirectArgs {
+        index_count: 1,
+        instance_count: 2,
+        first_index: 3,
+        base_vertex: -4,
+        first_instance: 5,
+    };
+    assert_eq!(bytemuck::bytes_of(&args), wgpu_args.as_bytes());
+}

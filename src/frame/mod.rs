@@ -58,6 +58,8 @@ pub enum RenderError {
     ClassTable(#[from] crate::classes::ClassTableError),
     #[error(transparent)]
     Seeds(#[from] crate::seeds::SeedError),
+    #[error(transparent)]
+    Compact(#[from] crate::passes::compact::CompactError),
     #[error("seeds.capacity = {capacity} records does not fit one GPU buffer binding here (at most {max})")]
     SeedCapacity { capacity: u32, max: u32 },
     #[error("the {layer} cache has {slots} slots; the whole layer is {tiles} tiles")]
@@ -393,6 +395,9 @@ impl Renderer {
             report.seed_cells = frame.cells.len();
             report.seed_cells_dropped = frame.cells_dropped;
             self.profiler.pass(&self.gpu, &mut encoder, "seed_select", |encoder| stage.encode(encoder))?;
+            // Compaction: the survivors grouped per (species, LOD) into indirect draws, on the GPU.
+            self.profiler
+                .pass(&self.gpu, &mut encoder, "compact", |encoder| stage.encode_compact(encoder))?;
         }
         // Read back a frame or two late, never waiting (recorded after the last timed pass: the
         // CPU-timing fallback submits each pass's encoder on its own).

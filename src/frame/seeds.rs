@@ -1,8 +1,10 @@
 //! How it works: the renderer's seed stage. A dataset with land cover gets, once, its species
 //! tables (from the class table its scheme names, or `seeds.class_table`), the P generic patterns
-//! and pass 3's pipeline bound to the caches and the depth target. Each frame it feeds pass 3 the
-//! ring-0 cells of the latest Tile Load Map and reads pass 3's counters back through a staging
-//! ring, never waiting: the counters a frame reports are a frame or two old.
+//! and pass 3's pipeline bound to the caches and the depth target, and compaction bound to pass 3's
+//! block table and keys. Each frame it feeds pass 3 the ring-0 cells of the latest Tile Load Map,
+//! has compaction group the survivors into one indirect draw per (species, LOD) on the GPU, and
+//! reads only pass 3's counters back, through a staging ring, never waiting: the counters a frame
+//! reports are a frame or two old.
 
 use std::collections::VecDeque;
 
@@ -12,9 +14,10 @@ use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::Dataset;
-use crate::gpu::gpu_types::SeedCounters;
+use crate::gpu::gpu_types::{CompactParams, SeedCounters};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError};
+use crate::passes::compact::{CompactInputs, CompactLimits, CompactPass};
 use crate::passes::seed_select::{SeedCellRef, SeedFrame, SeedInputs, SeedSelectPass, SeedSources};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
@@ -38,6 +41,10 @@ pub(super) struct SeedStage {
     pub patterns: SeedPatterns,
     pub pass: SeedSelectPass,
     pub bind_group: wgpu::BindGroup,
+    pub compact: CompactPass,
+    compact_bind_group: wgpu::BindGroup,
+    /// The last frame's compaction size.
+    compact_params: CompactParams,
     counters_ring: ReadbackRing,
     /// Frames (with their cells and ranks) whose counters are in flight, oldest first.
     in_flight: VecDeque<(u64, u32, u32)>,
@@ -73,6 +80,9 @@ impl SeedStage {
         let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds_per_pattern, settings.tlm.seed);
         let pass = SeedSelectPass::new(device, settings, &patterns, &tables);
         let bind_group = pass.bind_group(device, sources);
+        let compact = CompactPass::new(device, CompactLimits::from(settings))?;
+        let compact_bind_group =
+            compact.bind_group(device, &CompactInputs { blocks: pass.blocks(), keys: pass.keys() });
         let counters_ring =
             ReadbackRing::new(device, "seed counters", size_of::<SeedCounters>() as u64, DEFAULT_SLOTS);
         Ok(Some(Self {
@@ -80,6 +90,9 @@ impl SeedStage {
             patterns,
             pass,
             bind_group,
+            compact,
+            compact_bind_group,
+            compact_params: CompactParams::default(),
             counters_ring,
             in_flight: VecDeque::new(),
             last_frame: None,
@@ -87,9 +100,10 @@ impl SeedStage {
         }))
     }
 
-    /// Uploads this frame's cells.
+    /// Uploads this frame's cells, and the size of its block table to compaction.
     pub fn prepare(&mut self, gpu: &Gpu, inputs: &SeedInputs) -> Result<&SeedFrame, RenderError> {
         let frame = self.pass.prepare(&gpu.queue, inputs)?;
+        self.compact_params = self.compact.prepare(&gpu.queue, frame.blocks())?;
         Ok(self.last_frame.insert(frame))
     }
 
@@ -97,6 +111,13 @@ impl SeedStage {
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder) {
         if let Some(frame) = &self.last_frame {
             self.pass.encode(encoder, &self.bind_group, frame);
+        }
+    }
+
+    /// Records compaction of what pass 3 wrote: the frame's draw order and indirect draws.
+    pub fn encode_compact(&self, encoder: &mut wgpu::CommandEncoder) {
+        if self.last_frame.is_some() {
+            self.compact.encode(encoder, &self.compact_bind_group, &self.compact_params);
         }
     }
 

@@ -1,6 +1,6 @@
 //! How it works: what tools and tests ask of a renderer besides frames: all-resident references,
-//! rendering a view until it has streamed in, and blocking readbacks of the targets and the seeds.
-//! None of it is on the per-frame path.
+//! rendering a view until it has streamed in, and blocking readbacks of the targets, the seeds and
+//! their compaction, with the CPU twins to compare them with. None of it is on the per-frame path.
 
 use std::time::Duration;
 
@@ -12,8 +12,9 @@ use crate::streaming::{CacheStats, TileCache};
 use super::{FrameReport, RenderError, Renderer};
 use crate::camera::Camera;
 use crate::gpu::gpu_types::{SeedCounters, SeedRecord};
-use crate::passes::seed_select::SeedCellRef;
-use crate::reference::seed_select::{SeedSnapshot, seed_select, snapshot_caches};
+use crate::passes::compact::Compacted;
+use crate::passes::seed_select::{SeedCellRef, SeedOutput};
+use crate::reference::seed_select::{SeedSnapshot, seed_select, seed_select_blocks, snapshot_caches};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
 
@@ -112,6 +113,21 @@ impl Renderer {
         Ok(Some(stage.pass.read_back(&self.gpu)?))
     }
 
+    /// Everything pass 3 wrote in the last frame (records, keys, block table, counters), waiting
+    /// for the GPU (`None` without land cover or before a first frame).
+    pub fn read_seed_output(&self) -> Result<Option<SeedOutput>, RenderError> {
+        let Some(stage) = &self.seeds else { return Ok(None) };
+        let Some(frame) = &stage.last_frame else { return Ok(None) };
+        Ok(Some(stage.pass.read_output(&self.gpu, frame)?))
+    }
+
+    /// The last frame's compaction (draw order over pass 3's records, indirect draws), waiting for
+    /// the GPU (`None` without land cover).
+    pub fn read_compacted(&self) -> Result<Option<Compacted>, RenderError> {
+        let Some(stage) = &self.seeds else { return Ok(None) };
+        Ok(Some(stage.compact.read_back(&self.gpu)?))
+    }
+
     /// What pass 3 read in the last frame (its cells, the resident tiles, the depth), for its
     /// twin; `None` without land cover or before a first frame.
     pub fn seed_snapshot(&self) -> Result<Option<SeedSnapshot>, RenderError> {
@@ -130,6 +146,16 @@ impl Renderer {
     /// Pass 3 replayed by its CPU twin over the last frame's inputs, in canonical order.
     pub fn seed_twin(&self) -> Result<Option<(Vec<SeedRecord>, SeedCounters)>, RenderError> {
         Ok(self.seed_snapshot()?.map(|snapshot| seed_select(&snapshot.inputs())))
+    }
+
+    /// Pass 3 and compaction replayed by their CPU twins over the last frame's inputs: pass 3's
+    /// output with its blocks in table order, and its compaction (`None` without land cover).
+    pub fn compact_twin(&self) -> Result<Option<(SeedOutput, Compacted)>, RenderError> {
+        let (Some(stage), Some(snapshot)) = (&self.seeds, self.seed_snapshot()?) else { return Ok(None) };
+        let output = seed_select_blocks(&snapshot.inputs());
+        let templates = stage.compact.templates();
+        let compacted = crate::reference::compact::compact(&output.keys, &output.blocks, templates)?;
+        Ok(Some((output, compacted)))
     }
 
     /// Runs pass 3 alone over `cells` seen from `camera`, against the caches and depth as the last

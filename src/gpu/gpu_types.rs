@@ -305,3 +305,37 @@ pub struct SeedCounters {
     pub frustum: u32,
     pub occlusion: u32,
 }
+
+/// Where one pass-3 workgroup put its survivors. WGSL: `SeedBlock`. Entry `cell × workgroups per
+/// cell + workgroup` of the block table, so its index is fixed while `offset` (where its one
+/// atomic landed in the record buffer) varies; `count` records follow it, in rank order (0 for a
+/// workgroup that kept nothing or found the buffer full; `offset` is then 0).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default)]
+pub struct SeedBlock {
+    pub offset: u32,
+    pub count: u32,
+}
+
+/// One indexed indirect draw: wgpu's `DrawIndexedIndirectArgs` layout (5 × u32). WGSL:
+/// `SeedDrawArgs` in `shaders/compact.wgsl`, which writes one per draw group; as a template (what
+/// the draw pass uploads) `instance_count` and `first_instance` are ignored.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default)]
+pub struct SeedDrawArgs {
+    pub index_count: u32,
+    pub instance_count: u32,
+    pub first_index: u32,
+    pub base_vertex: i32,
+    pub first_instance: u32,
+}
+
+/// Per-run constants of compaction. WGSL: `CompactParams` in `shaders/compact.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default)]
+pub struct CompactParams {
+    /// Entries of the block table to compact, and the chunks (workgroups) they make.
+    pub blocks: u32,
+    pub chunks: u32,
+    pub _pad: [u32; 2],
+}

@@ -2,7 +2,10 @@
 //! ring-0 cells the latest Tile Load Map found visible within the radial LOD range, each with its
 //! pattern and land-cover level; `shaders/seed_select.wgsl` checks every seed of every such cell
 //! (one invocation per seed) and appends the survivors to a fixed-capacity record buffer, with
-//! counters of what was checked, culled (and why) and what overflowed.
+//! counters of what was checked, culled (and why) and what overflowed. Each workgroup writes its
+//! survivors in rank order, each with its draw group in a parallel key buffer, and where it put
+//! them in its own entry of a block table (`SeedBlock`), which compaction (`passes/compact.rs`)
+//! reads in order: the table, not the atomics, fixes the order in which seeds are drawn.
 //!
 //! `SeedFrame::new` is the CPU half, in f64: it turns each cell's corner into an integer texel and
 //! a remainder in every layer's own grid (height samples, level-1 land-cover texels, level-0
@@ -16,11 +19,10 @@ use wgpu::util::DeviceExt;
 use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::{Dataset, Pyramid, TileId};
-use crate::gpu::gpu_types::{SeedCell, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms};
-use crate::gpu::readback_ring::ReadbackRing;
+use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms};
 use crate::gpu::{Gpu, GpuError};
 use crate::seeds::patterns::SeedPatterns;
-use crate::seeds::{MAX_SEED_CELLS, SEED_WORKGROUP, SeedTables};
+use crate::seeds::{MAX_SEED_CELLS, SeedTables, block_capacity, max_cells, workgroups_per_cell};
 use crate::shaders::{self, MAX_LEVELS};
 use crate::streaming::TileCache;
 
@@ -50,8 +52,32 @@ pub struct SeedInputs<'a> {
 pub struct SeedFrame {
     pub uniforms: SeedUniforms,
     pub cells: Vec<SeedCell>,
-    /// Cells beyond `MAX_SEED_CELLS` (the farthest in the TLM's order) that were left out.
+    /// Cells beyond `seeds::max_cells` (the farthest in the TLM's order) that were left out.
     pub cells_dropped: usize,
+}
+
+/// Everything pass 3 wrote in a frame, read back (or replayed by the twin).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeedOutput {
+    /// The record buffer's filled part (`min(selected, capacity)` records), and each record's
+    /// draw group (`seeds::seed_group`).
+    pub records: Vec<SeedRecord>,
+    pub keys: Vec<u32>,
+    /// One entry per workgroup, cell by cell (`SeedFrame::blocks`).
+    pub blocks: Vec<SeedBlock>,
+    pub counters: SeedCounters,
+}
+
+impl SeedOutput {
+    /// The records block by block in table order: cell by cell, rank by rank, as the twin lists
+    /// them (when nothing overflowed), whatever order the blocks landed in.
+    pub fn in_block_order(&self) -> Vec<SeedRecord> {
+        self.blocks
+            .iter()
+            .flat_map(|b| &self.records[b.offset as usize..(b.offset + b.count) as usize])
+            .copied()
+            .collect()
+    }
 }
 
 /// Page-table addressing of a pyramid's levels: first entry, tiles along x and y.
@@ -154,7 +180,7 @@ impl SeedFrame {
         let camera_xy = [inputs.camera_grid_m.x, inputs.camera_grid_m.y];
         let (cx, cy) = (split(camera_xy[0] / spacing_m), split(camera_xy[1] / spacing_m));
         (u.camera_sample, u.camera_sample_frac) = ([cx.0, cy.0], [cx.1, cy.1]);
-        let kept = inputs.cells.len().min(MAX_SEED_CELLS as usize);
+        let kept = inputs.cells.len().min(max_cells(u.active_ranks) as usize);
         let cells = inputs.cells[..kept]
             .iter()
             .map(|c| {
@@ -191,6 +217,11 @@ impl SeedFrame {
     pub fn checked(&self) -> u64 {
         self.cells.len() as u64 * u64::from(self.uniforms.active_ranks)
     }
+
+    /// Entries of the block table this frame writes: one per workgroup, cell by cell.
+    pub fn blocks(&self) -> u32 {
+        self.cells.len() as u32 * workgroups_per_cell(self.uniforms.active_ranks)
+    }
 }
 
 pub struct SeedSelectPass {
@@ -203,7 +234,10 @@ pub struct SeedSelectPass {
     classes: wgpu::Buffer,
     records: wgpu::Buffer,
     counters: wgpu::Buffer,
+    keys: wgpu::Buffer,
+    blocks: wgpu::Buffer,
     capacity: u32,
+    block_capacity: u32,
 }
 
 /// The caches and depth pass 3 reads.
@@ -264,6 +298,8 @@ impl SeedSelectPass {
                 ),
                 entry(12, storage(false)),
                 entry(13, storage(false)),
+                entry(14, storage(false)),
+                entry(15, storage(false)),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -297,6 +333,8 @@ impl SeedSelectPass {
         };
         let copy_dst = wgpu::BufferUsages::COPY_DST;
         let capacity = settings.seeds.capacity;
+        let block_capacity = block_capacity(settings.seeds.seeds_per_pattern);
+        let output = storage_usage | wgpu::BufferUsages::COPY_SRC;
         // A binding may not be empty: a table without species still gets one (never read) entry.
         let no_species = [SeedSpecies::default()];
         let species: &[u8] =
@@ -316,14 +354,17 @@ impl SeedSelectPass {
             records: empty(
                 "seed records",
                 u64::from(capacity.max(1)) * size_of::<SeedRecord>() as u64,
-                storage_usage | wgpu::BufferUsages::COPY_SRC,
+                output,
             ),
             counters: empty(
                 "seed counters",
                 size_of::<SeedCounters>() as u64,
                 storage_usage | copy_dst | wgpu::BufferUsages::COPY_SRC,
             ),
+            keys: empty("seed keys", u64::from(capacity.max(1)) * 4, output),
+            blocks: empty("seed blocks", u64::from(block_capacity) * size_of::<SeedBlock>() as u64, output),
             capacity,
+            block_capacity,
         }
     }
 
@@ -353,6 +394,8 @@ impl SeedSelectPass {
                 texture(11, sources.depth),
                 buffer(12, &self.records),
                 buffer(13, &self.counters),
+                buffer(14, &self.keys),
+                buffer(15, &self.blocks),
             ],
         })
     }
@@ -385,7 +428,7 @@ impl SeedSelectPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.dispatch_workgroups(
-            frame.uniforms.active_ranks.div_ceil(SEED_WORKGROUP),
+            workgroups_per_cell(frame.uniforms.active_ranks),
             frame.cells.len() as u32,
             1,
         );
@@ -405,27 +448,46 @@ impl SeedSelectPass {
         self.capacity
     }
 
+    /// Each record's draw group (`capacity` entries, filled as the records are).
+    pub fn keys(&self) -> &wgpu::Buffer {
+        &self.keys
+    }
+
+    /// The block table (`block_capacity` entries; a frame writes `SeedFrame::blocks` of them).
+    pub fn blocks(&self) -> &wgpu::Buffer {
+        &self.blocks
+    }
+
+    pub fn block_capacity(&self) -> u32 {
+        self.block_capacity
+    }
+
     /// Reads the last frame's records and counters back, waiting for the GPU: for tests and
     /// tools, never the frame.
     pub fn read_back(&self, gpu: &Gpu) -> Result<(Vec<SeedRecord>, SeedCounters), GpuError> {
-        let read = |buffer: &wgpu::Buffer, bytes: u64| -> Result<Vec<u8>, GpuError> {
-            let mut ring = ReadbackRing::new(&gpu.device, "seeds (blocking)", bytes.max(4), 1);
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            ring.encode_copy(&mut encoder, buffer, bytes.max(4), 0);
-            gpu.queue.submit([encoder.finish()]);
-            ring.submitted();
-            gpu.wait()?;
-            let taken = ring.try_take(&gpu.device)?;
-            gpu.check()?;
-            taken
-                .map(|r| r.cast())
-                .ok_or_else(|| GpuError::Validation("a seed readback did not arrive after a wait".into()))
-        };
-        let counters: SeedCounters =
-            bytemuck::pod_read_unaligned(&read(&self.counters, size_of::<SeedCounters>() as u64)?);
+        let counters = self.read_counters(gpu)?;
         let kept = counters.selected.min(self.capacity);
-        let bytes = read(&self.records, u64::from(kept) * size_of::<SeedRecord>() as u64)?;
-        let records = bytemuck::pod_collect_to_vec(&bytes[..kept as usize * size_of::<SeedRecord>()]);
-        Ok((records, counters))
+        let bytes = super::read_buffer(gpu, &self.records, u64::from(kept) * size_of::<SeedRecord>() as u64)?;
+        Ok((bytemuck::pod_collect_to_vec(&bytes), counters))
+    }
+
+    /// Reads everything the last frame of `frame` wrote (records, keys, block table, counters),
+    /// waiting for the GPU: for tests and tools.
+    pub fn read_output(&self, gpu: &Gpu, frame: &SeedFrame) -> Result<SeedOutput, GpuError> {
+        let (records, counters) = self.read_back(gpu)?;
+        let keys = super::read_buffer(gpu, &self.keys, records.len() as u64 * 4)?;
+        let blocks = u64::from(frame.blocks().min(self.block_capacity)) * size_of::<SeedBlock>() as u64;
+        let blocks = super::read_buffer(gpu, &self.blocks, blocks)?;
+        Ok(SeedOutput {
+            records,
+            keys: bytemuck::pod_collect_to_vec(&keys),
+            blocks: bytemuck::pod_collect_to_vec(&blocks),
+            counters,
+        })
+    }
+
+    fn read_counters(&self, gpu: &Gpu) -> Result<SeedCounters, GpuError> {
+        let bytes = super::read_buffer(gpu, &self.counters, size_of::<SeedCounters>() as u64)?;
+        Ok(bytemuck::pod_read_unaligned(&bytes))
     }
 }

@@ -3,6 +3,7 @@
 //! GPU == CPU exactly for integer outputs. The exact oracle used to measure accuracy (f64, full
 //! resolution) is separate from these twins: a twin reproduces the GPU, the oracle judges it.
 
+pub mod compact;
 pub mod oracle;
 pub mod seed_select;
 pub mod tile_load_map;

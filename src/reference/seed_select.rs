@@ -3,18 +3,23 @@
 //! cache's page table with the texels of its resident slots, and the terrain depth — and decides
 //! every seed with the same f32 arithmetic in the same order (products are plain `a * b`: Rust
 //! never fuses them unasked). It returns the kept records in a canonical order (cell by cell,
-//! rank by rank) and the same counters; the GPU's records come in a varying order, so tests
-//! compare them as sets keyed by (cell address, rank).
+//! rank by rank) and the same counters, and (`seed_select_blocks`) the block table the GPU writes,
+//! as if every workgroup's block had landed in order: the GPU's blocks land in a varying order,
+//! but read in table order (`SeedOutput::in_block_order`) its records equal the twin's list.
 
 use std::collections::HashMap;
 
 use crate::classes::MAX_SPECIES_PER_CLASS;
 use crate::dataset::{Dataset, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, PackError, TileId};
-use crate::gpu::gpu_types::{SeedCell, SeedCounters, SeedRecord, SeedUniforms};
+use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::lcc::LCC_LEVELS;
-use crate::passes::seed_select::SeedFrame;
-use crate::seeds::{GROUND_SAMPLES, SeedTables, pcg, seed_hash, unit};
+use crate::passes::seed_select::{SeedFrame, SeedOutput};
+use crate::seeds::{GROUND_SAMPLES, SEED_WORKGROUP, SeedTables, pcg, seed_group, seed_hash, unit};
 use crate::streaming::TileCache;
+
+mod compare;
+
+pub use compare::SeedComparison;
 
 const LCC_TILE_TEXELS: u32 = crate::dataset::CELL_TILE_TEXELS;
 const IMAGERY_TILE_TEXELS: u32 = crate::dataset::CELL_TILE_TEXELS;
@@ -120,21 +125,48 @@ pub fn snapshot_caches(
 }
 
 /// The seeds pass 3 keeps, cell by cell and rank by rank, and its counters (with overflow as the
-/// GPU counts it when records beyond `capacity` are dropped).
+/// GPU counts it when records beyond `capacity` are dropped). All kept seeds are returned, those
+/// beyond `capacity` included.
 pub fn seed_select(inputs: &SeedTwinInputs) -> (Vec<SeedRecord>, SeedCounters) {
+    select_all(inputs, |_| {})
+}
+
+/// Pass 3's whole output as the GPU writes it when its blocks land in table order: the records
+/// that fit `capacity` with their draw-group keys, the block table and the counters.
+pub fn seed_select_blocks(inputs: &SeedTwinInputs) -> SeedOutput {
+    let capacity = inputs.frame.uniforms.capacity;
+    let mut blocks = Vec::new();
+    let mut selected = 0u32;
+    let (mut records, counters) = select_all(inputs, |kept| {
+        let count = kept.min(capacity.saturating_sub(selected));
+        blocks.push(SeedBlock { offset: if count == 0 { 0 } else { selected }, count });
+        selected += kept;
+    });
+    records.truncate(capacity as usize);
+    let keys = records.iter().map(|r| seed_group(r.species_lod & 0xff, (r.species_lod >> 8) & 0xf)).collect();
+    SeedOutput { records, keys, blocks, counters }
+}
+
+/// Every seed of every cell, workgroup by workgroup, calling `block` with each workgroup's
+/// survivor count.
+fn select_all(inputs: &SeedTwinInputs, mut block: impl FnMut(u32)) -> (Vec<SeedRecord>, SeedCounters) {
     let u = &inputs.frame.uniforms;
     let mut counts = [0u32; crate::seeds::SEED_COUNTERS as usize];
     let mut records = Vec::new();
     for cell in &inputs.frame.cells {
-        for rank in 0..u.active_ranks {
-            counts[crate::seeds::COUNT_CHECKED as usize] += 1;
-            match select_seed(inputs, cell, rank) {
-                Ok(record) => {
-                    counts[crate::seeds::COUNT_SELECTED as usize] += 1;
-                    records.push(record);
+        for first_rank in (0..u.active_ranks).step_by(SEED_WORKGROUP as usize) {
+            let first = records.len();
+            for rank in first_rank..u.active_ranks.min(first_rank + SEED_WORKGROUP) {
+                counts[crate::seeds::COUNT_CHECKED as usize] += 1;
+                match select_seed(inputs, cell, rank) {
+                    Ok(record) => {
+                        counts[crate::seeds::COUNT_SELECTED as usize] += 1;
+                        records.push(record);
+                    }
+                    Err(count) => counts[count as usize] += 1,
                 }
-                Err(count) => counts[count as usize] += 1,
             }
+            block((records.len() - first) as u32);
         }
     }
     let kept = records.len().min(u.capacity as usize);
@@ -426,56 +458,4 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         radius_m,
         ground_m: ground.height_m,
     })
-}
-
-/// How two seed sets differ, keyed by identity (cell address, rank).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct SeedComparison {
-    pub common: usize,
-    /// In the twin's set, not in the GPU's; and the reverse.
-    pub only_twin: Vec<([i32; 2], u32)>,
-    pub only_gpu: Vec<([i32; 2], u32)>,
-    /// Common seeds whose species, LOD, levels or jitter differ.
-    pub mismatched: Vec<([i32; 2], u32)>,
-    /// Largest difference of position, height, radius or ground height, metres.
-    pub max_length_error_m: f32,
-    /// Largest difference of a ground-colour channel, in 1/255.
-    pub max_colour_error: u32,
-}
-
-impl SeedComparison {
-    pub fn of(gpu: &[SeedRecord], twin: &[SeedRecord]) -> Self {
-        let key = |r: &SeedRecord| (r.address, r.rank);
-        let gpu_by_key: HashMap<_, _> = gpu.iter().map(|r| (key(r), r)).collect();
-        let twin_keys: std::collections::HashSet<_> = twin.iter().map(key).collect();
-        let mut out = Self::default();
-        for t in twin {
-            let Some(g) = gpu_by_key.get(&key(t)) else {
-                out.only_twin.push(key(t));
-                continue;
-            };
-            out.common += 1;
-            if (g.species_lod, g.jitter) != (t.species_lod, t.jitter) {
-                out.mismatched.push(key(t));
-            }
-            let lengths = [
-                (g.position_rel_m[0], t.position_rel_m[0]),
-                (g.position_rel_m[1], t.position_rel_m[1]),
-                (g.position_rel_m[2], t.position_rel_m[2]),
-                (g.height_m, t.height_m),
-                (g.radius_m, t.radius_m),
-                (g.ground_m, t.ground_m),
-            ];
-            for (a, b) in lengths {
-                out.max_length_error_m = out.max_length_error_m.max((a - b).abs());
-            }
-            for c in 0..4 {
-                let channel = |w: u32| (w >> (8 * c)) & 0xff;
-                out.max_colour_error =
-                    out.max_colour_error.max(channel(g.ground_colour).abs_diff(channel(t.ground_colour)));
-            }
-        }
-        out.only_gpu = gpu.iter().map(key).filter(|k| !twin_keys.contains(k)).collect();
-        out
-    }
 }

@@ -22,8 +22,18 @@ use crate::lcc::LccCoding;
 
 /// Workgroup size of the seed-selection dispatch (handed to WGSL through the prelude).
 pub const SEED_WORKGROUP: u32 = 64;
+/// Words of a ballot: one bit per lane of a pass-3 workgroup (`shaders/shared/blocks.wgsl`).
+pub const BALLOT_WORDS: u32 = SEED_WORKGROUP / 32;
+const _: () = assert!(SEED_WORKGROUP.is_multiple_of(32), "ballots need whole words");
 /// Cells one dispatch checks at most (a dispatch dimension's limit).
 pub const MAX_SEED_CELLS: u32 = 65535;
+/// Entries of pass 3's block table at most (one per workgroup: 8 MiB, 64 M seeds checked per
+/// frame); a frame checks no more cells than fill it (`max_cells`).
+pub const MAX_SEED_BLOCKS: u32 = 1 << 20;
+/// Radial LODs a seed can be drawn at (3 = inactive).
+pub const SEED_LODS: u32 = 3;
+/// Draw groups: one per (species, radial LOD), `species × SEED_LODS + lod` (`seed_group`).
+pub const SEED_GROUPS: u32 = MAX_SPECIES as u32 * SEED_LODS;
 /// Indices into `SeedCounters` (as an array of u32): where a seed's outcome is counted.
 pub const COUNT_SELECTED: u32 = 0;
 pub const COUNT_OVERFLOW: u32 = 1;
@@ -55,6 +65,27 @@ pub enum SeedError {
     TooDense { code: u8, name: String, density_per_km2: f64, max_per_km2: f64 },
     #[error("class table {scheme}: more than {MAX_SPECIES} species")]
     TooManySpecies { scheme: String },
+}
+
+/// The draw group of a seed of species `species` at radial LOD `lod`: the key pass 3 writes
+/// beside each record and compaction groups by.
+pub fn seed_group(species: u32, lod: u32) -> u32 {
+    species * SEED_LODS + lod
+}
+
+/// Workgroups (block-table entries) pass 3 runs per cell when it checks `active_ranks` ranks.
+pub fn workgroups_per_cell(active_ranks: u32) -> u32 {
+    active_ranks.div_ceil(SEED_WORKGROUP)
+}
+
+/// Cells one frame can check at `active_ranks` ranks each: the dispatch limit, and the block table.
+pub fn max_cells(active_ranks: u32) -> u32 {
+    MAX_SEED_CELLS.min(MAX_SEED_BLOCKS / workgroups_per_cell(active_ranks).max(1))
+}
+
+/// Entries the block table needs for patterns of `seeds_per_pattern` seeds.
+pub fn block_capacity(seeds_per_pattern: u32) -> u32 {
+    (MAX_SEED_CELLS * workgroups_per_cell(seeds_per_pattern)).clamp(1, MAX_SEED_BLOCKS)
 }
 
 /// PCG (O'Neill), as a hash: the shaders' `pcg`.
@@ -186,6 +217,19 @@ mod tests {
         assert_ne!(h, seed_hash([3, -3], 17, 1));
         assert_ne!(h, seed_hash([3, -4], 18, 1));
         assert_ne!(h, seed_hash([3, -4], 17, 2));
+    }
+
+    #[test]
+    fn every_frame_fits_the_block_table() {
+        for spp in [64, 100, 1280, 2048, 4096, 65536] {
+            let capacity = block_capacity(spp);
+            assert!(capacity <= MAX_SEED_BLOCKS, "{spp}");
+            for ranks in (0..=spp).step_by(7).chain([spp]) {
+                assert!(max_cells(ranks) * workgroups_per_cell(ranks) <= capacity, "{spp} {ranks}");
+            }
+        }
+        assert_eq!(max_cells(2048), 32768);
+        assert_eq!(seed_group(MAX_SPECIES as u32 - 1, SEED_LODS - 1), SEED_GROUPS - 1);
     }
 
     #[test]
