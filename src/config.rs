@@ -181,6 +181,9 @@ pub struct SeedSettings {
     pub ground_colour_radius_m: f64,
     /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
     pub class_table: String,
+    /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
+    /// selected but not drawn. Species whose model is not there are not drawn.
+    pub impostors: String,
 }
 
 impl SeedSettings {

@@ -27,6 +27,7 @@ pub const SHADERS: &[(&str, &[&str])] = &[
     ("tile_load_map", &[HASH, include_str!("../shaders/tile_load_map.wgsl")]),
     ("seed_select", &[HASH, BLOCKS, include_str!("../shaders/seed_select.wgsl")]),
     ("compact", &[BLOCKS, include_str!("../shaders/compact.wgsl")]),
+    ("draw_seeds", &[include_str!("../shaders/draw_seeds.wgsl")]),
 ];
 
 /// The constants every shader sees, generated from their Rust definitions.

@@ -85,3 +85,12 @@ fn compaction_structs_match_their_wgsl_twins() {
     };
     assert_eq!(bytemuck::bytes_of(&args), wgpu_args.as_bytes());
 }
+
+#[test]
+fn draw_seeds_structs_match_their_wgsl_twins() {
+    use terramp::gpu::gpu_types::{DrawSeedsGroup, DrawSeedsUniforms, SeedRecord};
+    let draw = module("draw_seeds");
+    assert_eq!(wgsl_size(&draw, "DrawSeedsUniforms") as usize, size_of::<DrawSeedsUniforms>());
+    assert_eq!(wgsl_size(&draw, "DrawSeedsGroup") as usize, size_of::<DrawSeedsGroup>());
+    assert_eq!(wgsl_size(&draw, "SeedRecord") as usize, size_of::<SeedRecord>());
+}

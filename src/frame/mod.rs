@@ -60,6 +60,8 @@ pub enum RenderError {
     Seeds(#[from] crate::seeds::SeedError),
     #[error(transparent)]
     Compact(#[from] crate::passes::compact::CompactError),
+    #[error(transparent)]
+    DrawSeeds(#[from] crate::passes::draw_seeds::DrawSeedsError),
     #[error("seeds.capacity = {capacity} records does not fit one GPU buffer binding here (at most {max})")]
     SeedCapacity { capacity: u32, max: u32 },
     #[error("the {layer} cache has {slots} slots; the whole layer is {tiles} tiles")]
@@ -89,6 +91,9 @@ pub struct FrameReport {
     pub seed_cells_dropped: usize,
     /// Pass 3's counters of the latest frame whose counters have arrived (a frame or two old).
     pub seeds: Option<SeedReport>,
+    /// Species drawn with an impostor, and species not drawn (no `seeds.impostors`, or no model).
+    pub seed_species_drawn: usize,
+    pub seed_species_undrawn: usize,
 }
 
 pub struct Renderer {
@@ -226,7 +231,7 @@ impl Renderer {
                 let depth_view = depth.create_view(&Default::default());
                 let sources =
                     SeedSources { heights: &heights, landcover, imagery: &imagery, depth: &depth_view };
-                seeds::SeedStage::new(device, &dataset, &settings, &sources)?
+                seeds::SeedStage::new(&gpu, &dataset, &settings, &sources)?
             }
             None => None,
         };
@@ -398,6 +403,12 @@ impl Renderer {
             // Compaction: the survivors grouped per (species, LOD) into indirect draws, on the GPU.
             self.profiler
                 .pass(&self.gpu, &mut encoder, "compact", |encoder| stage.encode_compact(encoder))?;
+            // Drawing: one indirect draw per group, over the ground, depth-tested against it.
+            stage.prepare_draw(&self.gpu, &self.settings, &uniforms);
+            (report.seed_species_drawn, report.seed_species_undrawn) = stage.species_counts();
+            self.profiler.pass(&self.gpu, &mut encoder, "draw_seeds", |encoder| {
+                stage.encode_draw(encoder, &colour, &depth)
+            })?;
         }
         // Read back a frame or two late, never waiting (recorded after the last timed pass: the
         // CPU-timing fallback submits each pass's encoder on its own).

@@ -4,7 +4,8 @@
 //! block table and keys. Each frame it feeds pass 3 the ring-0 cells of the latest Tile Load Map,
 //! has compaction group the survivors into one indirect draw per (species, LOD) on the GPU, and
 //! reads only pass 3's counters back, through a staging ring, never waiting: the counters a frame
-//! reports are a frame or two old.
+//! reports are a frame or two old. With `seeds.impostors` set, it also loads each species'
+//! impostor once, gives compaction the draw pass's templates, and has pass 4 draw the groups.
 
 use std::collections::VecDeque;
 
@@ -14,10 +15,11 @@ use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::Dataset;
-use crate::gpu::gpu_types::{CompactParams, SeedCounters};
+use crate::gpu::gpu_types::{CompactParams, SeedCounters, TerrainUniforms};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError};
 use crate::passes::compact::{CompactInputs, CompactLimits, CompactPass};
+use crate::passes::draw_seeds::{DrawSeedsInputs, DrawSeedsPass, draw_uniforms, load_impostors};
 use crate::passes::seed_select::{SeedCellRef, SeedFrame, SeedInputs, SeedSelectPass, SeedSources};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
@@ -37,12 +39,16 @@ pub struct SeedReport {
 }
 
 pub(super) struct SeedStage {
+    /// The class table the species come from.
+    pub table: ClassTable,
     pub tables: SeedTables,
     pub patterns: SeedPatterns,
     pub pass: SeedSelectPass,
     pub bind_group: wgpu::BindGroup,
     pub compact: CompactPass,
     compact_bind_group: wgpu::BindGroup,
+    /// Pass 4 and its bindings; `None` without `seeds.impostors`.
+    draw: Option<(DrawSeedsPass, wgpu::BindGroup)>,
     /// The last frame's compaction size.
     compact_params: CompactParams,
     counters_ring: ReadbackRing,
@@ -56,12 +62,13 @@ pub(super) struct SeedStage {
 impl SeedStage {
     /// The stage for `dataset`, or `None` when it has no land cover (nothing to grow seeds from).
     pub fn new(
-        device: &wgpu::Device,
+        gpu: &Gpu,
         dataset: &Dataset,
         settings: &Settings,
         sources: &SeedSources,
     ) -> Result<Option<Self>, RenderError> {
         let Some(landcover) = &dataset.manifest.landcover else { return Ok(None) };
+        let device = &gpu.device;
         let name = match settings.seeds.class_table.as_str() {
             "" => landcover.scheme.as_str(),
             name => name,
@@ -80,18 +87,31 @@ impl SeedStage {
         let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds_per_pattern, settings.tlm.seed);
         let pass = SeedSelectPass::new(device, settings, &patterns, &tables);
         let bind_group = pass.bind_group(device, sources);
-        let compact = CompactPass::new(device, CompactLimits::from(settings))?;
+        let mut compact = CompactPass::new(device, CompactLimits::from(settings))?;
         let compact_bind_group =
             compact.bind_group(device, &CompactInputs { blocks: pass.blocks(), keys: pass.keys() });
         let counters_ring =
             ReadbackRing::new(device, "seed counters", size_of::<SeedCounters>() as u64, DEFAULT_SLOTS);
+        let draw = match settings.seeds.impostors.as_str() {
+            "" => None,
+            dir => {
+                let impostors = load_impostors(std::path::Path::new(dir), &table.species)?;
+                let draw = DrawSeedsPass::new(device, &gpu.queue, &impostors)?;
+                compact.set_templates(&gpu.queue, draw.templates());
+                let inputs = DrawSeedsInputs { records: pass.records(), order: compact.order() };
+                let bind_group = draw.bind_group(device, &inputs);
+                Some((draw, bind_group))
+            }
+        };
         Ok(Some(Self {
+            table,
             tables,
             patterns,
             pass,
             bind_group,
             compact,
             compact_bind_group,
+            draw,
             compact_params: CompactParams::default(),
             counters_ring,
             in_flight: VecDeque::new(),
@@ -118,6 +138,31 @@ impl SeedStage {
     pub fn encode_compact(&self, encoder: &mut wgpu::CommandEncoder) {
         if self.last_frame.is_some() {
             self.compact.encode(encoder, &self.compact_bind_group, &self.compact_params);
+        }
+    }
+
+    /// Species drawn with an impostor, and species not drawn for want of one (all of them without
+    /// `seeds.impostors`).
+    pub fn species_counts(&self) -> (usize, usize) {
+        self.draw.as_ref().map_or((0, self.table.species.len()), |(draw, _)| draw.species_counts())
+    }
+
+    /// Writes pass 4's constants for this frame (the terrain's matrix, sun and haze).
+    pub fn prepare_draw(&self, gpu: &Gpu, settings: &Settings, terrain: &TerrainUniforms) {
+        if let Some((draw, _)) = &self.draw {
+            draw.prepare(&gpu.queue, &draw_uniforms(settings, terrain));
+        }
+    }
+
+    /// Records pass 4: the compacted groups drawn into the colour and depth targets.
+    pub fn encode_draw(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) {
+        if let (Some((draw, bind_group)), Some(_)) = (&self.draw, &self.last_frame) {
+            draw.encode(encoder, bind_group, self.compact.draw_args(), colour, depth);
         }
     }
 

@@ -109,7 +109,9 @@ impl Gpu {
             })?;
         let info = adapter.get_info();
         let wanted = wgpu_profiler::GpuProfiler::ALL_WGPU_TIMER_FEATURES
-            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            // The seed draws start at compaction's slots (`first_instance` of indirect draws).
+            | wgpu::Features::INDIRECT_FIRST_INSTANCE;
         let features = adapter.features() & wanted;
         let has_timestamps = features
             .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);

@@ -339,3 +339,35 @@ pub struct CompactParams {
     pub chunks: u32,
     pub _pad: [u32; 2],
 }
+
+/// Per-frame constants of the seed-drawing pass. WGSL: `DrawSeedsUniforms` in
+/// `shaders/draw_seeds.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct DrawSeedsUniforms {
+    /// The terrain's: clip space from camera-relative world space.
+    pub clip_from_view_world: [[f32; 4]; 4],
+    /// Unit vector towards the sun, w unused.
+    pub sun_dir: [f32; 4],
+    /// Haze colour (linear RGB), and the distance that hides half of what is behind it (w).
+    pub haze: [f32; 4],
+    /// Pass 3's radial LOD reaches, metres (scaled by each seed's size), infinity past the last.
+    pub radial_lod_m: [f32; 4],
+    pub inv_reference_height_m: f32,
+    pub sink_fraction: f32,
+    /// The outer part of each LOD band over which a seed dithers out, as a fraction of its reach.
+    pub fade_fraction: f32,
+    /// How much of the ground colour the seeds take on (0 to 1).
+    pub ground_blend: f32,
+}
+
+/// One draw group's look: its atlas layer, alpha cutoff and model scale. WGSL: `DrawSeedsGroup`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct DrawSeedsGroup {
+    pub layer: u32,
+    pub alpha_cutoff: f32,
+    /// 1 / the model's height (its top above its base), per metre.
+    pub inv_model_height_m: f32,
+    pub _pad: u32,
+}

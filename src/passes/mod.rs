@@ -5,6 +5,7 @@
 
 pub mod compact;
 pub mod depth_pyramid;
+pub mod draw_seeds;
 pub mod ground;
 pub mod seed_select;
 pub mod tile_load_map;

@@ -1,0 +1,210 @@
+//! Pass 4 on `nc/` (DEM, Landsat, land use): the shared models are baked into impostors once per
+//! test process (`terramp-data bake`), and a view over forest near the lake is rendered with
+//! `seeds.impostors` set and with it empty. The trees change many pixels, make them darker or
+//! greener, never stand behind the terrain (depth only grows nearer) and leave the sky well above
+//! the horizon alone. (Whether any tree stands on water is pass 3's to check: `tests/seeds.rs`.)
+//!
+//! The figure `docs/nc_trees.png` (960×540, accurate preset) comes from the ignored test:
+//! `WGPU_BACKEND=vulkan cargo test --release -p terramp-data-tools --test draw_seeds -- --ignored`.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use glam::DVec3;
+use terramp::camera::Camera;
+use terramp::config::Settings;
+use terramp::dataset::Dataset;
+use terramp::frame::{FrameReport, Renderer};
+use terramp::gpu::{AdapterChoice, Gpu};
+
+use support::{TempDir, build_nc, shared_data};
+
+const FOREST: u8 = 5;
+const WATER: u8 = 6;
+
+/// The species models of the nc table, baked once per test process into the target's temporary
+/// folder (each model's folder is replaced atomically, so a concurrent reader sees a whole one).
+fn impostors() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("draw_seeds-impostors");
+        let models = shared_data().expect("../shared/data").join("models");
+        let table = terramp::classes::ClassTable::load("nc").unwrap();
+        let mut args = vec!["bake".to_owned()];
+        for s in &table.species {
+            args.extend([
+                "--model".to_owned(),
+                models.join(format!("{}.glb", s.model)).display().to_string(),
+            ]);
+        }
+        args.extend(["--out".into(), out.display().to_string(), "--texels".into(), "256".into()]);
+        let output = Command::new(env!("CARGO_BIN_EXE_terramp-data")).args(&args).output().unwrap();
+        let (stdout, stderr) =
+            (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+        assert!(output.status.success(), "bake failed:\n{stdout}\n{stderr}");
+        out
+    })
+}
+
+/// A pose over forest with water ahead: grid (x, y) of a level-1 land-cover texel whose
+/// neighbourhood is mostly forest, the closest such to a lake, and the heading to that lake.
+fn forest_near_water(dataset: &Dataset) -> ([f64; 2], f64) {
+    let meta = dataset.manifest.landcover.clone().unwrap();
+    let texel_m = 2.0 * meta.layer.texel_m;
+    let [w, h] = dataset.manifest.extent_m();
+    let n = [(w / texel_m) as i64, (h / texel_m) as i64];
+    let code = |q: [i64; 2]| {
+        if q[0] < 0 || q[1] < 0 || q[0] >= n[0] || q[1] >= n[1] {
+            return meta.nodata_code;
+        }
+        let index = dataset.landcover_index(1, [q[0] as u32, q[1] as u32]).unwrap();
+        meta.coding.code_of(index).unwrap_or(meta.nodata_code)
+    };
+    // Codes on a coarse grid (each lookup reads a tile): enough to find a forest and a lake.
+    let step = 8;
+    let g = [n[0] / step, n[1] / step];
+    let grid: Vec<u8> = (0..g[1])
+        .flat_map(|y| (0..g[0]).map(move |x| [x, y]))
+        .map(|[x, y]| code([x * step, y * step]))
+        .collect();
+    let at = |x: i64, y: i64| grid[(y * g[0] + x) as usize];
+    let water: Vec<[i64; 2]> =
+        (0..g[1]).flat_map(|y| (0..g[0]).map(move |x| [x, y])).filter(|&[x, y]| at(x, y) == WATER).collect();
+    assert!(!water.is_empty(), "no water in nc");
+    let mut best: Option<(i64, [i64; 2], [i64; 2])> = None;
+    for y in 2..g[1] - 2 {
+        for x in 2..g[0] - 2 {
+            let forest = (-2..=2)
+                .flat_map(|j| (-2..=2).map(move |i| (x + i, y + j)))
+                .filter(|&(i, j)| at(i, j) == FOREST)
+                .count();
+            if forest < 20 {
+                continue;
+            }
+            let nearest = water.iter().min_by_key(|w| (w[0] - x).pow(2) + (w[1] - y).pow(2)).unwrap();
+            let d = (nearest[0] - x).pow(2) + (nearest[1] - y).pow(2);
+            // Water a little way off: a view across the forest to the lake.
+            if d >= 4 && best.is_none_or(|b| d < b.0) {
+                best = Some((d, [x * step, y * step], [nearest[0] * step, nearest[1] * step]));
+            }
+        }
+    }
+    let (_, at, lake) = best.expect("forest near water in nc");
+    let grid = at.map(|v| (v as f64 + 0.5) * texel_m);
+    let yaw = ((lake[0] - at[0]) as f64).atan2((lake[1] - at[1]) as f64).to_degrees();
+    (grid, yaw)
+}
+
+fn render(
+    dataset: Dataset,
+    mut settings: Settings,
+    impostors: &str,
+    size: [u32; 2],
+    pose: ([f64; 2], f64),
+    above_m: f64,
+) -> (image::RgbaImage, Vec<f32>, FrameReport) {
+    settings.render.width = size[0];
+    settings.render.height = size[1];
+    settings.seeds.impostors = impostors.to_owned();
+    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let mut r = Renderer::new(gpu, dataset, settings).unwrap();
+    let origin = r.dataset.manifest.origin_m;
+    let ([x, y], yaw_deg) = pose;
+    let ground = r.dataset.height_at(x, y, 0).unwrap();
+    let camera = Camera {
+        position_m: DVec3::new(origin[0] + x, origin[1] + y, ground + above_m),
+        yaw_deg,
+        pitch_deg: -12.0,
+        fov_deg: 60.0,
+        near_m: 0.1,
+    };
+    r.render_resolved(&camera, 200).unwrap();
+    // Seeds follow the TLM of a frame or two before: a few more frames of the same view.
+    let mut report = r.render(&camera).unwrap();
+    for _ in 0..4 {
+        report = r.render(&camera).unwrap();
+    }
+    (r.read_colour().unwrap(), r.read_depth().unwrap(), report)
+}
+
+#[test]
+fn nc_forest_draws_trees() {
+    if shared_data().is_none() {
+        return;
+    }
+    let tmp = TempDir::new("draw-seeds");
+    let path = tmp.path().join("nc");
+    let dataset = build_nc(&path);
+    let pose = forest_near_water(&dataset);
+    let dir = impostors().to_str().unwrap().to_owned();
+    let size = [320, 180];
+    let (bare, bare_depth, bare_report) = render(dataset, Settings::default(), "", size, pose, 40.0);
+    let reopened = Dataset::open(&path).unwrap();
+    let (trees, depth, report) = render(reopened, Settings::default(), &dir, size, pose, 40.0);
+    assert_eq!((bare_report.seed_species_drawn, bare_report.seed_species_undrawn), (0, 9));
+    assert_eq!((report.seed_species_drawn, report.seed_species_undrawn), (9, 0), "{report:?}");
+    assert!(report.seeds.is_some_and(|s| s.counters.selected > 0), "{report:?}");
+
+    assert!(depth.iter().all(|d| d.is_finite() && (0.0..=1.0).contains(d)), "NaN or odd depth");
+    let luma =
+        |p: &image::Rgba<u8>| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+    let green =
+        |p: &image::Rgba<u8>| f64::from(p[1]) / (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]) + 1.0);
+    let (mut changed, mut sky, mut sky_changed, mut high_sky_changed) = (0usize, 0usize, 0usize, 0usize);
+    let high = (size[0] * size[1] / 5) as usize;
+    let (mut luma_delta, mut green_delta) = (0.0, 0.0);
+    for (i, (a, b)) in bare.pixels().zip(trees.pixels()).enumerate() {
+        // Reversed-Z: a tree is only ever nearer than the ground it stands before.
+        assert!(
+            depth[i] >= bare_depth[i],
+            "pixel {i}: depth {} behind the terrain's {}",
+            depth[i],
+            bare_depth[i]
+        );
+        let differs = a.0[..3].iter().zip(&b.0[..3]).any(|(x, y)| x.abs_diff(*y) > 2);
+        if bare_depth[i] == 0.0 {
+            sky += 1;
+            sky_changed += usize::from(differs);
+            high_sky_changed += usize::from(differs && i < high);
+        }
+        if differs {
+            changed += 1;
+            luma_delta += luma(b) - luma(a);
+            green_delta += green(b) - green(a);
+        }
+    }
+    let total = bare.pixels().len();
+    println!(
+        "{changed} of {total} pixels changed (mean luma {:+.1}, greenness {:+.3}); {sky_changed} of {sky} sky pixels",
+        luma_delta / changed.max(1) as f64,
+        green_delta / changed.max(1) as f64
+    );
+    assert!(changed > total / 50, "only {changed} of {total} pixels show trees");
+    assert!(luma_delta < 0.0 || green_delta > 0.0, "trees neither darken nor green the ground");
+    // Trees on the skyline cover some sky; well above the horizon (the top fifth of the frame,
+    // 11° to 18° up) nothing stands.
+    assert!(sky_changed * 10 <= sky.max(1), "{sky_changed} of {sky} sky pixels changed");
+    assert_eq!(high_sky_changed, 0, "trees in the sky high above the horizon");
+}
+
+/// Makes `docs/nc_trees.png`: 960×540, accurate preset, over nc forest looking towards a lake.
+#[test]
+#[ignore = "writes the figure docs/nc_trees.png"]
+fn nc_trees_figure() {
+    if shared_data().is_none() {
+        return;
+    }
+    let tmp = TempDir::new("draw-seeds-figure");
+    let dataset = build_nc(&tmp.path().join("nc"));
+    let pose = forest_near_water(&dataset);
+    let dir = impostors().to_str().unwrap().to_owned();
+    let settings = Settings::preset("accurate").unwrap();
+    let (image, _, report) = render(dataset, settings, &dir, [960, 540], pose, 40.0);
+    println!("{report:?}");
+    let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/nc_trees.png");
+    image.save(&out).unwrap();
+    println!("wrote {}", out.display());
+}
