@@ -164,9 +164,8 @@ impl TlmSettings {
     }
 }
 
-/// Seed selection (pass 3), see `config/default.toml` `[seeds]`. Whether the densest class of a
-/// dataset's table fits `seeds_per_pattern` is not checked here (the table comes with the dataset);
-/// `seeds::SeedTables` refuses a table that does not (see `max_density_per_km2`).
+/// Seed selection and drawing, see `config/default.toml` `[seeds]`. The dataset's class table is
+/// checked against `seeds_per_pattern` by `seeds::SeedTables` (see `max_density_per_km2`).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SeedSettings {
