@@ -25,18 +25,6 @@ struct DrawSeedsGroup {
     _pad: u32,
 }
 
-struct SeedRecord {
-    position_rel_m: vec3<f32>,
-    height_m: f32,
-    address: vec2<i32>,
-    rank: u32,
-    species_lod: u32,
-    jitter: u32,
-    ground_colour: u32,
-    radius_m: f32,
-    ground_m: f32,
-}
-
 @group(0) @binding(0) var<uniform> u: DrawSeedsUniforms;
 @group(0) @binding(1) var<storage, read> records: array<SeedRecord>;
 @group(0) @binding(2) var<storage, read> order: array<u32>;

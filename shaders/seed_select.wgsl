@@ -84,18 +84,6 @@ struct SeedClass {
     species: vec4<u32>,
 }
 
-struct SeedRecord {
-    position_rel_m: vec3<f32>,
-    height_m: f32,
-    address: vec2<i32>,
-    rank: u32,
-    species_lod: u32,
-    jitter: u32,
-    ground_colour: u32,
-    radius_m: f32,
-    ground_m: f32,
-}
-
 struct SeedCounters {
     count: array<atomic<u32>, SEED_COUNTERS>,
 }

@@ -17,6 +17,8 @@ pub const MAX_LEVELS: u32 = 16;
 const TERRAIN_MESH: &str = include_str!("../shaders/shared/terrain_mesh.wgsl");
 /// The hashes that pick seed patterns and vary seeds.
 const HASH: &str = include_str!("../shaders/shared/hash.wgsl");
+/// One selected seed, shared by the pass that writes it and the pass that draws it.
+const SEED_RECORD: &str = include_str!("../shaders/shared/seed_record.wgsl");
 /// How pass 3 hands its survivors to compaction: the block table's entries and lane ballots.
 const BLOCKS: &str = include_str!("../shaders/shared/blocks.wgsl");
 
@@ -25,9 +27,9 @@ pub const SHADERS: &[(&str, &[&str])] = &[
     ("ground", &[TERRAIN_MESH, include_str!("../shaders/ground.wgsl")]),
     ("depth_pyramid", &[include_str!("../shaders/depth_pyramid.wgsl")]),
     ("tile_load_map", &[HASH, include_str!("../shaders/tile_load_map.wgsl")]),
-    ("seed_select", &[HASH, BLOCKS, include_str!("../shaders/seed_select.wgsl")]),
+    ("seed_select", &[HASH, BLOCKS, SEED_RECORD, include_str!("../shaders/seed_select.wgsl")]),
     ("compact", &[BLOCKS, include_str!("../shaders/compact.wgsl")]),
-    ("draw_seeds", &[include_str!("../shaders/draw_seeds.wgsl")]),
+    ("draw_seeds", &[SEED_RECORD, include_str!("../shaders/draw_seeds.wgsl")]),
 ];
 
 /// The constants every shader sees, generated from their Rust definitions.
