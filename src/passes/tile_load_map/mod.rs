@@ -23,7 +23,6 @@ use crate::camera::{Camera, CameraError};
 use crate::config::{ImagerySettings, Settings, TlmSettings};
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::gpu_types::{TlmCell, TlmRing, TlmSpan, TlmUniforms};
-use crate::gpu::readback_ring::ReadbackRing;
 use crate::gpu::{Gpu, GpuError};
 use crate::passes::depth_pyramid::DepthPyramid;
 use crate::shaders::{self, MAX_LEVELS};
@@ -345,16 +344,6 @@ impl TileLoadMapPass {
 
     /// Reads the frame's cells back, waiting for the GPU: for tests and tools, never the frame.
     pub fn read_back(&self, gpu: &Gpu, frame: &TlmFrame) -> Result<Vec<TlmCell>, GpuError> {
-        let mut ring = ReadbackRing::new(&gpu.device, "tlm (blocking)", frame.output_bytes(), 1);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        ring.encode_copy(&mut encoder, &self.output, frame.output_bytes(), 0);
-        gpu.queue.submit([encoder.finish()]);
-        ring.submitted();
-        gpu.wait()?;
-        let taken = ring.try_take(&gpu.device)?;
-        gpu.check()?;
-        taken
-            .map(|r| r.cast())
-            .ok_or_else(|| GpuError::Validation("the TLM readback did not arrive after a wait".into()))
+        Ok(bytemuck::pod_collect_to_vec(&super::read_buffer(gpu, &self.output, frame.output_bytes())?))
     }
 }
