@@ -3,7 +3,9 @@
 // order, then lane (rank) order inside a block, so the result equals the CPU twin
 // (`reference/compact.rs`) bit for bit. The output is a permutation, `order[slot]` = index of the
 // record (in pass 3's record buffer) drawn at `slot`; group g fills the slots
-// [args[g].first_instance, + args[g].instance_count), and `args` are the indirect draws.
+// [args[g].first_instance, + args[g].instance_count), and `args` are the indirect draws: each
+// group's own, then at SEED_GROUPS + g the same instances with the next LOD's geometry (from the
+// templates there), which the seeds in the outer band of their LOD cross-fade into.
 //
 // Reduce then scan, over chunks of COMPACT_CHUNK blocks (one workgroup each, one lane per block):
 //   `reduce`  each lane counts its block's records per group into its row of a block × group
@@ -34,10 +36,10 @@ struct SeedDrawArgs {
 @group(0) @binding(0) var<storage, read> params: CompactParams;
 @group(0) @binding(1) var<storage, read> blocks: array<SeedBlock>;
 @group(0) @binding(2) var<storage, read> keys: array<u32>;
-@group(0) @binding(3) var<storage, read> templates: array<SeedDrawArgs, SEED_GROUPS>;
+@group(0) @binding(3) var<storage, read> templates: array<SeedDrawArgs, SEED_DRAWS>;
 // Chunk counts, group-major (`g × chunks + chunk`); after `scan`, exclusive prefixes.
 @group(0) @binding(4) var<storage, read_write> chunk_counts: array<u32>;
-@group(0) @binding(5) var<storage, read_write> args: array<SeedDrawArgs, SEED_GROUPS>;
+@group(0) @binding(5) var<storage, read_write> args: array<SeedDrawArgs, SEED_DRAWS>;
 @group(0) @binding(6) var<storage, read_write> order: array<u32>;
 
 var<workgroup> wg_rows: array<u32, COMPACT_CHUNK * SEED_GROUPS>;
@@ -132,6 +134,8 @@ fn finish(@builtin(local_invocation_index) lane: u32) {
     }
     let t = templates[lane];
     args[lane] = SeedDrawArgs(t.index_count, wg_totals[lane], t.first_index, t.base_vertex, first);
+    let f = templates[SEED_GROUPS + lane];
+    args[SEED_GROUPS + lane] = SeedDrawArgs(f.index_count, wg_totals[lane], f.first_index, f.base_vertex, first);
 }
 
 @compute @workgroup_size(COMPACT_CHUNK)

@@ -1,41 +1,51 @@
-// Pass 4, drawing the seeds: one indexed indirect draw per (species, radial LOD) group, whose
-// instances are the draw slots compaction gave the group. An instance reads its record through
-// `order`, places the group's billboard cloud (model space: metres, +Y up, base at y = 0) at the
-// record's camera-relative anchor, scaled to its height and turned about the vertical by its
-// jitter, and projects it like the terrain. Fragments are alpha-tested against the group's atlas
-// layer, tinted a little towards the ground colour and by the seed's colour variation, lit like
-// the ground and hazed like it. Near the outer edge of its LOD band a seed fades out by an ordered
-// (Bayer 4×4) dither, so seeds thin out instead of popping.
+// Pass 4, drawing the seeds: two indexed indirect draws per (species, LOD) group, whose
+// instances are the draw slots compaction gave the group: the group's own geometry (LOD 0 the
+// real mesh, 1 to 3 the billboard clouds; model space: metres, +Y up, base at y = 0), then the
+// next LOD's, for the cross-fade. An instance reads its record through `order`, places the model
+// at the record's camera-relative anchor, scaled to its height and turned about the vertical by
+// its jitter, and projects it like the terrain. Fragments take their material's colour (times a
+// layer of the texture array), are alpha-tested, tinted a little towards the ground colour and by
+// the seed's colour variation, lit and hazed like the ground.
+//
+// Cross-fade: over the outer `fade_fraction` of its LOD's reach a seed's fade f falls from 1 to
+// 0. Its own geometry keeps the pixels whose ordered-dither threshold t (Bayer 4×4, shifted per
+// seed so neighbours do not share a pattern) is below f, the next LOD's geometry those at or above
+// it: each pixel shows one of the two, and the mix moves smoothly with distance. Outside the band
+// the cross-fade draw collapses its vertices; the last LOD has none and fades out to nothing.
 
 struct DrawSeedsUniforms {
     clip_from_view_world: mat4x4<f32>,
     sun_dir: vec4<f32>,
     haze: vec4<f32>,
-    radial_lod_m: vec4<f32>,
+    lod_reach_m: vec4<f32>,
     inv_reference_height_m: f32,
     sink_fraction: f32,
     fade_fraction: f32,
     ground_blend: f32,
 }
 
-struct DrawSeedsGroup {
+struct SeedMaterial {
+    base_colour: vec4<f32>,
     layer: u32,
     alpha_cutoff: f32,
-    inv_model_height_m: f32,
-    _pad: u32,
+    lod: u32,
+    flags: u32,
 }
 
 @group(0) @binding(0) var<uniform> u: DrawSeedsUniforms;
 @group(0) @binding(1) var<storage, read> records: array<SeedRecord>;
 @group(0) @binding(2) var<storage, read> order: array<u32>;
-@group(0) @binding(3) var<storage, read> groups: array<DrawSeedsGroup>;
-@group(0) @binding(4) var atlases: texture_2d_array<f32>;
-@group(0) @binding(5) var atlas_sampler: sampler;
+@group(0) @binding(3) var<storage, read> inv_model_height_m: array<f32>;
+@group(0) @binding(4) var<storage, read> materials: array<SeedMaterial>;
+@group(0) @binding(5) var textures: texture_2d_array<f32>;
+@group(0) @binding(6) var clamp_sampler: sampler;
+@group(0) @binding(7) var repeat_sampler: sampler;
 
 struct VertexIn {
     @location(0) position_model_m: vec3<f32>,
     @location(1) normal_model: vec3<f32>,
-    @location(2) uv_atlas: vec2<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) material: u32,
 }
 
 struct VertexOut {
@@ -43,12 +53,13 @@ struct VertexOut {
     @location(0) rel_m: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
-    // Albedo tint (rgb) and fade (w, 1 = fully drawn).
-    @location(3) tint: vec4<f32>,
-    @location(4) @interpolate(flat) layer: u32,
-    @location(5) @interpolate(flat) alpha_cutoff: f32,
+    // Albedo tint (rgb).
+    @location(3) @interpolate(flat) tint: vec3<f32>,
+    @location(4) @interpolate(flat) material: u32,
     // The ground colour (rgb) and how much of it to blend in (w).
-    @location(6) @interpolate(flat) ground: vec4<f32>,
+    @location(5) @interpolate(flat) ground: vec4<f32>,
+    // Dither thresholds this draw keeps, [x, y), and the seed's shift of the dither pattern (z).
+    @location(6) @interpolate(flat) keep: vec3<f32>,
 }
 
 // Model space (x, y up, z) to world (x east, y north, z up), turned by `angle` about the vertical.
@@ -59,12 +70,12 @@ fn model_to_world(v: vec3<f32>, angle: f32) -> vec3<f32> {
     return vec3<f32>(c * w.x - s * w.y, s * w.x + c * w.y, w.z);
 }
 
-// 1 inside the seed's LOD band, falling to 0 over the last `fade_fraction` of it.
+// 1 inside the seed's LOD reach, falling to 0 over the last `fade_fraction` of it.
 fn band_fade(record: SeedRecord, lod: u32) -> f32 {
     let ground_rel = record.position_rel_m + vec3<f32>(0.0, 0.0, record.height_m * u.sink_fraction);
     let distance_m = length(ground_rel);
     let size_scale = min(1.0, record.height_m * u.inv_reference_height_m);
-    let reach = u.radial_lod_m[min(lod, 3u)] * size_scale;
+    let reach = u.lod_reach_m[min(lod, 3u)] * size_scale;
     let width = max(reach * u.fade_fraction, 1e-3);
     return clamp((reach - distance_m) / width, 0.0, 1.0);
 }
@@ -74,41 +85,66 @@ fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     let record = records[order[instance]];
     let species = record.species_lod & 0xffu;
     let lod = (record.species_lod >> 8u) & 0xfu;
-    let group = groups[min(species * SEED_LODS + lod, SEED_GROUPS - 1u)];
-    let angle = f32(record.jitter & 0xffffu) * (6.2831853 / 65536.0);
-    let scale = record.height_m * group.inv_model_height_m;
-    let rel_m = record.position_rel_m + model_to_world(in.position_model_m * scale, angle);
+    let material = materials[in.material];
+    let fade = band_fade(record, lod);
     var out: VertexOut;
+    // The group's own geometry keeps thresholds below the fade, the next LOD's the rest.
+    out.keep = vec3<f32>(0.0, fade, f32(record.rank & 15u));
+    if material.lod != lod {
+        out.keep = vec3<f32>(fade, 2.0, f32(record.rank & 15u));
+        if fade >= 1.0 {
+            // Not in the band: nothing to cross-fade. Every vertex at one point outside the view.
+            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+            return out;
+        }
+    }
+    let angle = f32(record.jitter & 0xffffu) * (6.2831853 / 65536.0);
+    let scale = record.height_m * inv_model_height_m[min(species, arrayLength(&inv_model_height_m) - 1u)];
+    let rel_m = record.position_rel_m + model_to_world(in.position_model_m * scale, angle);
     out.clip = u.clip_from_view_world * vec4<f32>(rel_m, 1.0);
     out.rel_m = rel_m;
     out.normal = model_to_world(in.normal_model, angle);
-    out.uv = in.uv_atlas;
+    out.uv = in.uv;
     // Colour variation: brightness ±15 % and a slight shift between yellow-green and blue-green.
     let variation = f32(record.jitter >> 16u) / 65535.0 - 0.5;
     let shift = vec3<f32>(1.0 + 0.3 * variation, 1.0, 1.0 - 0.3 * variation);
+    out.tint = shift * (1.0 + 0.3 * variation);
+    out.material = in.material;
     let ground = unpack4x8unorm(record.ground_colour);
-    out.tint = vec4<f32>(shift * (1.0 + 0.3 * variation), band_fade(record, lod));
-    out.layer = group.layer;
-    out.alpha_cutoff = group.alpha_cutoff;
     out.ground = vec4<f32>(ground.rgb, ground.a * u.ground_blend);
     return out;
 }
 
-// Ordered dither threshold of a pixel, in (0, 1).
-fn bayer4(pixel: vec2<u32>) -> f32 {
+// Ordered dither threshold of a pixel, in (0, 1), the pattern shifted by `shift` (0 to 15).
+fn bayer4(pixel: vec2<u32>, shift: u32) -> f32 {
     let m = array<u32, 16>(0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
-    return (f32(m[(pixel.y & 3u) * 4u + (pixel.x & 3u)]) + 0.5) / 16.0;
+    let p = pixel + vec2<u32>(shift & 3u, shift >> 2u);
+    return (f32(m[(p.y & 3u) * 4u + (p.x & 3u)]) + 0.5) / 16.0;
 }
 
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    // The atlas is sRGB: samples are linear. Sampled before any discard (uniform control flow).
-    let texel = textureSample(atlases, atlas_sampler, in.uv, i32(in.layer));
-    if texel.a < in.alpha_cutoff || bayer4(vec2<u32>(in.clip.xy)) > in.tint.w {
+    let material = materials[in.material];
+    // Derivatives in uniform control flow; the samplers differ only in wrapping (the mesh's
+    // textures repeat, the atlases must not bleed across their edge).
+    let dx = dpdx(in.uv);
+    let dy = dpdy(in.uv);
+    var texel = vec4<f32>(1.0);
+    if (material.flags & MATERIAL_TEXTURED) != 0u {
+        let layer = i32(material.layer);
+        if (material.flags & MATERIAL_REPEAT) != 0u {
+            texel = textureSampleGrad(textures, repeat_sampler, in.uv, layer, dx, dy);
+        } else {
+            texel = textureSampleGrad(textures, clamp_sampler, in.uv, layer, dx, dy);
+        }
+    }
+    texel *= material.base_colour;
+    let t = bayer4(vec2<u32>(in.clip.xy), u32(in.keep.z));
+    if texel.a < material.alpha_cutoff || t < in.keep.x || t >= in.keep.y {
         discard;
     }
-    let albedo = mix(texel.rgb, in.ground.rgb, in.ground.w) * in.tint.rgb;
-    // A billboard is lit from the side facing the eye; foliage lets light wrap around.
+    let albedo = mix(texel.rgb, in.ground.rgb, in.ground.w) * in.tint;
+    // Seen from the side facing the eye (billboards, leaves); foliage lets light wrap around.
     var normal = normalize(in.normal);
     if dot(normal, in.rel_m) > 0.0 {
         normal = -normal;

@@ -350,7 +350,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     let size_scale = min(1.0, mul(height_m, u.inv_reference_height_m));
     var lod = 0u;
     loop {
-        if lod >= 3u {
+        if lod >= SEED_LODS {
             return out;
         }
         let reach = mul(u.radial_lod_m[lod], size_scale);

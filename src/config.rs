@@ -14,6 +14,10 @@ use toml::{Table, Value};
 
 use crate::gpu::AdapterChoice;
 
+mod seeds;
+
+pub use seeds::SeedSettings;
+
 const DEFAULTS: &str = include_str!("../config/default.toml");
 pub const PRESETS: &[(&str, &str)] = &[
     ("fast", include_str!("../config/presets/fast.toml")),
@@ -159,61 +163,6 @@ impl TlmSettings {
         ];
         match checks.into_iter().find(|(ok, ..)| !ok) {
             Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
-            None => Ok(()),
-        }
-    }
-}
-
-/// Seed selection and drawing, see `config/default.toml` `[seeds]`. The dataset's class table is
-/// checked against `seeds_per_pattern` by `seeds::SeedTables` (see `max_density_per_km2`).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SeedSettings {
-    pub seeds_per_pattern: u32,
-    pub capacity: u32,
-    pub frustum_epsilon: f64,
-    pub occlusion_tolerance_m: f64,
-    pub occlusion_tolerance_per_km: f64,
-    pub occlusion_refine_steps: u32,
-    pub reference_height_m: f64,
-    pub sink_fraction: f64,
-    pub ground_colour_radius_m: f64,
-    /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
-    pub class_table: String,
-    /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
-    /// selected but not drawn. Species whose model is not there are not drawn.
-    pub impostors: String,
-}
-
-impl SeedSettings {
-    /// Most seeds per km² a class can ask for: one full pattern per ring-0 cell of `cell_m` metres.
-    pub fn max_density_per_km2(&self, cell_m: f64) -> f64 {
-        f64::from(self.seeds_per_pattern) / (cell_m * cell_m * 1e-6)
-    }
-
-    fn validate(&self) -> Result<(), SettingsError> {
-        let s = self;
-        let (any, tiny) = (f64::MAX, f64::MIN_POSITIVE);
-        let steps = s.occlusion_refine_steps;
-        if !(steps == 0 || steps.is_power_of_two() && steps <= 65536) {
-            let (key, rule) = ("seeds.occlusion_refine_steps", "0 or a power of two up to 65536");
-            return Err(SettingsError::OutOfRange { key, value: steps.to_string(), rule });
-        }
-        let ranges: [(&'static str, f64, f64, f64, &'static str); 8] = [
-            ("seeds.seeds_per_pattern", s.seeds_per_pattern.into(), 64.0, 65536.0, "64 to 65536 seeds"),
-            ("seeds.capacity", s.capacity.into(), 1.0, 16_777_216.0, "1 to 16777216 seeds"),
-            ("seeds.frustum_epsilon", s.frustum_epsilon, 0.0, 1.0, "0 to 1 (NDC units)"),
-            ("seeds.occlusion_tolerance_m", s.occlusion_tolerance_m, 0.0, any, "0 or more metres"),
-            ("seeds.occlusion_tolerance_per_km", s.occlusion_tolerance_per_km, 0.0, any, "0 or more m/km"),
-            ("seeds.reference_height_m", s.reference_height_m, tiny, any, "a positive number of metres"),
-            ("seeds.sink_fraction", s.sink_fraction, 0.0, 0.5, "0 to 0.5 of the seed's height"),
-            ("seeds.ground_colour_radius_m", s.ground_colour_radius_m, 0.0, any, "0 or more metres"),
-        ];
-        // NaN and infinities fall outside every range.
-        match ranges.into_iter().find(|(_, value, lo, hi, _)| !(*lo..=*hi).contains(value)) {
-            Some((key, value, .., rule)) => {
-                Err(SettingsError::OutOfRange { key, value: value.to_string(), rule })
-            }
             None => Ok(()),
         }
     }

@@ -68,6 +68,9 @@ pub fn prelude() -> String {
         ("BALLOT_WORDS", seeds::BALLOT_WORDS),
         ("SEED_LODS", seeds::SEED_LODS),
         ("SEED_GROUPS", seeds::SEED_GROUPS),
+        ("SEED_DRAWS", seeds::SEED_DRAWS),
+        ("MATERIAL_TEXTURED", crate::gpu::gpu_types::MATERIAL_TEXTURED),
+        ("MATERIAL_REPEAT", crate::gpu::gpu_types::MATERIAL_REPEAT),
         ("COMPACT_WORKGROUP", compact::COMPACT_WORKGROUP),
         ("COMPACT_CHUNK", compact::COMPACT_CHUNK),
     ];

@@ -9,7 +9,7 @@ use terramp::gpu::Gpu;
 use terramp::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
 use terramp::passes::compact::{COMPACT_CHUNK, CompactInputs, CompactLimits, CompactPass, Compacted};
 use terramp::reference::compact::compact;
-use terramp::seeds::{SEED_GROUPS, SEED_WORKGROUP, pcg};
+use terramp::seeds::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP, pcg};
 
 /// A pass with its own input buffers, sized for one test's inputs.
 struct Harness {
@@ -121,9 +121,13 @@ fn check(harness: &Harness, input: &Input, what: &str) -> Compacted {
     expected.sort_by_key(|&(g, _)| g);
     assert_eq!(gpu.order, expected.iter().map(|&(_, i)| i).collect::<Vec<_>>(), "{what}");
     let mut first = 0;
-    for (g, args) in gpu.args.iter().enumerate() {
+    assert_eq!(gpu.args.len(), SEED_DRAWS as usize, "{what}");
+    let (own, fades) = gpu.args.split_at(SEED_GROUPS as usize);
+    for (g, (args, fade)) in own.iter().zip(fades).enumerate() {
         let total = expected.iter().filter(|&&(k, _)| k == g as u32).count() as u32;
         assert_eq!((args.instance_count, args.first_instance), (total, first), "{what}: group {g}");
+        // The cross-fade draw of a group draws the same instances.
+        assert_eq!((fade.instance_count, fade.first_instance), (total, first), "{what}: fade {g}");
         first += total;
     }
     gpu
@@ -167,13 +171,14 @@ fn all_kept_none_kept_one_group_every_group() {
     assert!(out.args.iter().all(|a| a.instance_count == 0 && a.first_instance == 0), "{:?}", out.args);
 
     let out = check(&harness, &one, "one group");
-    assert!(out.args.iter().enumerate().all(|(g, a)| (a.instance_count != 0) == (g == 17)));
+    let own = &out.args[..SEED_GROUPS as usize];
+    assert!(own.iter().enumerate().all(|(g, a)| (a.instance_count != 0) == (g == 17)));
     assert_eq!(out.args[17].first_instance, 0);
     assert_eq!(out.args[18].first_instance, out.drawn() as u32);
 
     let out = check(&harness, &every, "every group");
     assert!(out.args.iter().all(|a| a.instance_count > 0), "a group is empty: {:?}", out.args);
-    assert_eq!(out.args.len(), SEED_GROUPS as usize);
+    assert_eq!(out.args.len(), SEED_DRAWS as usize);
 }
 
 #[test]
@@ -188,7 +193,7 @@ fn keys_outside_the_groups_are_not_drawn() {
 fn draws_take_their_mesh_from_the_templates_and_runs_agree() {
     let input = random(777, 5);
     let mut harness = Harness::new(limits_for(&[&input]));
-    let templates: Vec<SeedDrawArgs> = (0..SEED_GROUPS)
+    let templates: Vec<SeedDrawArgs> = (0..SEED_DRAWS)
         .map(|g| SeedDrawArgs {
             index_count: 3 * (g + 1),
             instance_count: 999,

@@ -88,9 +88,9 @@ fn compaction_structs_match_their_wgsl_twins() {
 
 #[test]
 fn draw_seeds_structs_match_their_wgsl_twins() {
-    use terramp::gpu::gpu_types::{DrawSeedsGroup, DrawSeedsUniforms, SeedRecord};
+    use terramp::gpu::gpu_types::{DrawSeedsUniforms, SeedMaterial, SeedRecord};
     let draw = module("draw_seeds");
     assert_eq!(wgsl_size(&draw, "DrawSeedsUniforms") as usize, size_of::<DrawSeedsUniforms>());
-    assert_eq!(wgsl_size(&draw, "DrawSeedsGroup") as usize, size_of::<DrawSeedsGroup>());
+    assert_eq!(wgsl_size(&draw, "SeedMaterial") as usize, size_of::<SeedMaterial>());
     assert_eq!(wgsl_size(&draw, "SeedRecord") as usize, size_of::<SeedRecord>());
 }

@@ -351,8 +351,8 @@ pub struct DrawSeedsUniforms {
     pub sun_dir: [f32; 4],
     /// Haze colour (linear RGB), and the distance that hides half of what is behind it (w).
     pub haze: [f32; 4],
-    /// Pass 3's radial LOD reaches, metres (scaled by each seed's size), infinity past the last.
-    pub radial_lod_m: [f32; 4],
+    /// Each draw LOD's reach, metres (`seeds::lod_reach_m`, scaled by each seed's size).
+    pub lod_reach_m: [f32; 4],
     pub inv_reference_height_m: f32,
     pub sink_fraction: f32,
     /// The outer part of each LOD band over which a seed dithers out, as a fraction of its reach.
@@ -361,13 +361,33 @@ pub struct DrawSeedsUniforms {
     pub ground_blend: f32,
 }
 
-/// One draw group's look: its atlas layer, alpha cutoff and model scale. WGSL: `DrawSeedsGroup`.
+/// How a seed vertex is coloured: a base colour times (when `flags` has `MATERIAL_TEXTURED`) a
+/// layer of the seed texture array, alpha-tested, and the draw LOD of the geometry it belongs to
+/// (0 the mesh, 1 to 3 the billboard clouds), which tells a group's own draw from its cross-fade.
+/// WGSL: `SeedMaterial` in `shaders/draw_seeds.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
-pub struct DrawSeedsGroup {
+pub struct SeedMaterial {
+    /// Linear RGBA, multiplied with the texel.
+    pub base_colour: [f32; 4],
     pub layer: u32,
+    /// Fragments with alpha below this are cut out (below 0: opaque).
     pub alpha_cutoff: f32,
-    /// 1 / the model's height (its top above its base), per metre.
-    pub inv_model_height_m: f32,
-    pub _pad: u32,
+    pub lod: u32,
+    /// `MATERIAL_TEXTURED` | `MATERIAL_REPEAT` (wrap texture coordinates, else clamp).
+    pub flags: u32,
+}
+
+pub const MATERIAL_TEXTURED: u32 = 1;
+pub const MATERIAL_REPEAT: u32 = 2;
+
+/// A vertex of a seed's mesh or billboard cloud, model space (metres, +Y up, base at y = 0), as
+/// the draw pass uploads it; `material` indexes its `SeedMaterial` table.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+pub struct SeedVertex {
+    pub position_model_m: [f32; 3],
+    pub normal_model: [f32; 3],
+    pub uv: [f32; 2],
+    pub material: u32,
 }

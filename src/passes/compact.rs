@@ -6,7 +6,9 @@
 //! that into one instanced draw per group: a permutation `order` (draw slot → record index) in
 //! which group g holds slots `[first_instance, first_instance + instance_count)`, its records in
 //! table order, and the indirect draw arguments (`SeedDrawArgs`, wgpu's `DrawIndexedIndirectArgs`
-//! layout; mesh fields from templates the draw pass uploads with `set_templates`).
+//! layout; mesh fields from templates the draw pass uploads with `set_templates`), twice: each
+//! group's own draw, then (`SEED_DRAWS`) the same instances with the next LOD's geometry, for the
+//! cross-fade of the seeds in the outer band of their LOD.
 //!
 //! It is a reduce-then-scan over chunks of `COMPACT_CHUNK` blocks: count each group per chunk,
 //! scan each group's counts over the chunks in order, place the groups one after the other, then
@@ -23,7 +25,7 @@ use thiserror::Error;
 use crate::config::Settings;
 use crate::gpu::gpu_types::{CompactParams, SeedDrawArgs};
 use crate::gpu::{Gpu, GpuError};
-use crate::seeds::{SEED_GROUPS, SEED_WORKGROUP, block_capacity};
+use crate::seeds::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP, block_capacity};
 use crate::shaders;
 
 /// Blocks per chunk: the workgroup of `reduce` and `scatter`, one lane per block, whose block ×
@@ -70,14 +72,14 @@ impl From<&Settings> for CompactLimits {
 pub struct Compacted {
     /// Draw slot → record index, groups one after the other (`drawn()` slots).
     pub order: Vec<u32>,
-    /// One indirect draw per group (`SEED_GROUPS`).
+    /// `SEED_DRAWS` indirect draws: one per group, then each group's cross-fade draw.
     pub args: Vec<SeedDrawArgs>,
 }
 
 impl Compacted {
     /// Slots filled: the records of every group.
     pub fn drawn(&self) -> usize {
-        self.args.iter().map(|a| a.instance_count as usize).sum()
+        self.args.iter().take(SEED_GROUPS as usize).map(|a| a.instance_count as usize).sum()
     }
 
     /// The records in draw order, from the record buffer `order` indexes.
@@ -174,7 +176,7 @@ impl CompactPass {
             })
         };
         use wgpu::BufferUsages as U;
-        let groups_bytes = u64::from(SEED_GROUPS) * size_of::<SeedDrawArgs>() as u64;
+        let draws_bytes = u64::from(SEED_DRAWS) * size_of::<SeedDrawArgs>() as u64;
         Ok(Self {
             reduce: pipeline("reduce"),
             scan: pipeline("scan"),
@@ -182,11 +184,11 @@ impl CompactPass {
             scatter: pipeline("scatter"),
             layout,
             params: buffer("compact params", size_of::<CompactParams>() as u64, U::STORAGE | U::COPY_DST),
-            templates: buffer("seed draw templates", groups_bytes, U::STORAGE | U::COPY_DST),
+            templates: buffer("seed draw templates", draws_bytes, U::STORAGE | U::COPY_DST),
             chunk_counts: buffer("compact chunk counts", chunk_bytes, U::STORAGE),
-            args: buffer("seed draw args", groups_bytes, U::STORAGE | U::INDIRECT | U::COPY_SRC),
+            args: buffer("seed draw args", draws_bytes, U::STORAGE | U::INDIRECT | U::COPY_SRC),
             order: buffer("seed draw order", order_bytes, U::STORAGE | U::COPY_SRC),
-            template_copy: vec![SeedDrawArgs::default(); SEED_GROUPS as usize],
+            template_copy: vec![SeedDrawArgs::default(); SEED_DRAWS as usize],
             limits,
         })
     }
@@ -217,17 +219,18 @@ impl CompactPass {
         })
     }
 
-    /// Sets the mesh fields of each group's draw (`index_count`, `first_index`, `base_vertex`;
-    /// the rest is ignored), group by group from group 0; groups beyond `templates` keep theirs.
+    /// Sets the mesh fields of each draw (`index_count`, `first_index`, `base_vertex`; the rest
+    /// is ignored), draw by draw from 0 (`SEED_DRAWS`: the groups', then their cross-fades');
+    /// draws beyond `templates` keep theirs.
     pub fn set_templates(&mut self, queue: &wgpu::Queue, templates: &[SeedDrawArgs]) {
-        let n = templates.len().min(SEED_GROUPS as usize);
+        let n = templates.len().min(SEED_DRAWS as usize);
         if n > 0 {
             self.template_copy[..n].copy_from_slice(&templates[..n]);
             queue.write_buffer(&self.templates, 0, bytemuck::cast_slice(&templates[..n]));
         }
     }
 
-    /// The templates the draws are filled from (`SEED_GROUPS`).
+    /// The templates the draws are filled from (`SEED_DRAWS`).
     pub fn templates(&self) -> &[SeedDrawArgs] {
         &self.template_copy
     }
@@ -278,7 +281,7 @@ impl CompactPass {
         &self.order
     }
 
-    /// `SEED_GROUPS` indirect draws (`SeedDrawArgs`), usable with `draw_indexed_indirect`.
+    /// `SEED_DRAWS` indirect draws (`SeedDrawArgs`), usable with `draw_indexed_indirect`.
     pub fn draw_args(&self) -> &wgpu::Buffer {
         &self.args
     }
@@ -290,12 +293,11 @@ impl CompactPass {
     /// Reads the last run's draw arguments and permutation back, waiting for the GPU: for tests
     /// and tools, never the frame.
     pub fn read_back(&self, gpu: &Gpu) -> Result<Compacted, GpuError> {
-        let args_bytes = u64::from(SEED_GROUPS) * size_of::<SeedDrawArgs>() as u64;
-        let args: Vec<SeedDrawArgs> =
-            bytemuck::pod_collect_to_vec(&super::read_buffer(gpu, &self.args, args_bytes)?);
-        let drawn =
-            args.iter().map(|a| u64::from(a.instance_count)).sum::<u64>().min(self.limits.records.into());
-        let order = bytemuck::pod_collect_to_vec(&super::read_buffer(gpu, &self.order, drawn * 4)?);
-        Ok(Compacted { order, args })
+        let args_bytes = u64::from(SEED_DRAWS) * size_of::<SeedDrawArgs>() as u64;
+        let args = bytemuck::pod_collect_to_vec(&super::read_buffer(gpu, &self.args, args_bytes)?);
+        let mut out = Compacted { order: Vec::new(), args };
+        let drawn = (out.drawn() as u64).min(self.limits.records.into());
+        out.order = bytemuck::pod_collect_to_vec(&super::read_buffer(gpu, &self.order, drawn * 4)?);
+        Ok(out)
     }
 }

@@ -1,38 +1,41 @@
 //! How it works: pass 4b, drawing the seeds (DESIGN § "The frame", step 4). Everything a species
-//! looks like is uploaded once, at `new`: one vertex and one index buffer hold, species after
-//! species, the billboard clouds of its impostor's three LODs (17, 8 and 2 planes for radial LODs
-//! 0, 1 and 2), and one RGBA8 sRGB texture array holds every LOD's atlas, with its mips, as one
-//! layer (atlases of another size are resampled to the largest, nearest texel per mip). The
-//! draw group of (species, LOD) gets its index range as a compaction template (`templates`, for
-//! `CompactPass::set_templates`) and its layer, alpha cutoff and model scale in a small table.
-//! Species without an impostor keep a zero-index template: their seeds are selected but cost
-//! nothing to draw.
+//! looks like is uploaded once, at `new` (`assets`): its real mesh and its billboard clouds of 17,
+//! 8 and 2 planes in one vertex and one index buffer, every texture (cloud atlases, mesh textures)
+//! as a layer of one RGBA8 sRGB texture array, and a material table the vertices index. The draw
+//! group of (species, LOD) gets its index range as a compaction template (`templates`, for
+//! `CompactPass::set_templates`), and its cross-fade draw the next LOD's range.
 //!
-//! Each frame `encode` records one `draw_indexed_indirect` per group from compaction's argument
-//! buffer (a group of 0 instances costs nothing). `shaders/draw_seeds.wgsl` reads an instance's
-//! record through compaction's `order`, scales the model to the seed's height, turns it by the
-//! seed's jitter, places it camera-relative and projects it with the terrain's matrix; it draws
-//! into the colour target with the terrain depth (reversed-Z, `GreaterEqual`, depth written).
-//! Fragments are alpha-tested and a seed near the outer edge of its LOD band (its radial reach,
-//! scaled like pass 3's) dithers out (Bayer 4×4), so seeds thin out at the visibility radius and
-//! at LOD changes instead of popping. The next LOD is not drawn fading in (pass 3 gives each seed
-//! one LOD), so a LOD boundary shows as a band `fade_fraction` wide where seeds are thinner.
+//! Each frame `encode` records two `draw_indexed_indirect`s per group from compaction's argument
+//! buffer (an empty group costs nothing): its own, and the same instances with the next LOD's
+//! geometry. `shaders/draw_seeds.wgsl` reads an instance's record through compaction's `order`,
+//! scales the model to the seed's height, turns it by the seed's jitter, places it camera-relative
+//! and projects it with the terrain's matrix; it draws into the colour target with the terrain
+//! depth (reversed-Z, `GreaterEqual`, depth written). A seed in the outer `FADE_FRACTION` of its
+//! LOD's reach cross-fades: its own geometry keeps the pixels whose (per-seed shifted) Bayer
+//! threshold is below the fade, the next LOD's geometry the others, so each pixel shows exactly
+//! one of the two and nothing pops; outside the band the cross-fade draw collapses its vertices.
+//! The last LOD fades out to nothing at the visibility radius.
+
+mod assets;
 
 use std::path::{Path, PathBuf};
 
+use bytemuck::Zeroable;
 use thiserror::Error;
 use wgpu::util::DeviceExt;
 
 use crate::classes::Species;
 use crate::config::Settings;
-use crate::gpu::gpu_types::{DrawSeedsGroup, DrawSeedsUniforms, SeedDrawArgs};
-use crate::impostor::{Impostor, ImpostorError, MANIFEST_FILE, PlaneVertex, mip_size};
-use crate::seeds::{SEED_GROUPS, SEED_LODS};
+use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedVertex};
+use crate::impostor::{Impostor, ImpostorError, MANIFEST_FILE, mip_size};
+use crate::seeds::SEED_LODS;
 use crate::shaders;
 use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT};
-use bytemuck::Zeroable;
 
-/// The outer part of each LOD band over which seeds dither out, as a fraction of its reach.
+pub use assets::MAX_LAYER_TEXELS;
+
+/// The outer part of each LOD's reach over which a seed cross-fades into the next LOD (or, for
+/// the last, fades out), as a fraction of the reach.
 pub const FADE_FRACTION: f32 = 0.1;
 /// How much of the ground colour under a seed it takes on.
 pub const GROUND_BLEND: f32 = 0.2;
@@ -43,7 +46,7 @@ pub enum DrawSeedsError {
     NoFolder(PathBuf),
     #[error(transparent)]
     Impostor(#[from] ImpostorError),
-    #[error("impostor {model:?} has {lods} LODs; the seed draw needs {SEED_LODS}")]
+    #[error("impostor {model:?} has {lods} billboard-cloud LODs; the seed draw needs {}", SEED_LODS - 1)]
     TooFewLods { model: String, lods: usize },
     #[error("this GPU cannot start indirect draws at an instance (INDIRECT_FIRST_INSTANCE): no seeds")]
     NoFirstInstance,
@@ -82,26 +85,16 @@ pub struct DrawSeedsPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
-    groups: wgpu::Buffer,
+    materials: wgpu::Buffer,
+    species: wgpu::Buffer,
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
-    atlas_view: wgpu::TextureView,
-    sampler: wgpu::Sampler,
+    texture_view: wgpu::TextureView,
+    clamp_sampler: wgpu::Sampler,
+    repeat_sampler: wgpu::Sampler,
     templates: Vec<SeedDrawArgs>,
     species_drawn: usize,
     species_missing: usize,
-}
-
-/// Everything uploaded for the species: geometry, atlas layers and the group table.
-struct Species3 {
-    vertices: Vec<PlaneVertex>,
-    indices: Vec<u32>,
-    templates: Vec<SeedDrawArgs>,
-    groups: Vec<DrawSeedsGroup>,
-    /// Each layer's mips at the common size, in layer order.
-    layers: Vec<Vec<Vec<u8>>>,
-    size: u32,
-    mips: u32,
 }
 
 impl DrawSeedsPass {
@@ -114,14 +107,14 @@ impl DrawSeedsPass {
         if !device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE) {
             return Err(DrawSeedsError::NoFirstInstance);
         }
-        let built = gather(impostors)?;
+        let built = assets::gather(impostors)?;
         let max = device.limits().max_texture_array_layers;
         let layers = built.layers.len().max(1) as u32;
         if layers > max {
             return Err(DrawSeedsError::TooManyLayers { layers, max });
         }
-        let atlases = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("seed atlases"),
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("seed textures"),
             size: wgpu::Extent3d { width: built.size, height: built.size, depth_or_array_layers: layers },
             mip_level_count: built.mips,
             sample_count: 1,
@@ -135,7 +128,7 @@ impl DrawSeedsPass {
                 let [w, h] = mip_size([built.size; 2], mip as u32);
                 queue.write_texture(
                     wgpu::TexelCopyTextureInfo {
-                        texture: &atlases,
+                        texture: &texture,
                         mip_level: mip as u32,
                         origin: wgpu::Origin3d { x: 0, y: 0, z: layer as u32 },
                         aspect: wgpu::TextureAspect::All,
@@ -150,7 +143,7 @@ impl DrawSeedsPass {
                 );
             }
         }
-        let atlas_view = atlases.create_view(&wgpu::TextureViewDescriptor {
+        let texture_view = texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
@@ -162,43 +155,49 @@ impl DrawSeedsPass {
             })
         };
         // Empty buffers cannot be bound: a species-less pass keeps one zero element of each.
-        let vertices: &[PlaneVertex] =
-            if built.vertices.is_empty() { &[PlaneVertex::zeroed()] } else { &built.vertices };
-        let indices: &[u32] = if built.indices.is_empty() { &[0] } else { &built.indices };
-        let vertices = buffer("seed vertices", bytemuck::cast_slice(vertices), wgpu::BufferUsages::VERTEX);
-        let indices = buffer("seed indices", bytemuck::cast_slice(indices), wgpu::BufferUsages::INDEX);
-        let groups = buffer("seed groups", bytemuck::cast_slice(&built.groups), wgpu::BufferUsages::STORAGE);
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("draw_seeds uniforms"),
-            size: size_of::<DrawSeedsUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("seed atlases"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        let or_one = |v: &[u8], one: &[u8]| if v.is_empty() { one.to_vec() } else { v.to_vec() };
+        let vertices =
+            or_one(bytemuck::cast_slice(&built.vertices), bytemuck::bytes_of(&SeedVertex::zeroed()));
+        let indices = or_one(bytemuck::cast_slice(&built.indices), &[0; 4]);
+        let materials =
+            or_one(bytemuck::cast_slice(&built.materials), bytemuck::bytes_of(&SeedMaterial::zeroed()));
+        let storage = wgpu::BufferUsages::STORAGE;
+        let sampler = |label, address_mode| {
+            device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                address_mode_u: address_mode,
+                address_mode_v: address_mode,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..Default::default()
+            })
+        };
         let (pipeline, layout) = pipeline(device);
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
         Ok(Self {
             pipeline,
             layout,
-            uniforms,
-            groups,
-            vertices,
-            indices,
-            atlas_view,
-            sampler,
+            uniforms: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("draw_seeds uniforms"),
+                size: size_of::<DrawSeedsUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            materials: buffer("seed materials", &materials, storage),
+            species: buffer("seed species scale", bytemuck::cast_slice(&built.inv_model_height_m), storage),
+            vertices: buffer("seed vertices", &vertices, wgpu::BufferUsages::VERTEX),
+            indices: buffer("seed indices", &indices, wgpu::BufferUsages::INDEX),
+            texture_view,
+            clamp_sampler: sampler("seed atlases", wgpu::AddressMode::ClampToEdge),
+            repeat_sampler: sampler("seed mesh textures", wgpu::AddressMode::Repeat),
             templates: built.templates,
             species_drawn,
             species_missing: impostors.len() - species_drawn,
         })
     }
 
-    /// The per-group mesh ranges, for `CompactPass::set_templates` (`SEED_GROUPS` of them).
+    /// The draws' index ranges, for `CompactPass::set_templates` (`SEED_DRAWS` of them).
     pub fn templates(&self) -> &[SeedDrawArgs] {
         &self.templates
     }
@@ -209,17 +208,22 @@ impl DrawSeedsPass {
     }
 
     pub fn bind_group(&self, device: &wgpu::Device, inputs: &DrawSeedsInputs) -> wgpu::BindGroup {
-        let entries = [
-            wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: inputs.records.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: inputs.order.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: self.groups.as_entire_binding() },
-            wgpu::BindGroupEntry {
-                binding: 4,
-                resource: wgpu::BindingResource::TextureView(&self.atlas_view),
-            },
-            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+        use wgpu::BindingResource as R;
+        let resources = [
+            self.uniforms.as_entire_binding(),
+            inputs.records.as_entire_binding(),
+            inputs.order.as_entire_binding(),
+            self.species.as_entire_binding(),
+            self.materials.as_entire_binding(),
+            R::TextureView(&self.texture_view),
+            R::Sampler(&self.clamp_sampler),
+            R::Sampler(&self.repeat_sampler),
         ];
+        let entries: Vec<_> = resources
+            .into_iter()
+            .enumerate()
+            .map(|(binding, resource)| wgpu::BindGroupEntry { binding: binding as u32, resource })
+            .collect();
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("draw_seeds"),
             layout: &self.layout,
@@ -232,7 +236,8 @@ impl DrawSeedsPass {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
     }
 
-    /// Records one indirect draw per group from `draw_args` (compaction's) into the targets.
+    /// Records each group's draw and cross-fade draw from `draw_args` (compaction's) into the
+    /// targets.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -267,9 +272,9 @@ impl DrawSeedsPass {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         let stride = size_of::<SeedDrawArgs>() as u64;
-        for (group, template) in self.templates.iter().enumerate() {
+        for (draw, template) in self.templates.iter().enumerate() {
             if template.index_count > 0 {
-                pass.draw_indexed_indirect(draw_args, group as u64 * stride);
+                pass.draw_indexed_indirect(draw_args, draw as u64 * stride);
             }
         }
     }
@@ -280,89 +285,16 @@ pub fn draw_uniforms(
     settings: &Settings,
     terrain: &crate::gpu::gpu_types::TerrainUniforms,
 ) -> DrawSeedsUniforms {
-    let radial = &settings.tlm.radial_lod_m;
     DrawSeedsUniforms {
         clip_from_view_world: terrain.clip_from_view_world,
         sun_dir: terrain.sun_dir,
         haze: terrain.haze,
-        radial_lod_m: [0, 1, 2, 3].map(|k| radial.get(k).map_or(f32::INFINITY, |r| *r as f32)),
+        lod_reach_m: crate::seeds::lod_reach_m(settings).map(|r| r as f32),
         inv_reference_height_m: (1.0 / settings.seeds.reference_height_m) as f32,
         sink_fraction: settings.seeds.sink_fraction as f32,
         fade_fraction: FADE_FRACTION,
         ground_blend: GROUND_BLEND,
     }
-}
-
-/// Lays the species' billboard clouds and atlases out for upload.
-fn gather(impostors: &[Option<Impostor>]) -> Result<Species3, DrawSeedsError> {
-    let lods = SEED_LODS as usize;
-    let present = || impostors.iter().flatten();
-    for impostor in present() {
-        if impostor.lods.len() < lods {
-            return Err(DrawSeedsError::TooFewLods {
-                model: impostor.name.clone(),
-                lods: impostor.lods.len(),
-            });
-        }
-    }
-    let atlases = || present().flat_map(|i| i.lods[..lods].iter().map(|l| &l.atlas));
-    let size = atlases().map(|a| a.size[0].max(a.size[1])).max().unwrap_or(1).max(1);
-    let mips = atlases().map(|a| a.mip_count()).min().unwrap_or(1).clamp(1, size.ilog2() + 1);
-    let mut out = Species3 {
-        vertices: Vec::new(),
-        indices: Vec::new(),
-        templates: vec![SeedDrawArgs::default(); SEED_GROUPS as usize],
-        groups: vec![DrawSeedsGroup::default(); SEED_GROUPS as usize],
-        layers: Vec::new(),
-        size,
-        mips,
-    };
-    for (species, impostor) in impostors.iter().enumerate().take(SEED_GROUPS as usize / lods) {
-        let Some(impostor) = impostor else { continue };
-        let top = impostor.mesh.vertices.iter().map(|v| v.position_model_m[1]).fold(f32::MIN, f32::max);
-        let sphere = &impostor.bounding_sphere;
-        let height = if top > 0.0 { top } else { (sphere.centre_model_m[1] * 2.0).max(1e-3) };
-        for (lod, level) in impostor.lods[..lods].iter().enumerate() {
-            let group = species * lods + lod;
-            let indices = level.indices();
-            out.templates[group] = SeedDrawArgs {
-                index_count: indices.len() as u32,
-                instance_count: 0,
-                first_index: out.indices.len() as u32,
-                base_vertex: out.vertices.len() as i32,
-                first_instance: 0,
-            };
-            out.groups[group] = DrawSeedsGroup {
-                layer: out.layers.len() as u32,
-                alpha_cutoff: impostor.alpha_cutoff,
-                inv_model_height_m: 1.0 / height,
-                _pad: 0,
-            };
-            out.vertices.extend(level.vertices());
-            out.indices.extend(indices);
-            out.layers.push((0..mips).map(|m| resample(&level.atlas, m, mip_size([size; 2], m))).collect());
-        }
-    }
-    Ok(out)
-}
-
-/// Mip `level` of `atlas` at `to` texels, nearest texel (a copy when the sizes agree).
-fn resample(atlas: &crate::impostor::MipChain, level: u32, to: [u32; 2]) -> Vec<u8> {
-    let from = atlas.level_size(level);
-    let texels = &atlas.levels[level as usize];
-    if from == to {
-        return texels.clone();
-    }
-    let mut out = Vec::with_capacity((4 * to[0] * to[1]) as usize);
-    for y in 0..to[1] {
-        let sy = (y * from[1] / to[1]) as usize;
-        for x in 0..to[0] {
-            let sx = (x * from[0] / to[0]) as usize;
-            let i = 4 * (sy * from[0] as usize + sx);
-            out.extend_from_slice(&texels[i..i + 4]);
-        }
-    }
-    out
 }
 
 fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
@@ -378,36 +310,27 @@ fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayo
         },
         count: None,
     };
+    let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
+    let uniform = wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
+    let texture = wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+        view_dimension: wgpu::TextureViewDimension::D2Array,
+        multisampled: false,
+    };
+    let sampler = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
     let entries = [
-        wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: vertex | fragment,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        },
+        entry(0, vertex | fragment, uniform),
         storage(1),
         storage(2),
         storage(3),
-        wgpu::BindGroupLayoutEntry {
-            binding: 4,
-            visibility: fragment,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2Array,
-                multisampled: false,
-            },
-            count: None,
-        },
-        wgpu::BindGroupLayoutEntry {
-            binding: 5,
-            visibility: fragment,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        },
+        wgpu::BindGroupLayoutEntry { visibility: vertex | fragment, ..storage(4) },
+        entry(5, fragment, texture),
+        entry(6, fragment, sampler),
+        entry(7, fragment, sampler),
     ];
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("draw_seeds"),
@@ -419,7 +342,7 @@ fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayo
         bind_group_layouts: &[Some(&layout)],
         immediate_size: 0,
     });
-    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32];
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("draw_seeds"),
         layout: Some(&pipeline_layout),
@@ -428,7 +351,7 @@ fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayo
             entry_point: Some("vs_main"),
             compilation_options: Default::default(),
             buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: size_of::<PlaneVertex>() as u64,
+                array_stride: size_of::<SeedVertex>() as u64,
                 step_mode: wgpu::VertexStepMode::Vertex,
                 attributes: &attributes,
             })],
@@ -439,7 +362,7 @@ fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayo
             compilation_options: Default::default(),
             targets: &[Some(COLOUR_FORMAT.into())],
         }),
-        // A billboard is seen from both sides.
+        // A billboard is seen from both sides, and so are leaves (the glTF's double-sided ones).
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,

@@ -127,8 +127,7 @@ impl SeedFrame {
             occlusion_tolerance_per_m: (seeds.occlusion_tolerance_per_km / 1000.0) as f32,
             inv_reference_height_m: (1.0 / seeds.reference_height_m) as f32,
             sink_fraction: seeds.sink_fraction as f32,
-            radial_lod_m: [0, 1, 2, 3]
-                .map(|k| s.tlm.radial_lod_m.get(k).map_or(f32::INFINITY, |r| *r as f32)),
+            radial_lod_m: crate::seeds::lod_reach_m(s).map(|r| r as f32),
             cell_in_samples: (cell_m / spacing_m) as f32,
             cell_in_lcc_texels: 0.0,
             cell_in_imagery_texels: 0.0,

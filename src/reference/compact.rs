@@ -8,7 +8,7 @@
 
 use crate::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
 use crate::passes::compact::{COMPACT_CHUNK, CompactError, Compacted};
-use crate::seeds::{SEED_GROUPS, SEED_WORKGROUP};
+use crate::seeds::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP};
 
 const GROUPS: usize = SEED_GROUPS as usize;
 
@@ -18,7 +18,7 @@ fn key_at(keys: &[u32], index: u32) -> Option<usize> {
 }
 
 /// Compacts `blocks` (entries of a block table) over `keys` (each record's draw group), with the
-/// draws' mesh fields from `templates` (group by group; missing ones are zero). Fails when a block
+/// draws' mesh fields from `templates` (draw by draw, `SEED_DRAWS`; missing ones are zero). Fails when a block
 /// reaches beyond `keys` or holds more than a workgroup's records: the GPU would not read those.
 pub fn compact(
     keys: &[u32],
@@ -68,13 +68,21 @@ pub fn compact(
             totals[g] += n;
         }
     }
-    // finish: groups one after the other.
-    let mut args = Vec::with_capacity(GROUPS);
+    // finish: groups one after the other; each group's cross-fade draw takes its instances.
+    let mut args = Vec::with_capacity(SEED_DRAWS as usize);
     let mut first_instance = 0u32;
     for (g, &instance_count) in totals.iter().enumerate() {
         let t = templates.get(g).copied().unwrap_or_default();
         args.push(SeedDrawArgs { instance_count, first_instance, ..t });
         first_instance += instance_count;
+    }
+    for g in 0..GROUPS {
+        let (own, t) = (args[g], templates.get(GROUPS + g).copied().unwrap_or_default());
+        args.push(SeedDrawArgs {
+            instance_count: own.instance_count,
+            first_instance: own.first_instance,
+            ..t
+        });
     }
     // scatter: rows become each block's first slot per group, then records take the next one.
     let mut order = vec![0u32; first_instance as usize];

@@ -79,8 +79,8 @@ pub struct OracleSeed {
     /// The bilinear ground height under the seed (its anchor sinks below it).
     pub ground_m: f64,
     pub height_m: f64,
-    /// 0, 1 or 2: the first `tlm.radial_lod_m` threshold (scaled by size) the seed is within.
-    pub radial_lod: u32,
+    /// Its draw LOD: the first `seeds::lod_reach_m` (scaled by size) the seed is within.
+    pub lod: u32,
 }
 
 /// Seeds judged, and where each went: every candidate lands in exactly one other field.
@@ -284,11 +284,10 @@ impl View<'_> {
         let rel = DVec3::new(p.x, p.y, ground_m) - self.eye;
         let distance_m = rel.length();
         let scale = (height_m / seeds.reference_height_m).min(1.0);
-        let radial = settings.tlm.radial_lod_m;
-        if distance_m >= radial[2] * scale {
+        let Some(lod) = crate::seeds::lod_reach_m(settings).iter().position(|&r| distance_m < r * scale)
+        else {
             return Ok(Fate::Distance);
-        }
-        let radial_lod = radial.iter().position(|&r| distance_m < r * scale).unwrap_or(2) as u32;
+        };
         if !self.in_frustum(species, rel, height_m) {
             return Ok(Fate::Frustum);
         }
@@ -305,7 +304,7 @@ impl View<'_> {
             position_grid_m: [p.x, p.y],
             ground_m,
             height_m,
-            radial_lod,
+            lod: lod as u32,
         }))
     }
 

@@ -14,7 +14,7 @@ use crate::dataset::{Dataset, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, 
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::lcc::LCC_LEVELS;
 use crate::passes::seed_select::{SeedFrame, SeedOutput};
-use crate::seeds::{GROUND_SAMPLES, SEED_WORKGROUP, SeedTables, pcg, seed_group, seed_hash, unit};
+use crate::seeds::{GROUND_SAMPLES, SEED_LODS, SEED_WORKGROUP, SeedTables, pcg, seed_group, seed_hash, unit};
 use crate::streaming::TileCache;
 
 mod compare;
@@ -392,7 +392,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
 
     let distance_sq = rel_xy[0] * rel_xy[0] + rel_xy[1] * rel_xy[1] + ground_rel_m * ground_rel_m;
     let size_scale = (height_m * u.inv_reference_height_m).min(1.0);
-    let lod = (0..3u32)
+    let lod = (0..SEED_LODS)
         .find(|&lod| {
             let reach = u.radial_lod_m[lod as usize] * size_scale;
             distance_sq < reach * reach

@@ -30,10 +30,15 @@ pub const MAX_SEED_CELLS: u32 = 65535;
 /// Entries of pass 3's block table at most (one per workgroup: 8 MiB, 64 M seeds checked per
 /// frame); a frame checks no more cells than fill it (`max_cells`).
 pub const MAX_SEED_BLOCKS: u32 = 1 << 20;
-/// Radial LODs a seed can be drawn at (3 = inactive).
-pub const SEED_LODS: u32 = 3;
-/// Draw groups: one per (species, radial LOD), `species × SEED_LODS + lod` (`seed_group`).
+/// Draw LODs of a seed: 0 the real mesh, 1 to 3 its billboard clouds (17, 8 and 2 planes), out to
+/// `seeds.mesh_m` and the three `tlm.radial_lod_m` thresholds (`lod_reach_m`).
+pub const SEED_LODS: u32 = 4;
+/// Draw groups: one per (species, LOD), `species × SEED_LODS + lod` (`seed_group`).
 pub const SEED_GROUPS: u32 = MAX_SPECIES as u32 * SEED_LODS;
+/// Indirect draws compaction writes: each group's own, then (at `SEED_GROUPS + group`) the same
+/// instances with the next LOD's geometry, which the seeds in the outer band of their LOD
+/// cross-fade into.
+pub const SEED_DRAWS: u32 = 2 * SEED_GROUPS;
 /// Indices into `SeedCounters` (as an array of u32): where a seed's outcome is counted.
 pub const COUNT_SELECTED: u32 = 0;
 pub const COUNT_OVERFLOW: u32 = 1;
@@ -71,6 +76,14 @@ pub enum SeedError {
 /// beside each record and compaction groups by.
 pub fn seed_group(species: u32, lod: u32) -> u32 {
     species * SEED_LODS + lod
+}
+
+/// How far each draw LOD reaches for a seed of `seeds.reference_height_m` or taller (smaller seeds
+/// in proportion): the mesh to `seeds.mesh_m` (never beyond the first radial threshold), then the
+/// billboard clouds to each `tlm.radial_lod_m` threshold. Beyond the last, a seed is not drawn.
+pub fn lod_reach_m(settings: &crate::config::Settings) -> [f64; SEED_LODS as usize] {
+    let [r0, r1, r2] = settings.tlm.radial_lod_m;
+    [settings.seeds.mesh_m.min(r0), r0, r1, r2]
 }
 
 /// Workgroups (block-table entries) pass 3 runs per cell when it checks `active_ranks` ranks.

@@ -1,0 +1,207 @@
+//! How it works: lays the species' impostors out for one upload. Every species contributes four
+//! pieces of geometry to one vertex and one index buffer, one per draw LOD: its real mesh (LOD 0)
+//! and its billboard clouds of 17, 8 and 2 planes (LODs 1 to 3). Each vertex names its material:
+//! a mesh vertex its glTF material's (a base colour, maybe a texture, wrapped), a plane vertex its
+//! cloud's atlas (clamped). Every texture (the three atlases of a species, its mesh's textures)
+//! becomes one layer of a single texture array, so a draw never switches bindings: layers share
+//! one size (the largest, capped at `MAX_LAYER_TEXELS`) and the mip count of the shortest atlas
+//! chain (atlases stop where a mip would mix two planes; meshes are only drawn up close, so a few
+//! mips suffice), each level resampled from the source level nearest its size.
+//!
+//! The templates give each (species, LOD) group its index range, and each group's cross-fade draw
+//! (at `SEED_GROUPS + group`) the next LOD's range. A model baked without a mesh draws its
+//! 17-plane cloud up close instead; a species without an impostor keeps zero-index templates.
+
+use std::collections::HashMap;
+
+use crate::gpu::gpu_types::{MATERIAL_REPEAT, MATERIAL_TEXTURED, SeedDrawArgs, SeedMaterial, SeedVertex};
+use crate::impostor::{AlphaMode, Impostor, MipChain, mip_size};
+use crate::seeds::{SEED_DRAWS, SEED_GROUPS, SEED_LODS};
+
+use super::DrawSeedsError;
+
+/// Largest edge of a texture-array layer: larger atlases and textures are resampled down to it
+/// (a 1024² layer with mips is 5.6 MB; a species takes 3 to 5).
+pub const MAX_LAYER_TEXELS: u32 = 1024;
+/// Billboard-cloud LODs a species needs (draw LODs 1 to 3).
+const CLOUD_LODS: usize = SEED_LODS as usize - 1;
+
+/// Everything uploaded for the species.
+pub(super) struct SeedAssets {
+    pub vertices: Vec<SeedVertex>,
+    pub indices: Vec<u32>,
+    /// `SEED_DRAWS` draws: the groups' own, then their cross-fades into the next LOD.
+    pub templates: Vec<SeedDrawArgs>,
+    pub materials: Vec<SeedMaterial>,
+    /// 1 / each species' model height (top above base), per metre; 0 for species not drawn.
+    pub inv_model_height_m: Vec<f32>,
+    /// Each layer's mips at the common size, in layer order.
+    pub layers: Vec<Vec<Vec<u8>>>,
+    pub size: u32,
+    pub mips: u32,
+}
+
+impl SeedAssets {
+    /// One piece of geometry, its vertices already carrying their materials: appended, and its
+    /// index range returned as a template.
+    fn push(&mut self, vertices: impl IntoIterator<Item = SeedVertex>, indices: &[u32]) -> SeedDrawArgs {
+        let template = SeedDrawArgs {
+            index_count: indices.len() as u32,
+            instance_count: 0,
+            first_index: self.indices.len() as u32,
+            base_vertex: self.vertices.len() as i32,
+            first_instance: 0,
+        };
+        self.vertices.extend(vertices);
+        self.indices.extend_from_slice(indices);
+        template
+    }
+
+    /// A new layer from `chain`, resampled to the common size and mips.
+    fn layer(&mut self, chain: &MipChain) -> u32 {
+        let levels = (0..self.mips).map(|m| resample(chain, mip_size([self.size; 2], m))).collect();
+        self.layers.push(levels);
+        self.layers.len() as u32 - 1
+    }
+
+    fn material(&mut self, material: SeedMaterial) -> u32 {
+        self.materials.push(material);
+        self.materials.len() as u32 - 1
+    }
+}
+
+/// Lays out `impostors` (by species index; `None`: not drawn).
+pub(super) fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsError> {
+    let species_max = (SEED_GROUPS / SEED_LODS) as usize;
+    let present = || impostors.iter().take(species_max).flatten();
+    for impostor in present() {
+        if impostor.lods.len() < CLOUD_LODS {
+            return Err(DrawSeedsError::TooFewLods {
+                model: impostor.name.clone(),
+                lods: impostor.lods.len(),
+            });
+        }
+    }
+    let atlases = || present().flat_map(|i| i.lods[..CLOUD_LODS].iter().map(|l| &l.atlas));
+    let textures = || present().flat_map(|i| i.mesh.materials.iter().filter_map(|m| m.texture.as_ref()));
+    let size = atlases().chain(textures()).map(|a| a.size[0].max(a.size[1])).max().unwrap_or(1);
+    let size = size.clamp(1, MAX_LAYER_TEXELS);
+    let mips = atlases().map(|a| a.mip_count()).min().unwrap_or(1).clamp(1, size.ilog2() + 1);
+    let mut out = SeedAssets {
+        vertices: Vec::new(),
+        indices: Vec::new(),
+        templates: vec![SeedDrawArgs::default(); SEED_DRAWS as usize],
+        materials: Vec::new(),
+        inv_model_height_m: vec![0.0; species_max],
+        layers: Vec::new(),
+        size,
+        mips,
+    };
+    for (species, impostor) in impostors.iter().enumerate().take(species_max) {
+        let Some(impostor) = impostor else { continue };
+        out.inv_model_height_m[species] = 1.0 / model_height_m(impostor);
+        let mut lods = [SeedDrawArgs::default(); SEED_LODS as usize];
+        for (k, level) in impostor.lods[..CLOUD_LODS].iter().enumerate() {
+            let layer = out.layer(&level.atlas);
+            let material = out.material(SeedMaterial {
+                base_colour: [1.0; 4],
+                layer,
+                alpha_cutoff: impostor.alpha_cutoff,
+                lod: k as u32 + 1,
+                flags: MATERIAL_TEXTURED,
+            });
+            let vertices = level.vertices().into_iter().map(|v| SeedVertex {
+                position_model_m: v.position_model_m,
+                normal_model: v.normal_model,
+                uv: v.uv_atlas,
+                material,
+            });
+            lods[k + 1] = out.push(vertices, &level.indices());
+        }
+        lods[0] = if impostor.mesh.indices.is_empty() { lods[1] } else { push_mesh(&mut out, impostor) };
+        let first = species * SEED_LODS as usize;
+        out.templates[first..first + SEED_LODS as usize].copy_from_slice(&lods);
+        // A group's cross-fade draws the next LOD; the last LOD fades out to nothing.
+        let fades = SEED_GROUPS as usize + first;
+        out.templates[fades..fades + CLOUD_LODS].copy_from_slice(&lods[1..]);
+    }
+    Ok(out)
+}
+
+/// The model's height: its mesh's top, or its sphere's (centred at mid-height) without a mesh.
+fn model_height_m(impostor: &Impostor) -> f32 {
+    let top = impostor.mesh.vertices.iter().map(|v| v.position_model_m[1]).fold(f32::MIN, f32::max);
+    if top > 0.0 { top } else { (impostor.bounding_sphere.centre_model_m[1] * 2.0).max(1e-3) }
+}
+
+/// The mesh, one material per submesh; a vertex two submeshes share is repeated for each.
+fn push_mesh(out: &mut SeedAssets, impostor: &Impostor) -> SeedDrawArgs {
+    let mesh = &impostor.mesh;
+    let mut layers: HashMap<usize, u32> = HashMap::new();
+    let mut vertices = Vec::new();
+    let mut indices = Vec::with_capacity(mesh.indices.len());
+    for submesh in &mesh.submeshes {
+        let Some(source) = mesh.materials.get(submesh.material as usize) else { continue };
+        let layer = source
+            .texture
+            .as_ref()
+            .map(|chain| *layers.entry(submesh.material as usize).or_insert_with(|| out.layer(chain)));
+        let alpha_cutoff = match source.alpha_mode {
+            AlphaMode::Opaque => -1.0,
+            // (The baker reads glTF's BLEND as MASK: seeds are not sorted.)
+            AlphaMode::Mask => source.alpha_cutoff,
+        };
+        let material = out.material(SeedMaterial {
+            base_colour: source.base_color_factor,
+            layer: layer.unwrap_or(0),
+            alpha_cutoff,
+            lod: 0,
+            flags: layer.map_or(0, |_| MATERIAL_TEXTURED | MATERIAL_REPEAT),
+        });
+        let mut remap: HashMap<u32, u32> = HashMap::new();
+        let range = submesh.first_index as usize..(submesh.first_index + submesh.index_count) as usize;
+        for &index in mesh.indices.get(range).unwrap_or_default() {
+            let Some(v) = mesh.vertices.get(index as usize) else { continue };
+            let local = *remap.entry(index).or_insert_with(|| {
+                vertices.push(SeedVertex {
+                    position_model_m: v.position_model_m,
+                    normal_model: v.normal_model,
+                    uv: v.uv,
+                    material,
+                });
+                vertices.len() as u32 - 1
+            });
+            indices.push(local);
+        }
+    }
+    // A dropped out-of-range index would shift every later triangle: keep whole triangles only.
+    indices.truncate(indices.len() - indices.len() % 3);
+    out.push(vertices, &indices)
+}
+
+/// The level of `chain` nearest `to` texels (the first no larger, else the smallest), resampled
+/// to `to`, nearest texel (a copy when the sizes agree).
+fn resample(chain: &MipChain, to: [u32; 2]) -> Vec<u8> {
+    let levels = chain.levels.len().max(1) as u32;
+    let level = (0..levels)
+        .find(|&m| {
+            let s = chain.level_size(m);
+            s[0] <= to[0] && s[1] <= to[1]
+        })
+        .unwrap_or(levels - 1);
+    let from = chain.level_size(level);
+    let texels = &chain.levels[level as usize];
+    if from == to {
+        return texels.clone();
+    }
+    let mut out = Vec::with_capacity((4 * to[0] * to[1]) as usize);
+    for y in 0..to[1] {
+        let sy = (u64::from(y) * u64::from(from[1]) / u64::from(to[1])) as usize;
+        for x in 0..to[0] {
+            let sx = (u64::from(x) * u64::from(from[0]) / u64::from(to[0])) as usize;
+            let i = 4 * (sy * from[0] as usize + sx);
+            out.extend_from_slice(&texels[i..i + 4]);
+        }
+    }
+    out
+}
