@@ -76,7 +76,8 @@ fn band_fade(record: SeedRecord, lod: u32) -> f32 {
     let distance_m = length(ground_rel);
     let size_scale = min(1.0, record.height_m * u.inv_reference_height_m);
     let reach = u.lod_reach_m[min(lod, 3u)] * size_scale;
-    let width = max(reach * u.fade_fraction, 1e-3);
+    // Without a band (fade_fraction 0) a seed is whole up to its reach, then the next LOD's.
+    let width = max(reach * u.fade_fraction, 1e-6);
     return clamp((reach - distance_m) / width, 0.0, 1.0);
 }
 

@@ -2,7 +2,11 @@
 //! test process (`terramp-data bake`), and a view over forest near the lake is rendered with
 //! `seeds.impostors` set and with it empty. The trees change many pixels, make them darker or
 //! greener, never stand behind the terrain (depth only grows nearer) and leave the sky well above
-//! the horizon alone. (Whether any tree stands on water is pass 3's to check: `tests/seeds.rs`.)
+//! the horizon alone. Under each pixel the bare frame's depth gives the ground and its land-cover
+//! class: most forest pixels show trees, and no pixel of open water does (water that no tree on
+//! land in front of it could reach up or across to). The frame matches its reference image
+//! within 30 dB PSNR (`TERRAMP_BLESS=1` rewrites it), which the frame without trees misses.
+//! (Per seed, that no tree stands on water is pass 3's test: `tests/seeds.rs`.)
 //!
 //! The figure `docs/nc_trees.png` (960×540, accurate preset) comes from the ignored test:
 //! `WGPU_BACKEND=vulkan cargo test --release -p terramp-data-tools --test draw_seeds -- --ignored`.
@@ -23,6 +27,15 @@ use terramp::gpu::{AdapterChoice, Gpu};
 use support::{TempDir, build_nc, shared_data};
 
 const FOREST: u8 = 5;
+/// The test's view: metres above the forest, and pitch (degrees) down towards the lake: high
+/// and steep enough that trees on the near shore leave much of the lake uncovered.
+const VIEW: [f64; 2] = [120.0, -22.0];
+/// The frame with trees, balanced preset, 320×180 (`TERRAMP_BLESS=1` rewrites it).
+const REFERENCE: &str = "reference/nc_trees_320x180.png";
+/// lavapipe renders the same frame bit for bit (infinite PSNR); rasterisers differ in the last
+/// bits of filtering and coverage, well above this. The frame without trees is 20 dB from the
+/// reference: more than 5 dB below the tolerance (checked), so the trees cannot go missing.
+const MIN_PSNR_DB: f64 = 30.0;
 const WATER: u8 = 6;
 
 /// The species models of the nc table, baked once per test process into the target's temporary
@@ -47,6 +60,10 @@ fn impostors() -> &'static Path {
         assert!(output.status.success(), "bake failed:\n{stdout}\n{stderr}");
         out
     })
+}
+
+fn reference_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join(REFERENCE)
 }
 
 /// A pose over forest with water ahead: grid (x, y) of a level-1 land-cover texel whose
@@ -104,8 +121,8 @@ fn render(
     impostors: &str,
     size: [u32; 2],
     pose: ([f64; 2], f64),
-    above_m: f64,
-) -> (image::RgbaImage, Vec<f32>, FrameReport) {
+    [above_m, pitch_deg]: [f64; 2],
+) -> (image::RgbaImage, Vec<f32>, FrameReport, Camera) {
     settings.render.width = size[0];
     settings.render.height = size[1];
     settings.seeds.impostors = impostors.to_owned();
@@ -117,7 +134,7 @@ fn render(
     let camera = Camera {
         position_m: DVec3::new(origin[0] + x, origin[1] + y, ground + above_m),
         yaw_deg,
-        pitch_deg: -12.0,
+        pitch_deg,
         fov_deg: 60.0,
         near_m: 0.1,
     };
@@ -127,7 +144,7 @@ fn render(
     for _ in 0..4 {
         report = r.render(&camera).unwrap();
     }
-    (r.read_colour().unwrap(), r.read_depth().unwrap(), report)
+    (r.read_colour().unwrap(), r.read_depth().unwrap(), report, camera)
 }
 
 #[test]
@@ -141,9 +158,9 @@ fn nc_forest_draws_trees() {
     let pose = forest_near_water(&dataset);
     let dir = impostors().to_str().unwrap().to_owned();
     let size = [320, 180];
-    let (bare, bare_depth, bare_report) = render(dataset, Settings::default(), "", size, pose, 40.0);
+    let (bare, bare_depth, bare_report, camera) = render(dataset, Settings::default(), "", size, pose, VIEW);
     let reopened = Dataset::open(&path).unwrap();
-    let (trees, depth, report) = render(reopened, Settings::default(), &dir, size, pose, 40.0);
+    let (trees, depth, report, _) = render(reopened, Settings::default(), &dir, size, pose, VIEW);
     assert_eq!((bare_report.seed_species_drawn, bare_report.seed_species_undrawn), (0, 9));
     assert_eq!((report.seed_species_drawn, report.seed_species_undrawn), (9, 0), "{report:?}");
     assert!(report.seeds.is_some_and(|s| s.counters.selected > 0), "{report:?}");
@@ -154,7 +171,12 @@ fn nc_forest_draws_trees() {
     let green =
         |p: &image::Rgba<u8>| f64::from(p[1]) / (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]) + 1.0);
     let (mut changed, mut sky, mut sky_changed, mut high_sky_changed) = (0usize, 0usize, 0usize, 0usize);
-    let high = (size[0] * size[1] / 5) as usize;
+    // Rows more than 6° above the horizontal (the pitch and the vertical field of view, 60°).
+    let rows_up = |deg: f64| {
+        let t = ((deg - VIEW[1]).to_radians().tan() / 30f64.to_radians().tan()).min(1.0);
+        ((1.0 - t) * 0.5 * f64::from(size[1])).floor() as usize
+    };
+    let high = rows_up(6.0) * size[0] as usize;
     let (mut luma_delta, mut green_delta) = (0.0, 0.0);
     for (i, (a, b)) in bare.pixels().zip(trees.pixels()).enumerate() {
         // Reversed-Z: a tree is only ever nearer than the ground it stands before.
@@ -184,10 +206,111 @@ fn nc_forest_draws_trees() {
     );
     assert!(changed > total / 50, "only {changed} of {total} pixels show trees");
     assert!(luma_delta < 0.0 || green_delta > 0.0, "trees neither darken nor green the ground");
-    // Trees on the skyline cover some sky; well above the horizon (the top fifth of the frame,
-    // 11° to 18° up) nothing stands.
+    // Trees on the skyline cover some sky; well above the horizon (over 6° up) nothing stands.
     assert!(sky_changed * 10 <= sky.max(1), "{sky_changed} of {sky} sky pixels changed");
     assert_eq!(high_sky_changed, 0, "trees in the sky high above the horizon");
+
+    let reopened = Dataset::open(&path).unwrap();
+    trees_stand_on_forest_not_on_water(&reopened, &camera, size, &bare, &bare_depth, &trees);
+    support::check_reference(&trees, REFERENCE, MIN_PSNR_DB, tmp.path());
+    // Without the trees the frame is far from the reference: the tolerance cannot hide them.
+    let bare_db = support::psnr(&bare, &image::open(reference_path()).unwrap().to_rgba8());
+    println!("the frame without trees: {bare_db:.1} dB against the reference");
+    assert!(bare_db < MIN_PSNR_DB - 5.0, "the bare frame is {bare_db:.1} dB from the reference");
+}
+
+/// Where the pixels the trees changed stand, by the ground under each pixel of the bare frame:
+/// over forest most pixels change; over water, a pixel changes only if a tree on land in front
+/// of it (below it on screen, within the tallest tree's height in pixels there and its crown's
+/// width) can cover it.
+fn trees_stand_on_forest_not_on_water(
+    dataset: &Dataset,
+    camera: &Camera,
+    size: [u32; 2],
+    bare: &image::RgbaImage,
+    bare_depth: &[f32],
+    trees: &image::RgbaImage,
+) {
+    let [w, h] = size;
+    let clip_from_world = camera.clip_from_view(w, h).unwrap() * camera.view_from_world();
+    let world_from_clip = clip_from_world.inverse();
+    let meta = dataset.manifest.landcover.clone().unwrap();
+    let texel_m = 2.0 * meta.layer.texel_m;
+    let origin = dataset.manifest.origin_m;
+    let half = 0.5 * dataset.manifest.height.spacing_m;
+    let mut codes = std::collections::HashMap::new();
+    // Ground class and distance under each pixel (None: sky or outside the map).
+    let ground: Vec<Option<(u8, f64)>> = (0..w * h)
+        .map(|i| {
+            let d = f64::from(bare_depth[i as usize]);
+            if d <= 0.0 {
+                return None;
+            }
+            let ndc = [
+                (f64::from(i % w) + 0.5) / f64::from(w) * 2.0 - 1.0,
+                1.0 - (f64::from(i / w) + 0.5) / f64::from(h) * 2.0,
+            ];
+            let p = world_from_clip * glam::DVec4::new(ndc[0], ndc[1], d, 1.0);
+            let rel = p.truncate() / p.w;
+            let grid = [camera.position_m.x + rel.x - origin[0], camera.position_m.y + rel.y - origin[1]];
+            // Cell layers tile the extent from half a height spacing south-west of the grid.
+            let q = [((grid[0] + half) / texel_m).floor(), ((grid[1] + half) / texel_m).floor()];
+            if q[0] < 0.0 || q[1] < 0.0 {
+                return None;
+            }
+            let q = [q[0] as u32, q[1] as u32];
+            let code = *codes.entry(q).or_insert_with(|| {
+                let index = dataset.landcover_index(1, q).ok()?;
+                meta.coding.code_of(index)
+            });
+            code.map(|c| (c, rel.length()))
+        })
+        .collect();
+    let table = terramp::classes::ClassTable::load("nc").unwrap();
+    let tallest_m = table.species.iter().map(|s| f64::from(s.height_m[1])).fold(0.0, f64::max);
+    let widest = table.species.iter().map(|s| f64::from(s.radius_per_height)).fold(0.0, f64::max);
+    let changed = |i: usize| {
+        let (a, b) = (&bare.as_raw()[4 * i..4 * i + 3], &trees.as_raw()[4 * i..4 * i + 3]);
+        a.iter().zip(b).any(|(a, b)| a.abs_diff(*b) > 2)
+    };
+    // What a tree standing on each land pixel could cover: the tallest tree's height in pixels
+    // at that distance above it, and its widest crown either side.
+    let mut shadow = vec![false; (w * h) as usize];
+    for i in 0..(w * h) as usize {
+        let Some((code, distance_m)) = ground[i] else { continue };
+        if code == WATER {
+            continue;
+        }
+        let reach_px = (tallest_m / camera.metres_per_pixel(distance_m, h)).ceil() as i64 + 1;
+        let half_px = (reach_px as f64 * widest).ceil() as i64 + 1;
+        let (x, y) = ((i as u32 % w) as i64, (i as u32 / w) as i64);
+        for yy in (y - reach_px).max(0)..=y {
+            for xx in (x - half_px).max(0)..=(x + half_px).min(i64::from(w) - 1) {
+                shadow[(yy * i64::from(w) + xx) as usize] = true;
+            }
+        }
+    }
+    let (mut forest, mut forest_changed, mut open_water, mut water_changed) = (0, 0, 0, 0);
+    for i in 0..(w * h) as usize {
+        let Some((code, distance_m)) = ground[i] else { continue };
+        if code == FOREST && distance_m < 1000.0 {
+            forest += 1;
+            forest_changed += usize::from(changed(i));
+        }
+        if code == WATER && !shadow[i] {
+            open_water += 1;
+            water_changed += usize::from(changed(i));
+        }
+    }
+    println!(
+        "forest within 1 km: {forest_changed} of {forest} pixels show trees; open water: {water_changed} of {open_water}"
+    );
+    assert!(
+        forest > 500 && forest_changed * 2 > forest,
+        "{forest_changed} of {forest} forest pixels show trees"
+    );
+    assert!(open_water > 200, "only {open_water} pixels of open water in view: a weak test");
+    assert_eq!(water_changed, 0, "trees on the lake");
 }
 
 /// Makes `docs/nc_trees.png`: 960×540, accurate preset, over nc forest looking towards a lake.
@@ -202,7 +325,7 @@ fn nc_trees_figure() {
     let pose = forest_near_water(&dataset);
     let dir = impostors().to_str().unwrap().to_owned();
     let settings = Settings::preset("accurate").unwrap();
-    let (image, _, report) = render(dataset, settings, &dir, [960, 540], pose, 40.0);
+    let (image, _, report, _) = render(dataset, settings, &dir, [960, 540], pose, [40.0, -12.0]);
     println!("{report:?}");
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/nc_trees.png");
     image.save(&out).unwrap();

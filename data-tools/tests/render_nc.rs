@@ -4,8 +4,6 @@
 
 mod support;
 
-use std::path::Path;
-
 use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::config::Settings;
@@ -14,19 +12,9 @@ use terramp::gpu::{AdapterChoice, Gpu};
 
 use support::{TempDir, build_nc, shared_data};
 
-const REFERENCE: &str = "tests/reference/nc_240x135.png";
+const REFERENCE: &str = "reference/nc_240x135.png";
 /// Rasterisers differ in the last bits of filtering and coverage; a broken frame is far below this.
 const MIN_PSNR_DB: f64 = 30.0;
-
-fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let squared: f64 = a
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..3).map(move |c| (f64::from(p[c]) - f64::from(q[c])).powi(2)))
-        .sum();
-    let mse = squared / (3 * a.width() * a.height()) as f64;
-    if mse == 0.0 { f64::INFINITY } else { 10.0 * (255.0f64.powi(2) / mse).log10() }
-}
 
 #[test]
 fn nc_renders_like_its_reference() {
@@ -58,16 +46,5 @@ fn nc_renders_like_its_reference() {
     let lower: Vec<u32> = image.pixels().skip(image.pixels().len() / 2).map(|p| u32::from(p[1])).collect();
     assert!(lower.iter().max().unwrap() - lower.iter().min().unwrap() > 40);
 
-    let reference_path = Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE);
-    if std::env::var("TERRAMP_BLESS").is_ok_and(|v| v == "1") {
-        image.save(&reference_path).unwrap();
-        return;
-    }
-    let reference = image::open(&reference_path).unwrap().to_rgba8();
-    let db = psnr(&image, &reference);
-    println!("nc render vs reference: {db:.1} dB");
-    if db < MIN_PSNR_DB {
-        image.save(dir.path().join("nc_actual.png")).unwrap();
-        panic!("nc render differs from {REFERENCE}: PSNR {db:.1} dB < {MIN_PSNR_DB} dB");
-    }
+    support::check_reference(&image, REFERENCE, MIN_PSNR_DB, dir.path());
 }

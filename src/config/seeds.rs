@@ -22,6 +22,9 @@ pub struct SeedSettings {
     /// A seed of `reference_height_m` nearer than this is drawn with its real mesh (smaller seeds
     /// in proportion, like the radial LODs); farther, with its billboard clouds.
     pub mesh_m: f64,
+    /// The outer part of each LOD's reach over which a seed cross-fades into the next LOD (the
+    /// last LOD: fades out), as a fraction of the reach; 0 switches at once (pops).
+    pub fade_fraction: f64,
     /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
     pub class_table: String,
     /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
@@ -43,7 +46,7 @@ impl SeedSettings {
             let (key, rule) = ("seeds.occlusion_refine_steps", "0 or a power of two up to 65536");
             return Err(SettingsError::OutOfRange { key, value: steps.to_string(), rule });
         }
-        let ranges: [(&'static str, f64, f64, f64, &'static str); 9] = [
+        let ranges: [(&'static str, f64, f64, f64, &'static str); 10] = [
             ("seeds.seeds_per_pattern", s.seeds_per_pattern.into(), 64.0, 65536.0, "64 to 65536 seeds"),
             ("seeds.capacity", s.capacity.into(), 1.0, 16_777_216.0, "1 to 16777216 seeds"),
             ("seeds.frustum_epsilon", s.frustum_epsilon, 0.0, 1.0, "0 to 1 (NDC units)"),
@@ -53,6 +56,7 @@ impl SeedSettings {
             ("seeds.sink_fraction", s.sink_fraction, 0.0, 0.5, "0 to 0.5 of the seed's height"),
             ("seeds.ground_colour_radius_m", s.ground_colour_radius_m, 0.0, any, "0 or more metres"),
             ("seeds.mesh_m", s.mesh_m, 0.0, any, "0 (never) or more metres"),
+            ("seeds.fade_fraction", s.fade_fraction, 0.0, 0.5, "0 to 0.5 of each LOD's reach"),
         ];
         // NaN and infinities fall outside every range.
         match ranges.into_iter().find(|(_, value, lo, hi, _)| !(*lo..=*hi).contains(value)) {

@@ -10,7 +10,7 @@
 //! geometry. `shaders/draw_seeds.wgsl` reads an instance's record through compaction's `order`,
 //! scales the model to the seed's height, turns it by the seed's jitter, places it camera-relative
 //! and projects it with the terrain's matrix; it draws into the colour target with the terrain
-//! depth (reversed-Z, `GreaterEqual`, depth written). A seed in the outer `FADE_FRACTION` of its
+//! depth (reversed-Z, `GreaterEqual`, depth written). A seed in the outer `seeds.fade_fraction` of its
 //! LOD's reach cross-fades: its own geometry keeps the pixels whose (per-seed shifted) Bayer
 //! threshold is below the fade, the next LOD's geometry the others, so each pixel shows exactly
 //! one of the two and nothing pops; outside the band the cross-fade draw collapses its vertices.
@@ -34,9 +34,6 @@ use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT};
 
 pub use assets::MAX_LAYER_TEXELS;
 
-/// The outer part of each LOD's reach over which a seed cross-fades into the next LOD (or, for
-/// the last, fades out), as a fraction of the reach.
-pub const FADE_FRACTION: f32 = 0.1;
 /// How much of the ground colour under a seed it takes on.
 pub const GROUND_BLEND: f32 = 0.2;
 
@@ -292,7 +289,7 @@ pub fn draw_uniforms(
         lod_reach_m: crate::seeds::lod_reach_m(settings).map(|r| r as f32),
         inv_reference_height_m: (1.0 / settings.seeds.reference_height_m) as f32,
         sink_fraction: settings.seeds.sink_fraction as f32,
-        fade_fraction: FADE_FRACTION,
+        fade_fraction: settings.seeds.fade_fraction as f32,
         ground_blend: GROUND_BLEND,
     }
 }

@@ -154,3 +154,33 @@ pub fn number_before(text: &str, label: &str) -> u64 {
     let start = text[..end].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
     text[start..end].parse().unwrap()
 }
+
+/// PSNR of `a` against `b` over RGB, dB (infinite when equal).
+pub fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let squared: f64 = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| (f64::from(p[c]) - f64::from(q[c])).powi(2)))
+        .sum();
+    let mse = squared / (3 * a.width() * a.height()) as f64;
+    if mse == 0.0 { f64::INFINITY } else { 10.0 * (255.0f64.powi(2) / mse).log10() }
+}
+
+/// Compares `image` with the reference `tests/<name>` (PSNR at least `min_db`), or rewrites the
+/// reference when `TERRAMP_BLESS=1`. A mismatch saves the image beside `keep_dir` for inspection.
+pub fn check_reference(image: &image::RgbaImage, name: &str, min_db: f64, keep_dir: &Path) -> f64 {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join(name);
+    if std::env::var("TERRAMP_BLESS").is_ok_and(|v| v == "1") {
+        image.save(&path).unwrap();
+        return f64::INFINITY;
+    }
+    let reference = image::open(&path).unwrap().to_rgba8();
+    let db = psnr(image, &reference);
+    println!("{name}: {db:.1} dB against the reference");
+    if db < min_db {
+        let actual = keep_dir.join("actual.png");
+        image.save(&actual).unwrap();
+        panic!("the render differs from {name}: PSNR {db:.1} dB < {min_db} dB (saved {})", actual.display());
+    }
+    db
+}
