@@ -276,8 +276,8 @@ fn trees_stand_on_forest_not_on_water(
     // What a tree standing on each land pixel could cover: the tallest tree's height in pixels
     // at that distance above it, and its widest crown either side.
     let mut shadow = vec![false; (w * h) as usize];
-    for i in 0..(w * h) as usize {
-        let Some((code, distance_m)) = ground[i] else { continue };
+    for (i, g) in ground.iter().enumerate() {
+        let Some((code, distance_m)) = *g else { continue };
         if code == WATER {
             continue;
         }
