@@ -115,14 +115,16 @@ fn forest_near_water(dataset: &Dataset) -> ([f64; 2], f64) {
     (grid, yaw)
 }
 
-fn render(
+/// A renderer over `pose` seen from `[above_m, pitch_deg]`, every tile resident and the seeds of
+/// the final TLM selected (seeds follow the TLM of a frame or two before).
+fn open_view(
     dataset: Dataset,
     mut settings: Settings,
     impostors: &str,
     size: [u32; 2],
     pose: ([f64; 2], f64),
     [above_m, pitch_deg]: [f64; 2],
-) -> (image::RgbaImage, Vec<f32>, FrameReport, Camera) {
+) -> (Renderer, Camera, FrameReport) {
     settings.render.width = size[0];
     settings.render.height = size[1];
     settings.seeds.impostors = impostors.to_owned();
@@ -139,11 +141,22 @@ fn render(
         near_m: 0.1,
     };
     r.render_resolved(&camera, 200).unwrap();
-    // Seeds follow the TLM of a frame or two before: a few more frames of the same view.
     let mut report = r.render(&camera).unwrap();
     for _ in 0..4 {
         report = r.render(&camera).unwrap();
     }
+    (r, camera, report)
+}
+
+fn render(
+    dataset: Dataset,
+    settings: Settings,
+    impostors: &str,
+    size: [u32; 2],
+    pose: ([f64; 2], f64),
+    view: [f64; 2],
+) -> (image::RgbaImage, Vec<f32>, FrameReport, Camera) {
+    let (r, camera, report) = open_view(dataset, settings, impostors, size, pose, view);
     (r.read_colour().unwrap(), r.read_depth().unwrap(), report, camera)
 }
 
@@ -312,6 +325,73 @@ fn trees_stand_on_forest_not_on_water(
     assert!(open_water > 200, "only {open_water} pixels of open water in view: a weak test");
     assert_eq!(water_changed, 0, "trees on the lake");
 }
+
+/// Largest changes between consecutive frames: of one pixel's luma, and of a 4 × 4 block's mean
+/// luma (the dither's period: a cross-fade flips single pixels, a pop changes whole blocks).
+fn frame_change(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, f64) {
+    let luma =
+        |p: &image::Rgba<u8>| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+    let (w, h) = a.dimensions();
+    let delta = |x: u32, y: u32| luma(b.get_pixel(x, y)) - luma(a.get_pixel(x, y));
+    let pixel =
+        (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| delta(x, y).abs()).fold(0.0, f64::max);
+    let mut block = 0.0f64;
+    for by in 0..h / 4 {
+        for bx in 0..w / 4 {
+            let sum: f64 = (0..16).map(|k| delta(4 * bx + k % 4, 4 * by + k / 4)).sum();
+            block = block.max((sum / 16.0).abs());
+        }
+    }
+    (pixel, block)
+}
+
+/// A slow change of distance, with everything else still: the camera stays, and every seed's LOD
+/// reaches shrink by 0.2 % a frame (`seeds.reference_height_m` grows above every tree's height),
+/// as if the view drew back at 0.2 % of each distance a frame (1.4 m at 700 m). Every change
+/// between frames is then a LOD change. With the cross-fade (`seeds.fade_fraction` 0.1) the
+/// largest change of a 4 × 4 block between frames stays under 12 levels of 255 and under half of
+/// what switching at once gives (measured on lavapipe: 7.8 against 19.5). Single pixels still
+/// flip between the two LODs' geometry (up to ~125 levels either way): that is the dither.
+#[test]
+fn lod_changes_cross_fade_instead_of_popping() {
+    if shared_data().is_none() {
+        return;
+    }
+    let tmp = TempDir::new("draw-seeds-fade");
+    let path = tmp.path().join("nc");
+    let pose = forest_near_water(&build_nc(&path));
+    let dir = impostors().to_str().unwrap().to_owned();
+    let run = |fade_fraction: f64| {
+        let mut settings = Settings::default();
+        settings.seeds.fade_fraction = fade_fraction;
+        settings.seeds.reference_height_m = 40.0;
+        let (mut r, camera, _) =
+            open_view(Dataset::open(&path).unwrap(), settings, &dir, [320, 180], pose, [40.0, -12.0]);
+        let mut frames = vec![r.read_colour().unwrap()];
+        for _ in 0..FADE_FRAMES {
+            r.settings.seeds.reference_height_m *= 1.002;
+            // Pass 3 runs a frame behind the draw's constants: two frames per step.
+            r.render(&camera).unwrap();
+            r.render(&camera).unwrap();
+            frames.push(r.read_colour().unwrap());
+        }
+        let changes: Vec<(f64, f64)> = frames.windows(2).map(|f| frame_change(&f[0], &f[1])).collect();
+        let worst = changes.iter().fold((0.0f64, 0.0f64), |a, c| (a.0.max(c.0), a.1.max(c.1)));
+        println!(
+            "fade {fade_fraction}: largest change of a pixel {:.1}, of a 4×4 block {:.1} (of 255)",
+            worst.0, worst.1
+        );
+        worst
+    };
+    let (_, faded) = run(0.1);
+    let (_, popped) = run(0.0);
+    assert!(popped > 0.0, "nothing changed LOD in {FADE_FRAMES} frames: a void test");
+    assert!(faded <= 0.5 * popped, "cross-fades change a block by {faded:.1}, pops by {popped:.1}");
+    assert!(faded <= 12.0, "cross-fades change a 4×4 block by {faded:.1} of 255 in one frame");
+}
+
+/// Steps of the slow distance change.
+const FADE_FRAMES: usize = 24;
 
 /// Makes `docs/nc_trees.png`: 960×540, accurate preset, over nc forest looking towards a lake.
 #[test]
