@@ -176,4 +176,23 @@ impl Renderer {
         self.gpu.check()?;
         Ok(())
     }
+
+    /// Runs the last frame's seed passes again, as that frame recorded them (pass 3 over its
+    /// cells, then compaction, then, with `draw`, the draw into the colour and depth it left),
+    /// and waits for the GPU: for benchmarks of a fixed camera. `false` when there were none.
+    pub fn rerun_seed_passes(&mut self, draw: bool) -> Result<bool, RenderError> {
+        let Some(stage) = self.seeds.as_ref().filter(|s| s.last_frame.is_some()) else { return Ok(false) };
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        stage.encode(&mut encoder);
+        stage.encode_compact(&mut encoder);
+        if draw {
+            let colour = self.colour.create_view(&Default::default());
+            let depth = self.depth.create_view(&Default::default());
+            stage.encode_draw(&mut encoder, &colour, &depth);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        self.gpu.wait()?;
+        self.gpu.check()?;
+        Ok(true)
+    }
 }
