@@ -377,9 +377,11 @@ impl Renderer {
 
         // Instances: each node over its own height tile, or its finest resident ancestor.
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
-        let (batches, dropped) = node_batches(&lods, &selected, camera_grid_m, &self.heights, &mut |node| {
-            bounds.get(&lods, node, |tile| dataset.height_tile(tile).ok())
-        });
+        let floor_m = dataset.manifest.height.min_m;
+        let (batches, dropped) =
+            node_batches(&lods, &selected, camera_grid_m, &self.heights, floor_m, &mut |node| {
+                bounds.get(&lods, node, |tile| dataset.height_tile(tile).ok())
+            });
         report.nodes_drawn = batches.len();
         report.nodes_dropped = dropped;
         let uniforms = terrain_uniforms(
