@@ -45,8 +45,9 @@ impl Renderer {
         if lift_m <= 0.0 {
             return (*camera, 0.0);
         }
+        // Grid z is CRS z: set it, so that rendering the lifted camera lifts it no further.
         let mut lifted = *camera;
-        lifted.position_m.z += lift_m;
+        lifted.position_m.z = ground_m + clearance_m;
         (lifted, lift_m)
     }
 
