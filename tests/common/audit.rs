@@ -18,6 +18,7 @@ use terramp::camera::Camera;
 use terramp::dataset::{Dataset, TileId};
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::{SeedCounters, SeedRecord, TlmCell};
+use terramp::terrain::select::Lods;
 
 /// The level-0 DEM of a dataset, whole, in f64: the oracle's ground.
 pub struct Dem {
@@ -106,12 +107,28 @@ impl Dem {
     }
 }
 
-/// What the oracle may not judge: the terrain mesh's departure from the bilinear DEM (its LOD
-/// error, vertically) and a band along the dataset's edges.
+/// What the oracle may not judge: the terrain mesh's departure from the finest mesh, vertically,
+/// and a band along the dataset's edges.
 #[derive(Debug, Clone, Copy)]
 pub struct Tolerance {
+    /// Where the finest LOD is drawn (nearer than `Lods::morph_start_m[0]`).
     pub height_m: f64,
+    /// Beyond, where coarser levels stand in (datasets of one level never get there).
+    pub coarse_height_m: f64,
     pub margin_m: f64,
+}
+
+impl Tolerance {
+    /// The same slack at every distance.
+    pub fn flat(height_m: f64, margin_m: f64) -> Self {
+        Self { height_m, coarse_height_m: height_m, margin_m }
+    }
+}
+
+/// The vertical slack `tol` allows at distance `distance_m`, with the finest LOD drawn out to
+/// `fine_within_m`.
+fn slack_m(tol: &Tolerance, fine_within_m: f64, distance_m: f64) -> f64 {
+    if distance_m < fine_within_m { tol.height_m } else { tol.coarse_height_m }
 }
 
 /// What a pixel must show.
@@ -162,8 +179,10 @@ impl Rays {
 }
 
 /// What the ray from `eye` along `dir` must show over `dem`, from `t_near` on (where the ray
-/// crosses the near plane: nothing before it is drawn).
-pub fn expect(dem: &Dem, eye: DVec3, dir: DVec3, t_near: f64, tol: Tolerance) -> Expect {
+/// crosses the near plane: nothing before it is drawn), with the finest LOD out to `fine_within_m`.
+pub fn expect(dem: &Dem, eye: DVec3, dir: DVec3, t_near: f64, tol: Tolerance, fine_within_m: f64) -> Expect {
+    let slack = |t: f64| slack_m(&tol, fine_within_m, t);
+    let widest = tol.height_m.max(tol.coarse_height_m);
     let span = dem.span_m();
     let (mut t_lo, mut t_hi) = (t_near, f64::INFINITY);
     for a in 0..2 {
@@ -180,7 +199,7 @@ pub fn expect(dem: &Dem, eye: DVec3, dir: DVec3, t_near: f64, tol: Tolerance) ->
     if t_lo > t_hi {
         return Expect::Sky;
     }
-    let band = [dem.min_m - tol.height_m - 1.0, dem.max_m + tol.height_m + 1.0];
+    let band = [dem.min_m - widest - 1.0, dem.max_m + widest + 1.0];
     let z_at = |t: f64| eye.z + dir.z * t;
     let clearance = |t: f64| {
         let p = eye + dir * t;
@@ -188,7 +207,7 @@ pub fn expect(dem: &Dem, eye: DVec3, dir: DVec3, t_near: f64, tol: Tolerance) ->
     };
     // The ray must enter over the dataset from above the ground to be judged at all.
     let entry = z_at(t_lo);
-    if entry < band[0] || (entry <= band[1] && clearance(t_lo) <= tol.height_m) {
+    if entry < band[0] || (entry <= band[1] && clearance(t_lo) <= slack(t_lo)) {
         return Expect::Unknown;
     }
     // Only the stretch within the height band can meet the ground.
@@ -204,18 +223,18 @@ pub fn expect(dem: &Dem, eye: DVec3, dir: DVec3, t_near: f64, tol: Tolerance) ->
         return Expect::Sky;
     }
     let horizontal = dir.truncate().length();
-    let step =
-        (0.25 * dem.spacing_m / horizontal.max(1e-300)).min(0.5 * tol.height_m / dir.z.abs().max(1e-300));
+    let step = (0.25 * dem.spacing_m / horizontal.max(1e-300))
+        .min(0.5 * tol.height_m.min(widest) / dir.z.abs().max(1e-300));
     let steps = ((b - a) / step).ceil().min(1e6) as u64;
     let mut near_miss = false;
     for k in 0..=steps {
         let t = if steps == 0 { b } else { a + (b - a) * k as f64 / steps as f64 };
         let c = clearance(t);
-        if c < -tol.height_m {
+        if c < -slack(t) {
             let p = eye + dir * t;
             return if dem.covers(p.x, p.y, tol.margin_m) { Expect::Ground } else { Expect::Unknown };
         }
-        near_miss |= c <= tol.height_m;
+        near_miss |= c <= slack(t);
     }
     if near_miss { Expect::Unknown } else { Expect::Sky }
 }
@@ -239,7 +258,9 @@ pub struct Audit {
     pub spurious: usize,
     /// Ground pixels whose depth puts the point farther than the tolerance from the DEM.
     pub off_dem_px: usize,
+    /// Where the finest LOD is drawn, and beyond.
     pub worst_height_error_m: f64,
+    pub worst_coarse_height_error_m: f64,
     pub tlm_cells: usize,
     pub tlm_visible: usize,
     pub tlm_bad: usize,
@@ -280,6 +301,8 @@ impl Audit {
 pub fn audit(r: &Renderer, camera: &Camera, dem: &Dem, tol: Tolerance, ray_step_px: u32) -> Audit {
     let mut a = Audit::default();
     let rays = Rays::new(r, camera);
+    let lods = Lods::for_view(&r.dataset, &r.settings.terrain, camera, rays.height);
+    let fine_within_m = lods.morph_start_m.first().copied().unwrap_or(f64::INFINITY);
     let depth = r.read_depth().unwrap();
     let colour = r.read_colour().unwrap();
     a.pixels = depth.len();
@@ -293,7 +316,8 @@ pub fn audit(r: &Renderer, camera: &Camera, dem: &Dem, tol: Tolerance, ray_step_
             a.rays += 1;
             let d = at(x, y);
             let dir = rays.dir(x, y);
-            match expect(dem, rays.eye_grid_m, dir, camera.near_m / dir.dot(rays.forward), tol) {
+            match expect(dem, rays.eye_grid_m, dir, camera.near_m / dir.dot(rays.forward), tol, fine_within_m)
+            {
                 Expect::Ground => {
                     a.expect_ground += 1;
                     a.holes += usize::from(d == 0.0);
@@ -307,9 +331,15 @@ pub fn audit(r: &Renderer, camera: &Camera, dem: &Dem, tol: Tolerance, ray_step_
             if d > 0.0 && d.is_finite() {
                 let p = rays.point(x, y, d, camera.near_m);
                 if dem.covers(p.x, p.y, tol.margin_m) {
-                    let error_m = p.z - dem.mesh_height_m(p.x, p.y);
-                    a.worst_height_error_m = a.worst_height_error_m.max(error_m.abs());
-                    a.off_dem_px += usize::from(error_m.abs() > tol.height_m);
+                    let (error_m, distance_m) =
+                        (p.z - dem.mesh_height_m(p.x, p.y), (p - rays.eye_grid_m).length());
+                    let worst = if distance_m < fine_within_m {
+                        &mut a.worst_height_error_m
+                    } else {
+                        &mut a.worst_coarse_height_error_m
+                    };
+                    *worst = worst.max(error_m.abs());
+                    a.off_dem_px += usize::from(error_m.abs() > slack_m(&tol, fine_within_m, distance_m));
                 }
             }
         }

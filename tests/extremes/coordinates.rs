@@ -58,7 +58,7 @@ fn render(origin_m: [f64; 2], pose: [f64; 5]) -> Frame {
     let camera = camera(&r, &dem, pose);
     r.render_resolved(&camera, 60).unwrap();
     let what = format!("origin {origin_m:?}, pose {pose:?}");
-    let a = audit(&r, &camera, &dem, Tolerance { height_m: 0.1, margin_m: 20.0 }, 4);
+    let a = audit(&r, &camera, &dem, Tolerance::flat(0.1, 20.0), 4);
     a.assert_sound(&what);
     let (mut seeds, _) = r.read_seeds().unwrap().unwrap();
     seeds.sort_by_key(|s| (s.address, s.rank));
@@ -113,7 +113,7 @@ fn a_planet_size_dataset_places_seeds_to_the_centimetre_10_million_metres_out() 
         let pose = [grid[0] + 0.4567, grid[1] + 0.891, 3.0, 40.0 + 70.0 * k as f64, -8.0];
         let camera = camera(&r, &dem, pose);
         r.render_resolved(&camera, 60).unwrap();
-        let a = audit(&r, &camera, &dem, Tolerance { height_m: 1.0, margin_m: 100.0 }, 4);
+        let a = audit(&r, &camera, &dem, Tolerance::flat(1.0, 100.0), 4);
         a.assert_sound(&format!("pose {pose:?}"));
         let (seeds, _) = r.read_seeds().unwrap().unwrap();
         let camera_grid_m = DVec3::new(pose[0], pose[1], camera.position_m.z);

@@ -36,7 +36,7 @@ fn cameras_outside_every_corner_and_edge_look_in() {
             let what = format!("({dx}, {dy}) {away_m} m out, {z_m:.0} m high");
             let (report, _) = r.render_resolved(&camera, 60).unwrap();
             assert_eq!(report.camera_lifted_m, 0.0, "{what}: outside the dataset there is no ground");
-            let a = audit(&r, &camera, &dem, Tolerance { height_m: 0.05, margin_m: 20.0 }, 4);
+            let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 4);
             println!("{what}: {a:?}");
             a.assert_sound(&what);
             assert!(a.expect_ground > 50 && a.expect_sky > 50, "{what}: {a:?}");
@@ -63,7 +63,7 @@ fn datasets_of_one_sample_one_cell_and_one_tile_render() {
             let what = format!("size {size}, {what}");
             let (report, _) = r.render_resolved(&camera, 60).unwrap();
             assert!(report.nodes_drawn > 0 && report.nodes_dropped == 0, "{what}: {report:?}");
-            let a = audit(&r, &camera, &dem, Tolerance { height_m: 0.05, margin_m: 0.1 * span[0] }, 4);
+            let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 0.1 * span[0]), 4);
             println!("{what}: {a:?}");
             a.assert_sound(&what);
             assert!(a.expect_ground > 10, "{what}: {a:?}");
@@ -83,7 +83,7 @@ fn grows_nothing(name: &str, text: &str) {
     let span = dem.span_m();
     let camera = camera_at(&r, &dem, [0.4 * span[0], 0.4 * span[1]], 30.0, 60.0, -15.0);
     let (report, _) = r.render_resolved(&camera, 60).unwrap();
-    let a = audit(&r, &camera, &dem, Tolerance { height_m: 0.05, margin_m: 20.0 }, 4);
+    let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 4);
     println!("{name}: {report:?}\n{a:?}");
     a.assert_sound(name);
     assert!(report.seed_cells > 0, "{name}: no cell to grow seeds in: {report:?}");

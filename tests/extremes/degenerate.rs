@@ -78,7 +78,7 @@ fn fields_of_view_near_0_and_180_render_or_are_refused() {
     ];
     for (what, camera, height_m, judged) in views {
         r.render_resolved(&camera, 60).unwrap();
-        let a = audit(&r, &camera, &dem, Tolerance { height_m, margin_m: 20.0 }, 4);
+        let a = audit(&r, &camera, &dem, Tolerance::flat(height_m, 20.0), 4);
         println!("{what}: {a:?}");
         a.assert_sound(what);
         if judged {
@@ -178,7 +178,7 @@ fn a_camera_inside_the_terrain_is_lifted_above_it() {
         // The frame is the one seen from the lifted camera, and it is sound.
         let lifted = Camera { position_m: buried.position_m + DVec3::Z * lifted_m, ..buried };
         let image = r.read_colour().unwrap();
-        let a = audit(&r, &lifted, &dem, Tolerance { height_m: 0.05, margin_m: 20.0 }, 4);
+        let a = audit(&r, &lifted, &dem, Tolerance::flat(0.05, 20.0), 4);
         println!("{below_m} m under: {a:?}");
         a.assert_sound(&format!("{below_m} m under"));
         assert!(a.expect_ground > 100, "{a:?}");

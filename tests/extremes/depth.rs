@@ -279,7 +279,7 @@ fn cameras_2_m_and_100_km_and_500_km_up_see_ground_and_sky_where_they_must() {
     ];
     for (what, camera, height_m, sky) in views {
         r.render_resolved(&camera, 60).unwrap();
-        let a = audit(&r, &camera, &dem, Tolerance { height_m, margin_m: 20.0 }, 4);
+        let a = audit(&r, &camera, &dem, Tolerance::flat(height_m, 20.0), 4);
         println!("{what}: {a:?}");
         a.assert_sound(what);
         assert!(a.expect_ground > 100 && a.ground_px > a.pixels / 5, "{what}: too little ground ({a:?})");

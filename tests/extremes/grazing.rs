@@ -49,7 +49,7 @@ fn grazing_and_horizontal_views_keep_every_buffer_finite_and_the_ground_whole() 
     ];
     for (what, camera) in views {
         r.render_resolved(&camera, 60).unwrap();
-        let a = audit(&r, &camera, &dem, Tolerance { height_m: 0.05, margin_m: 20.0 }, 4);
+        let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 4);
         println!("{what}: {a:?}");
         a.assert_sound(what);
         assert!(a.expect_ground > 50 && a.expect_sky > 50, "{what}: {a:?}");
