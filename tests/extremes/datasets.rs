@@ -12,7 +12,8 @@ use crate::common::{self, small_settings};
 #[test]
 fn cameras_outside_every_corner_and_edge_look_in() {
     let dataset = common::synth_dataset(256, 7);
-    let mut r = common::renderer(&dataset, small_settings(320, 180));
+    // Sixteen views: a smaller frame keeps them quick.
+    let mut r = common::renderer(&dataset, small_settings(192, 108));
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let centre = [0.5 * span[0], 0.5 * span[1]];
@@ -36,10 +37,10 @@ fn cameras_outside_every_corner_and_edge_look_in() {
             let what = format!("({dx}, {dy}) {away_m} m out, {z_m:.0} m high");
             let (report, _) = r.render_resolved(&camera, 60).unwrap();
             assert_eq!(report.camera_lifted_m, 0.0, "{what}: outside the dataset there is no ground");
-            let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 4);
+            let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 3);
             println!("{what}: {a:?}");
             a.assert_sound(&what);
-            assert!(a.expect_ground > 50 && a.expect_sky > 50, "{what}: {a:?}");
+            assert!(a.expect_ground > 20 && a.expect_sky > 20, "{what}: {a:?}");
         }
     }
 }
