@@ -309,9 +309,12 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     var out: Outcome;
     out.count = COUNT_CLASS;
     let pos_unit = patterns[cell.pattern * u.seeds_per_pattern + rank];
-    // Outside the dataset there is no class.
+    // Outside the dataset there is no class. It ends at its last sample, where the terrain mesh
+    // does: a seed between it and the land cover's edge would stand beyond the ground.
     let sample = grid_pos(cell.height_sample, cell.height_frac, pos_unit, u.cell_in_samples);
-    if any(sample.texel < vec2<i32>(0)) || any(sample.texel > vec2<i32>(u.height_size) - 1) || u.lcc_sub_bits == 0u {
+    let last = vec2<i32>(u.height_size) - 1;
+    let beyond = any(sample.texel > last) || any((sample.texel == last) & (sample.frac > vec2<f32>(0.0)));
+    if any(sample.texel < vec2<i32>(0)) || beyond || u.lcc_sub_bits == 0u {
         return out;
     }
     let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);

@@ -6,16 +6,36 @@
 //!
 //! Angles: `yaw_deg` is the compass heading (0 = north, 90 = east), `pitch_deg` the elevation of
 //! the view direction above the horizon (negative looks down).
+//!
+//! `validate` refuses what the f32 GPU side cannot carry, with a typed error rather than a frame
+//! of garbage: non-finite numbers, a near plane that is not positive, a field of view outside
+//! [`MIN_FOV_DEG`, 180°), coordinates beyond `MAX_COORDINATE_M`.
 
 use glam::{DMat4, DVec3, DVec4, Mat4};
 use thiserror::Error;
+
+/// Narrowest vertical field of view, degrees. The GPU computes clip coordinates in f32 from
+/// camera-relative positions, with a relative error of about 1e-7: a pixel's angle, fov / height,
+/// must stay well above that for pixels to land where they belong. At 0.01° over 1080 rows a point
+/// lands within 0.46 px of its place; at 0.001°, 4.2 px away (`tests/extremes.rs`).
+pub const MIN_FOV_DEG: f64 = 0.01;
+/// Largest |coordinate| of a camera position, metres (a hundred times the Earth's circumference).
+/// Beyond it ring and cell indices leave i64 and relative positions lose every metre in f32.
+pub const MAX_COORDINATE_M: f64 = 4e9;
+/// Nearest near plane, metres. Reversed-Z depth is `near / distance`: a smaller near plane would
+/// push far depths into f32 denormals, which GPUs flush to 0, the sky.
+pub const MIN_NEAR_M: f64 = 1e-6;
 
 #[derive(Debug, Error, PartialEq)]
 pub enum CameraError {
     #[error("camera: {0} is not a finite number")]
     NotFinite(&'static str),
-    #[error("camera: field of view {0}° must be between 0 and 180")]
+    #[error("camera: field of view {0}° must be at least {MIN_FOV_DEG}° and below 180°")]
     Fov(f64),
+    #[error("camera: near plane {0} m must be at least {MIN_NEAR_M} m")]
+    Near(f64),
+    #[error("camera: {0} = {1} m is beyond ±{MAX_COORDINATE_M} m")]
+    TooFar(&'static str, f64),
     #[error("camera: viewport {0}×{1} has no area")]
     Viewport(u32, u32),
     #[error("camera: `{0}` is not X,Y,Z,YAW,PITCH (five numbers: metres, metres, metres, degrees, degrees)")]
@@ -62,8 +82,14 @@ impl Camera {
         if let Some((name, _)) = named.iter().find(|(_, v)| !v.is_finite()) {
             return Err(CameraError::NotFinite(name));
         }
-        if !(self.fov_deg > 0.0 && self.fov_deg < 180.0) {
+        if !(self.fov_deg >= MIN_FOV_DEG && self.fov_deg < 180.0) {
             return Err(CameraError::Fov(self.fov_deg));
+        }
+        if self.near_m < MIN_NEAR_M {
+            return Err(CameraError::Near(self.near_m));
+        }
+        if let Some((name, v)) = named[..3].iter().find(|(_, v)| v.abs() > MAX_COORDINATE_M) {
+            return Err(CameraError::TooFar(name, *v));
         }
         Ok(())
     }
@@ -182,5 +208,15 @@ mod tests {
         assert!(matches!(Camera::parse_pose("1,2,3,4,5", 180.0, 0.1), Err(CameraError::Fov(_))));
         assert!(matches!(Camera::parse_pose("1,2,inf,4,5", 60.0, 0.1), Err(CameraError::NotFinite("z"))));
         assert!(camera().clip_from_view(0, 10).is_err());
+        let c = camera();
+        assert_eq!(Camera { fov_deg: 0.001, ..c }.validate(), Err(CameraError::Fov(0.001)));
+        assert_eq!(Camera { fov_deg: 180.0, ..c }.validate(), Err(CameraError::Fov(180.0)));
+        assert!(Camera { fov_deg: MIN_FOV_DEG, ..c }.validate().is_ok());
+        assert!(Camera { fov_deg: 179.999, ..c }.validate().is_ok());
+        assert_eq!(Camera { near_m: 0.0, ..c }.validate(), Err(CameraError::Near(0.0)));
+        assert_eq!(Camera { near_m: -1.0, ..c }.validate(), Err(CameraError::Near(-1.0)));
+        let far = Camera { position_m: DVec3::new(0.0, -1e20, 0.0), ..c };
+        assert_eq!(far.validate(), Err(CameraError::TooFar("y", -1e20)));
+        assert!(Camera { position_m: DVec3::splat(1e7), ..c }.validate().is_ok());
     }
 }

@@ -5,10 +5,8 @@ mod support;
 
 use std::path::{Path, PathBuf};
 
-use gdal::raster::Buffer;
-use gdal::spatial_ref::SpatialRef;
-use gdal::{DriverManager, GeoTransform};
-use support::{TempDir, build, height_image, mask_image, run_build};
+use gdal::GeoTransform;
+use support::{TempDir, build, height_image, mask_image, run_build, write_geotiff};
 
 const NODATA: f64 = -9999.0;
 /// UTM 33N: a projected, metric CRS.
@@ -16,14 +14,7 @@ const EPSG: u32 = 32633;
 
 /// Writes a float32 GeoTIFF of `size` heights (row by row from the north) with 25 m pixels.
 fn write_dem(path: &Path, size: [usize; 2], heights: Vec<f32>, geo_transform: GeoTransform) -> PathBuf {
-    let driver = DriverManager::get_driver_by_name("GTiff").unwrap();
-    let mut dataset = driver.create_with_band_type::<f32, _>(path, size[0], size[1], 1).unwrap();
-    dataset.set_geo_transform(&geo_transform).unwrap();
-    dataset.set_spatial_ref(&SpatialRef::from_epsg(EPSG).unwrap()).unwrap();
-    let mut band = dataset.rasterband(1).unwrap();
-    band.set_no_data_value(Some(NODATA)).unwrap();
-    band.write((0, 0), (size[0], size[1]), &mut Buffer::new((size[0], size[1]), heights)).unwrap();
-    path.to_owned()
+    write_geotiff(path, size, heights, geo_transform, EPSG, Some(NODATA))
 }
 
 const NORTH_UP: GeoTransform = [500_000.0, 25.0, 0.0, 5_000_000.0, 0.0, -25.0];

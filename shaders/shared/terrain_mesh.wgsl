@@ -88,7 +88,12 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance
     let g_morphed = min(g - fract(g * 0.5) * 2.0 * morph, node.cells_inside);
 
     let xy = node.origin_rel_m + g_morphed * node.cell_m;
-    let z = height_at(node, g_morphed) - u.camera_grid_m.z - select(0.0, node.skirt_m, skirt);
+    // Skirts hang `skirt_m` below the edge, but never lower than a cell under the dataset's lowest
+    // ground: still below both sides of any seam, and nothing dangles under the terrain for a view
+    // past its edge to see.
+    let surface = height_at(node, g_morphed) - u.camera_grid_m.z;
+    let floor = u.height_range_m.x - node.cell_m - u.camera_grid_m.z;
+    let z = select(surface, max(surface - node.skirt_m, floor), skirt);
     // Central differences one (level) sample apart; the tile border makes them valid at the edges.
     let dx = height_at(node, g_morphed + vec2<f32>(1.0, 0.0)) - height_at(node, g_morphed - vec2<f32>(1.0, 0.0));
     let dy = height_at(node, g_morphed + vec2<f32>(0.0, 1.0)) - height_at(node, g_morphed - vec2<f32>(0.0, 1.0));

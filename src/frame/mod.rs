@@ -18,7 +18,7 @@ use crate::passes::depth_pyramid::DepthPyramid;
 use crate::passes::ground::GroundPass;
 use crate::passes::seed_select::SeedSources;
 use crate::passes::tile_load_map::{
-    TileLoadMapPass, TlmBindings, TlmError, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges,
+    TileLoadMapPass, TlmBindings, TlmError, TlmFrame, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges,
 };
 use crate::shaders::MAX_LEVELS;
 use crate::streaming::analysis::{LoadMaps, analyse};
@@ -27,8 +27,11 @@ use crate::streaming::{CacheStats, LayerKind, Loader, LoaderError, TileCache, Up
 use crate::terrain::select::{Lods, NodeBounds, select};
 use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass, node_batches, terrain_uniforms};
 
+mod clearance;
 mod seeds;
 mod tools;
+
+pub use clearance::GROUND_CLEARANCE_NEAR;
 
 pub use seeds::SeedReport;
 
@@ -66,6 +69,8 @@ pub enum RenderError {
     SeedCapacity { capacity: u32, max: u32 },
     #[error("the {layer} cache has {slots} slots; the whole layer is {tiles} tiles")]
     DoesNotFit { layer: &'static str, tiles: u64, slots: usize },
+    #[error("a {width}×{height} viewport is larger than this adapter's {max}-pixel targets")]
+    ViewportTooLarge { width: u32, height: u32, max: u32 },
 }
 
 /// What one frame did, for logs and tests.
@@ -94,6 +99,8 @@ pub struct FrameReport {
     /// Species drawn with an impostor, and species not drawn (no `seeds.impostors`, or no model).
     pub seed_species_drawn: usize,
     pub seed_species_undrawn: usize,
+    /// Metres the camera was lifted by because it was under the ground (0 when it was not).
+    pub camera_lifted_m: f64,
 }
 
 pub struct Renderer {
@@ -120,6 +127,8 @@ pub struct Renderer {
     tlm_readback: ReadbackRing,
     /// Layouts of the TLMs in flight, by frame: a TLM is read against its own frame's layout.
     tlm_layouts: VecDeque<(u64, TlmLayout, DVec3)>,
+    /// The last frame's TLM inputs, to read its output back (`read_tile_load_map`).
+    last_tlm: Option<TlmFrame>,
     /// The latest TLM's load maps; they drive the streaming of the next frames.
     load_maps: Option<LoadMaps>,
     terrain_bindings: wgpu::BindGroup,
@@ -135,6 +144,15 @@ impl Renderer {
     pub fn new(gpu: Gpu, dataset: Dataset, settings: Settings) -> Result<Self, RenderError> {
         let dataset = Arc::new(dataset);
         let device = &gpu.device;
+        // Targets of no area, or wider than the adapter allows, would only fail later as GPU errors.
+        let (width, height, max) =
+            (settings.render.width, settings.render.height, device.limits().max_texture_dimension_2d);
+        if width == 0 || height == 0 {
+            return Err(CameraError::Viewport(width, height).into());
+        }
+        if width.max(height) > max {
+            return Err(RenderError::ViewportTooLarge { width, height, max });
+        }
         let terrain = TerrainPass::new(device, &settings);
         let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
         let ground = GroundPass::new(device, &settings, software, &terrain);
@@ -258,6 +276,7 @@ impl Renderer {
             tlm_bindings,
             tlm_readback,
             tlm_layouts: VecDeque::new(),
+            last_tlm: None,
             load_maps: None,
             terrain_bindings,
             bounds,
@@ -281,12 +300,14 @@ impl Renderer {
     /// Renders one frame from `camera`.
     pub fn render(&mut self, camera: &Camera) -> Result<FrameReport, RenderError> {
         camera.validate()?;
+        let (camera, camera_lifted_m) = self.above_ground(camera);
+        let camera = &camera;
         let (width, height) = (self.settings.render.width, self.settings.render.height);
         let clip_from_view_world = camera.clip_from_view(width, height)? * camera.view_from_world();
         let frustum = Frustum::from_clip(clip_from_view_world);
         let origin = self.dataset.manifest.origin_m;
         let camera_grid_m = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
-        let mut report = FrameReport { frame: self.frame, ..Default::default() };
+        let mut report = FrameReport { frame: self.frame, camera_lifted_m, ..Default::default() };
 
         // Terrain LOD: choose the nodes whose triangles keep their target size on screen.
         let lods = Lods::for_view(&self.dataset, &self.settings.terrain, camera, height);
@@ -356,9 +377,11 @@ impl Renderer {
 
         // Instances: each node over its own height tile, or its finest resident ancestor.
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
-        let (batches, dropped) = node_batches(&lods, &selected, camera_grid_m, &self.heights, &mut |node| {
-            bounds.get(&lods, node, |tile| dataset.height_tile(tile).ok())
-        });
+        let floor_m = dataset.manifest.height.min_m;
+        let (batches, dropped) =
+            node_batches(&lods, &selected, camera_grid_m, &self.heights, floor_m, &mut |node| {
+                bounds.get(&lods, node, |tile| dataset.height_tile(tile).ok())
+            });
         report.nodes_drawn = batches.len();
         report.nodes_dropped = dropped;
         let uniforms = terrain_uniforms(
@@ -423,6 +446,7 @@ impl Renderer {
         if let Some(stage) = self.seeds.as_mut() {
             stage.encode_readback(&mut encoder, self.frame);
         }
+        self.last_tlm = Some(tlm_frame);
         self.profiler.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
         self.tlm_readback.submitted();

@@ -11,7 +11,7 @@ use crate::streaming::{CacheStats, TileCache};
 
 use super::{FrameReport, RenderError, Renderer};
 use crate::camera::Camera;
-use crate::gpu::gpu_types::{SeedCounters, SeedRecord};
+use crate::gpu::gpu_types::{SeedCounters, SeedRecord, TlmCell};
 use crate::passes::compact::Compacted;
 use crate::passes::seed_select::{SeedCellRef, SeedOutput};
 use crate::reference::seed_select::{SeedSnapshot, seed_select, seed_select_blocks, snapshot_caches};
@@ -99,6 +99,13 @@ impl Renderer {
     pub fn read_depth(&self) -> Result<Vec<f32>, RenderError> {
         let bytes = read_texture(&self.gpu, &self.depth, wgpu::TextureAspect::DepthOnly, 4)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// The last frame's Tile Load Map as pass 1 wrote it, waiting for the GPU (`None` before a
+    /// first frame): one cell per ring cell, ring by ring (`TlmLayout::cell_of`).
+    pub fn read_tile_load_map(&self) -> Result<Option<Vec<TlmCell>>, RenderError> {
+        let Some(frame) = &self.last_tlm else { return Ok(None) };
+        Ok(Some(self.tlm.read_back(&self.gpu, frame)?))
     }
 
     /// The seeded world of this renderer: species tables and patterns (`None` without land cover).

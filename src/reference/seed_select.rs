@@ -360,12 +360,10 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
     let u = &inputs.frame.uniforms;
     let pos_unit = inputs.patterns_unit[(cell.pattern * u.seeds_per_pattern + rank) as usize];
     let sample = grid_pos(cell.height_sample, cell.height_frac, pos_unit, u.cell_in_samples);
-    let size = u.height_size.map(|n| n as i32 - 1);
-    if sample.texel.iter().any(|&v| v < 0)
-        || sample.texel[0] > size[0]
-        || sample.texel[1] > size[1]
-        || u.lcc_sub_bits == 0
-    {
+    let last = u.height_size.map(|n| n as i32 - 1);
+    // Over the samples only, the last one included: the terrain mesh ends there.
+    let beyond = |a: usize| sample.texel[a] > last[a] || (sample.texel[a] == last[a] && sample.frac[a] > 0.0);
+    if sample.texel.iter().any(|&v| v < 0) || beyond(0) || beyond(1) || u.lcc_sub_bits == 0 {
         return Err(COUNT_CLASS);
     }
     let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);

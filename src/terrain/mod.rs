@@ -326,12 +326,15 @@ pub fn terrain_uniforms(
 /// The instances drawing `selected` from a camera at `camera_grid_m` (grid space). A node reads its
 /// own height tile, or while that streams in, its finest resident ancestor; a node with neither
 /// (only before the pinned levels load) is dropped and counted. `bounds` gives node height ranges
-/// (the skirt depth).
+/// (the skirt depth). Nodes on the dataset's boundary hang their skirts down to `floor_m`, the
+/// dataset's lowest ground (the shader stops every skirt a cell below it): seen from outside, from
+/// below the edge's ground, the terrain is then a solid block, not a shell showing its underside.
 pub fn node_batches(
     lods: &Lods,
     selected: &[Selected],
     camera_grid_m: DVec3,
     heights: &TileCache,
+    floor_m: f32,
     bounds: &mut dyn FnMut(NodeId) -> [f32; 2],
 ) -> (NodeBatches, usize) {
     let mut batches = NodeBatches::default();
@@ -344,6 +347,10 @@ pub fn node_batches(
         let size = lods.node_m(s.node.lod);
         let cell_m = size / f64::from(lods.cells);
         let [low_m, high_m] = bounds(s.node);
+        let (steps, inside) = (lods.steps(s.node.lod), lods.cells_inside(s.node));
+        let start = [s.node.x, s.node.y].map(|n| n * lods.cells);
+        let boundary = (0..2).any(|a| start[a] == 0 || start[a] + inside[a] >= steps[a]);
+        let low_m = if boundary { low_m.min(floor_m) } else { low_m };
         let lod = s.node.lod as usize;
         let node = TerrainNode {
             // Subtracted in f64: the GPU only sees offsets from the camera.

@@ -9,14 +9,22 @@ use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::{AdapterChoice, Gpu};
 
-/// The synthetic datasets this test process built, by (size, seed).
-static BUILT: Mutex<Vec<(u32, u64, PathBuf)>> = Mutex::new(Vec::new());
+pub mod audit;
+
+/// The synthetic datasets this test process built, by parameters.
+static BUILT: Mutex<Vec<(String, PathBuf)>> = Mutex::new(Vec::new());
 
 /// A synthetic dataset of `size`² samples, built once per test process (never reused across runs,
 /// so a change to the generator is always what is tested) and shared by its tests.
 pub fn synth_dataset(size: u32, seed: u64) -> PathBuf {
+    synth_dataset_with(&terramp::synth::SynthParams { size, seed, ..Default::default() })
+}
+
+/// As `synth_dataset`, for any parameters (spacing, origin, water level).
+pub fn synth_dataset_with(params: &terramp::synth::SynthParams) -> PathBuf {
+    let key = format!("{params:?}");
     let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((.., dir)) = built.iter().find(|(s, r, _)| (*s, *r) == (size, seed)) {
+    if let Some((_, dir)) = built.iter().find(|(k, _)| *k == key) {
         return dir.clone();
     }
     let root = Path::new(env!("CARGO_TARGET_TMPDIR"));
@@ -28,10 +36,10 @@ pub fn synth_dataset(size: u32, seed: u64) -> PathBuf {
             }
         }
     }
-    let dir = root.join(format!("synth-{size}-{seed}-{}", std::process::id()));
-    let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
-    terramp::synth::synthesize(&dir, &params, false).unwrap();
-    built.push((size, seed, dir.clone()));
+    let (size, seed, n) = (params.size, params.seed, built.len());
+    let dir = root.join(format!("synth-{size}-{seed}-{n}-{}", std::process::id()));
+    terramp::synth::synthesize(&dir, params, false).unwrap();
+    built.push((key, dir.clone()));
     dir
 }
 

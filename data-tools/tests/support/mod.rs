@@ -1,12 +1,20 @@
 //! Helpers for the `terramp-data build` tests: the shared data, temporary folders, running the
-//! binary, reading sources with GDAL and built layers level by level.
+//! binary, writing and reading rasters with GDAL, built layers level by level, and (from the
+//! library's tests) frame audits.
 
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use gdal::raster::{Buffer, GdalType};
+use gdal::spatial_ref::SpatialRef;
+use gdal::{DriverManager, GeoTransform};
 use terramp::dataset::{Dataset, Pyramid, Sampling, TileId};
+
+/// Frame audits shared with the library's extreme-case tests (`tests/extremes.rs`).
+#[path = "../../../tests/common/audit.rs"]
+pub mod audit;
 
 /// `<workspace root>/../shared/data`, or `None` (after saying why) when it is absent. On CI its
 /// absence is a failure, never a silent skip.
@@ -42,6 +50,25 @@ impl Drop for TempDir {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
     }
+}
+
+/// Writes a one-band GeoTIFF of `size` values (row by row from the north) in EPSG `epsg`.
+pub fn write_geotiff<T: GdalType + Copy>(
+    path: &Path,
+    size: [usize; 2],
+    values: Vec<T>,
+    geo_transform: GeoTransform,
+    epsg: u32,
+    nodata: Option<f64>,
+) -> PathBuf {
+    let driver = DriverManager::get_driver_by_name("GTiff").unwrap();
+    let mut dataset = driver.create_with_band_type::<T, _>(path, size[0], size[1], 1).unwrap();
+    dataset.set_geo_transform(&geo_transform).unwrap();
+    dataset.set_spatial_ref(&SpatialRef::from_epsg(epsg).unwrap()).unwrap();
+    let mut band = dataset.rasterband(1).unwrap();
+    band.set_no_data_value(nodata).unwrap();
+    band.write((0, 0), (size[0], size[1]), &mut Buffer::new((size[0], size[1]), values)).unwrap();
+    path.to_owned()
 }
 
 /// Runs `terramp-data build ARGS`.
