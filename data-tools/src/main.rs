@@ -1,11 +1,13 @@
 //! `terramp-data`: builds terramp datasets from GeoTIFF (`build`), synthesizes stress datasets
 //! (`synth`) and bakes impostors from glTF models (`bake`). GDAL does the reading and
-//! reprojection here, and only here: the runtime crate reads nothing but its own packs.
+//! reprojection here, and only here: the runtime crate reads nothing but its own packs. Baking
+//! lives in the library (`terramp::bake`, which the demo also uses): `bake` only parses its
+//! arguments.
 
-mod bake;
 mod build;
 
 use std::path::PathBuf;
+use std::time::Instant;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -34,13 +36,42 @@ enum Command {
         seed: u64,
     },
     /// Bake impostors (billboard clouds at 3 LODs, atlases with mips, the mesh) from glTF models.
-    Bake(bake::BakeArgs),
+    Bake(BakeArgs),
+}
+
+#[derive(clap::Args)]
+struct BakeArgs {
+    /// A glTF model (.glb) to bake; repeat for several. The impostor is named after the file.
+    #[arg(long = "model", required = true)]
+    models: Vec<PathBuf>,
+    /// The output folder: one sub-folder per model (replaced atomically).
+    #[arg(long)]
+    out: PathBuf,
+    /// Planes of each LOD's billboard cloud, finest first.
+    #[arg(long, value_delimiter = ',', default_values_t = terramp::bake::BakeOptions::default().planes)]
+    planes: Vec<usize>,
+    /// Width and height of each LOD's atlas in texels (a power of two, 64 to 8192).
+    #[arg(long, default_value_t = terramp::bake::BakeOptions::default().texels)]
+    texels: u32,
+}
+
+fn bake(args: BakeArgs) -> Result<()> {
+    let started = Instant::now();
+    let options = terramp::bake::BakeOptions { planes: args.planes, texels: args.texels };
+    let reports = terramp::bake::bake_models(None, &args.models, &args.out, &options, true)?;
+    println!(
+        "baked {} models into {} in {:.1} s",
+        reports.len(),
+        args.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Build(args) => build::run(&args),
-        Command::Bake(args) => bake::run(&args),
+        Command::Bake(args) => bake(args),
         Command::Synth { size, out, seed } => {
             let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
             let dir = terramp::synth::synthesize(&out, &params, true)?;

@@ -1,9 +1,9 @@
-// Impostor baking (terramp-data bake): draws a model's triangles orthographically onto one plane
+// Impostor baking (`terramp::bake`): draws a model's triangles orthographically onto one plane
 // of its billboard cloud, into that plane's rectangle of the atlas (the viewport). Unlit base
 // colour; alpha-masked materials are cut out at their cutoff and everything drawn is opaque, so
 // the atlas's alpha is exactly the model's coverage.
 
-// Twin of `BakeMaterial` in data-tools/src/bake/render.rs.
+// Twin of `BakeMaterial` in src/bake/render.rs.
 struct BakeMaterial {
     base_color_factor: vec4<f32>,
     alpha_cutoff: f32,

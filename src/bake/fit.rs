@@ -33,9 +33,18 @@
 //! everything with fewer planes than asked (a nearly flat model), the plane drawing the most
 //! triangles is split in two halves along its longer side until the count is met.
 
-use anyhow::{Result, bail};
 use glam::Vec3;
 use rayon::prelude::*;
+use thiserror::Error;
+
+/// Why no planes could be fitted.
+#[derive(Debug, Error, Clone, Copy, PartialEq, Eq)]
+pub enum FitError {
+    #[error("a billboard cloud needs at least one plane")]
+    NoPlanes,
+    #[error("the model has no triangle with an area")]
+    NoArea,
+}
 
 /// The fit's parameters (see the module doc).
 #[derive(Debug, Clone, Copy)]
@@ -245,14 +254,14 @@ fn greedy(
 }
 
 /// Fits `count` planes to `triangles` (model space).
-pub fn fit_planes(triangles: &[[Vec3; 3]], count: usize, params: &FitParams) -> Result<Fit> {
+pub fn fit_planes(triangles: &[[Vec3; 3]], count: usize, params: &FitParams) -> Result<Fit, FitError> {
     if count == 0 {
-        bail!("a billboard cloud needs at least one plane");
+        return Err(FitError::NoPlanes);
     }
     let area: Vec<f32> = triangles.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
     let total_area: f32 = area.iter().sum();
     if total_area <= 0.0 {
-        bail!("the model has no triangle with an area");
+        return Err(FitError::NoArea);
     }
     let (lo, hi) = triangles
         .iter()

@@ -6,36 +6,69 @@
 //! for alpha-masked ones), the alpha mode and cutoff, double-sidedness. Missing normals are
 //! computed from the faces; missing texture coordinates are 0.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
 use glam::{Mat3, Mat4, Vec3};
-use terramp::impostor::{AlphaMode, Material, Mesh, MeshVertex, MipChain, Submesh, build_mip_chain};
+use thiserror::Error;
 
-/// The mesh of the model at `path`.
-pub fn load(path: &Path) -> Result<Mesh> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    let gltf = gltf::Gltf::from_slice(&bytes)
-        .with_context(|| format!("{}: not a valid glTF model", path.display()))?;
-    read(&gltf, path).with_context(|| format!("{}: unusable glTF model", path.display()))
+use crate::impostor::{AlphaMode, Material, Mesh, MeshVertex, MipChain, Submesh, build_mip_chain};
+
+/// What makes a model unreadable. The error carrying it names the model's file.
+#[derive(Debug, Error)]
+pub enum ModelError {
+    #[error("reading it: {0}")]
+    Read(#[source] std::io::Error),
+    #[error("not a valid glTF model: {0}")]
+    NotGltf(#[source] gltf::Error),
+    #[error("unusable glTF model: embedded data URIs are not supported: use a .glb")]
+    DataUri,
+    #[error("unusable glTF model: reading {file}: {source}")]
+    Beside { file: PathBuf, source: std::io::Error },
+    #[error("unusable glTF model: the binary chunk is missing")]
+    NoBinaryChunk,
+    #[error("unusable glTF model: buffer {index} holds {found} bytes, {declared} declared")]
+    ShortBuffer { index: usize, found: usize, declared: usize },
+    #[error("unusable glTF model: image {image}: {problem}")]
+    ImageView { image: usize, problem: &'static str },
+    #[error("unusable glTF model: image {image}: decoding: {source}")]
+    ImageDecode { image: usize, source: image::ImageError },
+    #[error("unusable glTF model: the file has no scene")]
+    NoScene,
+    #[error("unusable glTF model: mesh {mesh}: a primitive without positions")]
+    NoPositions { mesh: usize },
+    #[error("unusable glTF model: mesh {mesh}: bad triangle indices")]
+    BadIndices { mesh: usize },
+    #[error("unusable glTF model: no triangles")]
+    NoTriangles,
 }
 
-fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh> {
-    let beside = |uri: &str| -> Result<Vec<u8>> {
+/// The mesh of the model at `path`.
+pub fn load(path: &Path) -> Result<Mesh, ModelError> {
+    let bytes = std::fs::read(path).map_err(ModelError::Read)?;
+    let gltf = gltf::Gltf::from_slice(&bytes).map_err(ModelError::NotGltf)?;
+    read(&gltf, path)
+}
+
+fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
+    let beside = |uri: &str| -> Result<Vec<u8>, ModelError> {
         if uri.starts_with("data:") {
-            bail!("embedded data URIs are not supported: use a .glb");
+            return Err(ModelError::DataUri);
         }
         let file = path.parent().unwrap_or(Path::new(".")).join(uri);
-        std::fs::read(&file).with_context(|| format!("reading {}", file.display()))
+        std::fs::read(&file).map_err(|source| ModelError::Beside { file, source })
     };
     let mut buffers = Vec::new();
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
-            gltf::buffer::Source::Bin => gltf.blob.clone().context("the binary chunk is missing")?,
+            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or(ModelError::NoBinaryChunk)?,
             gltf::buffer::Source::Uri(uri) => beside(uri)?,
         };
         if data.len() < buffer.length() {
-            bail!("buffer {} holds {} bytes, {} declared", buffer.index(), data.len(), buffer.length());
+            return Err(ModelError::ShortBuffer {
+                index: buffer.index(),
+                found: data.len(),
+                declared: buffer.length(),
+            });
         }
         buffers.push(data);
     }
@@ -53,10 +86,7 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh> {
                 tex_coords.push(info.tex_coord());
                 let image = info.texture().source();
                 let cutoff = (alpha_mode == AlphaMode::Mask).then_some(alpha_cutoff);
-                Some(
-                    decode_image(&image, &buffers, &beside, cutoff)
-                        .with_context(|| format!("image {}", image.index()))?,
-                )
+                Some(decode_image(&image, &buffers, &beside, cutoff)?)
             }
             None => {
                 tex_coords.push(0);
@@ -75,7 +105,7 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh> {
     let default_material = materials.len();
     let mut vertices = Vec::new();
     let mut by_material: Vec<Vec<u32>> = vec![Vec::new(); materials.len() + 1];
-    let scene = gltf.default_scene().or_else(|| gltf.scenes().next()).context("the file has no scene")?;
+    let scene = gltf.default_scene().or_else(|| gltf.scenes().next()).ok_or(ModelError::NoScene)?;
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
     while let Some((node, parent)) = stack.pop() {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
@@ -93,7 +123,7 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh> {
             let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
             let positions: Vec<Vec3> = reader
                 .read_positions()
-                .context("a primitive without positions")?
+                .ok_or(ModelError::NoPositions { mesh: mesh.index() })?
                 .map(|p| world.transform_point3(Vec3::from(p)))
                 .collect();
             let base = vertices.len() as u32;
@@ -102,7 +132,7 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh> {
                 None => (0..positions.len() as u32).collect(),
             };
             if !indices.len().is_multiple_of(3) || indices.iter().any(|&i| i as usize >= positions.len()) {
-                bail!("mesh {}: bad triangle indices", mesh.index());
+                return Err(ModelError::BadIndices { mesh: mesh.index() });
             }
             if mirrored {
                 indices.chunks_exact_mut(3).for_each(|t| t.swap(1, 2));
@@ -142,7 +172,7 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh> {
         submeshes.push(Submesh { material: material as u32, first_index, index_count: list.len() as u32 });
     }
     if indices.is_empty() {
-        bail!("no triangles");
+        return Err(ModelError::NoTriangles);
     }
     Ok(Mesh { vertices, indices, submeshes, materials })
 }
@@ -164,20 +194,24 @@ fn face_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
 fn decode_image(
     image: &gltf::Image,
     buffers: &[Vec<u8>],
-    beside: &dyn Fn(&str) -> Result<Vec<u8>>,
+    beside: &dyn Fn(&str) -> Result<Vec<u8>, ModelError>,
     alpha_cutoff: Option<f32>,
-) -> Result<MipChain> {
+) -> Result<MipChain, ModelError> {
+    let index = image.index();
+    let view_error = |problem| ModelError::ImageView { image: index, problem };
     let bytes = match image.source() {
         gltf::image::Source::View { view, .. } => {
-            let buffer = buffers.get(view.buffer().index()).context("no such buffer")?;
+            let buffer = buffers.get(view.buffer().index()).ok_or_else(|| view_error("no such buffer"))?;
             buffer
                 .get(view.offset()..view.offset() + view.length())
-                .context("view outside its buffer")?
+                .ok_or_else(|| view_error("view outside its buffer"))?
                 .to_vec()
         }
         gltf::image::Source::Uri { uri, .. } => beside(uri)?,
     };
-    let rgba = image::load_from_memory(&bytes).context("decoding")?.into_rgba8();
+    let rgba = image::load_from_memory(&bytes)
+        .map_err(|source| ModelError::ImageDecode { image: index, source })?
+        .into_rgba8();
     let size = [rgba.width(), rgba.height()];
     let mip_count = 32 - size[0].max(size[1]).leading_zeros();
     Ok(build_mip_chain(rgba.into_raw(), size, mip_count, alpha_cutoff, &[]))

@@ -1,17 +1,35 @@
-//! `terramp-data bake` on the shared models: three LODs of 17, 8 and 2 planes each, every plane
-//! with something in its atlas rectangle down to the last mip, a bounding sphere holding every
-//! vertex of the glTF, and `terramp::impostor::load` reading it all back.
+//! `terramp::bake` on the shared models: three LODs of 17, 8 and 2 planes each, every plane with
+//! something in its atlas rectangle down to the last mip, a bounding sphere holding every vertex
+//! of the glTF, and `terramp::impostor::load` reading it all back. Broken inputs are named.
 
-mod support;
+mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use support::{TempDir, shared_data};
+use common::shared_data;
+use terramp::bake::{BakeError, BakeOptions, bake_models};
 use terramp::impostor::{Impostor, MipChain, Plane};
 
-fn bake(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_terramp-data")).arg("bake").args(args).output().unwrap()
+/// A fresh folder under the target's temporary folder, removed when dropped.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+
+    fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 /// Every vertex position of the glTF at `path`, node transforms applied.
@@ -103,15 +121,18 @@ fn baking_every_model_gives_three_lods_with_their_planes_and_non_empty_atlases()
     models.sort();
     assert!(!models.is_empty(), "no .glb in {}", data.join("models").display());
     let out = TempDir::new("bake");
-    let mut args: Vec<&str> = models.iter().flat_map(|m| ["--model", m.to_str().unwrap()]).collect();
-    args.extend(["--out", out.path().to_str().unwrap(), "--texels", "256"]);
-    let output = bake(&args);
-    let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
-    assert!(output.status.success(), "bake failed:\n{stdout}\n{stderr}");
-    assert!(stdout.contains(&format!("baked {} models", models.len())), "{stdout}");
+    // The caller's adapter, as the demo passes its own.
+    let gpu = common::gpu();
+    let options = BakeOptions { texels: 256, ..Default::default() };
+    let reports =
+        bake_models(Some(&gpu), &models, out.path(), &options, true).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(reports.len(), models.len());
     let mut names = Vec::new();
-    for glb in &models {
+    for (glb, report) in models.iter().zip(&reports) {
         let name = glb.file_stem().unwrap().to_str().unwrap();
+        assert_eq!(report.name, name);
+        assert_eq!(report.folder, out.path().join(name));
+        assert!(report.triangles > 0, "{report:?}");
         let impostor = terramp::impostor::load(out.path(), name).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(impostor.name, name);
         check(&impostor, glb);
@@ -121,17 +142,22 @@ fn baking_every_model_gives_three_lods_with_their_planes_and_non_empty_atlases()
 }
 
 #[test]
-fn missing_and_corrupt_models_are_named() {
+fn missing_corrupt_and_same_named_models_are_named() {
     let dir = TempDir::new("bake-errors");
+    let bake = |models: &[PathBuf]| bake_models(None, models, dir.path(), &BakeOptions::default(), false);
     let missing = dir.path().join("Nothing.glb");
-    let output = bake(&["--model", missing.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success() && stderr.contains("Nothing.glb"), "{stderr}");
+    let err = bake(std::slice::from_ref(&missing)).unwrap_err();
+    assert!(matches!(err, BakeError::NoSuchModel(_)) && err.to_string().contains("Nothing.glb"), "{err}");
     let corrupt = dir.path().join("Broken.glb");
     std::fs::write(&corrupt, b"glTF\x02\x00\x00\x00 this is not a model").unwrap();
-    let output = bake(&["--model", corrupt.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success(), "{stderr}");
-    assert!(stderr.contains("Broken.glb") && stderr.contains("not a valid glTF"), "{stderr}");
+    let err = bake(std::slice::from_ref(&corrupt)).unwrap_err();
+    let message = err.to_string();
+    assert!(message.contains("Broken.glb") && message.contains("not a valid glTF"), "{message}");
     assert!(!dir.path().join("Broken").exists(), "nothing written for a failed model");
+    let elsewhere = dir.path().join("other");
+    std::fs::create_dir_all(&elsewhere).unwrap();
+    let twin = elsewhere.join("Broken.glb");
+    std::fs::copy(&corrupt, &twin).unwrap();
+    let err = bake(&[corrupt, twin]).unwrap_err();
+    assert!(matches!(&err, BakeError::SameName(name) if name == "Broken"), "{err}");
 }

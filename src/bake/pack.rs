@@ -6,7 +6,7 @@
 //! between them: then no mip's 2 × 2 box mixes two planes, and the last mip still has a texel of
 //! gap.
 
-use terramp::impostor::TexelRect;
+use crate::impostor::TexelRect;
 
 /// Rectangles for planes of `extents_m` (width, height in metres), in their order.
 #[derive(Debug, Clone, PartialEq)]

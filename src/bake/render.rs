@@ -1,4 +1,4 @@
-//! How it works: the offscreen half of baking, on whatever adapter `terramp::gpu::Gpu` opens (Mesa
+//! How it works: the offscreen half of baking, on whatever adapter `crate::gpu::Gpu` opens (Mesa
 //! lavapipe included). A model's mesh and materials are uploaded once ([`Baker::upload`]); each
 //! LOD's atlas is then one render pass into an RGBA8 sRGB texture cleared to transparent, with a
 //! depth buffer: per plane, the viewport and scissor are its atlas rectangle and one instanced
@@ -9,12 +9,26 @@
 
 use std::ops::Range;
 
-use anyhow::{Context, Result, bail};
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
-use terramp::gpu::Gpu;
-use terramp::impostor::{AlphaMode, Mesh, MeshVertex, MipChain, TexelRect};
+use thiserror::Error;
 use wgpu::util::DeviceExt;
+
+use crate::gpu::{Gpu, GpuError};
+use crate::impostor::{AlphaMode, Mesh, MeshVertex, MipChain, TexelRect};
+
+/// Why an atlas could not be rendered.
+#[derive(Debug, Error)]
+pub enum RenderError {
+    #[error("an atlas of {atlas} texels exceeds the adapter's limit of {limit}")]
+    TooLarge { atlas: u32, limit: u32 },
+    #[error("no triangle to draw")]
+    NothingToDraw,
+    #[error("reading the atlas back: {0}")]
+    Readback(#[source] GpuError),
+    #[error("baking an atlas: {0}")]
+    Gpu(#[source] GpuError),
+}
 
 const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -57,7 +71,7 @@ impl Baker {
         let device = &gpu.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bake billboard"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../../shaders/bake/billboard.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/bake/billboard.wgsl").into()),
         });
         let entry =
             |binding, visibility, ty| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
@@ -193,11 +207,11 @@ impl Baker {
         uploaded: &UploadedMesh,
         planes: &[PlaneDraw],
         atlas: u32,
-    ) -> Result<Vec<u8>> {
+    ) -> Result<Vec<u8>, RenderError> {
         let device = &gpu.device;
         let limit = device.limits().max_texture_dimension_2d;
         if atlas > limit {
-            bail!("an atlas of {atlas} texels exceeds the adapter's limit of {limit}");
+            return Err(RenderError::TooLarge { atlas, limit });
         }
         // Indices grouped by plane, then material: one draw each.
         let mut indices: Vec<u32> = Vec::new();
@@ -216,7 +230,7 @@ impl Baker {
             }
         }
         if indices.is_empty() {
-            bail!("no triangle to draw");
+            return Err(RenderError::NothingToDraw);
         }
         let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("bake indices"),
@@ -289,9 +303,9 @@ impl Baker {
             }
         }
         gpu.queue.submit([encoder.finish()]);
-        let texels = terramp::gpu::readback::read_texture(gpu, &colour, wgpu::TextureAspect::All, 4)
-            .context("reading the atlas back")?;
-        gpu.check().context("baking an atlas")?;
+        let texels = crate::gpu::readback::read_texture(gpu, &colour, wgpu::TextureAspect::All, 4)
+            .map_err(RenderError::Readback)?;
+        gpu.check().map_err(RenderError::Gpu)?;
         Ok(texels)
     }
 }

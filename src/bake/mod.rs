@@ -1,0 +1,364 @@
+//! How it works: [`bake_models`] (behind `terramp-data bake`, and the demo's first run) turns glTF
+//! models into impostors ([`crate::impostor`]). Every model is read before the GPU is touched, so
+//! a missing or broken file fails at once, named. Per model: read the mesh and materials
+//! (`model`); take its bounding sphere (centred at mid-height); then per LOD fit the planes
+//! (`fit`: Décoret-style greedy density with the smallest ε that lets that many planes cover the
+//! model), frame each plane (normal facing out of the model, "up" along model +Y, extent = the
+//! triangles it draws), give all planes of the LOD one texel density and shelf-pack their
+//! rectangles (`pack`), render every plane's triangles orthographically into its rectangle on the
+//! GPU (`render`), read the atlas back and build its coverage-preserving mips
+//! ([`build_mip_chain`], per plane). The impostor is then saved atomically.
+//!
+//! Mips: an atlas of 2^k texels keeps k − 5 levels (at most 5: 1024 → 64 texels), so rectangles
+//! aligned to 2^(mips−1) texels never share a box with a neighbour at any level.
+
+mod fit;
+mod model;
+mod pack;
+mod render;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::{Mat4, Vec3, Vec4};
+use thiserror::Error;
+
+use crate::gpu::{AdapterChoice, Gpu, GpuError};
+use crate::impostor::{BoundingSphere, Impostor, ImpostorError, ImpostorLod, Mesh, Plane, build_mip_chain};
+pub use fit::FitError;
+use fit::{FitParams, FittedPlane};
+pub use model::ModelError;
+pub use render::RenderError;
+use render::{Baker, PlaneDraw, UploadedMesh};
+
+/// Atlas texels below this alpha are not the model (the leaves' glTF cutoff).
+pub const ALPHA_CUTOFF: f32 = 0.5;
+
+/// What to bake: one LOD per plane count, each with a square atlas of `texels`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BakeOptions {
+    /// Planes of each LOD's billboard cloud, finest first.
+    pub planes: Vec<usize>,
+    /// Width and height of each LOD's atlas in texels (a power of two, 64 to 8192).
+    pub texels: u32,
+}
+
+impl Default for BakeOptions {
+    fn default() -> Self {
+        Self { planes: vec![17, 8, 2], texels: 1024 }
+    }
+}
+
+impl BakeOptions {
+    /// Checks the plane counts (at least one, none 0) and the atlas size.
+    pub fn validate(&self) -> Result<(), BakeError> {
+        if self.planes.is_empty() || self.planes.contains(&0) {
+            return Err(BakeError::Planes(self.planes.clone()));
+        }
+        if !self.texels.is_power_of_two() || !(64..=8192).contains(&self.texels) {
+            return Err(BakeError::Texels(self.texels));
+        }
+        Ok(())
+    }
+}
+
+/// One baked model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BakeReport {
+    /// The impostor's name: its model's file name without the extension.
+    pub name: String,
+    /// The impostor's folder (`out/<name>`).
+    pub folder: PathBuf,
+    pub triangles: usize,
+    pub seconds: f64,
+}
+
+#[derive(Debug, Error)]
+pub enum BakeError {
+    #[error("planes {0:?}: baking needs one or more plane counts (one per LOD), each at least 1")]
+    Planes(Vec<usize>),
+    #[error("texels {0}: an atlas must be a power of two from 64 to 8192 texels wide")]
+    Texels(u32),
+    #[error("{0}: no such model file")]
+    NoSuchModel(PathBuf),
+    #[error("{0}: cannot name an impostor after this file")]
+    Unnamed(PathBuf),
+    #[error("two models are named {0:?}: each impostor is named after its file")]
+    SameName(String),
+    // Boxed, as `Lod`'s: the rarely built large errors keep every `Result` small.
+    #[error("{path}: {source}")]
+    Model { path: PathBuf, source: Box<ModelError> },
+    #[error("opening a GPU to bake on: {0}")]
+    Gpu(#[from] GpuError),
+    #[error("baking {path}: LOD {lod}: {source}")]
+    Lod { path: PathBuf, lod: usize, source: Box<LodError> },
+    #[error("saving the impostor of {path}: {source}")]
+    Save { path: PathBuf, source: ImpostorError },
+}
+
+/// Why one LOD of a model could not be baked.
+#[derive(Debug, Error)]
+pub enum LodError {
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    #[error("the model gives {found} planes, not {wanted} (too few triangles?)")]
+    PlaneCount { found: usize, wanted: usize },
+    #[error("{planes} planes do not fit a {texels}-texel atlas: raise the atlas size (texels)")]
+    Pack { planes: usize, texels: u32 },
+    #[error(transparent)]
+    Render(#[from] RenderError),
+}
+
+/// Bakes every model of `models` into `out/<name>/` (each folder replaced atomically), named after
+/// its file, on `gpu` or, when `None`, on an adapter of its own (`AdapterChoice::Auto`, opened
+/// only once every model has been read). `progress` reports each model and LOD on stderr.
+pub fn bake_models(
+    gpu: Option<&Gpu>,
+    models: &[PathBuf],
+    out: &Path,
+    options: &BakeOptions,
+    progress: bool,
+) -> Result<Vec<BakeReport>, BakeError> {
+    options.validate()?;
+    // Name every model, then read them all, before opening the GPU: a missing, misnamed or broken
+    // file fails at once, named, and the cheap checks come before the slow reads.
+    let mut names: Vec<String> = Vec::new();
+    for path in models {
+        if !path.is_file() {
+            return Err(BakeError::NoSuchModel(path.clone()));
+        }
+        let name = model_name(path)?;
+        if names.contains(&name) {
+            return Err(BakeError::SameName(name));
+        }
+        names.push(name);
+    }
+    let mut meshes: Vec<(String, &Path, Mesh)> = Vec::new();
+    for (name, path) in names.into_iter().zip(models) {
+        let mesh = model::load(path)
+            .map_err(|source| BakeError::Model { path: path.clone(), source: Box::new(source) })?;
+        meshes.push((name, path, mesh));
+    }
+    if meshes.is_empty() {
+        return Ok(Vec::new());
+    }
+    let own;
+    let gpu = match gpu {
+        Some(gpu) => gpu,
+        None => {
+            own = Gpu::new(AdapterChoice::Auto)?;
+            &own
+        }
+    };
+    if progress {
+        eprintln!("baking {} models on {}", meshes.len(), gpu.describe());
+    }
+    let baker = Baker::new(gpu);
+    let mut reports = Vec::new();
+    for (name, path, mesh) in meshes {
+        let started = Instant::now();
+        let triangles = mesh.indices.len() / 3;
+        let impostor = bake_model(gpu, &baker, name, mesh, options, progress).map_err(|(lod, source)| {
+            BakeError::Lod { path: path.to_owned(), lod, source: Box::new(source) }
+        })?;
+        let folder = crate::impostor::save(out, &impostor)
+            .map_err(|source| BakeError::Save { path: path.to_owned(), source })?;
+        if progress {
+            eprintln!("  wrote {}", folder.display());
+        }
+        let seconds = started.elapsed().as_secs_f64();
+        reports.push(BakeReport { name: impostor.name, folder, triangles, seconds });
+    }
+    Ok(reports)
+}
+
+fn model_name(path: &Path) -> Result<String, BakeError> {
+    match path.file_stem().and_then(|s| s.to_str()) {
+        Some(name) if !name.is_empty() && !name.starts_with('.') => Ok(name.to_owned()),
+        _ => Err(BakeError::Unnamed(path.to_owned())),
+    }
+}
+
+/// The mip count and rectangle alignment for an atlas of `texels`.
+fn atlas_mips(texels: u32) -> (u32, u32) {
+    let mips = texels.ilog2().saturating_sub(5).clamp(1, 5);
+    (mips, 1 << (mips - 1))
+}
+
+/// A model being baked: what every LOD draws from.
+struct Job<'a> {
+    gpu: &'a Gpu,
+    baker: &'a Baker,
+    name: &'a str,
+    mesh: &'a Mesh,
+    uploaded: &'a UploadedMesh,
+    triangles: &'a [[Vec3; 3]],
+    sphere: &'a BoundingSphere,
+    progress: bool,
+}
+
+/// Bakes `mesh` into the impostor `name` with one LOD per plane count of `options`; an error
+/// comes with the LOD it stopped at.
+fn bake_model(
+    gpu: &Gpu,
+    baker: &Baker,
+    name: String,
+    mesh: Mesh,
+    options: &BakeOptions,
+    progress: bool,
+) -> Result<Impostor, (usize, LodError)> {
+    let bounding_sphere = BoundingSphere::enclosing(mesh.vertices.iter().map(|v| v.position_model_m));
+    let triangles: Vec<[Vec3; 3]> = mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| [0, 1, 2].map(|k| Vec3::from(mesh.vertices[t[k] as usize].position_model_m)))
+        .collect();
+    if progress {
+        eprintln!(
+            "{name}: {} triangles, {} materials, bounding radius {:.2} m",
+            triangles.len(),
+            mesh.materials.len(),
+            bounding_sphere.radius_m
+        );
+    }
+    let uploaded = baker.upload(gpu, &mesh);
+    let job = Job {
+        gpu,
+        baker,
+        name: &name,
+        mesh: &mesh,
+        uploaded: &uploaded,
+        triangles: &triangles,
+        sphere: &bounding_sphere,
+        progress,
+    };
+    let mut lods = Vec::new();
+    for (l, &count) in options.planes.iter().enumerate() {
+        lods.push(bake_lod(&job, count, options.texels, l).map_err(|e| (l, e))?);
+    }
+    Ok(Impostor { name, bounding_sphere, alpha_cutoff: ALPHA_CUTOFF, lods, mesh })
+}
+
+/// A fitted plane's frame and the extent of what it draws.
+struct Frame {
+    normal: Vec3,
+    offset_m: f32,
+    right: Vec3,
+    up: Vec3,
+    /// (min, max) of the drawn vertices along right, up and normal (from the plane).
+    extent_m: [[f32; 2]; 3],
+}
+
+fn frame(plane: &FittedPlane, triangles: &[[Vec3; 3]], centre: Vec3) -> Frame {
+    let (mut normal, mut offset_m) = (plane.normal.normalize(), plane.offset_m);
+    // Face out of the model, so the front shows the outermost surface (up, for a plane through it).
+    if offset_m - normal.dot(centre) < 0.0 {
+        (normal, offset_m) = (-normal, -offset_m);
+    }
+    let reference = if normal.y.abs() < 0.99 { Vec3::Y } else { Vec3::NEG_Z };
+    let up = (reference - reference.dot(normal) * normal).normalize();
+    let right = up.cross(normal);
+    let mut extent_m = [[f32::INFINITY, f32::NEG_INFINITY]; 3];
+    for &t in &plane.triangles {
+        for p in triangles[t as usize] {
+            for (k, value) in [right.dot(p), up.dot(p), normal.dot(p) - offset_m].into_iter().enumerate() {
+                extent_m[k] = [extent_m[k][0].min(value), extent_m[k][1].max(value)];
+            }
+        }
+    }
+    Frame { normal, offset_m, right, up, extent_m }
+}
+
+/// LOD `lod` of `job`'s model: `count` planes on an atlas of `texels`.
+fn bake_lod(job: &Job, count: usize, texels: u32, lod: usize) -> Result<ImpostorLod, LodError> {
+    let Job { gpu, baker, name, mesh, uploaded, triangles, sphere, progress } = *job;
+    let started = Instant::now();
+    let fit = fit::fit_planes(triangles, count, &FitParams::default())?;
+    if fit.planes.len() != count {
+        return Err(LodError::PlaneCount { found: fit.planes.len(), wanted: count });
+    }
+    let fitted_s = started.elapsed().as_secs_f64();
+    let centre = Vec3::from(sphere.centre_model_m);
+    let frames: Vec<Frame> = fit.planes.iter().map(|p| frame(p, triangles, centre)).collect();
+    let sizes: Vec<[f32; 2]> =
+        frames.iter().map(|f| [0, 1].map(|k| f.extent_m[k][1] - f.extent_m[k][0])).collect();
+    let (mip_count, align) = atlas_mips(texels);
+    let packing = pack::pack(&sizes, texels, align).ok_or(LodError::Pack { planes: count, texels })?;
+    let density = packing.texels_per_m;
+    let mut planes = Vec::new();
+    let mut draws = Vec::new();
+    for ((frame, fitted), rect) in frames.iter().zip(&fit.planes).zip(&packing.rects) {
+        // The rectangle's exact extent in metres, centred on what the plane draws.
+        let [[u0, u1], [v0, v1]] = [0, 1].map(|k| {
+            let (mid, half) = (
+                0.5 * (frame.extent_m[k][0] + frame.extent_m[k][1]),
+                [rect.width, rect.height][k] as f32 / (2.0 * density),
+            );
+            [mid - half, mid + half]
+        });
+        let [w0, w1] = frame.extent_m[2];
+        let margin = 0.01 * (w1 - w0) + 1e-4;
+        let (near, far) = (w1 + margin, w0 - margin);
+        let origin = frame.offset_m * frame.normal;
+        let at = |u: f32, v: f32| (origin + u * frame.right + v * frame.up).to_array();
+        let corner = |x: u32, y: u32| [x as f32 / texels as f32, y as f32 / texels as f32];
+        planes.push(Plane {
+            corners_model_m: [at(u0, v0), at(u1, v0), at(u1, v1), at(u0, v1)],
+            normal_model: frame.normal.to_array(),
+            uv_min: corner(rect.x, rect.y),
+            uv_max: corner(rect.x + rect.width, rect.y + rect.height),
+        });
+        // Rows of the clip-from-model transform: x from right, y from up, depth 0 at the front.
+        let row = |axis: Vec3, scale: f32, shift: f32| {
+            Vec4::new(axis.x * scale, axis.y * scale, axis.z * scale, shift)
+        };
+        let depth_scale = 1.0 / (near - far);
+        let rows = [
+            row(frame.right, 2.0 / (u1 - u0), -(u1 + u0) / (u1 - u0)),
+            row(frame.up, 2.0 / (v1 - v0), -(v1 + v0) / (v1 - v0)),
+            row(-frame.normal, depth_scale, (frame.offset_m + near) * depth_scale),
+            Vec4::new(0.0, 0.0, 0.0, 1.0),
+        ];
+        let clip_from_model = Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
+        draws.push(PlaneDraw { clip_from_model, rect: *rect, triangles: fitted.triangles.clone() });
+    }
+    let texels_level0 = baker.render_atlas(gpu, mesh, uploaded, &draws, texels)?;
+    let atlas =
+        build_mip_chain(texels_level0, [texels, texels], mip_count, Some(ALPHA_CUTOFF), &packing.rects);
+    if progress {
+        eprintln!(
+            "  {name} LOD {lod}: {count} planes, ε = {:.2} m ({:.0} % of the radius), \
+             {:.1} % of the area within ε, leftovers up to {:.2} m, {density:.0} texels/m; fit {fitted_s:.2} s, total {:.2} s",
+            fit.epsilon_m,
+            100.0 * fit.epsilon_m / sphere.radius_m,
+            100.0 * fit.covered_fraction,
+            fit.max_leftover_distance_m,
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(ImpostorLod { epsilon_m: fit.epsilon_m, planes, atlas })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_need_plane_counts_and_a_power_of_two_atlas() {
+        assert!(BakeOptions::default().validate().is_ok());
+        let with = |planes: Vec<usize>, texels| BakeOptions { planes, texels }.validate();
+        assert!(matches!(with(vec![], 1024), Err(BakeError::Planes(_))));
+        assert!(matches!(with(vec![4, 0], 1024), Err(BakeError::Planes(_))));
+        for texels in [0, 32, 1000, 16384] {
+            assert!(matches!(with(vec![2], texels), Err(BakeError::Texels(t)) if t == texels));
+        }
+        assert!(with(vec![1], 64).is_ok() && with(vec![1], 8192).is_ok());
+    }
+
+    #[test]
+    fn missing_models_fail_before_any_gpu_work() {
+        let missing = PathBuf::from("no/such/Nothing.glb");
+        let err = bake_models(None, &[missing], Path::new("unused"), &BakeOptions::default(), false);
+        assert!(matches!(&err, Err(BakeError::NoSuchModel(p)) if p.ends_with("Nothing.glb")), "{err:?}");
+    }
+}
