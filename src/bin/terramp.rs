@@ -1,16 +1,19 @@
 //! The `terramp` command line: render a frame of a dataset, fly the demo or a path, profile the
 //! passes, describe a dataset.
 
+// Under `terramp/`, not beside this file: every `src/bin/*.rs` is a binary of its own.
+#[path = "terramp/demo.rs"]
+mod demo;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
-use glam::DVec3;
 
 use terramp::camera::Camera;
 use terramp::config::Settings;
-use terramp::dataset::{Dataset, DatasetError, PackError};
+use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::{Gpu, PassTiming};
 use terramp::path::CameraPath;
@@ -65,17 +68,28 @@ enum Command {
         #[command(flatten)]
         settings: SettingsArgs,
     },
-    /// The main job on the embedded default: synthesize the default dataset if missing, then fly
-    /// over it and write the frames.
+    /// The main job on the embedded default: synthesize the default dataset and bake the
+    /// species' impostors if missing, then fly over it with seeds drawn, write the frames and
+    /// the profile table (`profile.txt`, `profile.json`).
     Demo {
         /// Where the default dataset lives (created when missing).
         #[arg(long, default_value = "data/default")]
         dataset: PathBuf,
-        /// Folder for the frames.
+        /// Folder for the frames and the profile.
         #[arg(long, default_value = "out/demo")]
         out: PathBuf,
         #[arg(long, default_value_t = 24)]
         frames: u32,
+        /// Frames rendered first at the start, neither written nor profiled.
+        #[arg(long, default_value_t = 4)]
+        warmup: u32,
+        /// Impostor folder (baked there from --models when a species' model is missing), unless
+        /// the settings name one (`seeds.impostors`).
+        #[arg(long, default_value = "data/impostors")]
+        impostors: PathBuf,
+        /// The glTF models (.glb) the class table's species name.
+        #[arg(long, default_value = "../shared/data/models")]
+        models: PathBuf,
         #[command(flatten)]
         settings: SettingsArgs,
     },
@@ -152,7 +166,18 @@ fn main() -> Result<()> {
             let camera = Camera::parse_pose(&camera, settings.render.fov_deg, settings.render.near_m)?;
             render_one(&dataset, settings, &camera, &out)
         }
-        Command::Demo { dataset, out, frames, settings } => demo(&dataset, &out, frames, settings.load()?),
+        Command::Demo { dataset, out, frames, warmup, impostors, models, settings } => {
+            demo::run(&demo::DemoArgs {
+                dataset,
+                out,
+                frames,
+                warmup,
+                impostors,
+                models,
+                preset: settings.preset,
+                settings_file: settings.settings,
+            })
+        }
         Command::Fly { dataset, path, frames, out, save_every, width, height, settings } => {
             let mut settings = settings.load()?;
             settings.render.width = width.unwrap_or(settings.render.width);
@@ -274,58 +299,6 @@ fn print_timings(timings: &[PassTiming]) {
     }
 }
 
-fn demo(dataset_dir: &Path, out: &Path, frames: u32, settings: Settings) -> Result<()> {
-    if frames == 0 {
-        bail!("--frames must be at least 1");
-    }
-    // The default dataset is ours to make: synthesize it when missing, or when it was made by a
-    // build whose format this one no longer reads.
-    match Dataset::open(dataset_dir) {
-        Ok(_) => {}
-        Err(
-            error @ (DatasetError::NotADataset { .. }
-            | DatasetError::Version { .. }
-            | DatasetError::Pack(PackError::Version { .. })),
-        ) => {
-            eprintln!("terramp: {error}; synthesizing the default dataset at {}", dataset_dir.display());
-            let start = Instant::now();
-            terramp::synth::synthesize(dataset_dir, &terramp::synth::SynthParams::default(), true)?;
-            eprintln!("terramp: synthesized in {:.1} s", start.elapsed().as_secs_f64());
-        }
-        Err(error) => return Err(error.into()),
-    }
-    let mut renderer = open_renderer(dataset_dir, settings)?;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let path = DemoPath::over(&renderer.dataset);
-    let mut frame_ms = Vec::new();
-    for i in 0..frames {
-        let camera = path.camera(&renderer, f64::from(i) / f64::from(frames.max(2) - 1))?;
-        let start = Instant::now();
-        let report = renderer.render(&camera)?;
-        let image = renderer.read_colour()?;
-        frame_ms.push(start.elapsed().as_secs_f64() * 1000.0);
-        let file = out.join(format!("frame_{i:04}.png"));
-        save_png(&image, &file)?;
-        println!(
-            "frame {i:>3}: {:>4} nodes, uploaded {:>3} height / {:>3} imagery tiles, {:>7.1} ms",
-            report.nodes_drawn,
-            report.height.uploaded,
-            report.imagery.uploaded,
-            frame_ms.last().copied().unwrap_or_default()
-        );
-    }
-    let drained = renderer.profiler.drain(&renderer.gpu)?;
-    println!("last frame's passes:");
-    print_timings(drained.last().map(Vec::as_slice).unwrap_or(renderer.last_timings()));
-    frame_ms.sort_by(f64::total_cmp);
-    println!(
-        "{frames} frames in {}: median {:.1} ms per frame (render + readback + PNG)",
-        out.display(),
-        frame_ms[frame_ms.len() / 2]
-    );
-    Ok(())
-}
-
 fn fly(
     dataset_dir: &Path,
     path: &CameraPath,
@@ -386,45 +359,6 @@ fn resident_kib() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
     line.split_whitespace().nth(1)?.parse().ok()
-}
-
-/// A straight flight across the dataset's middle, 120 m above the highest ground near the line,
-/// looking ahead and down.
-struct DemoPath {
-    start_m: DVec3,
-    end_m: DVec3,
-}
-
-impl DemoPath {
-    fn over(dataset: &Dataset) -> Self {
-        let m = &dataset.manifest;
-        let [w, h] = m.extent_m();
-        let corner = m.corner_m();
-        let at = |fx: f64, fy: f64| DVec3::new(corner[0] + fx * w, corner[1] + fy * h, 0.0);
-        Self { start_m: at(0.15, 0.2), end_m: at(0.75, 0.7) }
-    }
-
-    fn camera(&self, renderer: &Renderer, t: f64) -> Result<Camera> {
-        let m = &renderer.dataset.manifest;
-        let position = self.start_m.lerp(self.end_m, t);
-        let ahead = (self.end_m - self.start_m).normalize();
-        // Clearance over the ground below and a little ahead, so the camera never dives into a hill.
-        let mut ground_m = f64::MIN;
-        for step in 0..8 {
-            let probe = position + ahead * f64::from(step) * 40.0;
-            let grid = [probe.x - m.origin_m[0], probe.y - m.origin_m[1]];
-            ground_m = ground_m.max(renderer.dataset.height_at(grid[0], grid[1], 0)?);
-        }
-        let yaw_deg = ahead.x.atan2(ahead.y).to_degrees();
-        let r = &renderer.settings.render;
-        Ok(Camera {
-            position_m: DVec3::new(position.x, position.y, ground_m + 120.0),
-            yaw_deg,
-            pitch_deg: -12.0,
-            fov_deg: r.fov_deg,
-            near_m: r.near_m,
-        })
-    }
 }
 
 fn info(dataset_dir: &Path) -> Result<()> {
