@@ -1,8 +1,8 @@
 //! Seed selection (pass 3), compaction and drawing (pass 4) for a fixed camera over the default
 //! synthetic dataset at 1280 × 720, balanced preset: the view is rendered until every tile is
-//! resident, then the last frame's seed passes are replayed alone (`Renderer::rerun_seed_passes`)
-//! with and without the draw, so the draw's cost is the difference. Throughput is in seeds checked
-//! per second. The nc table's models are baked from `../shared/data/models` into the target dir
+//! resident, then the last frame's terrain depth is replayed alone, then with pass 3 and
+//! compaction, then with the draw too (`Renderer::replay_seed_passes`): each stage's cost is the
+//! difference from the one before. Throughput is in seeds checked per second. The nc table's models are baked from `../shared/data/models` into the target dir
 //! on first use. Run with `WGPU_BACKEND=vulkan cargo bench --bench seed_draw`.
 
 use std::path::{Path, PathBuf};
@@ -12,7 +12,7 @@ use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
-use terramp::frame::Renderer;
+use terramp::frame::{Renderer, Replay};
 use terramp::gpu::{AdapterChoice, Gpu};
 
 fn dataset_dir() -> PathBuf {
@@ -70,7 +70,7 @@ fn renderer() -> Renderer {
 
 fn seed_passes(c: &mut Criterion) {
     let mut renderer = renderer();
-    renderer.rerun_seed_passes(true).expect("seed passes");
+    renderer.replay_seed_passes(Replay::Draw).expect("seed passes");
     let (_, counters) = renderer.read_seeds().expect("read seeds").expect("seeds");
     let drawn = renderer.read_compacted().expect("read").expect("compacted").drawn();
     eprintln!(
@@ -80,12 +80,13 @@ fn seed_passes(c: &mut Criterion) {
     let mut group = c.benchmark_group("seed_passes");
     group.sample_size(10);
     group.throughput(Throughput::Elements(counters.checked.into()));
-    group.bench_function("select+compact", |b| {
-        b.iter(|| renderer.rerun_seed_passes(false).expect("seed passes"));
-    });
-    group.bench_function("select+compact+draw", |b| {
-        b.iter(|| renderer.rerun_seed_passes(true).expect("seed passes"));
-    });
+    for (name, through) in [
+        ("depth", Replay::Depth),
+        ("depth+select+compact", Replay::Select),
+        ("depth+select+compact+draw", Replay::Draw),
+    ] {
+        group.bench_function(name, |b| b.iter(|| renderer.replay_seed_passes(through).expect("seed passes")));
+    }
     group.finish();
 }
 

@@ -25,7 +25,9 @@ use crate::streaming::analysis::{LoadMaps, analyse};
 use crate::streaming::wants::{after_pinned, height_tiles, pinned_tiles};
 use crate::streaming::{CacheStats, LayerKind, Loader, LoaderError, TileCache, UploadBudget};
 use crate::terrain::select::{Lods, NodeBounds, select};
-use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass, node_batches, terrain_uniforms};
+use crate::terrain::{
+    COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, PreparedNodes, TerrainPass, node_batches, terrain_uniforms,
+};
 
 mod clearance;
 mod seeds;
@@ -34,6 +36,7 @@ mod tools;
 pub use clearance::GROUND_CLEARANCE_NEAR;
 
 pub use seeds::SeedReport;
+pub use tools::Replay;
 
 /// Tiles of the coarsest levels each cache keeps resident from the start, at most: the three
 /// coarsest levels of a square layer (1 + 4 + 16), a fallback everywhere at a quarter of the
@@ -127,8 +130,10 @@ pub struct Renderer {
     tlm_readback: ReadbackRing,
     /// Layouts of the TLMs in flight, by frame: a TLM is read against its own frame's layout.
     tlm_layouts: VecDeque<(u64, TlmLayout, DVec3)>,
-    /// The last frame's TLM inputs, to read its output back (`read_tile_load_map`).
+    /// The last frame's TLM inputs, to read its output back (`read_tile_load_map`), and its
+    /// terrain nodes, to replay its depth (`replay_seed_passes`).
     last_tlm: Option<TlmFrame>,
+    last_nodes: Option<PreparedNodes>,
     /// The latest TLM's load maps; they drive the streaming of the next frames.
     load_maps: Option<LoadMaps>,
     terrain_bindings: wgpu::BindGroup,
@@ -277,6 +282,7 @@ impl Renderer {
             tlm_readback,
             tlm_layouts: VecDeque::new(),
             last_tlm: None,
+            last_nodes: None,
             load_maps: None,
             terrain_bindings,
             bounds,
@@ -410,6 +416,7 @@ impl Renderer {
         })?;
         // Ground: imagery on the surface the depth pass kept, from the finest resident level.
         let mesh = MeshDraw { terrain: &self.terrain, bind_group: &self.terrain_bindings, nodes: &prepared };
+        self.last_nodes = Some(prepared.clone());
         self.profiler.pass(&self.gpu, &mut encoder, "ground", |encoder| {
             self.ground.encode(encoder, mesh, &colour, &depth, SKY_LINEAR)
         })?;

@@ -184,17 +184,27 @@ impl Renderer {
         Ok(())
     }
 
-    /// Runs the last frame's seed passes again, as that frame recorded them (pass 3 over its
-    /// cells, then compaction, then, with `draw`, the draw into the colour and depth it left),
-    /// and waits for the GPU: for benchmarks of a fixed camera. `false` when there were none.
-    pub fn rerun_seed_passes(&mut self, draw: bool) -> Result<bool, RenderError> {
-        let Some(stage) = self.seeds.as_ref().filter(|s| s.last_frame.is_some()) else { return Ok(false) };
+    /// Replays the last frame's terrain depth and then its seed passes up to `through` (pass 3
+    /// over its cells and compaction; then the draw into the colour and depth), as that frame
+    /// recorded them, and waits for the GPU: for benchmarks of a fixed camera. The depth comes
+    /// first because pass 3 must see the terrain's alone, not the trees the last draw left in
+    /// it. `false` when the last frame ran no seed passes.
+    pub fn replay_seed_passes(&mut self, through: Replay) -> Result<bool, RenderError> {
+        let (Some(stage), Some(nodes)) = (self.seeds.as_ref(), self.last_nodes.as_ref()) else {
+            return Ok(false);
+        };
+        if stage.last_frame.is_none() {
+            return Ok(false);
+        }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        stage.encode(&mut encoder);
-        stage.encode_compact(&mut encoder);
-        if draw {
+        let depth = self.depth.create_view(&Default::default());
+        self.terrain.encode(&mut encoder, &self.terrain_bindings, &depth, nodes);
+        if through != Replay::Depth {
+            stage.encode(&mut encoder);
+            stage.encode_compact(&mut encoder);
+        }
+        if through == Replay::Draw {
             let colour = self.colour.create_view(&Default::default());
-            let depth = self.depth.create_view(&Default::default());
             stage.encode_draw(&mut encoder, &colour, &depth);
         }
         self.gpu.queue.submit([encoder.finish()]);
@@ -202,4 +212,14 @@ impl Renderer {
         self.gpu.check()?;
         Ok(true)
     }
+}
+
+/// How far `Renderer::replay_seed_passes` goes after the terrain's depth.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Replay {
+    Depth,
+    /// Pass 3 and compaction.
+    Select,
+    /// Pass 3, compaction and the draw.
+    Draw,
 }

@@ -70,6 +70,7 @@ impl MeshDraw<'_> {
 }
 
 /// Instance ranges of each quadrant's draw, as uploaded.
+#[derive(Debug, Clone)]
 pub struct PreparedNodes {
     ranges: [Range<u32>; 4],
 }
