@@ -45,9 +45,12 @@ pub fn write(trade: &Trade, path: &Path) -> Result<(), SweepError> {
     {
         let root = BitMapBackend::with_buffer(&mut pixels, SIZE_PX).into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+        // The dataset's folder name: the title should not depend on where it was measured.
+        let dataset = Path::new(&trade.dataset)
+            .file_name()
+            .map_or(trade.dataset.clone(), |n| n.to_string_lossy().into_owned());
         let title = format!(
-            "terramp speed trade: {} at {}x{} ({} timed frames, {} sample poses)",
-            trade.dataset,
+            "terramp speed trade: {dataset} at {}x{} ({} timed frames, {} sample poses)",
             trade.resolution[0],
             trade.resolution[1],
             trade.frames,
