@@ -16,6 +16,10 @@ use terramp::gpu::{Gpu, PassTiming};
 use terramp::path::CameraPath;
 use terramp::profile::{Meta, Summary};
 
+// Crate roots look for modules beside themselves: this one keeps its own in src/bin/terramp/.
+#[path = "terramp/sweep.rs"]
+mod sweep;
+
 #[derive(Parser)]
 #[command(
     name = "terramp",
@@ -140,39 +144,7 @@ enum Command {
     /// error) and the images with an all-resident render of the accurate preset (ground PSNR, frame
     /// PSNR and SSIM). Writes trade.csv, trade.json, trade.png and trade.md (Markdown tables) into
     /// --out and prints a table.
-    Sweep {
-        #[arg(long)]
-        dataset: PathBuf,
-        /// Camera path (config/paths/*.toml). Default: as `profile` chooses it.
-        #[arg(long)]
-        path: Option<PathBuf>,
-        /// Folder for trade.csv, trade.json and trade.png (created when missing).
-        #[arg(long)]
-        out: PathBuf,
-        #[arg(long, value_delimiter = ',', default_value = "fast,balanced,accurate")]
-        presets: Vec<String>,
-        /// A settings key and values, each value a point with every preset (repeatable: points
-        /// are the product), e.g. `--knob seeds.occlusion_tolerance_m=0.5,1,2`.
-        #[arg(long)]
-        knob: Vec<terramp::sweep::Knob>,
-        /// Timed frames per point, spread evenly along the path.
-        #[arg(long, default_value_t = 60)]
-        frames: u32,
-        /// Unprofiled frames at the path's start before the timed ones.
-        #[arg(long, default_value_t = 10)]
-        warmup: u32,
-        /// Poses along the path where accuracy is measured.
-        #[arg(long, default_value_t = 3)]
-        samples: u32,
-        /// A TOML file laid over every preset and the reference, before the knobs (e.g. to set
-        /// `seeds.impostors` so that frames show trees).
-        #[arg(long)]
-        settings: Option<PathBuf>,
-        #[arg(long)]
-        width: Option<u32>,
-        #[arg(long)]
-        height: Option<u32>,
-    },
+    Sweep(sweep::SweepArgs),
     /// Describe a dataset: frame, extent, layers.
     Info {
         #[arg(long)]
@@ -201,58 +173,9 @@ fn main() -> Result<()> {
             let outputs = ProfileOutputs { json, trace, log };
             profile(&dataset, path.as_deref(), frames, warmup, (width, height), &settings, &outputs)
         }
-        Command::Sweep {
-            dataset,
-            path,
-            out,
-            presets,
-            knob,
-            frames,
-            warmup,
-            samples,
-            settings,
-            width,
-            height,
-        } => {
-            let options = terramp::sweep::SweepOptions {
-                dataset,
-                path,
-                presets,
-                knobs: knob,
-                settings,
-                frames,
-                warmup,
-                samples,
-                width,
-                height,
-            };
-            sweep(&options, &out)
-        }
+        Command::Sweep(args) => args.run(),
         Command::Info { dataset } => info(&dataset),
     }
-}
-
-fn sweep(options: &terramp::sweep::SweepOptions, out: &Path) -> Result<()> {
-    use terramp::sweep::{CSV_FILE, JSON_FILE, MARKDOWN_FILE, PLOT_FILE, Progress};
-    let bar = indicatif::ProgressBar::new(0);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {wide_msg}")?
-            .progress_chars("=> "),
-    );
-    let trade = terramp::sweep::run(options, &mut |event| match event {
-        Progress::Total(steps) => bar.set_length(steps),
-        Progress::Step(what) => {
-            bar.set_message(what.to_owned());
-            bar.inc(1);
-        }
-    });
-    bar.finish_and_clear();
-    let trade = trade?;
-    terramp::sweep::write_outputs(&trade, out)?;
-    print!("{}", terramp::sweep::report::table(&trade));
-    let files = [CSV_FILE, JSON_FILE, PLOT_FILE, MARKDOWN_FILE];
-    println!("\nwrote {}", files.map(|f| out.join(f).display().to_string()).join(", "));
-    Ok(())
 }
 
 struct ProfileOutputs {
