@@ -20,5 +20,6 @@ pub mod reference;
 pub mod seeds;
 pub mod shaders;
 pub mod streaming;
+pub mod sweep;
 pub mod synth;
 pub mod terrain;

@@ -18,6 +18,7 @@ use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::passes::seed_select::SeedCellRef;
+use terramp::reference::accuracy::{HeightError, SeedAgreement, SeedId, record_id};
 use terramp::reference::oracle::{OracleInputs, visible_seeds};
 use terramp::reference::seed_select::SeedComparison;
 use terramp::seeds::cell_pattern;
@@ -51,17 +52,7 @@ fn camera(r: &Renderer, [x, y, above_m, yaw_deg, pitch_deg]: [f64; 5]) -> Camera
 fn worst_base_error_m(r: &Renderer, camera: &Camera, seeds: &[SeedRecord]) -> f64 {
     let origin = r.dataset.manifest.origin_m;
     let c = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
-    seeds
-        .iter()
-        .map(|s| {
-            let exact_m = r.dataset.height_at(
-                c.x + f64::from(s.position_rel_m[0]),
-                c.y + f64::from(s.position_rel_m[1]),
-                0,
-            );
-            (f64::from(s.ground_m) - exact_m.unwrap()).abs()
-        })
-        .fold(0.0, f64::max)
+    HeightError::of(&r.dataset, c, seeds).unwrap().max_m
 }
 
 fn gpu_equals_twin(dataset: Dataset, views: Poses) {
@@ -135,23 +126,22 @@ fn recall_precision(r: &mut Renderer, what: &str, pose: [f64; 5]) -> (f64, f64, 
         camera: &camera,
         viewport_px,
     };
-    let (truth, counts) = visible_seeds(&inputs).unwrap();
-    let truth: HashSet<([i64; 2], u32)> = truth.iter().map(|s| (s.address, s.rank)).collect();
-    let kept: HashSet<([i64; 2], u32)> =
-        gpu.iter().map(|s| ([i64::from(s.address[0]), i64::from(s.address[1])], s.rank)).collect();
-    let common = truth.intersection(&kept).count();
+    let (truth_seeds, counts) = visible_seeds(&inputs).unwrap();
+    let agreement = SeedAgreement::of(&gpu, &truth_seeds);
+    let truth: HashSet<SeedId> = truth_seeds.iter().map(|s| (s.address, s.rank)).collect();
+    let kept: HashSet<SeedId> = gpu.iter().map(record_id).collect();
     // Where the GPU's set differs, and why: TLM cells never activated, or seeds the GPU keeps
     // whose summit the exact DEM hides or whose sphere only the frustum margin keeps.
     let snapshot = r.seed_snapshot().unwrap().unwrap();
     let active: HashSet<[i64; 2]> =
         snapshot.frame.cells.iter().map(|c| [i64::from(c.address[0]), i64::from(c.address[1])]).collect();
-    let missed = truth.difference(&kept).count();
+    let missed = agreement.missed();
     let missed_cells = truth.difference(&kept).filter(|(a, _)| !active.contains(a)).count();
     let origin = r.dataset.manifest.origin_m;
     let eye = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
     let extra_hidden = gpu
         .iter()
-        .filter(|g| !truth.contains(&([i64::from(g.address[0]), i64::from(g.address[1])], g.rank)))
+        .filter(|g| !truth.contains(&record_id(g)))
         .filter(|g| {
             let rel = DVec3::new(
                 f64::from(g.position_rel_m[0]),
@@ -163,19 +153,18 @@ fn recall_precision(r: &mut Renderer, what: &str, pose: [f64; 5]) -> (f64, f64, 
         .count();
     println!(
         "{what}: {missed} missed ({missed_cells} in cells the TLM left out); {} extra ({extra_hidden} hidden by the DEM)",
-        kept.len() - common
+        agreement.extra()
     );
-    let recall = common as f64 / truth.len().max(1) as f64;
-    let precision = common as f64 / kept.len().max(1) as f64;
+    let (recall, precision) = (agreement.recall(), agreement.precision());
     println!(
         "{what}: oracle {} visible of {} candidates ({counts:?}); GPU {} kept; recall {:.2} %, precision {:.2} %",
-        truth.len(),
+        agreement.visible,
         counts.candidates,
-        kept.len(),
+        agreement.kept,
         100.0 * recall,
         100.0 * precision
     );
-    (recall, precision, truth.len())
+    (recall, precision, agreement.visible as usize)
 }
 
 #[test]

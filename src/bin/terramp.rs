@@ -1,5 +1,5 @@
 //! The `terramp` command line: render a frame of a dataset, fly the demo or a path, profile the
-//! passes, describe a dataset.
+//! passes, measure the speed trade, describe a dataset.
 
 // Under `terramp/`, not beside this file: every `src/bin/*.rs` is a binary of its own.
 #[path = "terramp/demo.rs"]
@@ -18,6 +18,10 @@ use terramp::frame::Renderer;
 use terramp::gpu::{Gpu, PassTiming};
 use terramp::path::CameraPath;
 use terramp::profile::{Meta, Summary};
+
+// Crate roots look for modules beside themselves: this one keeps its own in src/bin/terramp/.
+#[path = "terramp/sweep.rs"]
+mod sweep;
 
 #[derive(Parser)]
 #[command(
@@ -149,6 +153,12 @@ enum Command {
         #[command(flatten)]
         settings: SettingsArgs,
     },
+    /// Measure the speed trade: fly the same path with every preset (and knob value), timing each
+    /// pass, then at sample poses compare the seeds with the exact oracle (recall, precision, height
+    /// error) and the images with an all-resident render of the accurate preset (ground PSNR, frame
+    /// PSNR and SSIM). Writes trade.csv, trade.json, trade.png and trade.md (Markdown tables) into
+    /// --out and prints a table.
+    Sweep(sweep::SweepArgs),
     /// Describe a dataset: frame, extent, layers.
     Info {
         #[arg(long)]
@@ -188,6 +198,7 @@ fn main() -> Result<()> {
             let outputs = ProfileOutputs { json, trace, log };
             profile(&dataset, path.as_deref(), frames, warmup, (width, height), &settings, &outputs)
         }
+        Command::Sweep(args) => args.run(),
         Command::Info { dataset } => info(&dataset),
     }
 }

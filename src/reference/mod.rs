@@ -2,8 +2,12 @@
 //! shader-shaped (same structure, same f32 arithmetic in the same order), so tests can demand
 //! GPU == CPU exactly for integer outputs. The exact oracle used to measure accuracy (f64, full
 //! resolution) is separate from these twins: a twin reproduces the GPU, the oracle judges it.
+//! `accuracy` (seeds against the oracle) and `image_metrics` (PSNR, SSIM of frames against
+//! all-resident references) are what the speed trade (`sweep`) reports.
 
+pub mod accuracy;
 pub mod compact;
+pub mod image_metrics;
 pub mod oracle;
 pub mod seed_select;
 pub mod tile_load_map;

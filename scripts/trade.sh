@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# The speed trade (issue 6): `terramp sweep` over nc/, zion/ and the synthetic default dataset, every
+# preset, and docs/TRADE.md written from what it measured. One command:
+#
+#   scripts/trade.sh            # needs ../shared/data (nc/, zion/ and models/)
+#
+# 1. Builds the release binaries, then the datasets into DATA_DIR (default data/trade; each is
+#    reused while `terramp info` reads it): nc/ (DEM, Landsat bands 3,2,1, land use) and zion/ (DEM,
+#    NLCD) as data-tools/tests/support builds them, and the synthetic default (`synth --size 1024`).
+# 2. Bakes the 11 shared models into impostors (reused when present) and writes a settings layer
+#    that points `seeds.impostors` at them, so that every frame, the references' included, shows
+#    its trees.
+# 3. Sweeps each dataset along its default path (nc/ and zion/: the generated orbit; synthetic:
+#    config/paths/default.toml) into docs/trade/<name>/ (trade.csv, trade.json, trade.png,
+#    trade.md), then writes docs/TRADE.md (`scripts/trade_page.py`): how it was measured, each
+#    dataset's tables and plot, and the issue's acceptance checks computed from the JSON.
+#
+# Environment: FRAMES (60 timed frames per point), WARMUP (10), SAMPLES (3 poses), PRESETS
+# (fast,balanced,accurate), WIDTH × HEIGHT (1280 × 720), DATA_DIR, SWEEP ("synthetic nc zion": the
+# datasets to sweep again; the page is always written from all three folders' trade.json, so
+# SWEEP=nc re-measures nc/ alone and SWEEP= only rewrites the page).
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
+unset RUST_BACKTRACE
+
+frames="${FRAMES:-60}"
+warmup="${WARMUP:-10}"
+samples="${SAMPLES:-3}"
+presets="${PRESETS:-fast,balanced,accurate}"
+width="${WIDTH:-1280}"
+height="${HEIGHT:-720}"
+# Relative to the repository root, so the figures' paths name no one's machine.
+data="${DATA_DIR:-data/trade}"
+shared="$root/../shared/data"
+[[ -d "$shared/nc" && -d "$shared/zion" && -d "$shared/models" ]] || {
+    echo "trade.sh: $shared (nc/, zion/, models/) is missing" >&2
+    exit 1
+}
+mkdir -p "$data" docs/trade
+
+cargo build --release --workspace -q
+terramp="$root/target/release/terramp"
+terramp_data="$root/target/release/terramp-data"
+
+# build NAME ARGS...: a dataset, unless a readable one is already there.
+build() {
+    local name="$1"
+    shift
+    if "$terramp" info --dataset "$data/$name" >/dev/null 2>&1; then
+        echo "dataset $name: reusing $data/$name" >&2
+    else
+        echo "dataset $name: building into $data/$name" >&2
+        "$@" --out "$data/$name" >/dev/null
+    fi
+}
+build nc "$terramp_data" build --dem "$shared/nc/elev_ned_30m.tif" --imagery "$shared/nc/landsat_multiband.tif" \
+    --bands 3,2,1 --landcover "$shared/nc/landuse_r.tif" --classes nc
+build zion "$terramp_data" build --dem "$shared/zion/dem_utm12n_30m.tif" \
+    --landcover "$shared/zion/nlcd_utm12n_30m.tif" --classes nlcd
+build synthetic "$terramp_data" synth --size 1024
+
+impostors="$data/impostors"
+models=(Birch_1 Birch_4 BushBerries_1 Bush_1 DeadTree_1 Pine_1 Pine_3 Rock_1 Rock_Moss_1 Tree_1 Tree_3)
+if [[ ! -d "$impostors/Tree_3" ]]; then
+    args=()
+    for m in "${models[@]}"; do args+=(--model "$shared/models/$m.glb"); done
+    "$terramp_data" bake "${args[@]}" --out "$impostors" --texels 256 >/dev/null
+fi
+trees="$data/trees.toml"
+printf '# Written by scripts/trade.sh: draw the seeds with the baked impostors.\n[seeds]\nimpostors = "%s"\n' \
+    "$(cd "$impostors" && pwd)" >"$trees"
+
+for name in ${SWEEP-synthetic nc zion}; do
+    echo "## sweep $name" >&2
+    "$terramp" sweep --dataset "$data/$name" --out "docs/trade/$name" --presets "$presets" \
+        --frames "$frames" --warmup "$warmup" --samples "$samples" --width "$width" --height "$height" \
+        --settings "$trees" 2>/dev/null
+done
+
+python3 scripts/trade_page.py "$frames" "$warmup" >docs/TRADE.md
+echo "wrote docs/TRADE.md and docs/trade/{synthetic,nc,zion}/" >&2

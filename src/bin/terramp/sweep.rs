@@ -1,0 +1,79 @@
+//! `terramp sweep`: its arguments, and the progress bar and printing around `terramp::sweep`.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use terramp::sweep::{CSV_FILE, JSON_FILE, Knob, MARKDOWN_FILE, PLOT_FILE, Progress, SweepOptions};
+
+#[derive(Args)]
+pub struct SweepArgs {
+    #[arg(long)]
+    dataset: PathBuf,
+    /// Camera path (config/paths/*.toml). Default: as `profile` chooses it.
+    #[arg(long)]
+    path: Option<PathBuf>,
+    /// Folder for trade.csv, trade.json, trade.png and trade.md (created when missing).
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long, value_delimiter = ',', default_value = "fast,balanced,accurate")]
+    presets: Vec<String>,
+    /// A settings key and values, each value a point with every preset (repeatable: points are
+    /// the product), e.g. `--knob seeds.occlusion_tolerance_m=0.5,1,2`.
+    #[arg(long)]
+    knob: Vec<Knob>,
+    /// Timed frames per point, spread evenly along the path.
+    #[arg(long, default_value_t = 60)]
+    frames: u32,
+    /// Unprofiled frames at the path's start before the timed ones.
+    #[arg(long, default_value_t = 10)]
+    warmup: u32,
+    /// Poses along the path where accuracy is measured.
+    #[arg(long, default_value_t = 3)]
+    samples: u32,
+    /// A TOML file laid over every preset and the reference, before the knobs (e.g. to set
+    /// `seeds.impostors` so that frames show trees).
+    #[arg(long)]
+    settings: Option<PathBuf>,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+}
+
+impl SweepArgs {
+    pub fn run(self) -> Result<()> {
+        let out = self.out;
+        let options = SweepOptions {
+            dataset: self.dataset,
+            path: self.path,
+            presets: self.presets,
+            knobs: self.knob,
+            settings: self.settings,
+            frames: self.frames,
+            warmup: self.warmup,
+            samples: self.samples,
+            width: self.width,
+            height: self.height,
+        };
+        let bar = indicatif::ProgressBar::new(0);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {wide_msg}")?
+                .progress_chars("=> "),
+        );
+        let trade = terramp::sweep::run(&options, &mut |event| match event {
+            Progress::Total(steps) => bar.set_length(steps),
+            Progress::Step(what) => {
+                bar.set_message(what.to_owned());
+                bar.inc(1);
+            }
+        });
+        bar.finish_and_clear();
+        let trade = trade?;
+        terramp::sweep::write_outputs(&trade, &out)?;
+        print!("{}", terramp::sweep::report::table(&trade));
+        let files = [CSV_FILE, JSON_FILE, PLOT_FILE, MARKDOWN_FILE];
+        println!("\nwrote {}", files.map(|f| out.join(f).display().to_string()).join(", "));
+        Ok(())
+    }
+}

@@ -1,0 +1,188 @@
+//! How it works: the points of a sweep. Each point is a preset plus, for every `--knob`, one of
+//! its values: the points are the cartesian product of the presets and the knobs' values, in the
+//! order given. A knob is a settings key with dots (`seeds.occlusion_tolerance_m`) and a list of
+//! values separated by commas, commas inside brackets excepted (`tlm.radial_lod_m=[500,1000,2000],
+//! [700,1400,3000]`). Each value becomes a one-key TOML layer over the preset (and over the user's
+//! settings file), so it goes through the same key and range checks as any settings file; a value
+//! that is not TOML (`fast`) is taken as a string.
+
+use std::str::FromStr;
+
+use crate::config::{PRESETS, Settings, SettingsError};
+
+/// One `--knob key=v1,v2,...`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Knob {
+    pub key: String,
+    pub values: Vec<String>,
+}
+
+impl FromStr for Knob {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let (key, values) = text
+            .split_once('=')
+            .ok_or_else(|| format!("`{text}`: expected KEY=V1,V2,... (e.g. seeds.frustum_epsilon=0,0.01)"))?;
+        let key = key.trim();
+        let parts: Vec<&str> = key.split('.').collect();
+        if parts.len() < 2
+            || parts.iter().any(|p| p.is_empty() || !p.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'))
+        {
+            return Err(format!("`{key}`: expected a settings key such as seeds.occlusion_tolerance_m"));
+        }
+        let values = split_values(values);
+        if values.is_empty() || values.iter().any(String::is_empty) {
+            return Err(format!("`{text}`: every value must be non-empty"));
+        }
+        Ok(Self { key: key.to_owned(), values })
+    }
+}
+
+/// Splits at commas outside brackets, trimming each value.
+fn split_values(text: &str) -> Vec<String> {
+    let mut values = Vec::new();
+    let (mut depth, mut current) = (0i32, String::new());
+    for c in text.chars() {
+        match c {
+            '[' => depth += 1,
+            ']' => depth -= 1,
+            ',' if depth == 0 => {
+                values.push(current.trim().to_owned());
+                current.clear();
+                continue;
+            }
+            _ => {}
+        }
+        current.push(c);
+    }
+    values.push(current.trim().to_owned());
+    values
+}
+
+/// The TOML layer that sets `key` (dotted) to `value`.
+fn layer_text(key: &str, value: &str) -> String {
+    let (table, leaf) = key.rsplit_once('.').unwrap_or(("", key));
+    let line = format!("{leaf} = {value}\n");
+    let line = match line.parse::<toml::Table>() {
+        Ok(_) => line,
+        Err(_) => format!("{leaf} = {}\n", toml::Value::String(value.to_owned())),
+    };
+    format!("[{table}]\n{line}")
+}
+
+/// A preset and the knob values that override it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Point {
+    pub preset: String,
+    /// (key, value) pairs, in the order of the `--knob` arguments.
+    pub knobs: Vec<(String, String)>,
+}
+
+impl Point {
+    /// `preset`, then ` key=value` for each knob.
+    pub fn label(&self) -> String {
+        let mut label = self.preset.clone();
+        for (key, value) in &self.knobs {
+            label.push_str(&format!(" {key}={value}"));
+        }
+        label
+    }
+
+    /// The knobs as `key=value;key=value`.
+    pub fn knobs_text(&self) -> String {
+        self.knobs.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";")
+    }
+
+    /// The defaults, the preset, the user's layer `user` (origin, TOML text) if any, then the knobs.
+    pub fn settings(&self, user: Option<&(String, String)>) -> Result<Settings, SettingsError> {
+        let (_, preset_text) = PRESETS
+            .iter()
+            .find(|(name, _)| *name == self.preset)
+            .ok_or_else(|| SettingsError::UnknownPreset(self.preset.clone()))?;
+        let mut layers = vec![(format!("preset {}", self.preset), (*preset_text).to_owned())];
+        layers.extend(user.cloned());
+        for (key, value) in &self.knobs {
+            layers.push((format!("--knob {key}={value}"), layer_text(key, value)));
+        }
+        Settings::from_layers(&layers)
+    }
+}
+
+/// Every preset with every combination of the knobs' values, presets outermost.
+pub fn points(presets: &[String], knobs: &[Knob]) -> Vec<Point> {
+    let mut points: Vec<Point> =
+        presets.iter().map(|preset| Point { preset: preset.clone(), knobs: Vec::new() }).collect();
+    for knob in knobs {
+        points = points
+            .iter()
+            .flat_map(|p| {
+                knob.values.iter().map(move |v| {
+                    let mut knobs = p.knobs.clone();
+                    knobs.push((knob.key.clone(), v.clone()));
+                    Point { preset: p.preset.clone(), knobs }
+                })
+            })
+            .collect();
+    }
+    points
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn knobs_parse_with_arrays_and_strings() {
+        let k: Knob = "seeds.occlusion_tolerance_m=0.5, 1,2".parse().unwrap();
+        assert_eq!(
+            (k.key.as_str(), k.values.clone()),
+            ("seeds.occlusion_tolerance_m", vec!["0.5".into(), "1".into(), "2".into()])
+        );
+        let k: Knob = "tlm.radial_lod_m=[500,1000,2000],[700, 1400, 3000]".parse().unwrap();
+        assert_eq!(k.values, ["[500,1000,2000]", "[700, 1400, 3000]"]);
+        assert!("seeds".parse::<Knob>().is_err());
+        assert!("frustum_epsilon=0".parse::<Knob>().is_err());
+        assert!("seeds.frustum_epsilon=0,".parse::<Knob>().is_err());
+    }
+
+    #[test]
+    fn points_are_the_product_and_settings_apply_in_order() {
+        let presets = vec!["fast".to_owned(), "accurate".to_owned()];
+        let knobs: Vec<Knob> = ["seeds.frustum_epsilon=0,0.05", "terrain.triangle_px=3"]
+            .iter()
+            .map(|k| k.parse().unwrap())
+            .collect();
+        let points = points(&presets, &knobs);
+        let labels: Vec<String> = points.iter().map(Point::label).collect();
+        assert_eq!(
+            labels,
+            [
+                "fast seeds.frustum_epsilon=0 terrain.triangle_px=3",
+                "fast seeds.frustum_epsilon=0.05 terrain.triangle_px=3",
+                "accurate seeds.frustum_epsilon=0 terrain.triangle_px=3",
+                "accurate seeds.frustum_epsilon=0.05 terrain.triangle_px=3",
+            ]
+        );
+        let user =
+            ("user.toml".to_owned(), "[terrain]\ntriangle_px = 5.0\n[seeds]\nimpostors = \"x\"\n".to_owned());
+        let s = points[3].settings(Some(&user)).unwrap();
+        assert_eq!(
+            (s.seeds.frustum_epsilon, s.terrain.triangle_px, s.seeds.impostors.as_str()),
+            (0.05, 3.0, "x")
+        );
+        assert_eq!(s.seeds.seeds_per_pattern, Settings::preset("accurate").unwrap().seeds.seeds_per_pattern);
+        assert_eq!(points[3].knobs_text(), "seeds.frustum_epsilon=0.05;terrain.triangle_px=3");
+        // A value that is not TOML is a string; a string where a number belongs names the key.
+        let k = Point { preset: "balanced".into(), knobs: vec![("seeds.class_table".into(), "nlcd".into())] };
+        assert_eq!(k.settings(None).unwrap().seeds.class_table, "nlcd");
+        let bad =
+            Point { preset: "balanced".into(), knobs: vec![("seeds.frustum_epsilon".into(), "wide".into())] };
+        let err = bad.settings(None).unwrap_err().to_string();
+        assert!(err.contains("seeds.frustum_epsilon"), "{err}");
+        let typo =
+            Point { preset: "balanced".into(), knobs: vec![("seeds.frustum_epsilonn".into(), "0".into())] };
+        assert!(typo.settings(None).unwrap_err().to_string().contains("frustum_epsilonn"));
+        assert!(Point { preset: "ludicrous".into(), knobs: vec![] }.settings(None).is_err());
+    }
+}

@@ -1,0 +1,190 @@
+//! How it works: `terramp sweep` measures the speed trade (DESIGN.md, "Accuracy, and the speed
+//! trade"). Its points are presets, optionally crossed with knob values (`knobs`). Every point
+//! flies the same camera path (`--path`, or the dataset's default as `terramp profile` chooses it)
+//! in a fresh renderer, timed by the profiling session (`profile::Session`): warm-up frames, then
+//! the timed frames, reduced by `profile::Summary` to per-pass GPU medians and the frame's median
+//! wall time. Then, at a few sample poses spread along the same path, it settles the view
+//! (`render_resolved`: everything the view asked for is resident) and measures it (`measure`):
+//! - its seeds against the exact oracle (`reference::oracle`): recall, precision, and the distance
+//!   of each kept seed's ground height from the f64 bilinear DEM (`reference::accuracy`);
+//! - its ground (the frame without seeds) against the ground of an all-resident reference render:
+//!   the accurate preset with every tile of every layer pinned, from the same pose (PSNR);
+//! - its frame against that reference's frame, seeds drawn when `seeds.impostors` is set (PSNR and
+//!   SSIM, `reference::image_metrics`).
+//!
+//! Seed counts add up over the sample poses (recall is over all their seeds); PSNR pools the
+//! samples' squared errors (as one image); SSIM is their mean. `report` writes `trade.csv`,
+//! `trade.json` (schema `terramp-trade/1`), `trade.md` and the terminal table; `plot` draws
+//! `trade.png`.
+//! Progress goes to a callback, one step per frame rendered and per pose settled.
+
+pub mod knobs;
+mod measure;
+pub mod plot;
+pub mod report;
+
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use crate::camera::Camera;
+use crate::config::{Settings, SettingsError};
+use crate::dataset::{Dataset, DatasetError};
+use crate::path::CameraPath;
+use crate::profile::ProfileError;
+pub use knobs::{Knob, Point, points};
+pub use report::{SCHEMA, Trade, TradePoint};
+
+#[derive(Debug, Error)]
+pub enum SweepError {
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    #[error(transparent)]
+    Dataset(#[from] DatasetError),
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    #[error(transparent)]
+    Render(#[from] crate::frame::RenderError),
+    #[error(transparent)]
+    Gpu(#[from] crate::gpu::GpuError),
+    #[error(transparent)]
+    Pack(#[from] crate::dataset::PackError),
+    #[error(transparent)]
+    Oracle(#[from] crate::reference::oracle::OracleError),
+    #[error(transparent)]
+    Image(#[from] crate::reference::image_metrics::ImageMetricError),
+    #[error(transparent)]
+    Path(#[from] crate::path::PathError),
+    #[error("{what}: {source}")]
+    Io { what: String, source: std::io::Error },
+    #[error("plotting {path}: {message}")]
+    Plot { path: String, message: String },
+    #[error("sweep: {0}")]
+    Options(String),
+}
+
+/// What to sweep, and how.
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    pub dataset: PathBuf,
+    /// Camera path file; `None` takes `profile::default_path`.
+    pub path: Option<PathBuf>,
+    pub presets: Vec<String>,
+    pub knobs: Vec<Knob>,
+    /// A settings file laid over every point's preset and over the reference (before the knobs).
+    pub settings: Option<PathBuf>,
+    /// Timed frames per point, spread evenly along the path, after `warmup` frames at its start.
+    pub frames: u32,
+    pub warmup: u32,
+    /// Poses along the path where accuracy is measured, at t = (i + ½) / samples.
+    pub samples: u32,
+    /// Overrides of `render.width` and `render.height`.
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
+/// A sweep's progress, for a progress bar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Progress<'a> {
+    /// The number of steps the whole sweep takes.
+    Total(u64),
+    /// One more step done; what is being done now.
+    Step(&'a str),
+}
+
+/// The file names `write_outputs` uses in its folder.
+pub const CSV_FILE: &str = "trade.csv";
+pub const JSON_FILE: &str = "trade.json";
+pub const PLOT_FILE: &str = "trade.png";
+pub const MARKDOWN_FILE: &str = "trade.md";
+
+/// Runs the sweep: the reference, then every point. Fails before rendering anything when a point's
+/// settings are invalid.
+pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result<Trade, SweepError> {
+    if options.frames == 0 || options.samples == 0 || options.presets.is_empty() {
+        return Err(SweepError::Options("--frames, --samples and --presets need at least one".into()));
+    }
+    let user = match &options.settings {
+        Some(file) => {
+            let text = std::fs::read_to_string(file)
+                .map_err(|source| SweepError::Io { what: format!("reading {}", file.display()), source })?;
+            Some((file.display().to_string(), text))
+        }
+        None => None,
+    };
+    let resize = |mut s: Settings| {
+        s.render.width = options.width.unwrap_or(s.render.width);
+        s.render.height = options.height.unwrap_or(s.render.height);
+        s
+    };
+    let points = points(&options.presets, &options.knobs);
+    let settings: Vec<Settings> =
+        points.iter().map(|p| p.settings(user.as_ref()).map(resize)).collect::<Result<_, _>>()?;
+    let reference_point = Point { preset: "accurate".into(), knobs: Vec::new() };
+    let reference_settings = resize(reference_point.settings(user.as_ref())?);
+
+    let dataset = Dataset::open(&options.dataset)?;
+    let (path, path_name) = match &options.path {
+        Some(file) => (CameraPath::load(file)?, file.display().to_string()),
+        None => crate::profile::default_path(&dataset)?,
+    };
+    let r = &reference_settings.render;
+    let poses: Vec<(f64, Camera)> = (0..options.samples)
+        .map(|i| {
+            let t = (f64::from(i) + 0.5) / f64::from(options.samples);
+            (t, path.camera_at(t, r.fov_deg, r.near_m))
+        })
+        .collect();
+    drop(dataset);
+
+    let per_point = |s: &Settings| {
+        let grounds = if s.seeds.impostors.is_empty() { 0 } else { 1 };
+        u64::from(options.warmup + options.frames) + u64::from(options.samples) * (1 + grounds)
+    };
+    let reference_steps =
+        u64::from(options.samples) * if reference_settings.seeds.impostors.is_empty() { 1 } else { 2 };
+    progress(Progress::Total(reference_steps + settings.iter().map(per_point).sum::<u64>()));
+
+    let flight = measure::Flight {
+        dataset_dir: &options.dataset,
+        path: &path,
+        poses: &poses,
+        warmup: options.warmup,
+        frames: options.frames,
+    };
+    let references = flight.references(&reference_settings, progress)?;
+    let mut measured = Vec::with_capacity(points.len());
+    for (point, settings) in points.iter().zip(settings) {
+        measured.push(flight.measure(point, settings, &references, progress)?);
+    }
+    let first = measured.first();
+    Ok(Trade {
+        schema: SCHEMA,
+        adapter: first.map(|m| m.adapter.clone()).unwrap_or_default(),
+        timing: first.map(|m| m.timing_note.clone()).unwrap_or_default(),
+        dataset: options.dataset.display().to_string(),
+        path: path_name,
+        resolution: [reference_settings.render.width, reference_settings.render.height],
+        warmup: options.warmup,
+        frames: options.frames,
+        sample_t: poses.iter().map(|(t, _)| *t).collect(),
+        reference: "accurate preset, every tile of every layer resident (pinned), same pose".into(),
+        settings: options.settings.as_ref().map(|f| f.display().to_string()),
+        points: measured.into_iter().map(|m| m.point).collect(),
+    })
+}
+
+/// Writes `trade.csv`, `trade.json`, `trade.png` and `trade.md` (the tables in Markdown) into `dir`
+/// (created if missing).
+pub fn write_outputs(trade: &Trade, dir: &Path) -> Result<(), SweepError> {
+    let io = |what: String| move |source| SweepError::Io { what, source };
+    std::fs::create_dir_all(dir).map_err(io(format!("creating {}", dir.display())))?;
+    let csv = dir.join(CSV_FILE);
+    std::fs::write(&csv, report::csv(trade)).map_err(io(format!("writing {}", csv.display())))?;
+    let json = dir.join(JSON_FILE);
+    std::fs::write(&json, report::json(trade)).map_err(io(format!("writing {}", json.display())))?;
+    let markdown = dir.join(MARKDOWN_FILE);
+    std::fs::write(&markdown, report::markdown(trade))
+        .map_err(io(format!("writing {}", markdown.display())))?;
+    plot::write(trade, &dir.join(PLOT_FILE))
+}

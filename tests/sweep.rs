@@ -1,0 +1,134 @@
+//! `terramp sweep` on a small synthetic dataset, two presets and a knob, a few frames at 160 × 90:
+//! it writes trade.csv, trade.json and trade.png; the CSV and the JSON hold the same figures; every
+//! point has positive times and sensible errors; the accurate preset against its own all-resident
+//! reference is (nearly) identical, its PSNR capped to a finite number.
+
+mod common;
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use serde_json::Value;
+use terramp::reference::image_metrics::PSNR_CAP_DB;
+
+#[test]
+fn sweep_writes_agreeing_csv_json_and_plot() {
+    let dataset = common::synth_dataset(300, 7);
+    let out: PathBuf = std::env::temp_dir().join(format!("terramp-sweep-{}", std::process::id()));
+    let output = Command::new(env!("CARGO_BIN_EXE_terramp"))
+        .args(["sweep", "--presets", "fast,accurate", "--frames", "4", "--warmup", "2", "--samples", "2"])
+        .args(["--width", "160", "--height", "90", "--knob", "seeds.frustum_epsilon=0,0.05"])
+        .arg("--dataset")
+        .arg(&dataset)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(output.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&output.stderr));
+
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("trade.json")).unwrap()).unwrap();
+    let csv = std::fs::read_to_string(out.join("trade.csv")).unwrap();
+    let plot = image::open(out.join("trade.png")).expect("trade.png is an image");
+    assert!(plot.width() > 600 && plot.height() > 300);
+    let _ = std::fs::remove_dir_all(&out);
+
+    assert_eq!(json["schema"], "terramp-trade/1");
+    assert_eq!(json["resolution"], serde_json::json!([160, 90]));
+    let points = json["points"].as_array().unwrap();
+    let labels: Vec<&str> = points.iter().map(|p| p["label"].as_str().unwrap()).collect();
+    assert_eq!(
+        labels,
+        [
+            "fast seeds.frustum_epsilon=0",
+            "fast seeds.frustum_epsilon=0.05",
+            "accurate seeds.frustum_epsilon=0",
+            "accurate seeds.frustum_epsilon=0.05",
+        ]
+    );
+    for label in &labels {
+        assert!(stdout.contains(label), "the table lacks {label}:\n{stdout}");
+    }
+
+    // The CSV: one row per point, the same figures as the JSON.
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<String>> = lines.map(split_csv).collect();
+    assert_eq!(rows.len(), points.len());
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no {name}"));
+    for (row, point) in rows.iter().zip(points) {
+        assert_eq!(row.len(), header.len());
+        assert_eq!(row[column("label")], point["label"].as_str().unwrap());
+        let seeds = &point["seeds"];
+        for (name, value) in [
+            ("frame_ms", &point["frame_ms"]),
+            ("gpu_ms", &point["gpu_ms"]),
+            ("ground_psnr_db", &point["ground_psnr_db"]),
+            ("frame_psnr_db", &point["frame_psnr_db"]),
+            ("frame_ssim", &point["frame_ssim"]),
+            ("recall_pct", &seeds["recall_pct"]),
+            ("precision_pct", &seeds["precision_pct"]),
+            ("height_error_max_m", &seeds["height_error_max_m"]),
+            ("visible", &seeds["visible"]),
+        ] {
+            let csv_value: f64 = row[column(name)].parse().unwrap_or_else(|_| panic!("{name}: {row:?}"));
+            // serde_json's float parsing may land one ulp away from the shortest form it wrote.
+            let json_value = value.as_f64().unwrap();
+            assert!((csv_value - json_value).abs() <= 1e-12 * json_value.abs(), "{name} of {}", row[0]);
+        }
+        for pass in point["passes"].as_array().unwrap() {
+            let name = format!("{}_ms", pass["label"].as_str().unwrap());
+            let (csv_ms, json_ms) =
+                (row[column(&name)].parse::<f64>().unwrap(), pass["median_ms"].as_f64().unwrap());
+            assert!((csv_ms - json_ms).abs() <= 1e-12 * json_ms.abs(), "{name} of {}", row[0]);
+        }
+
+        // Positive times, sensible errors.
+        assert!(
+            point["frame_ms"].as_f64().unwrap() > 0.0 && point["gpu_ms"].as_f64().unwrap() > 0.0,
+            "{point}"
+        );
+        let passes: Vec<&str> =
+            point["passes"].as_array().unwrap().iter().map(|p| p["label"].as_str().unwrap()).collect();
+        for pass in ["terrain", "ground", "tile_load_map", "seed_select"] {
+            assert!(passes.contains(&pass), "{} lacks {pass}: {passes:?}", row[0]);
+        }
+        assert!(point["passes"].as_array().unwrap().iter().all(|p| p["median_ms"].as_f64().unwrap() >= 0.0));
+        assert!(seeds["visible"].as_u64().unwrap() > 50, "{seeds}");
+        for key in ["recall_pct", "precision_pct"] {
+            let pct = seeds[key].as_f64().unwrap();
+            assert!((90.0..=100.0).contains(&pct), "{}: {key} {pct}", row[0]);
+        }
+        assert!(seeds["height_error_max_m"].as_f64().unwrap() < 0.01, "{seeds}");
+        let ssim = point["frame_ssim"].as_f64().unwrap();
+        assert!(ssim > 0.5 && ssim <= 1.0, "{ssim}");
+        for key in ["ground_psnr_db", "frame_psnr_db"] {
+            let db = point[key].as_f64().unwrap();
+            assert!(db > 20.0 && db <= PSNR_CAP_DB, "{}: {key} {db}", row[0]);
+        }
+        assert_eq!(point["samples"].as_array().unwrap().len(), 2);
+    }
+    // The accurate preset is the reference's own settings: its ground is the reference's.
+    let accurate = &points[2];
+    assert!(accurate["ground_psnr_db"].as_f64().unwrap() >= 40.0, "{accurate}");
+}
+
+/// One CSV line's fields (quoted fields may hold commas and doubled quotes).
+fn split_csv(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => fields.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
+}
