@@ -16,6 +16,8 @@ pub struct SeedSettings {
     pub occlusion_tolerance_m: f64,
     pub occlusion_tolerance_per_km: f64,
     pub occlusion_refine_steps: u32,
+    /// Every class's density is scaled by this (rank thinning: exactly that fraction).
+    pub density_scale: f64,
     pub reference_height_m: f64,
     pub sink_fraction: f64,
     pub ground_colour_radius_m: f64,
@@ -46,7 +48,7 @@ impl SeedSettings {
             let (key, rule) = ("seeds.occlusion_refine_steps", "0 or a power of two up to 65536");
             return Err(SettingsError::OutOfRange { key, value: steps.to_string(), rule });
         }
-        let ranges: [(&'static str, f64, f64, f64, &'static str); 10] = [
+        let ranges: [(&'static str, f64, f64, f64, &'static str); 11] = [
             ("seeds.seeds_per_pattern", s.seeds_per_pattern.into(), 64.0, 65536.0, "64 to 65536 seeds"),
             ("seeds.capacity", s.capacity.into(), 1.0, 16_777_216.0, "1 to 16777216 seeds"),
             ("seeds.frustum_epsilon", s.frustum_epsilon, 0.0, 1.0, "0 to 1 (NDC units)"),
@@ -55,6 +57,7 @@ impl SeedSettings {
             ("seeds.reference_height_m", s.reference_height_m, tiny, any, "a positive number of metres"),
             ("seeds.sink_fraction", s.sink_fraction, 0.0, 0.5, "0 to 0.5 of the seed's height"),
             ("seeds.ground_colour_radius_m", s.ground_colour_radius_m, 0.0, any, "0 or more metres"),
+            ("seeds.density_scale", s.density_scale, 0.0, 1.0, "0 to 1 of the class table's densities"),
             ("seeds.mesh_m", s.mesh_m, 0.0, any, "0 (never) or more metres"),
             ("seeds.fade_fraction", s.fade_fraction, 0.0, 0.5, "0 to 0.5 of each LOD's reach"),
         ];

@@ -83,7 +83,13 @@ impl SeedStage {
         }
         let table = ClassTable::load(name)?;
         let seeds_per_pattern = settings.seeds.seeds_per_pattern;
-        let tables = SeedTables::new(&table, &landcover.coding, settings.tlm.cell_m, seeds_per_pattern)?;
+        let tables = SeedTables::new(
+            &table,
+            &landcover.coding,
+            settings.tlm.cell_m,
+            seeds_per_pattern,
+            settings.seeds.density_scale,
+        )?;
         let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds_per_pattern, settings.tlm.seed);
         let pass = SeedSelectPass::new(device, settings, &patterns, &tables);
         let bind_group = pass.bind_group(device, sources);

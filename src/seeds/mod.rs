@@ -148,13 +148,15 @@ pub struct SeedTables {
 }
 
 impl SeedTables {
-    /// The tables for a dataset coded with `coding`, its classes grown per `table`, on patterns of
-    /// `seeds_per_pattern` seeds over cells of `cell_m`.
+    /// The tables for a dataset coded with `coding`, its classes grown per `table` with every
+    /// density scaled by `density_scale` (`seeds.density_scale`: rank thinning keeps exactly that
+    /// fraction, still blue noise), on patterns of `seeds_per_pattern` seeds over cells of `cell_m`.
     pub fn new(
         table: &ClassTable,
         coding: &LccCoding,
         cell_m: f64,
         seeds_per_pattern: u32,
+        density_scale: f64,
     ) -> Result<Self, SeedError> {
         if table.species.len() > MAX_SPECIES {
             return Err(SeedError::TooManySpecies { scheme: table.scheme.clone() });
@@ -187,7 +189,7 @@ impl SeedTables {
             };
             let mut cumulative_per_km2 = 0.0f64;
             for (k, rule) in class.seeds.iter().enumerate().take(MAX_SPECIES_PER_CLASS) {
-                cumulative_per_km2 += f64::from(rule.per_km2);
+                cumulative_per_km2 += f64::from(rule.per_km2) * density_scale;
                 entry.rank_limit[k] = (cumulative_per_km2 * cell_km2) as f32;
                 entry.species[k] = table.species_index(&rule.species).unwrap_or_default() as u32;
             }

@@ -211,7 +211,7 @@ fn run(dataset: &Dataset, pose: [f64; 5], viewport_px: [u32; 2]) -> (Vec<OracleS
     let landcover = dataset.manifest.landcover.as_ref().unwrap();
     let table = ClassTable::load(&landcover.scheme).unwrap();
     let spp = settings.seeds.seeds_per_pattern;
-    let tables = SeedTables::new(&table, &landcover.coding, settings.tlm.cell_m, spp).unwrap();
+    let tables = SeedTables::new(&table, &landcover.coding, settings.tlm.cell_m, spp, 1.0).unwrap();
     let patterns = SeedPatterns::generate(settings.tlm.patterns, spp, settings.tlm.seed);
     let [x, y, above_m, yaw_deg, pitch_deg] = pose;
     let origin = dataset.manifest.origin_m;
