@@ -10,11 +10,11 @@
 //! geometry. `shaders/draw_seeds.wgsl` reads an instance's record through compaction's `order`,
 //! scales the model to the seed's height, turns it by the seed's jitter, places it camera-relative
 //! and projects it with the terrain's matrix; it draws into the colour target with the terrain
-//! depth (reversed-Z, `GreaterEqual`, depth written). A seed in the outer `seeds.fade_fraction` of its
-//! LOD's reach cross-fades: its own geometry keeps the pixels whose (per-seed shifted) Bayer
-//! threshold is below the fade, the next LOD's geometry the others, so each pixel shows exactly
-//! one of the two and nothing pops; outside the band the cross-fade draw collapses its vertices.
-//! The last LOD fades out to nothing at the visibility radius.
+//! depth (reversed-Z, `GreaterEqual`, depth written). A seed in the outer `seeds.fade_fraction`
+//! of its LOD's reach cross-fades: its own geometry keeps the pixels whose (per-seed shifted)
+//! Bayer threshold is below the fade, the next LOD's geometry the others, so each pixel shows
+//! exactly one of the two and nothing pops; outside the band the cross-fade draw collapses its
+//! vertices. The last LOD fades out to nothing at the visibility radius.
 
 mod assets;
 
