@@ -50,7 +50,8 @@ here at {first['resolution'][0]} × {first['resolution'][1]} with every frame sh
 
 Recall and precision judge each preset's culling within its own seeded world and reach (the oracle
 enumerates the same patterns out to the same radial LOD distances); what a preset does not seed
-at all shows in its frame error instead: `fast` grows seeds out to 2 km, the others to 3 km.
+at all shows in its frame error instead: `fast` grows seeds out to 2 km, the others to 3 km, and
+`fast` grows half of every class's density (`seeds.density_scale` 0.5: exactly half the trees).
 The presets also draw different forests by design: `fast` has 1,536 seeds per pattern, `balanced`
 2,048, `accurate` 4,096, and rank thinning keeps each class's density but not the same trees, so
 the frame error of `fast` and `balanced` includes trees standing elsewhere, not only blur.
