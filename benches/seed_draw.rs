@@ -28,16 +28,10 @@ fn impostors() -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("bench-impostors");
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
     let table = terramp::classes::ClassTable::load("nc").expect("nc table");
-    let missing: Vec<PathBuf> = table
-        .species
-        .iter()
-        .filter(|s| !dir.join(&s.model).join(terramp::impostor::MANIFEST_FILE).is_file())
-        .map(|s| models.join(format!("{}.glb", s.model)))
-        .collect();
-    if !missing.is_empty() {
-        let options = terramp::bake::BakeOptions::default();
-        terramp::bake::bake_models(None, &missing, &dir, &options, false).expect("bake the nc models");
-    }
+    let names: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
+    let options = terramp::bake::BakeOptions::default();
+    let missing = terramp::bake::bake_missing(&models, &names, &dir, &options, false).expect("bake");
+    assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
     dir
 }
 

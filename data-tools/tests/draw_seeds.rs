@@ -17,7 +17,6 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
@@ -130,16 +129,8 @@ fn open_view(
     settings.seeds.impostors = impostors.to_owned();
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
-    let origin = r.dataset.manifest.origin_m;
     let ([x, y], yaw_deg) = pose;
-    let ground = r.dataset.height_at(x, y, 0).unwrap();
-    let camera = Camera {
-        position_m: DVec3::new(origin[0] + x, origin[1] + y, ground + above_m),
-        yaw_deg,
-        pitch_deg,
-        fov_deg: 60.0,
-        near_m: 0.1,
-    };
+    let camera = support::camera_over(&r, [x, y, above_m, yaw_deg, pitch_deg]);
     r.render_resolved(&camera, 200).unwrap();
     let mut report = r.render(&camera).unwrap();
     for _ in 0..4 {

@@ -23,7 +23,7 @@ use terramp::reference::oracle::{OracleInputs, visible_seeds};
 use terramp::reference::seed_select::SeedComparison;
 use terramp::seeds::cell_pattern;
 
-use support::{TempDir, build_nc, build_zion, shared_data};
+use support::{TempDir, build_nc, build_zion, camera_over, shared_data};
 
 /// Named camera poses: grid x, y, height above the ground, yaw, pitch.
 type Poses<'a> = &'a [(&'a str, [f64; 5])];
@@ -33,19 +33,6 @@ fn renderer(dataset: Dataset, mut settings: Settings, width: u32, height: u32) -
     settings.render.height = height;
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     Renderer::new(gpu, dataset, settings).unwrap()
-}
-
-/// A camera at grid (`x`, `y`), `above_m` over the ground there.
-fn camera(r: &Renderer, [x, y, above_m, yaw_deg, pitch_deg]: [f64; 5]) -> Camera {
-    let origin = r.dataset.manifest.origin_m;
-    let ground = r.dataset.height_at(x, y, 0).unwrap();
-    Camera {
-        position_m: DVec3::new(origin[0] + x, origin[1] + y, ground + above_m),
-        yaw_deg,
-        pitch_deg,
-        fov_deg: 60.0,
-        near_m: 0.1,
-    }
 }
 
 /// Largest distance between a seed's base and the f64 bilinear DEM under it, metres.
@@ -58,7 +45,7 @@ fn worst_base_error_m(r: &Renderer, camera: &Camera, seeds: &[SeedRecord]) -> f6
 fn gpu_equals_twin(dataset: Dataset, views: Poses) {
     let mut r = renderer(dataset, Settings::default(), 320, 180);
     for &(what, pose) in views {
-        let camera = camera(&r, pose);
+        let camera = camera_over(&r, pose);
         r.render_resolved(&camera, 80).unwrap();
         let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
         let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
@@ -113,7 +100,7 @@ fn nc_and_zion_gpu_equals_twin() {
 
 /// Recall and precision of the GPU's seeds against the oracle's visible set from `pose`.
 fn recall_precision(r: &mut Renderer, what: &str, pose: [f64; 5]) -> (f64, f64, usize) {
-    let camera = camera(r, pose);
+    let camera = camera_over(r, pose);
     r.render_resolved(&camera, 80).unwrap();
     let (gpu, _) = r.read_seeds().unwrap().unwrap();
     let (tables, patterns) = r.seed_world().unwrap();
@@ -221,7 +208,7 @@ fn nc_species_follow_the_land_cover() {
     r.pin_everything().unwrap();
     let [w, h] = r.dataset.manifest.extent_m();
     // Straight down from high above the middle: a 16 × 16 block of cells (4 km) in full view.
-    let camera = camera(&r, [0.5 * w, 0.5 * h, 12000.0, 0.0, -89.9]);
+    let camera = camera_over(&r, [0.5 * w, 0.5 * h, 12000.0, 0.0, -89.9]);
     r.render_resolved(&camera, 40).unwrap();
     let cell_m = r.settings.tlm.cell_m;
     let first = [0.5 * w, 0.5 * h].map(|v| (v / cell_m).floor() as i64 - 8);

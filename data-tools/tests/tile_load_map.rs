@@ -61,17 +61,9 @@ fn check(dataset: Dataset, cameras: &[(&str, [f64; 5])]) {
     settings.render.height = 96;
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
-    let origin = r.dataset.manifest.origin_m;
-    for &(what, [x, y, above_m, yaw_deg, pitch_deg]) in cameras {
+    for &(what, pose) in cameras {
         // Positions are grid metres; heights above the ground there (clamped into the dataset).
-        let ground = r.dataset.height_at(x, y, 0).unwrap();
-        let camera = Camera {
-            position_m: DVec3::new(origin[0] + x, origin[1] + y, ground + above_m),
-            yaw_deg,
-            pitch_deg,
-            fov_deg: 60.0,
-            near_m: 0.1,
-        };
+        let camera = support::camera_over(&r, pose);
         let (gpu, twin, rings) = gpu_and_twin(&mut r, &camera);
         let differ: Vec<usize> = (0..gpu.len()).filter(|&i| gpu[i] != twin[i]).collect();
         let shown: Vec<_> = differ.iter().take(5).map(|&i| (i, gpu[i], twin[i])).collect();

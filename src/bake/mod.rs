@@ -172,6 +172,36 @@ pub fn bake_models(
     Ok(reports)
 }
 
+/// What [`bake_missing`] did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Missing {
+    /// The impostors it baked.
+    pub baked: Vec<BakeReport>,
+    /// Model files it needed and could not find: their impostors are still missing.
+    pub absent: Vec<PathBuf>,
+}
+
+/// Bakes into `out` each of `names` (model file stems) whose impostor is missing there or of
+/// another format ([`crate::impostor::is_current`]), from `models/<name>.glb`; the others are
+/// left as they are. Names without a model file are reported, not an error.
+pub fn bake_missing(
+    models: &Path,
+    names: &[&str],
+    out: &Path,
+    options: &BakeOptions,
+    progress: bool,
+) -> Result<Missing, BakeError> {
+    let mut names: Vec<&str> =
+        names.iter().copied().filter(|n| !crate::impostor::is_current(out, n)).collect();
+    names.sort_unstable();
+    names.dedup();
+    let (found, absent): (Vec<PathBuf>, Vec<PathBuf>) =
+        names.iter().map(|n| models.join(format!("{n}.glb"))).partition(|p| p.is_file());
+    let baked =
+        if found.is_empty() { Vec::new() } else { bake_models(None, &found, out, options, progress)? };
+    Ok(Missing { baked, absent })
+}
+
 fn model_name(path: &Path) -> Result<String, BakeError> {
     match path.file_stem().and_then(|s| s.to_str()) {
         Some(name) if !name.is_empty() && !name.starts_with('.') => Ok(name.to_owned()),

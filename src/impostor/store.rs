@@ -201,6 +201,13 @@ fn read_chain(folder: &Path, entry: &ImageEntry) -> Result<MipChain, ImpostorErr
     Ok(MipChain { size: entry.size, levels })
 }
 
+/// Whether `dir/model` holds an impostor this build reads (its manifest's format version), without
+/// loading it.
+pub fn is_current(dir: &Path, model: &str) -> bool {
+    let Ok(text) = fs::read_to_string(dir.join(model).join(MANIFEST_FILE)) else { return false };
+    toml::from_str::<VersionOnly>(&text).is_ok_and(|v| v.format_version == FORMAT_VERSION)
+}
+
 /// The models in `dir` (folders holding a manifest), sorted by name.
 pub fn models(dir: &Path) -> Result<Vec<String>, ImpostorError> {
     let mut names = Vec::new();

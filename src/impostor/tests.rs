@@ -79,7 +79,9 @@ fn other_versions_and_damaged_meshes_are_named() {
     std::fs::write(&manifest, text.replace("format_version = 1", "format_version = 99")).unwrap();
     let error = load(&dir, "Quads").unwrap_err();
     assert!(matches!(error, ImpostorError::Version { found: 99, .. }), "{error}");
+    assert!(!is_current(&dir, "Quads") && !is_current(&dir, "Absent"));
     std::fs::write(&manifest, text).unwrap();
+    assert!(is_current(&dir, "Quads"));
     let mesh = folder.join(MESH_FILE);
     let mut bytes = std::fs::read(&mesh).unwrap();
     let last = bytes.len() - 5;

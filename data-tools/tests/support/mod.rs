@@ -211,3 +211,19 @@ pub fn check_reference(image: &image::RgbaImage, name: &str, min_db: f64, keep_d
     }
     db
 }
+
+/// A camera at grid (`x`, `y`), `above_m` over the ground there, 60° field of view.
+pub fn camera_over(
+    r: &terramp::frame::Renderer,
+    [x, y, above_m, yaw_deg, pitch_deg]: [f64; 5],
+) -> terramp::camera::Camera {
+    let origin = r.dataset.manifest.origin_m;
+    let ground = r.dataset.height_at(x, y, 0).unwrap();
+    terramp::camera::Camera {
+        position_m: glam::DVec3::new(origin[0] + x, origin[1] + y, ground + above_m),
+        yaw_deg,
+        pitch_deg,
+        fov_deg: 60.0,
+        near_m: 0.1,
+    }
+}

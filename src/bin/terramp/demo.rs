@@ -140,34 +140,20 @@ fn ensure_impostors(
         name => name,
     };
     let table = ClassTable::load(name)?;
-    let mut wanted: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
-    wanted.sort_unstable();
-    wanted.dedup();
-    let missing: Vec<&str> = wanted.iter().copied().filter(|m| !is_baked(dir, m)).collect();
-    if missing.is_empty() {
+    let wanted: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
+    if wanted.iter().all(|m| terramp::impostor::is_current(dir, m)) {
         return Ok(Some(dir.to_path_buf()));
     }
-    let (found, absent): (Vec<PathBuf>, Vec<PathBuf>) =
-        missing.iter().map(|m| models.join(format!("{m}.glb"))).partition(|p| p.is_file());
-    for path in &absent {
+    eprintln!("terramp: baking the missing impostors into {} (once)", dir.display());
+    let start = Instant::now();
+    let options = terramp::bake::BakeOptions::default();
+    let missing = terramp::bake::bake_missing(models, &wanted, dir, &options, true)?;
+    for path in &missing.absent {
         eprintln!("terramp: no model {} (--models): its species are selected but not drawn", path.display());
     }
-    if found.is_empty() {
-        return Ok((missing.len() < wanted.len()).then(|| dir.to_path_buf()));
-    }
-    eprintln!("terramp: baking {} impostors into {} (once)", found.len(), dir.display());
-    let start = Instant::now();
-    terramp::bake::bake_models(None, &found, dir, &terramp::bake::BakeOptions::default(), true)?;
-    eprintln!("terramp: baked in {:.1} s", start.elapsed().as_secs_f64());
-    Ok(Some(dir.to_path_buf()))
-}
-
-/// Whether `dir/model` holds an impostor of this build's format.
-fn is_baked(dir: &Path, model: &str) -> bool {
-    let manifest = dir.join(model).join(terramp::impostor::MANIFEST_FILE);
-    let Ok(text) = std::fs::read_to_string(manifest) else { return false };
-    toml::from_str::<terramp::impostor::manifest::VersionOnly>(&text)
-        .is_ok_and(|v| v.format_version == terramp::impostor::FORMAT_VERSION)
+    eprintln!("terramp: baked {} in {:.1} s", missing.baked.len(), start.elapsed().as_secs_f64());
+    let any = wanted.iter().any(|m| terramp::impostor::is_current(dir, m));
+    Ok(any.then(|| dir.to_path_buf()))
 }
 
 /// A straight flight across the dataset's middle, 120 m above the highest ground near the line,
