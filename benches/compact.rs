@@ -9,9 +9,11 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use terramp::gpu::gpu_types::SeedBlock;
+use terramp::gpu::layout::{SEED_GROUPS, SEED_WORKGROUP};
 use terramp::gpu::{AdapterChoice, Gpu};
-use terramp::passes::compact::{CompactInputs, CompactLimits, CompactPass};
-use terramp::seeds::{SEED_GROUPS, SEED_WORKGROUP, pcg};
+use terramp::passes::compact::frame::CompactLimits;
+use terramp::passes::compact::gpu::{CompactInputs, CompactPass};
+use terramp::seeds::pcg;
 use wgpu::util::DeviceExt;
 
 const SIZES: [u32; 5] = [1 << 16, 1 << 18, 1 << 20, 1 << 22, 1 << 24];

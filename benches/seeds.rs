@@ -15,7 +15,7 @@ use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::{AdapterChoice, Gpu};
-use terramp::passes::seed_select::SeedCellRef;
+use terramp::passes::seed_select::frame::SeedCellRef;
 use terramp::seeds::cell_pattern;
 
 const SEEDS_PER_PATTERN: u32 = 4096;

@@ -75,7 +75,7 @@ fn band_fade(record: SeedRecord, lod: u32) -> f32 {
     let ground_rel = record.position_rel_m + vec3<f32>(0.0, 0.0, record.height_m * u.sink_fraction);
     let distance_m = length(ground_rel);
     let size_scale = min(1.0, record.height_m * u.inv_reference_height_m);
-    let reach = u.lod_reach_m[min(lod, 3u)] * size_scale;
+    let reach = u.lod_reach_m[min(lod, SEED_LODS - 1u)] * size_scale;
     // Without a band (fade_fraction 0) a seed is whole up to its reach, then the next LOD's.
     let width = max(reach * u.fade_fraction, 1e-6);
     return clamp((reach - distance_m) / width, 0.0, 1.0);
@@ -84,8 +84,9 @@ fn band_fade(record: SeedRecord, lod: u32) -> f32 {
 @vertex
 fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     let record = records[order[instance]];
-    let species = record.species_lod & 0xffu;
-    let lod = (record.species_lod >> 8u) & 0xfu;
+    let seed = unpack_species_lod(record.species_lod);
+    let species = seed.species;
+    let lod = seed.lod;
     let material = materials[in.material];
     let fade = band_fade(record, lod);
     var out: VertexOut;
@@ -99,7 +100,8 @@ fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
             return out;
         }
     }
-    let angle = f32(record.jitter & 0xffffu) * (6.2831853 / 65536.0);
+    let jitter = unpack_seed_jitter(record.jitter);
+    let angle = f32(jitter.angle) * (6.2831853 / 65536.0);
     let scale = record.height_m * inv_model_height_m[min(species, arrayLength(&inv_model_height_m) - 1u)];
     let rel_m = record.position_rel_m + model_to_world(in.position_model_m * scale, angle);
     out.clip = u.clip_from_view_world * vec4<f32>(rel_m, 1.0);
@@ -107,7 +109,7 @@ fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     out.normal = model_to_world(in.normal_model, angle);
     out.uv = in.uv;
     // Colour variation: brightness ±15 % and a slight shift between yellow-green and blue-green.
-    let variation = f32(record.jitter >> 16u) / 65535.0 - 0.5;
+    let variation = f32(jitter.colour) / 65535.0 - 0.5;
     let shift = vec3<f32>(1.0 + 0.3 * variation, 1.0, 1.0 - 0.3 * variation);
     out.tint = shift * (1.0 + 0.3 * variation);
     out.material = in.material;

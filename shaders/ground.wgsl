@@ -29,18 +29,18 @@ fn imagery_albedo(grid_m: vec2<f32>) -> vec4<f32> {
     let wanted = log2(max(footprint, 1e-6)) + u.imagery_frame.w;
     let last = u.imagery_level_count - 1u;
     var level = u32(clamp(floor(wanted), 0.0, f32(last)));
-    var slot = 0u;
+    var slot = PAGE_EMPTY;
     loop {
         let info = u.imagery_levels[level];
         let tile = clamp(vec2<i32>(floor(texel0 / f32(1u << level) / f32(IMAGERY_TILE_TEXELS))),
                          vec2<i32>(0), vec2<i32>(info.yz) - 1);
         slot = imagery_page_table[info.x + u32(tile.y) * info.y + u32(tile.x)];
-        if slot != 0u || level >= last {
+        if slot != PAGE_EMPTY || level >= last {
             break;
         }
         level += 1u;
     }
-    if slot == 0u {
+    if slot == PAGE_EMPTY {
         return vec4<f32>(0.0);
     }
     let info = u.imagery_levels[level];
@@ -50,7 +50,7 @@ fn imagery_albedo(grid_m: vec2<f32>) -> vec4<f32> {
     let extent = f32(IMAGERY_TILE_EXTENT);
     let uv = (texel - tile * f32(IMAGERY_TILE_TEXELS) + f32(IMAGERY_BORDER)) / extent;
     // The cache is an sRGB texture: filtering happens on linear values, as it should.
-    let colour = textureSampleGrad(imagery_tiles, imagery_sampler, uv, i32(slot - 1u),
+    let colour = textureSampleGrad(imagery_tiles, imagery_sampler, uv, page_layer(slot),
                                    ddx0 * scale / extent, ddy0 * scale / extent);
     return colour;
 }

@@ -157,23 +157,23 @@ struct Ground {
 fn ground_at(p: GridPos) -> Ground {
     let s0 = vec2<u32>(p.texel);
     var level = 0u;
-    var slot = 0u;
+    var slot = PAGE_EMPTY;
     var tile = vec2<u32>(0u);
     loop {
         let info = u.height_levels[level];
         tile = min((s0 >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
         slot = height_page_table[info.x + tile.y * info.y + tile.x];
-        if slot != 0u || level + 1u >= u.height_level_count {
+        if slot != PAGE_EMPTY || level + 1u >= u.height_level_count {
             break;
         }
         level += 1u;
     }
-    if slot == 0u {
+    if slot == PAGE_EMPTY {
         return Ground(0.0, vec2<f32>(0.0), level, false);
     }
     let s = s0 >> vec2<u32>(level);
     let local = vec2<i32>(s - tile * HEIGHT_TILE_CELLS + HEIGHT_BORDER);
-    let layer = i32(slot - 1u);
+    let layer = page_layer(slot);
     let h00 = textureLoad(height_tiles, local, layer, 0).r;
     let h10 = textureLoad(height_tiles, local + vec2<i32>(1, 0), layer, 0).r;
     let h01 = textureLoad(height_tiles, local + vec2<i32>(0, 1), layer, 0).r;
@@ -193,29 +193,29 @@ fn ground_at(p: GridPos) -> Ground {
 }
 
 // Palette index of level-1 land-cover texel `q`, read from `wanted` or, while that streams in,
-// another resident level (they all decode to the same class); 0xffffffff when none is resident.
+// another resident level (they all decode to the same class); NO_CLASS when none is resident.
 fn class_at(q: vec2<u32>, wanted: u32) -> vec2<u32> {
     for (var n = 0u; n < LCC_LEVELS; n += 1u) {
         let level = (wanted + n) % LCC_LEVELS;
-        var texel = q >> vec2<u32>(1u);
-        if level == 0u {
-            texel = q << vec2<u32>(1u);
-        } else if level == 1u {
+        var texel = q << vec2<u32>(1u);
+        if level == LCC_SOURCE_LEVEL {
             texel = q;
+        } else if level == LCC_PACKED_LEVEL {
+            texel = q >> vec2<u32>(1u);
         }
         let info = u.lcc_levels[level];
         let tile = min(texel / LCC_TILE_TEXELS, info.yz - 1u);
         let slot = lcc_page_table[info.x + tile.y * info.y + tile.x];
-        if slot != 0u {
-            let word = textureLoad(lcc_tiles, vec2<i32>(texel - tile * LCC_TILE_TEXELS), i32(slot - 1u), 0).x;
-            if level != 2u {
+        if slot != PAGE_EMPTY {
+            let word = textureLoad(lcc_tiles, vec2<i32>(texel - tile * LCC_TILE_TEXELS), page_layer(slot), 0).x;
+            if level != LCC_PACKED_LEVEL {
                 return vec2<u32>(word, level);
             }
             let shift = u.lcc_sub_bits * ((q.x & 1u) + 2u * (q.y & 1u));
             return vec2<u32>((word >> shift) & ((1u << u.lcc_sub_bits) - 1u), level);
         }
     }
-    return vec2<u32>(0xffffffffu, 0u);
+    return vec2<u32>(NO_CLASS, 0u);
 }
 
 // Linear colour of level-0 imagery texel `t` from the finest resident level (alpha 0: none).
@@ -226,9 +226,9 @@ fn imagery_texel(t: vec2<u32>) -> vec4<f32> {
         let texel = t >> vec2<u32>(level);
         let tile = min(texel / IMAGERY_TILE_TEXELS, info.yz - 1u);
         let slot = imagery_page_table[info.x + tile.y * info.y + tile.x];
-        if slot != 0u {
+        if slot != PAGE_EMPTY {
             let local = vec2<i32>(texel - tile * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
-            return textureLoad(imagery_tiles, local, i32(slot - 1u), 0);
+            return textureLoad(imagery_tiles, local, page_layer(slot), 0);
         }
         if level + 1u >= u.imagery_level_count {
             return vec4<f32>(0.0);
@@ -414,14 +414,14 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     }
 
     out.count = COUNT_SELECTED;
-    out.key = species_index * SEED_LODS + lod;
+    out.key = seed_group(species_index, lod);
     let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     out.record = SeedRecord(
         vec3<f32>(rel_xy, base_rel_m),
         height_m,
         cell.address,
         rank,
-        species_index | (lod << 8u) | (found.y << 12u) | (ground.level << 16u),
+        pack_species_lod(SpeciesLod(species_index, lod, found.y, ground.level)),
         pcg(hash),
         ground_colour(imagery, hash),
         radius_m,

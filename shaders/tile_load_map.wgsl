@@ -73,8 +73,10 @@ fn length_sq(v: vec3<f32>) -> f32 {
 fn height_range(ring: u32, tiles_x: u32, tiles_y: u32) -> vec2<f32> {
     let level = u.height_levels[u.rings_info[ring].height_level];
     var range = vec2<f32>(3.4e38, -3.4e38);
-    for (var ty = tiles_y & 0xffffu; ty <= tiles_y >> 16u; ty += 1u) {
-        for (var tx = tiles_x & 0xffffu; tx <= tiles_x >> 16u; tx += 1u) {
+    let xs = unpack_tile_span(tiles_x);
+    let ys = unpack_tile_span(tiles_y);
+    for (var ty = ys.first; ty <= ys.last; ty += 1u) {
+        for (var tx = xs.first; tx <= xs.last; tx += 1u) {
             let r = height_ranges_m[level.x + ty * level.y + tx];
             range = vec2<f32>(min(range.x, r.x), max(range.y, r.y));
         }
@@ -183,7 +185,7 @@ fn height_lod(d_sq: f32) -> u32 {
 }
 
 fn tlm_cell(ring: u32, cx: u32, cy: u32) -> TlmCell {
-    let culled = TlmCell(0u, 0u, 0u, 3u);
+    let culled = TlmCell(TLM_CULLED, 0u, 0u, RADIAL_INACTIVE);
     let sx = spans[(ring * 2u) * u.cells + cx];
     let sy = spans[(ring * 2u + 1u) * u.cells + cy];
     let flags = sx.flags & sy.flags;
@@ -200,18 +202,18 @@ fn tlm_cell(ring: u32, cx: u32, cy: u32) -> TlmCell {
     let far_sq = length_sq(max(abs(lo), abs(hi)));
 
     var cell: TlmCell;
-    cell.visibility = 1u;
+    cell.visibility = TLM_FIRST_PATTERN;
     if ring == 0u {
         let g = u.rings_info[0].origin_cell + vec2<i32>(i32(cx), i32(cy));
-        cell.visibility = 1u + pattern_hash(bitcast<u32>(g.x), bitcast<u32>(g.y), u.seed) % u.patterns;
+        cell.visibility = tlm_visibility(pattern_hash(bitcast<u32>(g.x), bitcast<u32>(g.y), u.seed) % u.patterns);
     }
     cell.imagery_lod = 0u;
     if u.imagery_levels > 0u {
-        cell.imagery_lod = imagery_level(near_sq) | (imagery_level(far_sq) << 8u);
+        cell.imagery_lod = pack_level_range(LevelRange(imagery_level(near_sq), imagery_level(far_sq)));
     }
-    cell.height_lod = height_lod(near_sq) | (height_lod(far_sq) << 8u);
-    cell.radial_lod = 3u;
-    for (var k = 2; k >= 0; k -= 1) {
+    cell.height_lod = pack_level_range(LevelRange(height_lod(near_sq), height_lod(far_sq)));
+    cell.radial_lod = RADIAL_INACTIVE;
+    for (var k = i32(TLM_RADIAL_BANDS) - 1; k >= 0; k -= 1) {
         if near_sq < u.radial_lod_sq_m2[k] {
             cell.radial_lod = u32(k);
         }

@@ -13,11 +13,12 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::dataset::ClassName;
+use crate::gpu::layout;
 
-/// Most species in one table (the seed-selection pass indexes them in 4 bits).
-pub const MAX_SPECIES: usize = 16;
-/// Most seed rules in one class.
-pub const MAX_SPECIES_PER_CLASS: usize = 4;
+/// Most species in one table (`layout::MAX_SPECIES`, as a count).
+pub const MAX_SPECIES: usize = layout::MAX_SPECIES as usize;
+/// Most seed rules in one class (`layout::MAX_SPECIES_PER_CLASS`, as a count).
+pub const MAX_SPECIES_PER_CLASS: usize = layout::MAX_SPECIES_PER_CLASS as usize;
 /// Largest density a rule may ask for, seeds per km² (one seed per 10 m²).
 pub const MAX_PER_KM2: f32 = 100_000.0;
 

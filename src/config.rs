@@ -126,7 +126,7 @@ pub struct TlmSettings {
 
 impl TlmSettings {
     fn validate(&self) -> Result<(), SettingsError> {
-        let max_rings = crate::passes::tile_load_map::TLM_MAX_RINGS;
+        let max_rings = crate::gpu::layout::TLM_MAX_RINGS;
         let r = self.radial_lod_m;
         let checks: [(bool, &'static str, String, &'static str); 6] = [
             (

@@ -2,7 +2,7 @@
 //! (a tree, a bush, a rock) at any distance: the real mesh up close and, further out, a *billboard
 //! cloud* at three levels of detail: a few textured planes fitted to the model (Décoret et al.
 //! 2003, Fuhrmann et al. 2005), whose atlas holds the geometry near each plane rendered
-//! orthographically onto it. [`crate::bake`] makes impostors from glTF models; [`load`] reads
+//! orthographically onto it. The baker (`bake`) makes impostors from glTF models; [`load`] reads
 //! one back, ready for upload: plane vertices and indices ([`ImpostorLod::vertices`]), atlas texels
 //! per mip, mesh vertices, indices and materials.
 //!

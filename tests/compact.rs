@@ -7,9 +7,11 @@ mod common;
 
 use terramp::gpu::Gpu;
 use terramp::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
-use terramp::passes::compact::{COMPACT_CHUNK, CompactInputs, CompactLimits, CompactPass, Compacted};
+use terramp::gpu::layout::{COMPACT_CHUNK, SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP};
+use terramp::passes::compact::frame::{CompactLimits, Compacted};
+use terramp::passes::compact::gpu::{CompactInputs, CompactPass};
 use terramp::reference::compact::compact;
-use terramp::seeds::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP, pcg};
+use terramp::seeds::pcg;
 
 /// A pass with its own input buffers, sized for one test's inputs.
 struct Harness {

@@ -9,8 +9,8 @@ use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
+use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SpeciesLod, seed_group};
 use terramp::reference::seed_select::SeedComparison;
-use terramp::seeds::{SEED_DRAWS, SEED_GROUPS, seed_group};
 
 const SIZE: u32 = 1024;
 
@@ -71,7 +71,7 @@ fn gpu_seed_selection_equals_its_cpu_twin() {
         let output = r.read_seed_output().unwrap().unwrap();
         let (twin_output, _) = r.compact_twin().unwrap().unwrap();
         assert_eq!(identities(&output.in_block_order()), identities(&twin), "view {i}");
-        let counts = |o: &terramp::passes::seed_select::SeedOutput| {
+        let counts = |o: &terramp::passes::seed_select::frame::SeedOutput| {
             o.blocks.iter().map(|b| b.count).collect::<Vec<_>>()
         };
         assert_eq!(counts(&output), counts(&twin_output), "view {i}");
@@ -109,7 +109,8 @@ fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
     for (g, args) in compacted.args[..SEED_GROUPS as usize].iter().enumerate() {
         let slots = args.first_instance as usize..(args.first_instance + args.instance_count) as usize;
         for s in &drawn[slots] {
-            assert_eq!(seed_group(s.species_lod & 0xff, (s.species_lod >> 8) & 0xf), g as u32);
+            let SpeciesLod { species, lod, .. } = SpeciesLod::unpack(s.species_lod);
+            assert_eq!(seed_group(species, lod), g as u32);
         }
     }
     assert_eq!(compacted.args.len(), SEED_DRAWS as usize);
@@ -146,7 +147,11 @@ fn seeds_sit_on_the_bilinear_dem() {
         let y = camera_grid.y + f64::from(record.position_rel_m[1]);
         let exact_m = r.dataset.height_at(x, y, 0).unwrap();
         worst_m = worst_m.max((f64::from(record.ground_m) - exact_m).abs());
-        assert_eq!(record.species_lod >> 16, 0, "a seed stood on a coarse height level");
+        assert_eq!(
+            SpeciesLod::unpack(record.species_lod).height_level,
+            0,
+            "a seed stood on a coarse height level"
+        );
     }
     println!("{} seeds, largest base error {:.2} mm", records.len(), worst_m * 1000.0);
     assert!(worst_m <= 0.01, "a seed's base is {worst_m} m off the DEM");

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use terramp::classes::ClassTable;
+use terramp::dataset::lcc::LCC_SOURCE_LEVEL;
 use terramp::dataset::{Dataset, TileId};
-use terramp::lcc::LCC_SOURCE_LEVEL;
 use terramp::synth::{IMAGERY_PACK, LANDCOVER_PACK, SynthError, SynthParams, code, synthesize};
 
 fn temp_out(name: &str) -> PathBuf {

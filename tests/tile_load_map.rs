@@ -12,14 +12,17 @@ use terramp::camera::Camera;
 use terramp::config::{Settings, TlmSettings};
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::TlmCell;
+use terramp::gpu::layout::TileSpan;
 use terramp::gpu::readback_ring::ReadbackRing;
 use terramp::gpu::{Profiler, TimeSource};
-use terramp::passes::depth_pyramid::DepthPyramid;
-use terramp::passes::tile_load_map::{
-    TileLoadMapPass, TlmFrame, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges,
-};
-use terramp::reference::tile_load_map::{HizMips, pattern_hash, tile_load_map};
-use terramp::terrain::select::Lods;
+use terramp::passes::depth_pyramid::frame::HizMips;
+use terramp::passes::depth_pyramid::gpu::DepthPyramid;
+use terramp::passes::terrain::select::Lods;
+use terramp::passes::tile_load_map::frame::{TlmFrame, TlmImagery, TlmInputs, height_tile_ranges};
+use terramp::passes::tile_load_map::gpu::TileLoadMapPass;
+use terramp::passes::tile_load_map::layout::TlmLayout;
+use terramp::reference::depth_pyramid::depth_pyramid;
+use terramp::reference::tile_load_map::{pattern_hash, tile_load_map};
 
 use common::{gpu, renderer, small_settings, synth_dataset};
 
@@ -171,8 +174,9 @@ fn cell_height_range(run: &Run, ring: u32, cx: u32, cy: u32) -> [f32; 2] {
     );
     let level = u.height_levels[u.rings_info[ring as usize].height_level as usize];
     let mut range = [f32::MAX, f32::MIN];
-    for ty in sy.height_tiles & 0xffff..=sy.height_tiles >> 16 {
-        for tx in sx.height_tiles & 0xffff..=sx.height_tiles >> 16 {
+    let (xs, ys) = (TileSpan::unpack(sx.height_tiles), TileSpan::unpack(sy.height_tiles));
+    for ty in ys.first..=ys.last {
+        for tx in xs.first..=xs.last {
             let r = run.ranges[(level[0] + ty * level[1] + tx) as usize];
             range = [range[0].min(r[0]), range[1].max(r[1])];
         }
@@ -512,7 +516,7 @@ fn depth_pyramid_equals_a_cpu_min_reduction_at_odd_sizes() {
         hiz.encode(&mut encoder, &r.depth_texture().create_view(&Default::default()));
         r.gpu.queue.submit([encoder.finish()]);
         let gpu_mips = hiz.read_back(&r.gpu).unwrap();
-        let cpu_mips = HizMips::from_depth(&r.read_depth().unwrap(), w, h);
+        let cpu_mips = depth_pyramid(&r.read_depth().unwrap(), w, h);
         assert_eq!(gpu_mips.sizes, cpu_mips.sizes);
         assert_eq!(gpu_mips.sizes.last(), Some(&[1, 1]));
         assert!(gpu_mips == cpu_mips, "{w}×{h}: GPU and CPU pyramids differ");
@@ -563,12 +567,12 @@ fn readback_ring_never_waits_and_delivers_frames_in_order() {
     }
     assert_eq!(ring.in_flight(), 0);
     assert_eq!(taken.len() as u64 + ring.skipped(), 40);
-    assert!(taken.windows(2).all(|w| w[0].frame < w[1].frame), "frames out of order");
+    assert!(taken.windows(2).all(|w| w[0].tag < w[1].tag), "frames out of order");
     for readback in &taken {
         assert!(
-            readback.cast::<u32>().iter().all(|&v| u64::from(v) == readback.frame),
+            readback.cast::<u32>().iter().all(|&v| u64::from(v) == readback.tag),
             "frame {}",
-            readback.frame
+            readback.tag
         );
     }
     assert!(slowest < Duration::from_millis(500), "try_take took {slowest:?}");

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use support::{TempDir, build, gdal_band, level_image, shared_data};
 use terramp::dataset::Dataset;
-use terramp::lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
+use terramp::dataset::lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
 
 /// The source's classes, south row first, with the source's nodata as the table's nodata code.
 struct Truth {

@@ -16,8 +16,9 @@ use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
+use terramp::gpu::layout::SpeciesLod;
 use terramp::gpu::{AdapterChoice, Gpu};
-use terramp::passes::seed_select::SeedCellRef;
+use terramp::passes::seed_select::frame::SeedCellRef;
 use terramp::reference::accuracy::{HeightError, SeedAgreement, SeedId, record_id};
 use terramp::reference::oracle::{OracleInputs, visible_seeds};
 use terramp::reference::seed_select::SeedComparison;
@@ -240,7 +241,7 @@ fn nc_species_follow_the_land_cover() {
     let mut seeds_per_code = std::collections::BTreeMap::<u8, u64>::new();
     for s in &records {
         let code = code_at(c.x + f64::from(s.position_rel_m[0]), c.y + f64::from(s.position_rel_m[1]));
-        let species = &table.species[(s.species_lod & 0xff) as usize];
+        let species = &table.species[SpeciesLod::unpack(s.species_lod).species as usize];
         assert!(
             !(species.kind == SpeciesKind::Tree && (code == 1 || code == 6)),
             "a {} stands on class {code}",

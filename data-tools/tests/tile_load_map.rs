@@ -11,10 +11,12 @@ use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::{AdapterChoice, Gpu};
-use terramp::passes::depth_pyramid::DepthPyramid;
-use terramp::passes::tile_load_map::{TileLoadMapPass, TlmImagery, TlmInputs, TlmLayout, height_tile_ranges};
+use terramp::passes::depth_pyramid::gpu::DepthPyramid;
+use terramp::passes::terrain::select::Lods;
+use terramp::passes::tile_load_map::frame::{TlmImagery, TlmInputs, height_tile_ranges};
+use terramp::passes::tile_load_map::gpu::TileLoadMapPass;
+use terramp::passes::tile_load_map::layout::TlmLayout;
 use terramp::reference::tile_load_map::tile_load_map;
-use terramp::terrain::select::Lods;
 
 use support::{TempDir, build, shared_data};
 

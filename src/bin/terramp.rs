@@ -406,7 +406,7 @@ fn info(dataset_dir: &Path) -> Result<()> {
         );
     }
     if let Some(l) = &m.landcover {
-        let source = l.layer.pyramid.size_at(terramp::lcc::LCC_SOURCE_LEVEL);
+        let source = l.layer.pyramid.size_at(terramp::dataset::lcc::LCC_SOURCE_LEVEL);
         println!(
             "  land cover ({}, {} classes): {}×{} texels at {} m, LCC quadtree of {} levels in {}-bit words, {} codes",
             l.scheme,

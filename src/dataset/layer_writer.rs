@@ -7,7 +7,7 @@
 //! page cache, never held whole), by one `Reduce` rule per layer: heights are decimated so that a
 //! coarse sample equals the fine sample at the same place (which is what keeps LOD seams exact),
 //! imagery is box-filtered. A tile's mips are reduced from its own bordered mip 0, with the same
-//! rule, so mips and coarser levels agree. Land cover is not reduced at all: `crate::lcc` writes
+//! rule, so mips and coarser levels agree. Land cover is not reduced at all: `crate::dataset::lcc` writes
 //! its lossless 3-level quadtree, cutting its source windows with the same `read_replicated`.
 
 use std::path::Path;
@@ -19,7 +19,7 @@ use thiserror::Error;
 use super::pack::{PackError, PackWriter};
 use super::pyramid::{Pyramid, Sampling, TileId};
 use super::{CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS};
-use crate::lcc::LccError;
+use crate::dataset::lcc::LccError;
 
 /// How a texel of level `l + 1` is made from the 2 × 2 texels of level `l` beneath it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

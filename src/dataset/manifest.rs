@@ -9,9 +9,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::pyramid::Pyramid;
-use crate::lcc::LccCoding;
+use crate::dataset::lcc::LccCoding;
 
-/// Version 2: land cover is the LCC quadtree of palette indices (`crate::lcc`).
+/// Version 2: land cover is the LCC quadtree of palette indices (`crate::dataset::lcc`).
 pub const FORMAT_VERSION: u32 = 2;
 pub const MANIFEST_FILE: &str = "manifest.toml";
 
@@ -72,7 +72,7 @@ pub struct CellLayer {
     pub source: String,
 }
 
-/// The land cover: an LCC quadtree (`crate::lcc`) whose `layer.pyramid` has exactly `LCC_LEVELS`
+/// The land cover: an LCC quadtree (`crate::dataset::lcc`) whose `layer.pyramid` has exactly `LCC_LEVELS`
 /// levels, level 1 the source's texels; `layer.texel_m` is level 0's texel, half the source's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

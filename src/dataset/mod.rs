@@ -5,7 +5,7 @@
 //!
 //! The manifest's format version is read on its own before the rest, so a dataset of another
 //! version is reported as such (and rebuilt by whoever owns it), not as a malformed manifest.
-//! Land cover is an LCC quadtree (`crate::lcc`): its words are read back through the manifest's
+//! Land cover is an LCC quadtree (`lcc`): its words are read back through the manifest's
 //! `LccCoding`, never as raw class codes.
 //!
 //! Writing goes through `Staging` (atomic publication) and `layer_writer::write_layer` (one pack,
@@ -13,6 +13,7 @@
 //! synthetic generator.
 
 pub mod layer_writer;
+pub mod lcc;
 pub mod manifest;
 pub mod pack;
 pub mod pyramid;
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use thiserror::Error;
 
-use crate::lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
+use lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
 
 pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer};
 pub use manifest::{
@@ -33,16 +34,11 @@ pub use pack::{Pack, PackError};
 pub use pyramid::{Pyramid, Sampling, TileId};
 pub use staging::Staging;
 
-/// Height tiles: 256 cells (257 shared-edge samples) plus a 1-sample border for normals.
-pub const HEIGHT_TILE_CELLS: u32 = 256;
-pub const HEIGHT_BORDER: u32 = 1;
-/// Imagery and land-cover tiles: 512 texels. Imagery carries an 8-texel border, enough for
-/// trilinear and anisotropic filtering down its 4 stored mips (8, 4, 2, 1 texels of border).
-pub const CELL_TILE_TEXELS: u32 = 512;
-pub const IMAGERY_BORDER: u32 = 8;
-pub const IMAGERY_MIPS: u32 = 4;
-/// Land cover is read texel by texel (nearest), so it needs no border.
-pub const LANDCOVER_BORDER: u32 = 0;
+/// The tiles' shapes: cells, texels, borders and mips per layer (defined with every other
+/// constant the shaders share, in `gpu::layout`).
+pub use crate::gpu::layout::{
+    CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS, LANDCOVER_BORDER,
+};
 
 #[derive(Debug, Error)]
 pub enum DatasetError {
@@ -233,7 +229,7 @@ impl Dataset {
     /// dataset without land cover is bare everywhere (index 0).
     pub fn landcover_index(&self, level: u32, q: [u32; 2]) -> Result<u32, PackError> {
         if self.landcover.is_none() {
-            return Ok(crate::lcc::LCC_BARE_INDEX);
+            return Ok(crate::dataset::lcc::LCC_BARE_INDEX);
         }
         let (layer, coding) = self.landcover_layer()?;
         let pyramid = &layer.pyramid;

@@ -3,7 +3,7 @@ use std::path::PathBuf;
 use indicatif::ProgressBar;
 
 use super::*;
-use crate::lcc::{self, LccCoding};
+use crate::dataset::lcc::{self, LccCoding};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("terramp-dataset-{}-{name}", std::process::id()));
@@ -321,4 +321,13 @@ fn a_bad_lcc_coding_is_refused_naming_the_manifest() {
     let err = Dataset::open(&dataset.dir).err().expect("a 12-bit coding must not open");
     assert!(matches!(&err, DatasetError::Manifest { path: p, .. } if *p == path), "{err}");
     assert!(err.to_string().contains("12 bits"), "{err}");
+}
+
+#[test]
+fn stored_tiles_have_the_extents_the_shaders_read() {
+    use crate::gpu::layout::{HEIGHT_TILE_EXTENT, IMAGERY_TILE_EXTENT};
+    for size in [[1, 1], [257, 257], [1000, 3]] {
+        assert_eq!(LayerSpec::heights(size).pyramid.tile_extent(), HEIGHT_TILE_EXTENT);
+        assert_eq!(LayerSpec::imagery(size).pyramid.tile_extent(), IMAGERY_TILE_EXTENT);
+    }
 }

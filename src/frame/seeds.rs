@@ -7,24 +7,25 @@
 //! reports are a frame or two old. With `seeds.impostors` set, it also loads each species'
 //! impostor once, gives compaction the draw pass's templates, and has pass 4 draw the groups.
 
-use std::collections::VecDeque;
-
 use glam::DVec3;
 
 use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::Dataset;
-use crate::gpu::gpu_types::{CompactParams, SeedCounters, TerrainUniforms};
+use crate::gpu::gpu_types::{CompactParams, SeedCounters, SeedRecord, TerrainUniforms};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError};
-use crate::passes::compact::{CompactInputs, CompactLimits, CompactPass};
-use crate::passes::draw_seeds::{DrawSeedsInputs, DrawSeedsPass, draw_uniforms, load_impostors};
-use crate::passes::seed_select::{SeedCellRef, SeedFrame, SeedInputs, SeedSelectPass, SeedSources};
+use crate::passes::compact::frame::CompactLimits;
+use crate::passes::compact::gpu::{CompactInputs, CompactPass};
+use crate::passes::draw_seeds::frame::{draw_uniforms, load_impostors};
+use crate::passes::draw_seeds::gpu::{DrawSeedsInputs, DrawSeedsPass};
+use crate::passes::seed_select::frame::{SeedCellRef, SeedFrame, SeedInputs};
+use crate::passes::seed_select::gpu::{SeedSelectPass, SeedSources};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
 
-use super::RenderError;
+use super::{Caches, RenderError};
 
 /// Pass 3's counters for one frame, as the frame log records them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
@@ -36,6 +37,14 @@ pub struct SeedReport {
     pub ranks: u32,
     #[serde(flatten)]
     pub counters: SeedCounters,
+}
+
+/// What a frame's counters are read with: the frame, its cells and the ranks checked in each.
+#[derive(Debug, Clone, Copy)]
+struct CountersTag {
+    frame: u64,
+    cells: u32,
+    ranks: u32,
 }
 
 pub(super) struct SeedStage {
@@ -51,29 +60,38 @@ pub(super) struct SeedStage {
     draw: Option<(DrawSeedsPass, wgpu::BindGroup)>,
     /// The last frame's compaction size.
     compact_params: CompactParams,
-    counters_ring: ReadbackRing,
-    /// Frames (with their cells and ranks) whose counters are in flight, oldest first.
-    in_flight: VecDeque<(u64, u32, u32)>,
+    counters_ring: ReadbackRing<CountersTag>,
     /// The last frame's inputs, for the twin.
     pub last_frame: Option<SeedFrame>,
     pub latest: Option<SeedReport>,
 }
 
 impl SeedStage {
-    /// The stage for `dataset`, or `None` when it has no land cover (nothing to grow seeds from).
+    /// The stage for `dataset` over the renderer's caches and depth target, or `None` when it has
+    /// no land cover (nothing to grow seeds from).
     pub fn new(
         gpu: &Gpu,
         dataset: &Dataset,
         settings: &Settings,
-        sources: &SeedSources,
+        caches: &Caches,
+        depth: &wgpu::TextureView,
     ) -> Result<Option<Self>, RenderError> {
-        let Some(landcover) = &dataset.manifest.landcover else { return Ok(None) };
+        let (Some(landcover), Some(landcover_cache)) = (&dataset.manifest.landcover, &caches.landcover)
+        else {
+            return Ok(None);
+        };
+        let sources = SeedSources {
+            heights: &caches.heights,
+            landcover: landcover_cache,
+            imagery: &caches.imagery,
+            depth,
+        };
         let device = &gpu.device;
         let name = match settings.seeds.class_table.as_str() {
             "" => landcover.scheme.as_str(),
             name => name,
         };
-        let record_bytes = size_of::<crate::gpu::gpu_types::SeedRecord>() as u64;
+        let record_bytes = size_of::<SeedRecord>() as u64;
         let max_bytes = device.limits().max_storage_buffer_binding_size;
         if u64::from(settings.seeds.capacity) * record_bytes > max_bytes {
             return Err(RenderError::SeedCapacity {
@@ -92,7 +110,7 @@ impl SeedStage {
         )?;
         let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds_per_pattern, settings.tlm.seed);
         let pass = SeedSelectPass::new(device, settings, &patterns, &tables);
-        let bind_group = pass.bind_group(device, sources);
+        let bind_group = pass.bind_group(device, &sources);
         let mut compact = CompactPass::new(device, CompactLimits::from(settings))?;
         let compact_bind_group =
             compact.bind_group(device, &CompactInputs { blocks: pass.blocks(), keys: pass.keys() });
@@ -120,7 +138,6 @@ impl SeedStage {
             draw,
             compact_params: CompactParams::default(),
             counters_ring,
-            in_flight: VecDeque::new(),
             last_frame: None,
             latest: None,
         }))
@@ -176,11 +193,14 @@ impl SeedStage {
     /// the CPU-timing fallback submits each pass on its own), unless every slot is in flight.
     pub fn encode_readback(&mut self, encoder: &mut wgpu::CommandEncoder, frame: u64) {
         let bytes = size_of::<SeedCounters>() as u64;
-        if self.counters_ring.encode_copy(encoder, self.pass.counters(), bytes, frame) {
-            let (cells, ranks) =
-                self.last_frame.as_ref().map_or((0, 0), |f| (f.cells.len() as u32, f.uniforms.active_ranks));
-            self.in_flight.push_back((frame, cells, ranks));
-        }
+        let (cells, ranks) =
+            self.last_frame.as_ref().map_or((0, 0), |f| (f.cells.len() as u32, f.uniforms.active_ranks));
+        self.counters_ring.encode_copy(
+            encoder,
+            self.pass.counters(),
+            bytes,
+            CountersTag { frame, cells, ranks },
+        );
     }
 
     /// Tells the ring its copy was submitted.
@@ -191,10 +211,7 @@ impl SeedStage {
     /// Takes every counter readback that has arrived, keeping the newest.
     pub fn collect(&mut self, device: &wgpu::Device) -> Result<(), GpuError> {
         while let Some(readback) = self.counters_ring.try_take(device)? {
-            while self.in_flight.front().is_some_and(|(frame, ..)| *frame < readback.frame) {
-                self.in_flight.pop_front();
-            }
-            let Some((frame, cells, ranks)) = self.in_flight.pop_front() else { continue };
+            let CountersTag { frame, cells, ranks } = readback.tag;
             if let Some(&counters) = readback.cast::<SeedCounters>().first() {
                 self.latest = Some(SeedReport { frame, cells, ranks, counters });
             }

@@ -4,19 +4,19 @@
 
 use std::time::Duration;
 
+use crate::camera::Camera;
 use crate::gpu::GpuError;
+use crate::gpu::gpu_types::{SeedCounters, SeedRecord, TlmCell};
 use crate::gpu::readback::read_texture;
+use crate::passes::compact::frame::Compacted;
+use crate::passes::seed_select::frame::{SeedCellRef, SeedOutput};
+use crate::reference::seed_select::{SeedSnapshot, seed_select, seed_select_blocks, snapshot_caches};
+use crate::seeds::SeedTables;
+use crate::seeds::patterns::SeedPatterns;
 use crate::streaming::wants::pinned_tiles;
 use crate::streaming::{CacheStats, TileCache};
 
 use super::{FrameReport, RenderError, Renderer};
-use crate::camera::Camera;
-use crate::gpu::gpu_types::{SeedCounters, SeedRecord, TlmCell};
-use crate::passes::compact::Compacted;
-use crate::passes::seed_select::{SeedCellRef, SeedOutput};
-use crate::reference::seed_select::{SeedSnapshot, seed_select, seed_select_blocks, snapshot_caches};
-use crate::seeds::SeedTables;
-use crate::seeds::patterns::SeedPatterns;
 
 impl Renderer {
     /// Loads every tile of the dataset now (heights, imagery, land cover) and pins it, for
@@ -33,17 +33,16 @@ impl Renderer {
             }
             Ok(pinned_tiles(pyramid, usize::MAX))
         };
-        let queue = &self.gpu.queue;
-        self.pinned_heights = everything(&self.heights, "height")?;
-        self.heights
-            .load_now(queue, &self.pinned_heights, self.frame, |id| self.dataset.height.tile_bytes(id));
+        let (queue, c, frame) = (&self.gpu.queue, &mut self.caches, self.frame);
+        c.pinned_heights = everything(&c.heights, "height")?;
+        c.heights.load_now(queue, &c.pinned_heights, frame, |id| self.dataset.height.tile_bytes(id));
         if let Some(layer) = &self.dataset.imagery {
-            self.pinned_imagery = everything(&self.imagery, "imagery")?;
-            self.imagery.load_now(queue, &self.pinned_imagery, self.frame, |id| layer.tile_bytes(id));
+            c.pinned_imagery = everything(&c.imagery, "imagery")?;
+            c.imagery.load_now(queue, &c.pinned_imagery, frame, |id| layer.tile_bytes(id));
         }
-        if let (Some(layer), Some(cache)) = (&self.dataset.landcover, self.landcover.as_mut()) {
-            self.pinned_landcover = everything(cache, "land-cover")?;
-            cache.load_now(queue, &self.pinned_landcover, self.frame, |id| layer.tile_bytes(id));
+        if let (Some(layer), Some(cache)) = (&self.dataset.landcover, c.landcover.as_mut()) {
+            c.pinned_landcover = everything(cache, "land-cover")?;
+            cache.load_now(queue, &c.pinned_landcover, frame, |id| layer.tile_bytes(id));
         }
         Ok(())
     }
@@ -54,12 +53,13 @@ impl Renderer {
         let done = |s: &CacheStats, cache: &TileCache| {
             s.needed_resident + s.failed >= s.needed.min(cache.capacity()) && s.staged == 0
         };
-        let landcover = match &self.landcover {
+        let c = &self.caches;
+        let landcover = match &c.landcover {
             Some(cache) => done(&report.landcover, cache),
             None => true,
         };
-        done(&report.height, &self.heights)
-            && done(&report.imagery, &self.imagery)
+        done(&report.height, &c.heights)
+            && done(&report.imagery, &c.imagery)
             && landcover
             && self.loader.is_idle()
     }
@@ -89,23 +89,24 @@ impl Renderer {
 
     /// The last frame's colour, as an sRGB image.
     pub fn read_colour(&self) -> Result<image::RgbaImage, RenderError> {
-        let bytes = read_texture(&self.gpu, &self.colour, wgpu::TextureAspect::All, 4)?;
-        let (w, h) = (self.colour.width(), self.colour.height());
+        let colour = &self.targets.colour;
+        let bytes = read_texture(&self.gpu, colour, wgpu::TextureAspect::All, 4)?;
+        let (w, h) = (colour.width(), colour.height());
         image::RgbaImage::from_raw(w, h, bytes)
             .ok_or_else(|| RenderError::Gpu(GpuError::Validation("readback size mismatch".into())))
     }
 
     /// The last frame's depth (reversed-Z: 1 at the near plane, 0 for the sky), top row first.
     pub fn read_depth(&self) -> Result<Vec<f32>, RenderError> {
-        let bytes = read_texture(&self.gpu, &self.depth, wgpu::TextureAspect::DepthOnly, 4)?;
+        let bytes = read_texture(&self.gpu, &self.targets.depth, wgpu::TextureAspect::DepthOnly, 4)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
     /// The last frame's Tile Load Map as pass 1 wrote it, waiting for the GPU (`None` before a
     /// first frame): one cell per ring cell, ring by ring (`TlmLayout::cell_of`).
     pub fn read_tile_load_map(&self) -> Result<Option<Vec<TlmCell>>, RenderError> {
-        let Some(frame) = &self.last_tlm else { return Ok(None) };
-        Ok(Some(self.tlm.read_back(&self.gpu, frame)?))
+        let Some(last) = &self.last else { return Ok(None) };
+        Ok(Some(self.tlm.read_back(&self.gpu, &last.tlm)?))
     }
 
     /// The seeded world of this renderer: species tables and patterns (`None` without land cover).
@@ -138,9 +139,10 @@ impl Renderer {
     /// What pass 3 read in the last frame (its cells, the resident tiles, the depth), for its
     /// twin; `None` without land cover or before a first frame.
     pub fn seed_snapshot(&self) -> Result<Option<SeedSnapshot>, RenderError> {
-        let (Some(stage), Some(landcover)) = (&self.seeds, &self.landcover) else { return Ok(None) };
+        let c = &self.caches;
+        let (Some(stage), Some(landcover)) = (&self.seeds, &c.landcover) else { return Ok(None) };
         let Some(frame) = &stage.last_frame else { return Ok(None) };
-        let caches = snapshot_caches(&self.dataset, &self.heights, landcover, &self.imagery)?;
+        let caches = snapshot_caches(&self.dataset, &c.heights, landcover, &c.imagery)?;
         Ok(Some(SeedSnapshot {
             frame: frame.clone(),
             patterns_unit: stage.patterns.positions_unit.clone(),
@@ -190,22 +192,21 @@ impl Renderer {
     /// first because pass 3 must see the terrain's alone, not the trees the last draw left in
     /// it. `false` when the last frame ran no seed passes.
     pub fn replay_seed_passes(&mut self, through: Replay) -> Result<bool, RenderError> {
-        let (Some(stage), Some(nodes)) = (self.seeds.as_ref(), self.last_nodes.as_ref()) else {
+        let (Some(stage), Some(last)) = (self.seeds.as_ref(), self.last.as_ref()) else {
             return Ok(false);
         };
         if stage.last_frame.is_none() {
             return Ok(false);
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        let depth = self.depth.create_view(&Default::default());
-        self.terrain.encode(&mut encoder, &self.terrain_bindings, &depth, nodes);
+        let t = &self.targets;
+        self.terrain.encode(&mut encoder, &self.terrain_bindings, &t.depth_view, &last.nodes);
         if through != Replay::Depth {
             stage.encode(&mut encoder);
             stage.encode_compact(&mut encoder);
         }
         if through == Replay::Draw {
-            let colour = self.colour.create_view(&Default::default());
-            stage.encode_draw(&mut encoder, &colour, &depth);
+            stage.encode_draw(&mut encoder, &t.colour_view, &t.depth_view);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait()?;

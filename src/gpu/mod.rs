@@ -1,12 +1,20 @@
-//! How it works: everything terramp asks of the GPU outside the passes themselves: picking and
-//! opening a headless device (`device`), timing passes (`profiler`), the `#[repr(C)]` structs that
-//! cross to WGSL (`gpu_types`), and reading textures back (`readback`).
+//! How it works: everything terramp asks of the GPU outside the passes themselves: the constants
+//! and bit layouts shared with WGSL (`layout`, a leaf) and the prelude and sources generated from
+//! them (`shaders`), the `#[repr(C)]` structs that cross to WGSL (`gpu_types`, checked through
+//! `struct_layout`), binding tables (`bindings`) and the resources passes build (`resources`),
+//! picking and opening a headless device (`device`), timing passes (`profiler`), and reading back:
+//! blocking for tools and tests (`readback`), non-blocking for the frame (`readback_ring`).
 
+pub mod bindings;
 pub mod device;
 pub mod gpu_types;
+pub mod layout;
 pub mod profiler;
 pub mod readback;
 pub mod readback_ring;
+pub mod resources;
+pub mod shaders;
+pub mod struct_layout;
 
 pub use device::{AdapterChoice, Gpu, GpuError};
 pub use profiler::{PassTiming, Profiler, TimeSource};

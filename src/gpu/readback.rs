@@ -1,8 +1,37 @@
-//! How it works: copies a 2D texture into a mappable buffer (rows padded to wgpu's 256-byte copy
-//! alignment), waits, and returns the tightly packed texels. Used for frames written to disk and
-//! for tests; the per-frame data paths never read back synchronously.
+//! How it works: blocking readbacks, for frames written to disk, tools and tests; the per-frame
+//! data paths never read back synchronously (they use `readback_ring`). A texture is copied into a
+//! mappable buffer (rows padded to wgpu's 256-byte copy alignment) and returned tightly packed; a
+//! buffer goes through a one-slot `ReadbackRing`, waited for.
 
+use super::readback_ring::ReadbackRing;
 use super::{Gpu, GpuError};
+
+/// The first `bytes` of `buffer` (a `COPY_SRC` buffer), waiting for the GPU.
+pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>, GpuError> {
+    let mut ring = ReadbackRing::new(&gpu.device, "blocking readback", bytes.max(4), 1);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    ring.encode_copy(&mut encoder, buffer, bytes.next_multiple_of(4), ());
+    gpu.queue.submit([encoder.finish()]);
+    ring.submitted();
+    gpu.wait()?;
+    let taken = ring.try_take(&gpu.device)?;
+    gpu.check()?;
+    let mut bytes_read = taken
+        .map(|r| r.bytes)
+        .ok_or_else(|| GpuError::Validation("a blocking readback did not arrive after a wait".into()))?;
+    bytes_read.truncate(bytes as usize);
+    Ok(bytes_read)
+}
+
+/// The first `count` values of type `T` in `buffer`, waiting for the GPU.
+pub fn read_values<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    count: u64,
+) -> Result<Vec<T>, GpuError> {
+    let bytes = read_buffer(gpu, buffer, count * size_of::<T>() as u64)?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
+}
 
 /// The texels of mip 0 of `texture` (a 2D colour or depth texture), top row first,
 /// `texel_bytes` per texel.

@@ -1,10 +1,12 @@
 //! How it works: reading a GPU buffer back without stalling the frame. The ring owns a few
 //! mappable staging buffers. Each frame, `encode_copy` records a copy of the source into the next
-//! free one (tagged with the frame's index); after the frame's submit, `submitted` asks wgpu to
-//! map it. `try_take` polls the device without waiting and hands back the oldest frame whose
-//! buffer has mapped, as an owned copy, and frees its buffer. Results come in frame order, one or
-//! two frames late. When every buffer is still in flight (the GPU is that far behind), the frame's
-//! copy is skipped and counted: a late CPU reader loses a frame, never the frame rate.
+//! free one, with the caller's tag (the frame's index and whatever the caller needs to read the
+//! bytes: a layout, a camera); after the frame's submit, `submitted` asks wgpu to map it.
+//! `try_take` polls the device without waiting and hands back the oldest copy whose buffer has
+//! mapped, as owned bytes with their tag, and frees its buffer. Results come in the order they
+//! were recorded, one or two frames late, so a caller keeps no queue of its own. When every buffer
+//! is still in flight (the GPU is that far behind), the frame's copy is skipped and counted: a
+//! late CPU reader loses a frame, never the frame rate.
 
 use std::collections::VecDeque;
 use std::sync::{Arc, OnceLock};
@@ -15,15 +17,15 @@ use super::GpuError;
 /// one being read on the CPU.
 pub const DEFAULT_SLOTS: usize = 3;
 
-/// One frame's bytes, read back.
+/// One copy's bytes, read back, with the tag it was recorded with.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Readback {
-    /// The index the caller gave `encode_copy` for that frame.
-    pub frame: u64,
+pub struct Readback<Tag> {
+    /// What the caller gave `encode_copy` with this copy.
+    pub tag: Tag,
     pub bytes: Vec<u8>,
 }
 
-impl Readback {
+impl<Tag> Readback<Tag> {
     /// The bytes as `T`s (a copy; the byte count must be a multiple of `T`'s size).
     pub fn cast<T: bytemuck::Pod>(&self) -> Vec<T> {
         bytemuck::pod_collect_to_vec(&self.bytes)
@@ -36,26 +38,27 @@ enum Slot {
     Free,
     /// A copy is recorded but its encoder is not known to be submitted yet.
     Recorded {
-        frame: u64,
         bytes: u64,
     },
     Mapping {
-        frame: u64,
         bytes: u64,
         status: MapStatus,
     },
 }
 
-pub struct ReadbackRing {
+/// A ring of staging buffers whose copies carry a `Tag`.
+pub struct ReadbackRing<Tag> {
     buffers: Vec<wgpu::Buffer>,
     slots: Vec<Slot>,
+    /// The tag of each slot holding a copy.
+    tags: Vec<Option<Tag>>,
     /// Slots holding a frame, oldest first.
     order: VecDeque<usize>,
     capacity_bytes: u64,
     skipped: u64,
 }
 
-impl ReadbackRing {
+impl<Tag> ReadbackRing<Tag> {
     /// `slots` staging buffers of `capacity_bytes` each.
     pub fn new(device: &wgpu::Device, label: &str, capacity_bytes: u64, slots: usize) -> Self {
         let capacity_bytes = capacity_bytes.next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT);
@@ -70,18 +73,19 @@ impl ReadbackRing {
             })
             .collect::<Vec<_>>();
         let slots = buffers.iter().map(|_| Slot::Free).collect();
-        Self { buffers, slots, order: VecDeque::new(), capacity_bytes, skipped: 0 }
+        let tags = buffers.iter().map(|_| None).collect();
+        Self { buffers, slots, tags, order: VecDeque::new(), capacity_bytes, skipped: 0 }
     }
 
-    /// Records a copy of the first `bytes` of `source` for frame `frame` into a free staging
-    /// buffer. False (and counted) when none is free or `bytes` exceeds the capacity; the frame
-    /// is then simply not read back.
+    /// Records a copy of the first `bytes` of `source`, tagged `tag`, into a free staging
+    /// buffer. False (and counted) when none is free or `bytes` exceeds the capacity; the copy
+    /// is then simply not made.
     pub fn encode_copy(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         source: &wgpu::Buffer,
         bytes: u64,
-        frame: u64,
+        tag: Tag,
     ) -> bool {
         let free = self.slots.iter().position(|s| matches!(s, Slot::Free));
         let (Some(index), true) = (free, bytes <= self.capacity_bytes && bytes.is_multiple_of(4)) else {
@@ -91,7 +95,8 @@ impl ReadbackRing {
         if bytes > 0 {
             encoder.copy_buffer_to_buffer(source, 0, &self.buffers[index], 0, bytes);
         }
-        self.slots[index] = Slot::Recorded { frame, bytes };
+        self.slots[index] = Slot::Recorded { bytes };
+        self.tags[index] = Some(tag);
         self.order.push_back(index);
         true
     }
@@ -99,7 +104,7 @@ impl ReadbackRing {
     /// Call after submitting the encoder(s) holding the copies: starts mapping them.
     pub fn submitted(&mut self) {
         for (slot, buffer) in self.slots.iter_mut().zip(&self.buffers) {
-            if let Slot::Recorded { frame, bytes } = *slot {
+            if let Slot::Recorded { bytes } = *slot {
                 let status: MapStatus = Arc::default();
                 let sink = Arc::clone(&status);
                 if bytes > 0 {
@@ -109,23 +114,27 @@ impl ReadbackRing {
                 } else {
                     let _ = sink.set(Ok(()));
                 }
-                *slot = Slot::Mapping { frame, bytes, status };
+                *slot = Slot::Mapping { bytes, status };
             }
         }
     }
 
-    /// The oldest frame whose copy has arrived, if it has; never waits for the GPU.
-    pub fn try_take(&mut self, device: &wgpu::Device) -> Result<Option<Readback>, GpuError> {
+    /// The oldest copy, if it has arrived; never waits for the GPU.
+    pub fn try_take(&mut self, device: &wgpu::Device) -> Result<Option<Readback<Tag>>, GpuError> {
         device.poll(wgpu::PollType::Poll)?;
         let Some(&index) = self.order.front() else { return Ok(None) };
-        let Slot::Mapping { frame, bytes, status } = &self.slots[index] else { return Ok(None) };
+        let Slot::Mapping { bytes, status } = &self.slots[index] else { return Ok(None) };
         let Some(result) = status.get() else { return Ok(None) };
-        let (frame, bytes, result) = (*frame, *bytes, result.clone());
+        let (bytes, result) = (*bytes, result.clone());
         self.order.pop_front();
         self.slots[index] = Slot::Free;
+        let tag = self.tags[index].take();
         result?;
+        let Some(tag) = tag else {
+            return Err(GpuError::Validation("a readback slot held a copy without its tag".into()));
+        };
         if bytes == 0 {
-            return Ok(Some(Readback { frame, bytes: Vec::new() }));
+            return Ok(Some(Readback { tag, bytes: Vec::new() }));
         }
         let buffer = &self.buffers[index];
         let copy = {
@@ -134,15 +143,15 @@ impl ReadbackRing {
             mapped.to_vec()
         };
         buffer.unmap();
-        Ok(Some(Readback { frame, bytes: copy }))
+        Ok(Some(Readback { tag, bytes: copy }))
     }
 
-    /// Frames whose copy was skipped because no staging buffer was free (or it did not fit).
+    /// Copies skipped because no staging buffer was free (or they did not fit).
     pub fn skipped(&self) -> u64 {
         self.skipped
     }
 
-    /// Frames recorded and not yet taken.
+    /// Copies recorded and not yet taken.
     pub fn in_flight(&self) -> usize {
         self.order.len()
     }

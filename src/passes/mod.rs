@@ -1,32 +1,85 @@
-//! How it works: one module per GPU pass of the frame after the terrain, each with its shader of
-//! the same name in `shaders/` and, for the passes whose output the CPU relies on, a CPU twin of
-//! the same name in `reference/`. A pass builds its pipelines once in `new`, writes its per-frame
-//! inputs in `prepare`, and only records commands in `encode`; `frame.rs` calls them in order.
+//! How it works: one folder per GPU pass of the frame, each with its shader of the same name in
+//! `shaders/` and, for the passes whose output the CPU relies on, a CPU twin of the same name in
+//! `reference/`. A pass folder holds a `frame` half (plain CPU data the pass consumes and produces:
+//! layouts, frame inputs, cell lists, Hi-Z mips, compaction results), which the twins and the
+//! renderer's CPU work may import, and a `gpu` half (pipelines and binding tables built once in
+//! `new`, per-frame uploads in `prepare`, commands recorded in `encode`). `frame::Renderer` calls
+//! them in the order of the paper's passes:
+//!
+//! 0. `terrain` (+ `depth_pyramid`): the ground's depth, and its Hi-Z pyramid;
+//! 1. `tile_load_map`: which tiles and seed patterns the view needs, read back a frame late;
+//! 2. `ground`: imagery on the terrain, from the finest resident level;
+//! 3. `seed_select`: the seeds of the visible near cells, culled and classified;
+//! 4. `compact` and `draw_seeds`: the survivors grouped into indirect draws, and drawn.
 
 pub mod compact;
 pub mod depth_pyramid;
 pub mod draw_seeds;
 pub mod ground;
 pub mod seed_select;
+pub mod terrain;
 pub mod tile_load_map;
 
-use crate::gpu::readback_ring::ReadbackRing;
-use crate::gpu::{Gpu, GpuError};
+use crate::gpu::bindings::PipelineBindings;
+use crate::gpu::shaders::WgslSource;
 
-/// The first `bytes` of `buffer` (a `COPY_SRC` buffer), waiting for the GPU: for tests and tools,
-/// never the frame.
-pub(crate) fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>, GpuError> {
-    let mut ring = ReadbackRing::new(&gpu.device, "blocking readback", bytes.max(4), 1);
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    ring.encode_copy(&mut encoder, buffer, bytes.next_multiple_of(4), 0);
-    gpu.queue.submit([encoder.finish()]);
-    ring.submitted();
-    gpu.wait()?;
-    let taken = ring.try_take(&gpu.device)?;
-    gpu.check()?;
-    let mut bytes_read = taken
-        .map(|r| r.bytes)
-        .ok_or_else(|| GpuError::Validation("a blocking readback did not arrive after a wait".into()))?;
-    bytes_read.truncate(bytes as usize);
-    Ok(bytes_read)
-}
+/// The colour target every pass that shades draws into (sRGB: the hardware encodes on store).
+pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// The depth target: reversed-Z (1 at the near plane, 0 at infinity), written by the terrain.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Every pass's shader, in frame order.
+pub const SHADERS: &[&WgslSource] = &[
+    &terrain::gpu::SHADER,
+    &depth_pyramid::gpu::SHADER,
+    &tile_load_map::gpu::SHADER,
+    &ground::gpu::SHADER,
+    &seed_select::gpu::SHADER,
+    &compact::gpu::SHADER,
+    &draw_seeds::gpu::SHADER,
+];
+
+/// Every pipeline's bind group and the shader entry points it serves: what the binding-table test
+/// checks against the WGSL.
+pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
+    PipelineBindings {
+        shader: &terrain::gpu::SHADER,
+        entry_points: &["vs_main"],
+        bindings: &terrain::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &depth_pyramid::gpu::SHADER,
+        entry_points: &["reduce_depth"],
+        bindings: &depth_pyramid::gpu::FROM_DEPTH.bindings,
+    },
+    PipelineBindings {
+        shader: &depth_pyramid::gpu::SHADER,
+        entry_points: &["reduce_mip"],
+        bindings: &depth_pyramid::gpu::FROM_MIP.bindings,
+    },
+    PipelineBindings {
+        shader: &tile_load_map::gpu::SHADER,
+        entry_points: &["main"],
+        bindings: &tile_load_map::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &ground::gpu::SHADER,
+        entry_points: &["vs_main", "fs_main"],
+        bindings: &terrain::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &seed_select::gpu::SHADER,
+        entry_points: &["main"],
+        bindings: &seed_select::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &compact::gpu::SHADER,
+        entry_points: &["reduce", "scan", "finish", "scatter"],
+        bindings: &compact::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &draw_seeds::gpu::SHADER,
+        entry_points: &["vs_main", "fs_main"],
+        bindings: &draw_seeds::gpu::BINDINGS.bindings,
+    },
+];

@@ -7,8 +7,9 @@
 //! every position follows from the order of the blocks, so the GPU must equal this exactly.
 
 use crate::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
-use crate::passes::compact::{COMPACT_CHUNK, CompactError, Compacted};
-use crate::seeds::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP};
+use crate::gpu::layout::{COMPACT_CHUNK, SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP};
+use crate::passes::compact::CompactError;
+use crate::passes::compact::frame::Compacted;
 
 const GROUPS: usize = SEED_GROUPS as usize;
 

@@ -7,6 +7,7 @@
 
 pub mod accuracy;
 pub mod compact;
+pub mod depth_pyramid;
 pub mod image_metrics;
 pub mod oracle;
 pub mod seed_select;

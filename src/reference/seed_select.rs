@@ -10,19 +10,21 @@
 use std::collections::HashMap;
 
 use crate::classes::MAX_SPECIES_PER_CLASS;
-use crate::dataset::{Dataset, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, PackError, TileId};
+use crate::dataset::{Dataset, PackError, TileId};
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
-use crate::lcc::LCC_LEVELS;
-use crate::passes::seed_select::{SeedFrame, SeedOutput};
-use crate::seeds::{GROUND_SAMPLES, SEED_LODS, SEED_WORKGROUP, SeedTables, pcg, seed_group, seed_hash, unit};
+use crate::gpu::layout::{
+    COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_OVERFLOW, COUNT_RULE,
+    COUNT_SELECTED, GROUND_SAMPLES, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_TILE_TEXELS,
+    LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS,
+    SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group,
+};
+use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
+use crate::seeds::{SeedTables, pcg, seed_hash, unit};
 use crate::streaming::TileCache;
 
 mod compare;
 
 pub use compare::SeedComparison;
-
-const LCC_TILE_TEXELS: u32 = crate::dataset::CELL_TILE_TEXELS;
-const IMAGERY_TILE_TEXELS: u32 = crate::dataset::CELL_TILE_TEXELS;
 
 /// One cache as the shader sees it: the page table, and the texels (mip 0, border included) of
 /// each resident slot.
@@ -143,7 +145,13 @@ pub fn seed_select_blocks(inputs: &SeedTwinInputs) -> SeedOutput {
         selected += kept;
     });
     records.truncate(capacity as usize);
-    let keys = records.iter().map(|r| seed_group(r.species_lod & 0xff, (r.species_lod >> 8) & 0xf)).collect();
+    let keys = records
+        .iter()
+        .map(|r| {
+            let SpeciesLod { species, lod, .. } = SpeciesLod::unpack(r.species_lod);
+            seed_group(species, lod)
+        })
+        .collect();
     SeedOutput { records, keys, blocks, counters }
 }
 
@@ -151,16 +159,16 @@ pub fn seed_select_blocks(inputs: &SeedTwinInputs) -> SeedOutput {
 /// survivor count.
 fn select_all(inputs: &SeedTwinInputs, mut block: impl FnMut(u32)) -> (Vec<SeedRecord>, SeedCounters) {
     let u = &inputs.frame.uniforms;
-    let mut counts = [0u32; crate::seeds::SEED_COUNTERS as usize];
+    let mut counts = [0u32; SEED_COUNTERS as usize];
     let mut records = Vec::new();
     for cell in &inputs.frame.cells {
         for first_rank in (0..u.active_ranks).step_by(SEED_WORKGROUP as usize) {
             let first = records.len();
             for rank in first_rank..u.active_ranks.min(first_rank + SEED_WORKGROUP) {
-                counts[crate::seeds::COUNT_CHECKED as usize] += 1;
+                counts[COUNT_CHECKED as usize] += 1;
                 match select_seed(inputs, cell, rank) {
                     Ok(record) => {
-                        counts[crate::seeds::COUNT_SELECTED as usize] += 1;
+                        counts[COUNT_SELECTED as usize] += 1;
                         records.push(record);
                     }
                     Err(count) => counts[count as usize] += 1,
@@ -170,7 +178,7 @@ fn select_all(inputs: &SeedTwinInputs, mut block: impl FnMut(u32)) -> (Vec<SeedR
         }
     }
     let kept = records.len().min(u.capacity as usize);
-    counts[crate::seeds::COUNT_OVERFLOW as usize] = (records.len() - kept) as u32;
+    counts[COUNT_OVERFLOW as usize] = (records.len() - kept) as u32;
     let counters: SeedCounters = bytemuck::cast(counts);
     (records, counters)
 }
@@ -210,21 +218,19 @@ fn ground_at(u: &SeedUniforms, heights: &TwinCache<f32>, p: &GridPos) -> Option<
             ((s0[0] >> level) / HEIGHT_TILE_CELLS).min(info[1] - 1),
             ((s0[1] >> level) / HEIGHT_TILE_CELLS).min(info[2] - 1),
         ];
-        slot = heights.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize];
-        if slot != 0 || level + 1 >= u.height_level_count {
+        slot = page_slot(heights.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize]);
+        if slot.is_some() || level + 1 >= u.height_level_count {
             break;
         }
         level += 1;
     }
-    if slot == 0 {
-        return None;
-    }
+    let slot = slot?;
     let s = s0.map(|v| v >> level);
     let local = [
         s[0] - tile[0] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
         s[1] - tile[1] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
     ];
-    let load = |dx: u32, dy: u32| heights.load(slot - 1, local[0] + dx, local[1] + dy);
+    let load = |dx: u32, dy: u32| heights.load(slot, local[0] + dx, local[1] + dy);
     let (h00, h10, h01, h11) = (load(0, 0), load(1, 0), load(0, 1), load(1, 1));
     let mask = (1u32 << level) - 1;
     let scale = 1.0 / (1u32 << level) as f32;
@@ -242,21 +248,21 @@ fn class_at(u: &SeedUniforms, landcover: &TwinCache<u32>, q: [u32; 2], wanted: u
     (0..LCC_LEVELS).find_map(|n| {
         let level = (wanted + n) % LCC_LEVELS;
         let texel = match level {
-            0 => q.map(|v| v << 1),
-            1 => q,
-            _ => q.map(|v| v >> 1),
+            LCC_SOURCE_LEVEL => q,
+            LCC_PACKED_LEVEL => q.map(|v| v >> 1),
+            _ => q.map(|v| v << 1),
         };
         let info = u.lcc_levels[level as usize];
         let tile =
             [(texel[0] / LCC_TILE_TEXELS).min(info[1] - 1), (texel[1] / LCC_TILE_TEXELS).min(info[2] - 1)];
-        let slot = landcover.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize];
-        (slot != 0).then(|| {
+        let slot = page_slot(landcover.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize]);
+        slot.map(|slot| {
             let word = landcover.load(
-                slot - 1,
+                slot,
                 texel[0] - tile[0] * LCC_TILE_TEXELS,
                 texel[1] - tile[1] * LCC_TILE_TEXELS,
             );
-            if level != 2 {
+            if level != LCC_PACKED_LEVEL {
                 return (word, level);
             }
             let shift = u.lcc_sub_bits * ((q[0] & 1) + 2 * (q[1] & 1));
@@ -279,10 +285,9 @@ fn imagery_texel(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, t: [u32; 2]) ->
             (texel[0] / IMAGERY_TILE_TEXELS).min(info[1] - 1),
             (texel[1] / IMAGERY_TILE_TEXELS).min(info[2] - 1),
         ];
-        let slot = imagery.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize];
-        if slot != 0 {
+        if let Some(slot) = page_slot(imagery.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize]) {
             let local = [0, 1].map(|a| texel[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
-            let rgba = imagery.load(slot - 1, local[0], local[1]);
+            let rgba = imagery.load(slot, local[0], local[1]);
             return [
                 srgb_to_linear(rgba[0]),
                 srgb_to_linear(rgba[1]),
@@ -356,7 +361,6 @@ fn pixel_of(x: f32, w: f32, n: u32, step: f32) -> u32 {
 }
 
 fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<SeedRecord, u32> {
-    use crate::seeds::{COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_RULE};
     let u = &inputs.frame.uniforms;
     let pos_unit = inputs.patterns_unit[(cell.pattern * u.seeds_per_pattern + rank) as usize];
     let sample = grid_pos(cell.height_sample, cell.height_frac, pos_unit, u.cell_in_samples);
@@ -415,7 +419,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
     if summit[3] > u.near_m {
         let px = pixel_of(summit[0], summit[3], u.screen_px[0], u.ndc_per_px[0]);
         let py = pixel_of(-summit[1], summit[3], u.screen_px[1], u.ndc_per_px[1]);
-        let reach = crate::seeds::OCCLUSION_FOOTPRINT_PX;
+        let reach = OCCLUSION_FOOTPRINT_PX;
         let (mut farthest, mut nearest) = (1.0f32, 0.0f32);
         let depth_at = |x: i32, y: i32| {
             let x = x.clamp(0, u.screen_px[0] as i32 - 1) as u32;
@@ -450,7 +454,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         height_m,
         address: cell.address,
         rank,
-        species_lod: species_index | (lod << 8) | (lcc_level << 12) | (ground.level << 16),
+        species_lod: SpeciesLod { species: species_index, lod, lcc_level, height_level: ground.level }.pack(),
         jitter: pcg(hash),
         ground_colour: ground_colour(u, inputs.imagery, &imagery, hash),
         radius_m,

@@ -4,57 +4,15 @@
 //! shader's, in the shader's order: products are plain `a * b` here (the shader's `mul` only
 //! stops its compiler fusing them into FMAs, which Rust never does unasked), decisions compare
 //! squares and products, and the one division only seeds a search settled by exact comparisons.
-//!
-//! `HizMips` is the CPU form of the depth pyramid, with the reference min-reduction the GPU
-//! pyramid is tested against.
+//! The depth pyramid it reads is `HizMips` (reduced on the CPU by `reference::depth_pyramid`).
 
 use crate::gpu::gpu_types::{TlmCell, TlmSpan, TlmUniforms};
-use crate::passes::tile_load_map::{TLM_SPAN_COVERED, TLM_SPAN_INSIDE};
+use crate::gpu::layout::{
+    LevelRange, RADIAL_INACTIVE, TLM_CULLED, TLM_FIRST_PATTERN, TLM_RADIAL_BANDS, TLM_SPAN_COVERED,
+    TLM_SPAN_INSIDE, TileSpan, tlm_visibility,
+};
+use crate::passes::depth_pyramid::frame::HizMips;
 pub use crate::seeds::{pattern_hash, pcg};
-
-/// A depth pyramid on the CPU: level sizes and texels (top row first) of every level.
-#[derive(Debug, Clone, PartialEq)]
-pub struct HizMips {
-    pub sizes: Vec<[u32; 2]>,
-    pub levels: Vec<Vec<f32>>,
-}
-
-impl HizMips {
-    /// The reference reduction of a `width` × `height` reversed-Z depth image (top row first):
-    /// each texel the minimum of what it covers, the last texel of an odd edge covering three.
-    pub fn from_depth(depth: &[f32], width: u32, height: u32) -> Self {
-        let sizes = crate::passes::depth_pyramid::level_sizes(width, height);
-        let mut levels: Vec<Vec<f32>> = Vec::with_capacity(sizes.len());
-        let mut source = ([width, height], depth.to_vec());
-        for &size in &sizes {
-            let covered = |x: u32, n: u32, source_n: u32| {
-                let last = if x + 1 == n { source_n - 1 } else { 2 * x + 1 };
-                (2 * x).min(source_n - 1)..=last.min(source_n - 1)
-            };
-            let mut texels = Vec::with_capacity((size[0] * size[1]) as usize);
-            for y in 0..size[1] {
-                for x in 0..size[0] {
-                    let mut farthest = f32::INFINITY;
-                    for sy in covered(y, size[1], source.0[1]) {
-                        for sx in covered(x, size[0], source.0[0]) {
-                            farthest = farthest.min(source.1[(sy * source.0[0] + sx) as usize]);
-                        }
-                    }
-                    texels.push(farthest);
-                }
-            }
-            levels.push(texels.clone());
-            source = (size, texels);
-        }
-        Self { sizes, levels }
-    }
-
-    /// Texel (`x`, `y`) of `level`.
-    pub fn texel(&self, level: u32, x: u32, y: u32) -> f32 {
-        let [w, _] = self.sizes[level as usize];
-        self.levels[level as usize][(y * w + x) as usize]
-    }
-}
 
 fn length_sq(v: [f32; 3]) -> f32 {
     v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
@@ -63,8 +21,9 @@ fn length_sq(v: [f32; 3]) -> f32 {
 fn height_range(u: &TlmUniforms, ranges_m: &[[f32; 2]], ring: u32, tiles_x: u32, tiles_y: u32) -> [f32; 2] {
     let level = u.height_levels[u.rings_info[ring as usize].height_level as usize];
     let mut range = [3.4e38f32, -3.4e38];
-    for ty in tiles_y & 0xffff..=tiles_y >> 16 {
-        for tx in tiles_x & 0xffff..=tiles_x >> 16 {
+    let (xs, ys) = (TileSpan::unpack(tiles_x), TileSpan::unpack(tiles_y));
+    for ty in ys.first..=ys.last {
+        for tx in xs.first..=xs.last {
             let r = ranges_m[(level[0] + ty * level[1] + tx) as usize];
             range = [range[0].min(r[0]), range[1].max(r[1])];
         }
@@ -162,7 +121,8 @@ fn tlm_cell(
     cx: u32,
     cy: u32,
 ) -> TlmCell {
-    let culled = TlmCell { visibility: 0, imagery_lod: 0, height_lod: 0, radial_lod: 3 };
+    let culled =
+        TlmCell { visibility: TLM_CULLED, imagery_lod: 0, height_lod: 0, radial_lod: RADIAL_INACTIVE };
     let sx = spans[((ring * 2) * u.cells + cx) as usize];
     let sy = spans[((ring * 2 + 1) * u.cells + cy) as usize];
     let flags = sx.flags & sy.flags;
@@ -179,20 +139,21 @@ fn tlm_cell(
     let near_sq = length_sq(std::array::from_fn(|a| 0.0f32.max(lo[a]).min(hi[a])));
     let far_sq = length_sq(std::array::from_fn(|a| lo[a].abs().max(hi[a].abs())));
 
-    let mut cell = TlmCell { visibility: 1, ..Default::default() };
+    let mut cell = TlmCell { visibility: TLM_FIRST_PATTERN, ..Default::default() };
     if ring == 0 {
         let origin = u.rings_info[0].origin_cell;
         let g = [origin[0].wrapping_add(cx as i32), origin[1].wrapping_add(cy as i32)];
-        cell.visibility = 1 + pattern_hash(g[0] as u32, g[1] as u32, u.seed) % u.patterns;
+        cell.visibility = tlm_visibility(pattern_hash(g[0] as u32, g[1] as u32, u.seed) % u.patterns);
     }
     if u.imagery_levels > 0 {
-        cell.imagery_lod = imagery_level(u, near_sq) | (imagery_level(u, far_sq) << 8);
+        cell.imagery_lod =
+            LevelRange { min: imagery_level(u, near_sq), max: imagery_level(u, far_sq) }.pack();
     }
-    cell.height_lod = height_lod(u, near_sq) | (height_lod(u, far_sq) << 8);
-    cell.radial_lod = 3;
-    for k in (0..3).rev() {
-        if near_sq < u.radial_lod_sq_m2[k] {
-            cell.radial_lod = k as u32;
+    cell.height_lod = LevelRange { min: height_lod(u, near_sq), max: height_lod(u, far_sq) }.pack();
+    cell.radial_lod = RADIAL_INACTIVE;
+    for k in (0..TLM_RADIAL_BANDS).rev() {
+        if near_sq < u.radial_lod_sq_m2[k as usize] {
+            cell.radial_lod = k;
         }
     }
     cell

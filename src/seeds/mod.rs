@@ -17,49 +17,15 @@ pub mod patterns;
 use thiserror::Error;
 
 use crate::classes::{ClassTable, MAX_SPECIES, MAX_SPECIES_PER_CLASS, SpeciesKind};
+use crate::dataset::lcc::LccCoding;
 use crate::gpu::gpu_types::{SeedClass, SeedSpecies};
-use crate::lcc::LccCoding;
+use crate::gpu::layout::{KIND_BUSH, KIND_ROCK, KIND_TREE, SEED_LODS, SEED_SALT, SEED_WORKGROUP};
 
-/// Workgroup size of the seed-selection dispatch (handed to WGSL through the prelude).
-pub const SEED_WORKGROUP: u32 = 64;
-/// Words of a ballot: one bit per lane of a pass-3 workgroup (`shaders/shared/blocks.wgsl`).
-pub const BALLOT_WORDS: u32 = SEED_WORKGROUP / 32;
-const _: () = assert!(SEED_WORKGROUP.is_multiple_of(32), "ballots need whole words");
 /// Cells one dispatch checks at most (a dispatch dimension's limit).
 pub const MAX_SEED_CELLS: u32 = 65535;
 /// Entries of pass 3's block table at most (one per workgroup: 8 MiB, 64 M seeds checked per
 /// frame); a frame checks no more cells than fill it (`max_cells`).
 pub const MAX_SEED_BLOCKS: u32 = 1 << 20;
-/// Draw LODs of a seed: 0 the real mesh, 1 to 3 its billboard clouds (17, 8 and 2 planes), out to
-/// `seeds.mesh_m` and the three `tlm.radial_lod_m` thresholds (`lod_reach_m`).
-pub const SEED_LODS: u32 = 4;
-/// Draw groups: one per (species, LOD), `species × SEED_LODS + lod` (`seed_group`).
-pub const SEED_GROUPS: u32 = MAX_SPECIES as u32 * SEED_LODS;
-/// Indirect draws compaction writes: each group's own, then (at `SEED_GROUPS + group`) the same
-/// instances with the next LOD's geometry, which the seeds in the outer band of their LOD
-/// cross-fade into.
-pub const SEED_DRAWS: u32 = 2 * SEED_GROUPS;
-/// Indices into `SeedCounters` (as an array of u32): where a seed's outcome is counted.
-pub const COUNT_SELECTED: u32 = 0;
-pub const COUNT_OVERFLOW: u32 = 1;
-pub const COUNT_CHECKED: u32 = 2;
-pub const COUNT_CLASS: u32 = 3;
-pub const COUNT_RULE: u32 = 4;
-pub const COUNT_DISTANCE: u32 = 5;
-pub const COUNT_FRUSTUM: u32 = 6;
-pub const COUNT_OCCLUSION: u32 = 7;
-pub const SEED_COUNTERS: u32 = 8;
-/// `SeedSpecies::kind` codes.
-pub const KIND_TREE: u32 = 0;
-pub const KIND_BUSH: u32 = 1;
-pub const KIND_ROCK: u32 = 2;
-/// Pixels around a summit's whose farthest terrain depth decides its occlusion (1: a 3 × 3
-/// block), so a summit within a pixel of a silhouette is kept.
-pub const OCCLUSION_FOOTPRINT_PX: i32 = 1;
-/// Imagery texels averaged into a seed's ground colour.
-pub const GROUND_SAMPLES: u32 = 4;
-/// Mixed into the seed hash so it never equals the pattern hash of the same cell.
-pub const SEED_SALT: u32 = 0x5eed_5eed;
 
 #[derive(Debug, Error)]
 pub enum SeedError {
@@ -70,12 +36,6 @@ pub enum SeedError {
     TooDense { code: u8, name: String, density_per_km2: f64, max_per_km2: f64 },
     #[error("class table {scheme}: more than {MAX_SPECIES} species")]
     TooManySpecies { scheme: String },
-}
-
-/// The draw group of a seed of species `species` at radial LOD `lod`: the key pass 3 writes
-/// beside each record and compaction groups by.
-pub fn seed_group(species: u32, lod: u32) -> u32 {
-    species * SEED_LODS + lod
 }
 
 /// How far each draw LOD reaches for a seed of `seeds.reference_height_m` or taller (smaller seeds
@@ -244,7 +204,6 @@ mod tests {
             }
         }
         assert_eq!(max_cells(2048), 32768);
-        assert_eq!(seed_group(MAX_SPECIES as u32 - 1, SEED_LODS - 1), SEED_GROUPS - 1);
     }
 
     #[test]

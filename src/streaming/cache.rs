@@ -2,8 +2,9 @@
 //! table. GPU memory is fixed at creation by the slot count; nothing grows with the dataset.
 //!
 //! The page table is a storage buffer with one `u32` per tile of the layer's pyramid, in the
-//! pyramid's own tile order (so a shader finds a tile's entry in O(1) from its level, x and y): 0
-//! when the tile is not resident, else its slot + 1. Only the entries that changed are written.
+//! pyramid's own tile order (so a shader finds a tile's entry in O(1) from its level, x and y, at
+//! `page_levels`): `PAGE_EMPTY` when the tile is not resident, else `page_entry(slot)`. Only the
+//! entries that changed are written.
 //!
 //! The render thread drives it once a frame: `set_wanted` records what the frame needs (most
 //! important first) and returns the loader requests; `upload` takes what the loader read and
@@ -14,49 +15,9 @@
 //! shaders (and `resident_ancestor`) fall back to its finest resident ancestor.
 
 use super::loader::{LayerKind, Loaded};
-use super::residency::{Placement, Residency};
-use crate::config::CacheSettings;
+use super::residency::{CacheStats, Placement, Residency, UploadBudget};
 use crate::dataset::{PackError, Pyramid, TileId};
-
-/// What one frame did to a cache.
-#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
-pub struct CacheStats {
-    /// Distinct tiles the frame wants.
-    pub needed: usize,
-    pub resident: usize,
-    /// Wanted tiles that are resident.
-    pub needed_resident: usize,
-    /// New loader requests this frame (the push list).
-    pub requested: usize,
-    /// Requested and not arrived yet.
-    pub in_flight: usize,
-    /// Arrived and waiting for a later frame's upload budget.
-    pub staged: usize,
-    pub uploaded: usize,
-    pub evicted: usize,
-    /// Tiles found unusable this frame (each is counted once, ever).
-    pub failed: usize,
-    pub bytes_uploaded: u64,
-    /// Arrivals thrown away: no longer wanted, or no slot without evicting something more needed.
-    pub dropped: usize,
-}
-
-/// How much one frame may upload to one cache. The first tile of a frame always goes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct UploadBudget {
-    pub tiles: usize,
-    pub bytes: u64,
-}
-
-impl UploadBudget {
-    pub const UNLIMITED: Self = Self { tiles: usize::MAX, bytes: u64::MAX };
-}
-
-impl From<&CacheSettings> for UploadBudget {
-    fn from(settings: &CacheSettings) -> Self {
-        Self { tiles: settings.upload_tiles_per_frame as usize, bytes: settings.upload_bytes_per_frame }
-    }
-}
+use crate::gpu::layout::{PAGE_EMPTY, page_entry};
 
 pub struct TileCache {
     label: &'static str,
@@ -98,7 +59,7 @@ impl TileCache {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let page_table_cpu = vec![0u32; pyramid.tile_count() as usize];
+        let page_table_cpu = vec![PAGE_EMPTY; pyramid.tile_count() as usize];
         let page_table = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: (page_table_cpu.len().max(1) * 4) as u64,
@@ -122,8 +83,8 @@ impl TileCache {
         }
     }
 
-    /// The page table as last written to the GPU (`slot + 1` per tile, 0 when absent): for CPU
-    /// twins of the passes that read it.
+    /// The page table as last written to the GPU (`page_entry(slot)` per tile, `PAGE_EMPTY` when
+    /// absent): for CPU twins of the passes that read it.
     pub fn page_table_entries(&self) -> &[u32] {
         &self.page_table_cpu
     }
@@ -243,10 +204,10 @@ impl TileCache {
             return;
         };
         if let Some(old) = evicted {
-            self.set_entry(old, 0);
+            self.set_entry(old, PAGE_EMPTY);
         }
         self.write_tile(queue, slot, payload);
-        self.set_entry(id, slot + 1);
+        self.set_entry(id, page_entry(slot));
     }
 
     fn set_entry(&mut self, id: TileId, value: u32) {
@@ -293,4 +254,16 @@ impl TileCache {
             offset += bytes;
         }
     }
+}
+
+/// Page-table addressing of `pyramid`'s levels as the shaders read it: per level its first entry,
+/// tiles along x and tiles along y, then 0 (levels beyond `N` are left out).
+pub fn page_levels<const N: usize>(pyramid: &Pyramid) -> [[u32; 4]; N] {
+    let mut table = [[0; 4]; N];
+    for level in 0..pyramid.levels.min(N as u32) {
+        let [nx, ny] = pyramid.tiles_at(level);
+        let first = pyramid.tile_index(TileId::new(level, 0, 0)).unwrap_or_default() as u32;
+        table[level as usize] = [first, nx, ny, 0];
+    }
+    table
 }

@@ -1,15 +1,16 @@
-//! How it works: which tiles a view needs (`wants`), the fixed-size GPU caches that hold them
-//! behind page tables (`cache`, with its CPU policy in `residency`), and the loader threads that
-//! read and verify tiles off the render thread (`loader`). Each frame the render thread hands each
-//! cache its wanted list, sends the resulting requests to the loader, and uploads what arrived
-//! within the frame's budget; see `TileCache::set_wanted`.
+//! How it works: which tiles a view asks for (`wants`: areas to tile lists, pinned levels), the
+//! fixed-size GPU caches that hold them behind page tables (`cache`, with its CPU policy in
+//! `residency`), and the loader threads that read and verify tiles off the render thread
+//! (`loader`). Each frame the render thread hands each cache its wanted list, sends the resulting
+//! requests to the loader, and uploads what arrived within the frame's budget; see
+//! `TileCache::set_wanted`. Nothing here knows the passes: they tell it what they want.
 
-pub mod analysis;
 pub mod cache;
 pub mod loader;
 mod residency;
 pub mod wants;
 
-pub use cache::{CacheStats, TileCache, UploadBudget};
+pub use cache::{TileCache, page_levels};
 pub use loader::{LayerKind, Loaded, Loader, LoaderError, TileRequest};
+pub use residency::{CacheStats, UploadBudget};
 pub use wants::{AreaWant, tiles_over};

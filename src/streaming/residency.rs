@@ -19,9 +19,49 @@
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
-use super::cache::{CacheStats, UploadBudget};
 use super::loader::{LayerKind, Loaded, TileRequest};
+use crate::config::CacheSettings;
 use crate::dataset::TileId;
+
+/// What one frame did to a cache.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct CacheStats {
+    /// Distinct tiles the frame wants.
+    pub needed: usize,
+    pub resident: usize,
+    /// Wanted tiles that are resident.
+    pub needed_resident: usize,
+    /// New loader requests this frame (the push list).
+    pub requested: usize,
+    /// Requested and not arrived yet.
+    pub in_flight: usize,
+    /// Arrived and waiting for a later frame's upload budget.
+    pub staged: usize,
+    pub uploaded: usize,
+    pub evicted: usize,
+    /// Tiles found unusable this frame (each is counted once, ever).
+    pub failed: usize,
+    pub bytes_uploaded: u64,
+    /// Arrivals thrown away: no longer wanted, or no slot without evicting something more needed.
+    pub dropped: usize,
+}
+
+/// How much one frame may upload to one cache. The first tile of a frame always goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UploadBudget {
+    pub tiles: usize,
+    pub bytes: u64,
+}
+
+impl UploadBudget {
+    pub const UNLIMITED: Self = Self { tiles: usize::MAX, bytes: u64::MAX };
+}
+
+impl From<&CacheSettings> for UploadBudget {
+    fn from(settings: &CacheSettings) -> Self {
+        Self { tiles: settings.upload_tiles_per_frame as usize, bytes: settings.upload_bytes_per_frame }
+    }
+}
 
 #[derive(Debug, Clone, Copy)]
 struct Slot {

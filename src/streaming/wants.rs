@@ -1,13 +1,13 @@
 //! How it works: the wanted lists of a frame, most important first. Heights: the tiles the
-//! selected terrain nodes read. Other layers: the tiles the Tile Load Map's cells ask for
-//! (`analysis`), each with every ancestor up to the root. Every list starts with the *pinned* tiles,
+//! selected terrain nodes read (`passes::terrain`). Other layers: the tiles the Tile Load Map's
+//! cells ask for (`passes::tile_load_map`'s analysis, through `tiles_over`), each with every
+//! ancestor up to the root. Every list starts with the *pinned* tiles,
 //! the coarsest levels of each layer, loaded before the first frame and never evicted, so every
 //! place of the dataset always has some resident ancestor to stand in.
 
 use std::collections::HashMap;
 
 use crate::dataset::{Pyramid, TileId};
-use crate::terrain::select::{Lods, Selected};
 
 /// A rectangle of a layer wanting the levels `levels` (inclusive), from `distance_m` away.
 #[derive(Debug, Clone, Copy)]
@@ -75,14 +75,6 @@ pub fn after_pinned(pinned: &[TileId], wants: &[TileId]) -> Vec<TileId> {
     let mut list = pinned.to_vec();
     list.extend(wants.iter().filter(|id| !pinned.contains(id)));
     list
-}
-
-/// The height tiles the selected nodes read, coarse first (they stand in for everything finer).
-pub fn height_tiles(lods: &Lods, selected: &[Selected]) -> Vec<TileId> {
-    let mut tiles: Vec<TileId> = selected.iter().map(|s| lods.tile_of(s.node)).collect();
-    tiles.sort_by(|a, b| b.level.cmp(&a.level).then(a.cmp(b)));
-    tiles.dedup();
-    tiles
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 //! south-west, so imagery texel (i, j) is centred at ((i, j) + ½) · spacing / 4 − spacing / 2.
 //! The manifest's height range is gathered from the samples as they are written. Land cover is
 //! classified at 2 texels per spacing (the LCC quadtree's level 1): a first pass counts the codes
-//! for the palette, a second writes the 3 levels (`crate::lcc`).
+//! for the palette, a second writes the 3 levels (`crate::dataset::lcc`).
 
 mod colour;
 mod noise;
@@ -24,11 +24,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use thiserror::Error;
 
 use crate::classes::{ClassTable, ClassTableError};
+use crate::dataset::lcc::{LccCoding, LccError, scan_codes, write_lcc_layer};
 use crate::dataset::{
     CellLayer, Crs, DatasetError, FORMAT_VERSION, HeightLayer, LandcoverLayer, LayerError, LayerSpec,
     Manifest, Staging, Texel, Window, write_layer,
 };
-use crate::lcc::{LccCoding, LccError, scan_codes, write_lcc_layer};
 
 pub use colour::Painter;
 pub use noise::Field;

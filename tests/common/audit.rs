@@ -18,7 +18,8 @@ use terramp::camera::Camera;
 use terramp::dataset::{Dataset, TileId};
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::{SeedCounters, SeedRecord, TlmCell};
-use terramp::terrain::select::Lods;
+use terramp::gpu::layout::{LevelRange, RADIAL_INACTIVE, SpeciesLod, TLM_CULLED, TLM_FIRST_PATTERN};
+use terramp::passes::terrain::select::Lods;
 
 /// The level-0 DEM of a dataset, whole, in f64: the oracle's ground.
 pub struct Dem {
@@ -360,12 +361,16 @@ fn audit_tlm(r: &Renderer, a: &mut Audit) {
     for (i, c) in cells.iter().enumerate() {
         let TlmCell { visibility, imagery_lod, height_lod, radial_lod } = *c;
         let ring0 = i < cells_per_ring;
-        let pair_ok = |v: u32, levels: u32| (v & 0xff) <= (v >> 8) && (v >> 8) < levels;
-        let ok = visibility <= if ring0 { r.settings.tlm.patterns } else { 1 }
-            && radial_lod <= 3
-            && (visibility == 0
+        // A level range holds nothing beyond its two fields, finest first, within the levels.
+        let pair_ok = |v: u32, levels: u32| {
+            let range = LevelRange::unpack(v);
+            range.pack() == v && range.min <= range.max && range.max < levels
+        };
+        let ok = visibility <= if ring0 { r.settings.tlm.patterns } else { TLM_FIRST_PATTERN }
+            && radial_lod <= RADIAL_INACTIVE
+            && (visibility == TLM_CULLED
                 || (pair_ok(imagery_lod, imagery_levels) && pair_ok(height_lod, height_levels)));
-        a.tlm_visible += usize::from(visibility > 0);
+        a.tlm_visible += usize::from(visibility != TLM_CULLED);
         a.tlm_bad += usize::from(!ok);
     }
 }
@@ -396,7 +401,7 @@ fn audit_seeds(r: &Renderer, rays: &Rays, dem: &Dem, a: &mut Audit) {
         let slack_m = 0.01f64.max(rays.eye_grid_m.z.abs() * 2e-7);
         let mut off = gap_m.abs() > slack_m;
         a.worst_seed_gap_m = a.worst_seed_gap_m.max(p.z - dem.mesh_height_m(p.x, p.y));
-        if record.species_lod >> 16 == 0 {
+        if SpeciesLod::unpack(record.species_lod).height_level == 0 {
             let error_m = (f64::from(ground_m) - dem.height_m(p.x, p.y)).abs();
             a.worst_seed_ground_error_m = a.worst_seed_ground_error_m.max(error_m);
             off |= error_m > 0.01;

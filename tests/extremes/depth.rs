@@ -11,7 +11,7 @@
 use glam::{DVec3, Mat4, Vec4};
 use terramp::camera::Camera;
 use terramp::gpu::Gpu;
-use terramp::terrain::DEPTH_FORMAT;
+use terramp::passes::DEPTH_FORMAT;
 use wgpu::util::DeviceExt;
 
 use crate::common::audit::{Dem, Tolerance, audit, camera_at};

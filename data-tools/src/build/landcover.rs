@@ -2,7 +2,7 @@
 //! pixel size: directly when it is aligned with the DEM's grid, else through GDAL's warper with
 //! nearest-neighbour resampling, since blending class codes would invent classes. The source's
 //! nodata becomes the class table's `nodata_code`. Those codes are stored losslessly in the
-//! library's LCC quadtree (`terramp::lcc`), whose level 1 is this grid: a first pass over the
+//! library's LCC quadtree (`terramp::dataset::lcc`), whose level 1 is this grid: a first pass over the
 //! source counts every code, which gives the palette (and so the word width) and the texels whose
 //! code is missing from the table (kept, they mean "no class", and reported, so a wrong
 //! `--classes` shows in the build's summary); a second pass writes the 3 levels.
@@ -12,8 +12,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 use terramp::classes::ClassTable;
+use terramp::dataset::lcc::{CodeCounts, LccCoding, scan_codes, write_lcc_layer};
 use terramp::dataset::{CellLayer, LandcoverLayer, Staging, Window};
-use terramp::lcc::{CodeCounts, LccCoding, scan_codes, write_lcc_layer};
 
 use super::frame::{Frame, Grid};
 use super::raster::{Access, GridRaster, Resampling, SourceRaster};

@@ -14,9 +14,9 @@
 
 use std::collections::HashMap;
 
-use crate::gpu::gpu_types::{MATERIAL_REPEAT, MATERIAL_TEXTURED, SeedDrawArgs, SeedMaterial, SeedVertex};
+use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
+use crate::gpu::layout::{MATERIAL_REPEAT, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS};
 use crate::impostor::{AlphaMode, Impostor, MipChain, mip_size};
-use crate::seeds::{SEED_DRAWS, SEED_GROUPS, SEED_LODS};
 
 use super::DrawSeedsError;
 
@@ -27,7 +27,7 @@ pub const MAX_LAYER_TEXELS: u32 = 1024;
 const CLOUD_LODS: usize = SEED_LODS as usize - 1;
 
 /// Everything uploaded for the species.
-pub(super) struct SeedAssets {
+pub struct SeedAssets {
     pub vertices: Vec<SeedVertex>,
     pub indices: Vec<u32>,
     /// `SEED_DRAWS` draws: the groups' own, then their cross-fades into the next LOD.
@@ -71,7 +71,7 @@ impl SeedAssets {
 }
 
 /// Lays out `impostors` (by species index; `None`: not drawn).
-pub(super) fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsError> {
+pub fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsError> {
     let species_max = (SEED_GROUPS / SEED_LODS) as usize;
     let present = || impostors.iter().take(species_max).flatten();
     for impostor in present() {

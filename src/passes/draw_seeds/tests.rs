@@ -1,7 +1,9 @@
-use super::*;
-use crate::gpu::gpu_types::{MATERIAL_REPEAT, MATERIAL_TEXTURED};
+use super::DrawSeedsError;
+use super::assets;
+use super::frame::load_impostors;
+use crate::gpu::layout::{MATERIAL_REPEAT, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS};
 use crate::impostor::{
-    AlphaMode, BoundingSphere, ImpostorLod, Material, Mesh, MeshVertex, MipChain, Plane, Submesh,
+    AlphaMode, BoundingSphere, Impostor, ImpostorLod, Material, Mesh, MeshVertex, MipChain, Plane, Submesh,
 };
 
 /// A plain atlas of `size`² texels and `mips` levels, every texel `value`.
@@ -67,9 +69,9 @@ fn groups_get_their_index_ranges_materials_and_layers_and_missing_species_draw_n
     // 16² leaves set the size; the atlases' 2 mips the count; 3 atlases + 1 texture + 3 atlases.
     assert_eq!((built.size, built.mips, built.layers.len()), (16, 2, 7));
     let lods = SEED_LODS as usize;
-    let groups = crate::seeds::SEED_GROUPS as usize;
+    let groups = SEED_GROUPS as usize;
     let t = &built.templates;
-    assert_eq!(t.len(), crate::seeds::SEED_DRAWS as usize);
+    assert_eq!(t.len(), SEED_DRAWS as usize);
     // Species 0: clouds of 3, 2 and 1 planes (LODs 1-3), then its mesh (LOD 0): 6 vertices, as
     // the shared vertex is repeated for the second material.
     assert_eq!([t[0].index_count, t[1].index_count, t[2].index_count, t[3].index_count], [6, 18, 12, 6]);

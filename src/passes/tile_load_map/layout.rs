@@ -1,5 +1,5 @@
 //! How it works: the geometry of the Tile Load Map's camera-centred rings, in f64 (see the
-//! module above): which square of ground each cell covers, the global address of a cell, and the
+//! pass's module): which square of ground each cell covers, the global address of a cell, and the
 //! per-column / per-row spans the GPU pass and its twin combine.
 
 use glam::DVec3;
@@ -7,8 +7,7 @@ use glam::DVec3;
 use crate::config::TlmSettings;
 use crate::dataset::{HEIGHT_TILE_CELLS, Pyramid};
 use crate::gpu::gpu_types::TlmSpan;
-
-use super::{TLM_MAX_RINGS, TLM_SPAN_COVERED, TLM_SPAN_INSIDE};
+use crate::gpu::layout::{TLM_MAX_RINGS, TLM_SPAN_COVERED, TLM_SPAN_INSIDE, TileSpan};
 
 /// The rings of one frame, in grid space (f64).
 #[derive(Debug, Clone, PartialEq)]
@@ -153,7 +152,7 @@ impl TlmLayout {
                         let last_tile = f64::from(tiles[axis] - 1);
                         let first = (lo / tile_m).floor().clamp(0.0, last_tile);
                         let last = ((hi / tile_m).ceil() - 1.0).clamp(first, last_tile);
-                        span.height_tiles = first as u32 | (last as u32) << 16;
+                        span.height_tiles = TileSpan { first: first as u32, last: last as u32 }.pack();
                     }
                     spans.push(span);
                 }

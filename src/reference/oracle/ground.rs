@@ -9,8 +9,8 @@ use std::collections::hash_map::Entry;
 
 use glam::{DVec2, DVec3};
 
+use crate::dataset::lcc::{LCC_SOURCE_LEVEL, LccCoding};
 use crate::dataset::{Dataset, PackError, TileId};
-use crate::lcc::{LCC_SOURCE_LEVEL, LccCoding};
 
 /// Level-0 height samples [first, first + held) per axis, copied out of their tiles.
 pub(super) struct DemWindow {
@@ -205,7 +205,7 @@ impl LandcoverTiles {
     /// Palette index of the land cover at `p` (0, bare, without land cover).
     pub(super) fn index(&self, dataset: &Dataset, p: DVec2) -> Result<u32, PackError> {
         if self.grid.is_none() {
-            return Ok(crate::lcc::LCC_BARE_INDEX);
+            return Ok(crate::dataset::lcc::LCC_BARE_INDEX);
         }
         let q = LccCoding::texel_of(LCC_SOURCE_LEVEL, self.texel(p));
         let Some(words) = self.tiles.get(&q.map(|v| v / self.tile)) else {

@@ -245,7 +245,7 @@ fn the_oracle_is_deterministic_and_accounts_for_every_seed() {
     let eye = DVec3::new(pose[0], pose[1], z);
     let sink = Settings::default().seeds.sink_fraction;
     for seed in seeds.iter().step_by(97) {
-        assert!(seed.lod < crate::seeds::SEED_LODS);
+        assert!(seed.lod < crate::gpu::layout::SEED_LODS);
         let [x, y] = seed.position_grid_m;
         assert!((seed.ground_m - ds.height_at(x, y, 0).unwrap()).abs() < 1e-9);
         let summit = DVec3::new(x, y, seed.ground_m + (1.0 - sink) * seed.height_m);

@@ -12,10 +12,11 @@ use glam::DVec3;
 
 use crate::dataset::{Dataset, HEIGHT_TILE_CELLS, TileId};
 use crate::gpu::gpu_types::TlmCell;
-use crate::passes::seed_select::SeedCellRef;
-use crate::passes::tile_load_map::TlmLayout;
+use crate::gpu::layout::{LevelRange, RADIAL_INACTIVE, tlm_pattern};
+use crate::passes::seed_select::frame::SeedCellRef;
+use crate::streaming::wants::{AreaWant, tiles_over};
 
-use super::wants::{AreaWant, tiles_over};
+use super::layout::TlmLayout;
 
 /// The load maps of one TLM.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -34,9 +35,6 @@ pub struct LoadMaps {
     pub seed_cells: Vec<SeedCellRef>,
     pub visible_cells: usize,
 }
-
-/// Radial LOD meaning "no seeds here".
-const RADIAL_INACTIVE: u32 = 3;
 
 /// The load maps of `cells`, computed by frame `frame` with `layout`, for a camera that was at
 /// `camera_grid_m` then.
@@ -57,9 +55,7 @@ pub fn analyse(
     let mut seed_cells = Vec::new();
     let mut visible_cells = 0;
     for (index, cell) in cells.iter().enumerate().take(layout.cell_count()) {
-        if cell.visibility == 0 {
-            continue;
-        }
+        let Some(pattern) = tlm_pattern(cell.visibility) else { continue };
         visible_cells += 1;
         let (ring, cx, cy) = layout.cell_of(index);
         let (min_m, max_m) = layout.cell_rect_m(ring, cx, cy);
@@ -71,7 +67,10 @@ pub fn analyse(
             levels,
             distance_m,
         };
-        let lods = |packed: u32| [packed & 0xff, (packed >> 8) & 0xff];
+        let lods = |packed: u32| {
+            let LevelRange { min, max } = LevelRange::unpack(packed);
+            [min, max]
+        };
         if dataset.imagery.is_some() {
             ground.push(in_cell_layer(lods(cell.imagery_lod)));
         }
@@ -80,7 +79,6 @@ pub fn analyse(
             classification.push(in_cell_layer([cell.radial_lod; 2]));
             // Seeds stand on the finest heights, whatever the mesh draws there.
             heights.push(AreaWant { min_m, max_m, levels: [0, 0], distance_m });
-            let pattern = cell.visibility - 1;
             *patterns.entry(pattern).or_default() += 1;
             let address = layout.global_address(0, cx, cy);
             seed_cells.push(SeedCellRef {

@@ -21,14 +21,13 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::dataset::layer_writer::read_replicated;
-use crate::dataset::pack::PackWriter;
-use crate::dataset::{CELL_TILE_TEXELS, LANDCOVER_BORDER, LayerError, Pyramid, Sampling, TileId, Window};
+use super::layer_writer::read_replicated;
+use super::pack::PackWriter;
+use super::{CELL_TILE_TEXELS, LANDCOVER_BORDER, LayerError, Pyramid, Sampling, TileId, Window};
 
-/// Levels of the LCC quadtree, whatever the layer's size.
-pub const LCC_LEVELS: u32 = 3;
-/// The level whose texels are the source's.
-pub const LCC_SOURCE_LEVEL: u32 = 1;
+/// The levels of the LCC quadtree (whatever the layer's size) and the level that holds the
+/// source's texels, as the shaders read them.
+pub use crate::gpu::layout::{LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL};
 /// Word widths, narrowest first.
 pub const LCC_WORD_BITS: [u32; 3] = [8, 16, 32];
 /// Palette index that no source texel gets: "bare ground / no class".

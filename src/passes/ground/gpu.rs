@@ -1,15 +1,15 @@
-//! How it works: pass 2, the ground. It draws the terrain pass's node instances again, with the
-//! same vertex code (`shaders/shared/terrain_mesh.wgsl`, positions `@invariant`), at depth-equal
-//! without writing depth, so each pixel is shaded once, by the surface the depth pass kept. The
-//! shading (`shaders/ground.wgsl`) reads imagery through the imagery cache's page table from the
-//! finest resident level at or above the one the pixel's footprint asks for: a tile not loaded
-//! yet shows its ancestor, blurry, never a hole. Borders stored with each tile let trilinear and
-//! anisotropic filtering run inside one tile; gradients come from continuous coordinates, so tile
-//! edges cause no derivative spikes.
+//! The ground pass's GPU half: the pipeline over the terrain's bind group, and the recorded draw.
 
 use crate::config::Settings;
-use crate::shaders;
-use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT, MeshDraw, TerrainPass};
+use crate::gpu::resources::pipeline_layout;
+use crate::gpu::shaders::{TERRAIN_MESH, WgslSource};
+use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
+use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
+
+/// The ground pass's shader: the terrain mesh again, shaded (its bindings are the terrain's,
+/// `terrain::gpu::BINDINGS`).
+pub const SHADER: WgslSource =
+    WgslSource { name: "ground", parts: &[TERRAIN_MESH, include_str!("../../../shaders/ground.wgsl")] };
 
 pub struct GroundPass {
     pipeline: wgpu::RenderPipeline,
@@ -19,12 +19,8 @@ pub struct GroundPass {
 impl GroundPass {
     /// `software`: the adapter is a CPU rasteriser (decides automatic anisotropy).
     pub fn new(device: &wgpu::Device, settings: &Settings, software: bool, terrain: &TerrainPass) -> Self {
-        let module = shaders::module(device, "ground");
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("ground"),
-            bind_group_layouts: &[Some(terrain.bind_group_layout())],
-            immediate_size: 0,
-        });
+        let module = SHADER.module(device);
+        let layout = pipeline_layout(device, "ground", &[terrain.bind_group_layout()]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("ground"),
             layout: Some(&layout),

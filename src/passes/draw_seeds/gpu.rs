@@ -1,76 +1,48 @@
-//! How it works: pass 4b, drawing the seeds (DESIGN § "The frame", step 4). Everything a species
-//! looks like is uploaded once, at `new` (`assets`): its real mesh and its billboard clouds of 17,
-//! 8 and 2 planes in one vertex and one index buffer, every texture (cloud atlases, mesh textures)
-//! as a layer of one RGBA8 sRGB texture array, and a material table the vertices index. The draw
-//! group of (species, LOD) gets its index range as a compaction template (`templates`, for
-//! `CompactPass::set_templates`), and its cross-fade draw the next LOD's range.
-//!
-//! Each frame `encode` records two `draw_indexed_indirect`s per group from compaction's argument
-//! buffer (an empty group costs nothing): its own, and the same instances with the next LOD's
-//! geometry. `shaders/draw_seeds.wgsl` reads an instance's record through compaction's `order`,
-//! scales the model to the seed's height, turns it by the seed's jitter, places it camera-relative
-//! and projects it with the terrain's matrix; it draws into the colour target with the terrain
-//! depth (reversed-Z, `GreaterEqual`, depth written). A seed in the outer `seeds.fade_fraction`
-//! of its LOD's reach cross-fades: its own geometry keeps the pixels whose (per-seed shifted)
-//! Bayer threshold is below the fade, the next LOD's geometry the others, so each pixel shows
-//! exactly one of the two and nothing pops; outside the band the cross-fade draw collapses its
-//! vertices. The last LOD fades out to nothing at the visibility radius.
-
-mod assets;
-
-use std::path::{Path, PathBuf};
+//! Pass 4's GPU half: everything the species look like uploaded once (`new`: geometry, materials,
+//! one texture array), the pipeline and binding table, the frame's constants and the recorded
+//! indirect draws.
 
 use bytemuck::Zeroable;
-use thiserror::Error;
-use wgpu::util::DeviceExt;
+use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
-use crate::classes::Species;
-use crate::config::Settings;
-use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedVertex};
-use crate::impostor::{Impostor, ImpostorError, MANIFEST_FILE, mip_size};
-use crate::seeds::SEED_LODS;
-use crate::shaders;
-use crate::terrain::{COLOUR_FORMAT, DEPTH_FORMAT};
+use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedVertex};
+use crate::gpu::resources::{buffer, buffer_init, pipeline_layout};
+use crate::gpu::shaders::{SEED_RECORD, WgslSource};
+use crate::gpu::struct_layout::GpuLayout;
+use crate::impostor::{Impostor, mip_size};
+use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
-pub use assets::MAX_LAYER_TEXELS;
+use super::DrawSeedsError;
+use super::assets;
 
-/// How much of the ground colour under a seed it takes on.
-pub const GROUND_BLEND: f32 = 0.2;
+/// Pass 4's shader.
+pub const SHADER: WgslSource = WgslSource {
+    name: "draw_seeds",
+    parts: &[SEED_RECORD, include_str!("../../../shaders/draw_seeds.wgsl")],
+};
 
-#[derive(Debug, Error)]
-pub enum DrawSeedsError {
-    #[error("seeds.impostors = {0:?} is not a folder (bake one with `terramp-data bake`)")]
-    NoFolder(PathBuf),
-    #[error(transparent)]
-    Impostor(#[from] ImpostorError),
-    #[error("impostor {model:?} has {lods} billboard-cloud LODs; the seed draw needs {}", SEED_LODS - 1)]
-    TooFewLods { model: String, lods: usize },
-    #[error("this GPU cannot start indirect draws at an instance (INDIRECT_FIRST_INSTANCE): no seeds")]
-    NoFirstInstance,
-    #[error("{layers} atlas layers; this GPU holds at most {max} in a texture array")]
-    TooManyLayers { layers: u32, max: u32 },
-}
-
-/// Each species' impostor (index = species index of the class table), `None` where the folder has
-/// no model of that name.
-pub fn load_impostors(dir: &Path, species: &[Species]) -> Result<Vec<Option<Impostor>>, DrawSeedsError> {
-    if !dir.is_dir() {
-        return Err(DrawSeedsError::NoFolder(dir.to_path_buf()));
-    }
-    let mut loaded: Vec<Option<Impostor>> = Vec::with_capacity(species.len());
-    for s in species {
-        let known = loaded.iter().flatten().find(|i| i.name == s.model).cloned();
-        let impostor = match known {
-            Some(impostor) => Some(impostor),
-            None if dir.join(&s.model).join(MANIFEST_FILE).is_file() => {
-                Some(crate::impostor::load(dir, &s.model)?)
-            }
-            None => None,
-        };
-        loaded.push(impostor);
-    }
-    Ok(loaded)
-}
+/// Pass 4's bindings: the frame's constants, pass 3's records through compaction's order, and the
+/// species' scales, materials and textures.
+pub const BINDINGS: BindingTable<8> = BindingTable {
+    label: "draw_seeds",
+    bindings: [
+        Binding::uniform::<DrawSeedsUniforms>(0, "u", Stage::VERTEX_FRAGMENT),
+        Binding::storage_array::<SeedRecord>(1, "records", Stage::VERTEX, Access::Read),
+        Binding::storage_array::<u32>(2, "order", Stage::VERTEX, Access::Read),
+        Binding::storage_array::<f32>(3, "inv_model_height_m", Stage::VERTEX, Access::Read),
+        Binding::storage_array::<SeedMaterial>(4, "materials", Stage::VERTEX_FRAGMENT, Access::Read),
+        Binding::texture(
+            5,
+            "textures",
+            Stage::FRAGMENT,
+            TextureSampleType::Float { filterable: true },
+            TextureViewDimension::D2Array,
+        ),
+        Binding::sampler(6, "clamp_sampler", Stage::FRAGMENT, wgpu::SamplerBindingType::Filtering),
+        Binding::sampler(7, "repeat_sampler", Stage::FRAGMENT, wgpu::SamplerBindingType::Filtering),
+    ],
+};
 
 /// What the draw reads from the earlier passes: pass 3's records and compaction's order.
 pub struct DrawSeedsInputs<'a> {
@@ -144,13 +116,7 @@ impl DrawSeedsPass {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let buffer = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
-        };
+        let buffer_of = |label, contents: &[u8], usage| buffer_init(device, label, contents, usage);
         // Empty buffers cannot be bound: a species-less pass keeps one zero element of each.
         let or_one = |v: &[u8], one: &[u8]| if v.is_empty() { one.to_vec() } else { v.to_vec() };
         let vertices =
@@ -175,16 +141,20 @@ impl DrawSeedsPass {
         Ok(Self {
             pipeline,
             layout,
-            uniforms: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("draw_seeds uniforms"),
-                size: size_of::<DrawSeedsUniforms>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            materials: buffer("seed materials", &materials, storage),
-            species: buffer("seed species scale", bytemuck::cast_slice(&built.inv_model_height_m), storage),
-            vertices: buffer("seed vertices", &vertices, wgpu::BufferUsages::VERTEX),
-            indices: buffer("seed indices", &indices, wgpu::BufferUsages::INDEX),
+            uniforms: buffer(
+                device,
+                "draw_seeds uniforms",
+                size_of::<DrawSeedsUniforms>() as u64,
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            ),
+            materials: buffer_of("seed materials", &materials, storage),
+            species: buffer_of(
+                "seed species scale",
+                bytemuck::cast_slice(&built.inv_model_height_m),
+                storage,
+            ),
+            vertices: buffer_of("seed vertices", &vertices, wgpu::BufferUsages::VERTEX),
+            indices: buffer_of("seed indices", &indices, wgpu::BufferUsages::INDEX),
             texture_view,
             clamp_sampler: sampler("seed atlases", wgpu::AddressMode::ClampToEdge),
             repeat_sampler: sampler("seed mesh textures", wgpu::AddressMode::Repeat),
@@ -204,28 +174,23 @@ impl DrawSeedsPass {
         (self.species_drawn, self.species_missing)
     }
 
+    /// The bind group over pass 3's records and compaction's order (fixed for a renderer's life).
     pub fn bind_group(&self, device: &wgpu::Device, inputs: &DrawSeedsInputs) -> wgpu::BindGroup {
         use wgpu::BindingResource as R;
-        let resources = [
-            self.uniforms.as_entire_binding(),
-            inputs.records.as_entire_binding(),
-            inputs.order.as_entire_binding(),
-            self.species.as_entire_binding(),
-            self.materials.as_entire_binding(),
-            R::TextureView(&self.texture_view),
-            R::Sampler(&self.clamp_sampler),
-            R::Sampler(&self.repeat_sampler),
-        ];
-        let entries: Vec<_> = resources
-            .into_iter()
-            .enumerate()
-            .map(|(binding, resource)| wgpu::BindGroupEntry { binding: binding as u32, resource })
-            .collect();
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("draw_seeds"),
-            layout: &self.layout,
-            entries: &entries,
-        })
+        BINDINGS.bind_group(
+            device,
+            &self.layout,
+            [
+                self.uniforms.as_entire_binding(),
+                inputs.records.as_entire_binding(),
+                inputs.order.as_entire_binding(),
+                self.species.as_entire_binding(),
+                self.materials.as_entire_binding(),
+                R::TextureView(&self.texture_view),
+                R::Sampler(&self.clamp_sampler),
+                R::Sampler(&self.repeat_sampler),
+            ],
+        )
     }
 
     /// Writes the frame's constants.
@@ -277,69 +242,11 @@ impl DrawSeedsPass {
     }
 }
 
-/// The frame's constants from the settings and the terrain's matrix, sun and haze.
-pub fn draw_uniforms(
-    settings: &Settings,
-    terrain: &crate::gpu::gpu_types::TerrainUniforms,
-) -> DrawSeedsUniforms {
-    DrawSeedsUniforms {
-        clip_from_view_world: terrain.clip_from_view_world,
-        sun_dir: terrain.sun_dir,
-        haze: terrain.haze,
-        lod_reach_m: crate::seeds::lod_reach_m(settings).map(|r| r as f32),
-        inv_reference_height_m: (1.0 / settings.seeds.reference_height_m) as f32,
-        sink_fraction: settings.seeds.sink_fraction as f32,
-        fade_fraction: settings.seeds.fade_fraction as f32,
-        ground_blend: GROUND_BLEND,
-    }
-}
-
 fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
-    let vertex = wgpu::ShaderStages::VERTEX;
-    let fragment = wgpu::ShaderStages::FRAGMENT;
-    let storage = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: vertex,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
-    let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
-    let uniform = wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Uniform,
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    };
-    let texture = wgpu::BindingType::Texture {
-        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-        view_dimension: wgpu::TextureViewDimension::D2Array,
-        multisampled: false,
-    };
-    let sampler = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
-    let entries = [
-        entry(0, vertex | fragment, uniform),
-        storage(1),
-        storage(2),
-        storage(3),
-        wgpu::BindGroupLayoutEntry { visibility: vertex | fragment, ..storage(4) },
-        entry(5, fragment, texture),
-        entry(6, fragment, sampler),
-        entry(7, fragment, sampler),
-    ];
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("draw_seeds"),
-        entries: &entries,
-    });
-    let module = shaders::module(device, "draw_seeds");
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("draw_seeds"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Uint32];
+    let layout = BINDINGS.layout(device);
+    let module = SHADER.module(device);
+    let pipeline_layout = pipeline_layout(device, "draw_seeds", &[&layout]);
+    let attributes = SeedVertex::layout().vertex_attributes();
     let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("draw_seeds"),
         layout: Some(&pipeline_layout),
@@ -374,6 +281,3 @@ fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayo
     });
     (pipeline, layout)
 }
-
-#[cfg(test)]
-mod tests;

@@ -1,0 +1,170 @@
+//! How it works: the CPU half of a frame, done before anything is recorded. The terrain's LOD
+//! selection picks the nodes; the streaming hands each cache what the terrain and the latest Tile
+//! Load Map want and uploads what the loader read, within the frame's budget; then every upload
+//! of the frame is written: the TLM's rings, the terrain's instances and uniforms, pass 3's cells
+//! and pass 4's constants. `encode` then only records commands over what this left.
+
+use glam::DVec3;
+
+use crate::camera::{Camera, Frustum};
+use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms};
+use crate::passes::terrain::gpu::PreparedNodes;
+use crate::passes::terrain::select::{Lods, Selected, select};
+use crate::passes::tile_load_map::analysis::LoadMaps;
+use crate::passes::tile_load_map::frame::{TlmFrame, TlmImagery, TlmInputs};
+use crate::passes::tile_load_map::layout::TlmLayout;
+use crate::streaming::wants::after_pinned;
+use crate::streaming::{CacheStats, TileCache, UploadBudget};
+
+use super::{FrameReport, RenderError, Renderer, SKY_LINEAR};
+
+/// What `prepare` uploaded for a frame, which the passes are recorded over.
+pub(super) struct FramePlan {
+    /// The frame's TLM rings, and where the camera was (the TLM's readback is read against them).
+    pub layout: TlmLayout,
+    pub camera_grid_m: DVec3,
+    pub tlm: TlmFrame,
+    pub nodes: PreparedNodes,
+}
+
+/// The camera, as this frame's passes see it.
+struct View<'a> {
+    camera: &'a Camera,
+    /// Camera position in grid space (CRS position − `Manifest::origin_m`), metres.
+    grid_m: DVec3,
+    clip_from_view_world: glam::DMat4,
+    lods: Lods,
+}
+
+impl Renderer {
+    /// The frame's CPU work and uploads, for `camera` (already above the ground).
+    pub(super) fn prepare(
+        &mut self,
+        camera: &Camera,
+        report: &mut FrameReport,
+    ) -> Result<FramePlan, RenderError> {
+        let (width, height) = (self.settings.render.width, self.settings.render.height);
+        let origin = self.dataset.manifest.origin_m;
+        let view = View {
+            camera,
+            grid_m: camera.position_m - DVec3::new(origin[0], origin[1], 0.0),
+            clip_from_view_world: camera.clip_from_view(width, height)? * camera.view_from_world(),
+            lods: Lods::for_view(&self.dataset, &self.settings.terrain, camera, height),
+        };
+        let selected = self.select_nodes(&view);
+        self.stream(&view, &selected, report);
+        let (layout, tlm) = self.prepare_tlm(&view)?;
+        let nodes = self.prepare_terrain(&view, &selected, report);
+        self.prepare_seeds(&view, report)?;
+        Ok(FramePlan { layout, camera_grid_m: view.grid_m, tlm, nodes })
+    }
+
+    /// Terrain LOD: the nodes whose triangles keep their target size on screen.
+    fn select_nodes(&mut self, view: &View) -> Vec<Selected> {
+        let frustum = Frustum::from_clip(view.clip_from_view_world);
+        let (dataset, bounds) = (&self.dataset, &mut self.bounds);
+        self.profiler.cpu("terrain_select", || {
+            select(&view.lods, view.grid_m, &frustum, &mut |node| {
+                bounds.get(&view.lods, node, |tile| dataset.height_tile(tile).ok())
+            })
+        })
+    }
+
+    /// Streaming: the terrain's own height tiles first, then what the latest Tile Load Map asks
+    /// for; upload what arrived, within the frame's budget.
+    fn stream(&mut self, view: &View, selected: &[Selected], report: &mut FrameReport) {
+        let no_tlm_yet = LoadMaps::default();
+        let latest = self.load_maps.as_ref().unwrap_or(&no_tlm_yet);
+        report.tlm_frame = self.load_maps.as_ref().map(|m| m.frame);
+        report.tlm_visible_cells = latest.visible_cells;
+        report.tlm_patterns = latest.patterns.len();
+        let mut selected_heights = height_tiles(&view.lods, selected);
+        let prefetch: Vec<_> =
+            latest.heights.iter().filter(|id| !selected_heights.contains(id)).copied().collect();
+        selected_heights.extend(prefetch);
+        let c = &mut self.caches;
+        let wanted_heights = after_pinned(&c.pinned_heights, &selected_heights);
+        let wanted_imagery = after_pinned(&c.pinned_imagery, &latest.ground);
+        let wanted_landcover = after_pinned(&c.pinned_landcover, &latest.classification);
+        let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
+        let (loader, has_imagery) = (&self.loader, self.dataset.imagery.is_some());
+        let (heights, imagery, landcover) = (&mut c.heights, &mut c.imagery, &mut c.landcover);
+        [report.height, report.imagery, report.landcover] = self.profiler.cpu("streaming", || {
+            let mut requests = heights.set_wanted(&wanted_heights, frame);
+            if has_imagery {
+                requests.extend(imagery.set_wanted(&wanted_imagery, frame));
+            }
+            if let Some(landcover) = landcover.as_mut() {
+                requests.extend(landcover.set_wanted(&wanted_landcover, frame));
+            }
+            // Every frame, even with nothing new: it also cancels what is no longer wanted.
+            loader.submit(&requests);
+            let loaded = loader.try_recv_all();
+            let uploads = |cache: &mut TileCache| cache.upload(queue, &loaded, budget);
+            [
+                uploads(heights),
+                if has_imagery { uploads(imagery) } else { CacheStats::default() },
+                landcover.as_mut().map(uploads).unwrap_or_default(),
+            ]
+        });
+    }
+
+    /// This frame's Tile Load Map, over rings centred on the camera.
+    fn prepare_tlm(&self, view: &View) -> Result<(TlmLayout, TlmFrame), RenderError> {
+        let s = &self.settings;
+        let dataset_rect =
+            TlmLayout::dataset_rect_m(&self.dataset.height.pyramid, self.dataset.manifest.height.spacing_m);
+        let layout = TlmLayout::new(&s.tlm, dataset_rect, [view.grid_m.x, view.grid_m.y]);
+        let inputs = TlmInputs {
+            settings: &s.tlm,
+            layout: &layout,
+            camera: view.camera,
+            camera_grid_m: view.grid_m,
+            viewport_px: [s.render.width, s.render.height],
+            lods: &view.lods,
+            imagery: TlmImagery::of(&self.dataset, &s.imagery),
+            hiz_mips: self.depth_pyramid.mips(),
+        };
+        let tlm = self.tlm.prepare(&self.gpu.queue, &inputs)?;
+        Ok((layout, tlm))
+    }
+
+    /// The terrain's instances (each node over its own height tile, or its finest resident
+    /// ancestor) and the uniforms both terrain passes read.
+    fn prepare_terrain(
+        &mut self,
+        view: &View,
+        selected: &[Selected],
+        report: &mut FrameReport,
+    ) -> PreparedNodes {
+        let (dataset, bounds) = (&self.dataset, &mut self.bounds);
+        let floor_m = dataset.manifest.height.min_m;
+        let (batches, dropped) =
+            node_batches(&view.lods, selected, view.grid_m, &self.caches.heights, floor_m, &mut |node| {
+                bounds.get(&view.lods, node, |tile| dataset.height_tile(tile).ok())
+            });
+        report.nodes_drawn = batches.len();
+        report.nodes_dropped = dropped;
+        let clip = view.clip_from_view_world.as_mat4();
+        let uniforms = terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR);
+        let nodes = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
+        if let Some(stage) = &self.seeds {
+            stage.prepare_draw(&self.gpu, &self.settings, &uniforms);
+        }
+        nodes
+    }
+
+    /// Pass 3's cells: those the latest TLM found near and visible.
+    fn prepare_seeds(&mut self, view: &View, report: &mut FrameReport) -> Result<(), RenderError> {
+        let Some(stage) = self.seeds.as_mut() else { return Ok(()) };
+        let cells = self.load_maps.as_ref().map_or(&[][..], |m| &m.seed_cells[..]);
+        let ranks = stage.tables.active_ranks();
+        let inputs =
+            super::seeds::seed_inputs(&self.settings, &self.dataset, view.camera, view.grid_m, cells, ranks);
+        let frame = stage.prepare(&self.gpu, &inputs)?;
+        report.seed_cells = frame.cells.len();
+        report.seed_cells_dropped = frame.cells_dropped;
+        (report.seed_species_drawn, report.seed_species_undrawn) = stage.species_counts();
+        Ok(())
+    }
+}

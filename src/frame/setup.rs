@@ -1,0 +1,120 @@
+//! How it works: what a renderer makes once, before its first frame: the render targets (checked
+//! against the adapter's limits, so a bad viewport is an error here rather than a GPU error
+//! later) and the three tile caches, whose coarsest levels load now, synchronously, because every
+//! later frame falls back on them.
+
+use crate::config::Settings;
+use crate::dataset::{Dataset, IMAGERY_MIPS, LayerSpec};
+use crate::gpu::Gpu;
+use crate::gpu::layout::MAX_LEVELS;
+use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
+use crate::streaming::wants::pinned_tiles;
+use crate::streaming::{LayerKind, TileCache};
+
+use super::{Caches, RenderError, Targets};
+use crate::camera::CameraError;
+
+/// Tiles of the coarsest levels each cache keeps resident from the start, at most: the three
+/// coarsest levels of a square layer (1 + 4 + 16), a fallback everywhere at a quarter of the
+/// finest pinned detail, for a few MiB.
+const MAX_PINNED_TILES: usize = 21;
+
+impl Targets {
+    /// The colour and depth targets of `settings.render`'s size.
+    pub(super) fn new(device: &wgpu::Device, settings: &Settings) -> Result<Self, RenderError> {
+        let (width, height, max) =
+            (settings.render.width, settings.render.height, device.limits().max_texture_dimension_2d);
+        if width == 0 || height == 0 {
+            return Err(CameraError::Viewport(width, height).into());
+        }
+        if width.max(height) > max {
+            return Err(RenderError::ViewportTooLarge { width, height, max });
+        }
+        let target = |label, format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let colour = target("colour", COLOUR_FORMAT);
+        let depth = target("depth", DEPTH_FORMAT);
+        let colour_view = colour.create_view(&Default::default());
+        let depth_view = depth.create_view(&Default::default());
+        Ok(Self { colour, depth, colour_view, depth_view })
+    }
+}
+
+impl Caches {
+    /// The caches of `dataset`'s layers, sized by `settings.cache`, their pinned tiles loaded.
+    pub(super) fn new(gpu: &Gpu, dataset: &Dataset, settings: &Settings) -> Result<Self, RenderError> {
+        let device = &gpu.device;
+        let slots = &settings.cache;
+        let mut heights = TileCache::new(
+            device,
+            "height cache",
+            LayerKind::Height,
+            dataset.height.pyramid,
+            1,
+            wgpu::TextureFormat::R32Float,
+            slots.height_slots,
+        );
+        let mut imagery = match &dataset.imagery {
+            Some(layer) if layer.pyramid.levels > MAX_LEVELS => {
+                return Err(RenderError::TooManyLevels { levels: layer.pyramid.levels });
+            }
+            Some(layer) => TileCache::new(
+                device,
+                "imagery cache",
+                LayerKind::Imagery,
+                layer.pyramid,
+                layer.mips,
+                wgpu::TextureFormat::Rgba8UnormSrgb,
+                slots.imagery_slots,
+            ),
+            // The shader reads imagery through the same bindings either way; a one-slot cache
+            // that stays empty costs 1.5 MiB and keeps one code path.
+            None => TileCache::new(
+                device,
+                "no imagery",
+                LayerKind::Imagery,
+                LayerSpec::imagery([1, 1]).pyramid,
+                IMAGERY_MIPS,
+                wgpu::TextureFormat::Rgba8UnormSrgb,
+                1,
+            ),
+        };
+        let pin =
+            |cache: &TileCache| pinned_tiles(cache.pyramid(), MAX_PINNED_TILES.min(cache.capacity() / 4));
+        let pinned_heights = pin(&heights);
+        heights.load_now(&gpu.queue, &pinned_heights, 0, |id| dataset.height.tile_bytes(id));
+        let pinned_imagery = match &dataset.imagery {
+            Some(layer) => {
+                let pinned = pin(&imagery);
+                imagery.load_now(&gpu.queue, &pinned, 0, |id| layer.tile_bytes(id));
+                pinned
+            }
+            None => Vec::new(),
+        };
+        let landcover = match (&dataset.landcover, &dataset.manifest.landcover) {
+            (Some(layer), Some(meta)) => Some(TileCache::new(
+                device,
+                "land-cover cache",
+                LayerKind::Landcover,
+                layer.pyramid,
+                1,
+                meta.coding.texture_format(),
+                slots.landcover_slots,
+            )),
+            _ => None,
+        };
+        Ok(Self { heights, imagery, landcover, pinned_heights, pinned_imagery, pinned_landcover: Vec::new() })
+    }
+}

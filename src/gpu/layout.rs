@@ -1,0 +1,368 @@
+//! How it works: every constant and bit layout the CPU and the shaders share, defined once (the
+//! role `config.h` plays in niagara). `wgsl_constant!` defines a Rust constant and lists it for the
+//! generated WGSL prelude (`gpu::shaders::prelude`); `packed_word!` defines a bit-packed u32 word
+//! as a Rust struct with `pack`/`unpack` and emits the same struct and functions in WGSL, so a
+//! shift or a mask is never written by hand on either side. This module imports nothing of the
+//! crate: anything may depend on it, and it on nothing.
+//!
+//! To add a constant the shaders see: add it to one of the `wgsl_constants!` blocks below. That is
+//! the only file to touch; the shader then names it.
+
+/// A value the WGSL prelude can declare.
+pub trait WgslLiteral {
+    /// The WGSL type and literal, e.g. `("u32", "256u")`.
+    fn wgsl(&self) -> (&'static str, String);
+}
+
+impl WgslLiteral for u32 {
+    fn wgsl(&self) -> (&'static str, String) {
+        ("u32", format!("{self}u"))
+    }
+}
+
+impl WgslLiteral for i32 {
+    fn wgsl(&self) -> (&'static str, String) {
+        ("i32", format!("{self}i"))
+    }
+}
+
+/// Defines constants and a function listing them (name, WGSL type, literal) for the prelude.
+macro_rules! wgsl_constants {
+    ($list:ident: $($(#[$meta:meta])* pub const $name:ident: $ty:ty = $value:expr;)*) => {
+        $($(#[$meta])* pub const $name: $ty = $value;)*
+
+        /// The constants of this block as the prelude declares them: name, WGSL type, literal.
+        fn $list() -> Vec<(&'static str, &'static str, String)> {
+            vec![$({
+                let (ty, literal) = WgslLiteral::wgsl(&$name);
+                (stringify!($name), ty, literal)
+            }),*]
+        }
+    };
+}
+
+/// One field of a packed word: its name and width in bits (fields are packed from bit 0 up).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BitField {
+    pub name: &'static str,
+    pub bits: u32,
+}
+
+/// A packed word as the prelude emits it: a WGSL struct of the same name, `pack_<word>` and
+/// `unpack_<word>`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PackedWord {
+    /// The Rust (and WGSL) struct name.
+    pub name: &'static str,
+    /// The snake-case name of its pack and unpack functions.
+    pub function: &'static str,
+    pub fields: &'static [BitField],
+}
+
+/// Defines a packed u32 word: a Rust struct of its fields, `pack`/`unpack` (each field masked to
+/// its width, as WGSL does), and its `PackedWord` description for the prelude.
+macro_rules! packed_word {
+    ($(#[$meta:meta])* pub struct $name:ident as $function:ident {
+        $($(#[$fmeta:meta])* $field:ident: $bits:expr),* $(,)?
+    }) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        pub struct $name {
+            $($(#[$fmeta])* pub $field: u32,)*
+        }
+
+        impl $name {
+            /// The word's layout, as the WGSL prelude declares it.
+            pub const WORD: PackedWord = PackedWord {
+                name: stringify!($name),
+                function: stringify!($function),
+                fields: &[$(BitField { name: stringify!($field), bits: $bits }),*],
+            };
+
+            /// The fields in one word, each masked to its width.
+            pub const fn pack(self) -> u32 {
+                let mut word = 0u32;
+                let mut shift = 0u32;
+                $(
+                    word |= (self.$field & mask($bits)) << shift;
+                    shift += $bits;
+                )*
+                let _ = shift;
+                word
+            }
+
+            /// The fields of `word`.
+            pub const fn unpack(word: u32) -> Self {
+                let mut shift = 0u32;
+                $(
+                    let $field = (word >> shift) & mask($bits);
+                    shift += $bits;
+                )*
+                let _ = shift;
+                Self { $($field),* }
+            }
+        }
+
+        const _: () = assert!(0 $(+ $bits)* <= 32, concat!(stringify!($name), " does not fit 32 bits"));
+    };
+}
+
+/// The low `bits` bits set.
+pub const fn mask(bits: u32) -> u32 {
+    if bits >= 32 { u32::MAX } else { (1u32 << bits) - 1 }
+}
+
+// --- The dataset's tiles (on disk and in the caches) ---
+wgsl_constants! { dataset_constants:
+    /// Height tiles: 256 cells (257 shared-edge samples) plus a 1-sample border for normals.
+    pub const HEIGHT_TILE_CELLS: u32 = 256;
+    pub const HEIGHT_BORDER: u32 = 1;
+    /// Samples along a stored height tile's edge, borders included.
+    pub const HEIGHT_TILE_EXTENT: u32 = HEIGHT_TILE_CELLS + 1 + 2 * HEIGHT_BORDER;
+    /// Imagery and land-cover tiles: 512 texels.
+    pub const CELL_TILE_TEXELS: u32 = 512;
+    /// Imagery carries an 8-texel border, enough for trilinear and anisotropic filtering down its
+    /// 4 stored mips (8, 4, 2, 1 texels of border).
+    pub const IMAGERY_BORDER: u32 = 8;
+    pub const IMAGERY_MIPS: u32 = 4;
+    /// Texels along a stored imagery tile's edge (mip 0), borders included.
+    pub const IMAGERY_TILE_EXTENT: u32 = CELL_TILE_TEXELS + 2 * IMAGERY_BORDER;
+    pub const IMAGERY_TILE_TEXELS: u32 = CELL_TILE_TEXELS;
+    /// Land cover is read texel by texel (nearest), so it needs no border.
+    pub const LANDCOVER_BORDER: u32 = 0;
+    pub const LCC_TILE_TEXELS: u32 = CELL_TILE_TEXELS;
+    /// Levels of the LCC quadtree (paper § 4.1): 0 duplicates each source texel onto its four
+    /// children, 1 is the source, 2 packs four level-1 classes into sub-codes.
+    pub const LCC_LEVELS: u32 = 3;
+    /// The level that stores the source's classes one per texel.
+    pub const LCC_SOURCE_LEVEL: u32 = 1;
+    /// The level that packs four neighbouring level-1 classes into one word.
+    pub const LCC_PACKED_LEVEL: u32 = 2;
+    /// Levels a page table describes at most (a 2^15-tile-wide layer).
+    pub const MAX_LEVELS: u32 = 16;
+    /// A page-table entry of a tile that is not resident; otherwise the entry is its slot + 1
+    /// (`PageEntry`).
+    pub const PAGE_EMPTY: u32 = 0;
+}
+
+/// A page-table entry: the tile's cache slot (texture-array layer) + 1, or `PAGE_EMPTY`.
+pub const fn page_entry(slot: u32) -> u32 {
+    slot + 1
+}
+
+/// The cache slot of a page-table entry, `None` for `PAGE_EMPTY`.
+pub const fn page_slot(entry: u32) -> Option<u32> {
+    if entry == PAGE_EMPTY { None } else { Some(entry - 1) }
+}
+
+// --- Pass 1, the Tile Load Map ---
+wgsl_constants! { tlm_constants:
+    /// Workgroup edge of the TLM dispatch.
+    pub const TLM_WORKGROUP: u32 = 8;
+    /// Rings the uniforms have room for (`tlm.max_rings` is at most this).
+    pub const TLM_MAX_RINGS: u32 = 16;
+    /// `TlmSpan::flags`: the column (row) overlaps the dataset.
+    pub const TLM_SPAN_INSIDE: u32 = 1;
+    /// `TlmSpan::flags`: the column (row) lies within the inner ring's; a cell whose column and row
+    /// both do is covered by the inner ring.
+    pub const TLM_SPAN_COVERED: u32 = 2;
+    /// Distance bands of a ring-0 cell (`tlm.radial_bands_m`): its radial LOD is the first band
+    /// its nearest point lies in, the land-cover level its seeds read.
+    pub const TLM_RADIAL_BANDS: u32 = 3;
+    /// Radial LOD of a cell beyond every band, or culled: no seeds there.
+    pub const RADIAL_INACTIVE: u32 = TLM_RADIAL_BANDS;
+    /// `TlmCell::visibility` of a culled cell.
+    pub const TLM_CULLED: u32 = 0;
+    /// `TlmCell::visibility` of a visible cell is `TLM_FIRST_PATTERN + pattern` in ring 0 (and
+    /// `TLM_FIRST_PATTERN` in outer rings, which show no seeds).
+    pub const TLM_FIRST_PATTERN: u32 = 1;
+}
+
+/// `TlmCell::visibility` of a visible ring-0 cell showing seed pattern `pattern`.
+pub const fn tlm_visibility(pattern: u32) -> u32 {
+    TLM_FIRST_PATTERN + pattern
+}
+
+/// The seed pattern of a visible ring-0 cell, `None` for a culled one.
+pub const fn tlm_pattern(visibility: u32) -> Option<u32> {
+    if visibility == TLM_CULLED { None } else { Some(visibility - TLM_FIRST_PATTERN) }
+}
+
+packed_word! {
+    /// A range of levels, finest first: `TlmCell::imagery_lod` (the imagery levels a cell's pixels
+    /// need) and `TlmCell::height_lod` (the terrain LODs at its nearest and farthest points).
+    pub struct LevelRange as level_range {
+        min: 8,
+        max: 8,
+    }
+}
+
+packed_word! {
+    /// `TlmSpan::height_tiles`: the first and last height tile a column (row) overlaps.
+    pub struct TileSpan as tile_span {
+        first: 16,
+        last: 16,
+    }
+}
+
+// --- The depth pyramid ---
+wgsl_constants! { hiz_constants:
+    /// Workgroup edge of the reduction dispatches.
+    pub const HIZ_WORKGROUP: u32 = 8;
+}
+
+// --- Pass 3, seed selection ---
+wgsl_constants! { seed_constants:
+    /// Workgroup size of the seed-selection dispatch.
+    pub const SEED_WORKGROUP: u32 = 64;
+    /// Words of a ballot: one bit per lane of a pass-3 workgroup (`shaders/shared/blocks.wgsl`).
+    pub const BALLOT_WORDS: u32 = SEED_WORKGROUP / 32;
+    /// Most species in one class table.
+    pub const MAX_SPECIES: u32 = 16;
+    /// Most seed rules (species) in one class.
+    pub const MAX_SPECIES_PER_CLASS: u32 = 4;
+    /// Draw LODs of a seed: 0 the real mesh, 1 to 3 its billboard clouds (17, 8 and 2 planes), out
+    /// to the four `draw_seeds.reach_m`.
+    pub const SEED_LODS: u32 = 4;
+    /// Draw groups: one per (species, LOD), `species × SEED_LODS + lod` (`seed_group`).
+    pub const SEED_GROUPS: u32 = MAX_SPECIES * SEED_LODS;
+    /// Indirect draws compaction writes: each group's own, then (at `SEED_GROUPS + group`) the
+    /// same instances with the next LOD's geometry, which the seeds in the outer band of their LOD
+    /// cross-fade into.
+    pub const SEED_DRAWS: u32 = 2 * SEED_GROUPS;
+    /// Indices into `SeedCounters` (as an array of u32): where a seed's outcome is counted.
+    pub const COUNT_SELECTED: u32 = 0;
+    pub const COUNT_OVERFLOW: u32 = 1;
+    pub const COUNT_CHECKED: u32 = 2;
+    pub const COUNT_CLASS: u32 = 3;
+    pub const COUNT_RULE: u32 = 4;
+    pub const COUNT_DISTANCE: u32 = 5;
+    pub const COUNT_FRUSTUM: u32 = 6;
+    pub const COUNT_OCCLUSION: u32 = 7;
+    pub const SEED_COUNTERS: u32 = 8;
+    /// `SeedSpecies::kind` codes.
+    pub const KIND_TREE: u32 = 0;
+    pub const KIND_BUSH: u32 = 1;
+    pub const KIND_ROCK: u32 = 2;
+    /// Pixels around a summit's whose farthest terrain depth decides its occlusion (1: a 3 × 3
+    /// block), so a summit within a pixel of a silhouette is kept.
+    pub const OCCLUSION_FOOTPRINT_PX: i32 = 1;
+    /// Imagery texels averaged into a seed's ground colour.
+    pub const GROUND_SAMPLES: u32 = 4;
+    /// Mixed into the seed hash so it never equals the pattern hash of the same cell.
+    pub const SEED_SALT: u32 = 0x5eed_5eed;
+    /// A land-cover lookup that found no resident level.
+    pub const NO_CLASS: u32 = u32::MAX;
+}
+
+const _: () = assert!(SEED_WORKGROUP.is_multiple_of(32), "ballots need whole words");
+
+/// The draw group of a seed of species `species` at draw LOD `lod`: the key pass 3 writes beside
+/// each record and compaction groups by.
+pub const fn seed_group(species: u32, lod: u32) -> u32 {
+    species * SEED_LODS + lod
+}
+
+packed_word! {
+    /// `SeedRecord::species_lod`: what a seed is and which levels it was read from.
+    pub struct SpeciesLod as species_lod {
+        /// Index into the species table.
+        species: 8,
+        /// Draw LOD (0 the mesh, 1 to 3 the billboard clouds).
+        lod: 4,
+        /// Land-cover level its class was read from.
+        lcc_level: 4,
+        /// Height level it was placed on.
+        height_level: 16,
+    }
+}
+
+packed_word! {
+    /// `SeedRecord::jitter`: the hash bits that vary a seed.
+    pub struct SeedJitter as seed_jitter {
+        /// Turn about the vertical, in 1/65536 of a full turn.
+        angle: 16,
+        /// Colour variation, 0 to 65535 (half way: none).
+        colour: 16,
+    }
+}
+
+// --- Pass 4, compaction and drawing ---
+wgsl_constants! { draw_constants:
+    /// Blocks per chunk: the workgroup of `reduce` and `scatter`, one lane per block, whose
+    /// block × group table of counts (`COMPACT_CHUNK × SEED_GROUPS` words) fits WebGPU's 16 KiB of
+    /// workgroup memory.
+    pub const COMPACT_CHUNK: u32 = 64;
+    /// Invocations of the `scan` workgroup (one per group), each summing a run of chunks.
+    pub const COMPACT_WORKGROUP: u32 = 256;
+    /// `SeedMaterial::flags`: the material samples a layer of the seed texture array.
+    pub const MATERIAL_TEXTURED: u32 = 1;
+    /// `SeedMaterial::flags`: texture coordinates wrap (else they clamp).
+    pub const MATERIAL_REPEAT: u32 = 2;
+}
+
+const _: () = assert!(SEED_GROUPS <= COMPACT_CHUNK, "a lane per group sums or scans a column");
+const _: () = assert!(COMPACT_CHUNK * SEED_GROUPS * 4 <= 16384, "the chunk's table fits workgroup memory");
+
+/// The WGSL twins of the functions of this module, emitted into the prelude after the constants
+/// (kept here, beside their Rust twins, so the two change together).
+pub const WGSL_FUNCTIONS: &str = r"
+// The texture-array layer of a resident tile's page-table entry (Rust: `page_slot`).
+fn page_layer(entry: u32) -> i32 {
+    return i32(entry - 1u);
+}
+
+// The visibility of a ring-0 cell showing seed pattern `pattern` (Rust: `tlm_visibility`).
+fn tlm_visibility(pattern: u32) -> u32 {
+    return TLM_FIRST_PATTERN + pattern;
+}
+
+// The draw group of a seed (Rust: `seed_group`).
+fn seed_group(species: u32, lod: u32) -> u32 {
+    return species * SEED_LODS + lod;
+}
+";
+
+/// Every constant the prelude declares: name, WGSL type, literal.
+pub fn wgsl_constants() -> Vec<(&'static str, &'static str, String)> {
+    [dataset_constants(), tlm_constants(), hiz_constants(), seed_constants(), draw_constants()].concat()
+}
+
+/// Every packed word the prelude declares.
+pub const PACKED_WORDS: &[PackedWord] =
+    &[LevelRange::WORD, TileSpan::WORD, SpeciesLod::WORD, SeedJitter::WORD];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_round_trip_and_mask_each_field() {
+        let s = SpeciesLod { species: 9, lod: 3, lcc_level: 2, height_level: 11 };
+        assert_eq!(s.pack(), 9 | 3 << 8 | 2 << 12 | 11 << 16);
+        assert_eq!(SpeciesLod::unpack(s.pack()), s);
+        let wide = LevelRange { min: 0x1ff, max: 1 };
+        assert_eq!(LevelRange::unpack(wide.pack()), LevelRange { min: 0xff, max: 1 });
+        assert_eq!(TileSpan { first: 3, last: 70_000 }.pack() >> 16, 70_000 & 0xffff);
+        assert_eq!(SeedJitter::unpack(0xabcd_1234), SeedJitter { angle: 0x1234, colour: 0xabcd });
+    }
+
+    #[test]
+    fn every_constant_is_declared_once() {
+        let names: Vec<_> = wgsl_constants().into_iter().map(|(name, ..)| name).collect();
+        let mut unique = names.clone();
+        unique.sort_unstable();
+        unique.dedup();
+        assert_eq!(names.len(), unique.len(), "{names:?}");
+        assert!(names.contains(&"RADIAL_INACTIVE") && names.contains(&"COUNT_OCCLUSION"));
+    }
+
+    #[test]
+    fn page_entries_and_patterns_round_trip() {
+        assert_eq!(page_slot(PAGE_EMPTY), None);
+        assert_eq!(page_slot(page_entry(7)), Some(7));
+        assert_eq!(tlm_pattern(TLM_CULLED), None);
+        assert_eq!(tlm_pattern(tlm_visibility(5)), Some(5));
+        assert_eq!(seed_group(MAX_SPECIES - 1, SEED_LODS - 1), SEED_GROUPS - 1);
+    }
+}

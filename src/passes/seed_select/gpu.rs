@@ -1,0 +1,242 @@
+//! Pass 3's GPU half: the pipeline and binding table (built once), the patterns and species
+//! tables uploaded once, the frame's upload and the recorded dispatch, and blocking readbacks for
+//! tests.
+
+use wgpu::{ShaderStages as Stage, TextureSampleType as Sample, TextureViewDimension as Dim};
+
+use crate::camera::CameraError;
+use crate::config::Settings;
+use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::gpu_types::{
+    SeedBlock, SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms,
+};
+use crate::gpu::readback::read_values;
+use crate::gpu::resources::{buffer, buffer_init, compute_pipeline, pipeline_layout};
+use crate::gpu::shaders::{BLOCKS, HASH, SEED_RECORD, WgslSource};
+use crate::gpu::{Gpu, GpuError};
+use crate::seeds::patterns::SeedPatterns;
+use crate::seeds::{MAX_SEED_CELLS, SeedTables, block_capacity, workgroups_per_cell};
+use crate::streaming::TileCache;
+
+use super::frame::{SeedFrame, SeedInputs, SeedOutput};
+
+/// Pass 3's shader.
+pub const SHADER: WgslSource = WgslSource {
+    name: "seed_select",
+    parts: &[HASH, BLOCKS, SEED_RECORD, include_str!("../../../shaders/seed_select.wgsl")],
+};
+
+/// Pass 3's bindings: the frame's constants and cells (a storage buffer, not a uniform one: see
+/// `tile_load_map.wgsl`), the patterns and tables, the three caches and the terrain depth it reads,
+/// and what it writes.
+pub const BINDINGS: BindingTable<16> = BindingTable {
+    label: "seed select",
+    bindings: [
+        Binding::storage::<SeedUniforms>(0, "u", Stage::COMPUTE, Access::Read),
+        Binding::storage_array::<SeedCell>(1, "cells", Stage::COMPUTE, Access::Read),
+        Binding::storage_array::<[f32; 2]>(2, "patterns", Stage::COMPUTE, Access::Read),
+        Binding::storage_array::<SeedSpecies>(3, "species_table", Stage::COMPUTE, Access::Read),
+        Binding::storage_array::<SeedClass>(4, "class_table", Stage::COMPUTE, Access::Read),
+        Binding::storage_array::<u32>(5, "height_page_table", Stage::COMPUTE, Access::Read),
+        Binding::texture(
+            6,
+            "height_tiles",
+            Stage::COMPUTE,
+            Sample::Float { filterable: false },
+            Dim::D2Array,
+        ),
+        Binding::storage_array::<u32>(7, "lcc_page_table", Stage::COMPUTE, Access::Read),
+        Binding::texture(8, "lcc_tiles", Stage::COMPUTE, Sample::Uint, Dim::D2Array),
+        Binding::storage_array::<u32>(9, "imagery_page_table", Stage::COMPUTE, Access::Read),
+        Binding::texture(
+            10,
+            "imagery_tiles",
+            Stage::COMPUTE,
+            Sample::Float { filterable: false },
+            Dim::D2Array,
+        ),
+        Binding::texture(11, "depth", Stage::COMPUTE, Sample::Depth, Dim::D2),
+        Binding::storage_array::<SeedRecord>(12, "records", Stage::COMPUTE, Access::ReadWrite),
+        Binding::storage::<SeedCounters>(13, "counters", Stage::COMPUTE, Access::ReadWrite),
+        Binding::storage_array::<u32>(14, "keys", Stage::COMPUTE, Access::ReadWrite),
+        Binding::storage_array::<SeedBlock>(15, "blocks", Stage::COMPUTE, Access::ReadWrite),
+    ],
+};
+
+pub struct SeedSelectPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    cells: wgpu::Buffer,
+    patterns: wgpu::Buffer,
+    species: wgpu::Buffer,
+    classes: wgpu::Buffer,
+    records: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    keys: wgpu::Buffer,
+    blocks: wgpu::Buffer,
+    capacity: u32,
+    block_capacity: u32,
+}
+
+/// The caches and depth pass 3 reads.
+pub struct SeedSources<'a> {
+    pub heights: &'a TileCache,
+    pub landcover: &'a TileCache,
+    pub imagery: &'a TileCache,
+    pub depth: &'a wgpu::TextureView,
+}
+
+impl SeedSelectPass {
+    /// Builds the pipeline and uploads the patterns and tables, which a renderer keeps for life.
+    pub fn new(
+        device: &wgpu::Device,
+        settings: &Settings,
+        patterns: &SeedPatterns,
+        tables: &SeedTables,
+    ) -> Self {
+        let module = SHADER.module(device);
+        let layout = BINDINGS.layout(device);
+        let pipeline_layout = pipeline_layout(device, "seed select", &[&layout]);
+        let pipeline = compute_pipeline(device, "seed select", &pipeline_layout, &module, "main");
+        use wgpu::BufferUsages as U;
+        let empty = |label, size: u64, usage| buffer(device, label, size, usage);
+        let init = |label, contents: &[u8]| buffer_init(device, label, contents, U::STORAGE);
+        let capacity = settings.seeds.capacity;
+        let block_capacity = block_capacity(settings.seeds.seeds_per_pattern);
+        let output = U::STORAGE | U::COPY_SRC;
+        // A binding may not be empty: a table without species still gets one (never read) entry.
+        let no_species = [SeedSpecies::default()];
+        let species: &[u8] =
+            bytemuck::cast_slice(if tables.species.is_empty() { &no_species[..] } else { &tables.species });
+        let records_bytes = u64::from(capacity.max(1)) * size_of::<SeedRecord>() as u64;
+        let cells_bytes = u64::from(MAX_SEED_CELLS) * size_of::<SeedCell>() as u64;
+        let blocks_bytes = u64::from(block_capacity) * size_of::<SeedBlock>() as u64;
+        Self {
+            pipeline,
+            layout,
+            uniforms: empty("seed uniforms", size_of::<SeedUniforms>() as u64, U::STORAGE | U::COPY_DST),
+            cells: empty("seed cells", cells_bytes, U::STORAGE | U::COPY_DST),
+            patterns: init("seed patterns", bytemuck::cast_slice(&patterns.positions_unit)),
+            species: init("seed species", species),
+            classes: init("seed classes", bytemuck::cast_slice(&tables.classes)),
+            records: empty("seed records", records_bytes, output),
+            counters: empty("seed counters", size_of::<SeedCounters>() as u64, output | U::COPY_DST),
+            keys: empty("seed keys", u64::from(capacity.max(1)) * 4, output),
+            blocks: empty("seed blocks", blocks_bytes, output),
+            capacity,
+            block_capacity,
+        }
+    }
+
+    /// The bind group over a renderer's caches and depth target (fixed for its life).
+    pub fn bind_group(&self, device: &wgpu::Device, sources: &SeedSources) -> wgpu::BindGroup {
+        use wgpu::BindingResource::TextureView as View;
+        BINDINGS.bind_group(
+            device,
+            &self.layout,
+            [
+                self.uniforms.as_entire_binding(),
+                self.cells.as_entire_binding(),
+                self.patterns.as_entire_binding(),
+                self.species.as_entire_binding(),
+                self.classes.as_entire_binding(),
+                sources.heights.page_table.as_entire_binding(),
+                View(&sources.heights.view),
+                sources.landcover.page_table.as_entire_binding(),
+                View(&sources.landcover.view),
+                sources.imagery.page_table.as_entire_binding(),
+                View(&sources.imagery.view),
+                View(sources.depth),
+                self.records.as_entire_binding(),
+                self.counters.as_entire_binding(),
+                self.keys.as_entire_binding(),
+                self.blocks.as_entire_binding(),
+            ],
+        )
+    }
+
+    /// Builds the frame's uniforms and cells and uploads them; returns them (the twin reads the same).
+    pub fn prepare(&self, queue: &wgpu::Queue, inputs: &SeedInputs) -> Result<SeedFrame, CameraError> {
+        let frame = SeedFrame::new(inputs)?;
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&frame.uniforms));
+        if !frame.cells.is_empty() {
+            queue.write_buffer(&self.cells, 0, bytemuck::cast_slice(&frame.cells));
+        }
+        Ok(frame)
+    }
+
+    /// Records the pass: counters cleared, then one invocation per seed of every cell.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        bind_group: &wgpu::BindGroup,
+        frame: &SeedFrame,
+    ) {
+        encoder.clear_buffer(&self.counters, 0, None);
+        if frame.cells.is_empty() {
+            return;
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("seed select"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.dispatch_workgroups(
+            workgroups_per_cell(frame.uniforms.active_ranks),
+            frame.cells.len() as u32,
+            1,
+        );
+    }
+
+    /// The record buffer (`capacity` records; a frame fills `min(selected, capacity)`).
+    pub fn records(&self) -> &wgpu::Buffer {
+        &self.records
+    }
+
+    /// The counters (`SeedCounters`), cleared at the start of each frame's pass.
+    pub fn counters(&self) -> &wgpu::Buffer {
+        &self.counters
+    }
+
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// Each record's draw group (`capacity` entries, filled as the records are).
+    pub fn keys(&self) -> &wgpu::Buffer {
+        &self.keys
+    }
+
+    /// The block table (`block_capacity` entries; a frame writes `SeedFrame::blocks` of them).
+    pub fn blocks(&self) -> &wgpu::Buffer {
+        &self.blocks
+    }
+
+    pub fn block_capacity(&self) -> u32 {
+        self.block_capacity
+    }
+
+    /// Reads the last frame's records and counters back, waiting for the GPU: for tests and
+    /// tools, never the frame.
+    pub fn read_back(&self, gpu: &Gpu) -> Result<(Vec<SeedRecord>, SeedCounters), GpuError> {
+        let counters = self.read_counters(gpu)?;
+        let kept = counters.selected.min(self.capacity);
+        Ok((read_values(gpu, &self.records, kept.into())?, counters))
+    }
+
+    /// Reads everything the last frame of `frame` wrote (records, keys, block table, counters),
+    /// waiting for the GPU: for tests and tools.
+    pub fn read_output(&self, gpu: &Gpu, frame: &SeedFrame) -> Result<SeedOutput, GpuError> {
+        let (records, counters) = self.read_back(gpu)?;
+        let keys = read_values(gpu, &self.keys, records.len() as u64)?;
+        let blocks = read_values(gpu, &self.blocks, frame.blocks().min(self.block_capacity).into())?;
+        Ok(SeedOutput { records, keys, blocks, counters })
+    }
+
+    fn read_counters(&self, gpu: &Gpu) -> Result<SeedCounters, GpuError> {
+        let counters: Vec<SeedCounters> = read_values(gpu, &self.counters, 1)?;
+        counters.first().copied().ok_or_else(|| GpuError::Validation("no seed counters read back".into()))
+    }
+}

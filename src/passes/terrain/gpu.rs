@@ -1,0 +1,211 @@
+//! The terrain pass's GPU half: the pipeline and binding table (built once), the frame's uploads
+//! (`prepare`) and the recorded draw (`encode`), and the mesh draw the ground pass repeats.
+
+use std::ops::Range;
+
+use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
+
+use crate::config::Settings;
+use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
+use crate::gpu::resources::{buffer, buffer_init, pipeline_layout};
+use crate::gpu::shaders::{TERRAIN_MESH, WgslSource};
+use crate::passes::DEPTH_FORMAT;
+use crate::streaming::TileCache;
+
+use super::frame::{NodeBatches, grid_indices};
+
+/// Node instances one frame can draw.
+pub const MAX_NODES: u32 = 16384;
+
+/// The terrain pass's shader (the mesh alone: depth only).
+pub const SHADER: WgslSource =
+    WgslSource { name: "terrain", parts: &[TERRAIN_MESH, include_str!("../../../shaders/terrain.wgsl")] };
+
+/// The bind group both terrain passes use: uniforms, nodes and the height cache (the mesh), then
+/// the imagery cache with its sampler and page table (the ground's shading).
+pub const BINDINGS: BindingTable<6> = BindingTable {
+    label: "terrain",
+    bindings: [
+        Binding::uniform::<TerrainUniforms>(0, "u", Stage::VERTEX_FRAGMENT),
+        Binding::storage_array::<TerrainNode>(1, "nodes", Stage::VERTEX, Access::Read),
+        Binding::texture(
+            2,
+            "height_tiles",
+            Stage::VERTEX,
+            TextureSampleType::Float { filterable: false },
+            TextureViewDimension::D2Array,
+        ),
+        Binding::texture(
+            3,
+            "imagery_tiles",
+            Stage::FRAGMENT,
+            TextureSampleType::Float { filterable: true },
+            TextureViewDimension::D2Array,
+        ),
+        Binding::sampler(4, "imagery_sampler", Stage::FRAGMENT, wgpu::SamplerBindingType::Filtering),
+        Binding::storage_array::<u32>(5, "imagery_page_table", Stage::FRAGMENT, Access::Read),
+    ],
+};
+
+pub struct TerrainPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    quadrant_indices: [Range<u32>; 4],
+}
+
+/// Everything a pass needs to draw this frame's terrain mesh.
+#[derive(Clone, Copy)]
+pub struct MeshDraw<'a> {
+    pub terrain: &'a TerrainPass,
+    pub bind_group: &'a wgpu::BindGroup,
+    pub nodes: &'a PreparedNodes,
+}
+
+impl MeshDraw<'_> {
+    /// Draws the node instances with the pipeline already set on `pass`.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        self.terrain.draw_mesh(pass, self.bind_group, self.nodes);
+    }
+}
+
+/// Instance ranges of each quadrant's draw, as uploaded.
+#[derive(Debug, Clone)]
+pub struct PreparedNodes {
+    ranges: [Range<u32>; 4],
+}
+
+impl TerrainPass {
+    pub fn new(device: &wgpu::Device, settings: &Settings) -> Self {
+        let module = SHADER.module(device);
+        let layout = BINDINGS.layout(device);
+        let pipeline_layout = pipeline_layout(device, "terrain", &[&layout]);
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("terrain"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: None,
+            primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        use wgpu::BufferUsages as U;
+        let uniforms =
+            buffer(device, "terrain uniforms", size_of::<TerrainUniforms>() as u64, U::UNIFORM | U::COPY_DST);
+        let nodes_bytes = u64::from(MAX_NODES) * size_of::<TerrainNode>() as u64;
+        let nodes = buffer(device, "terrain nodes", nodes_bytes, U::STORAGE | U::COPY_DST);
+        let (index_data, quadrant_indices) = grid_indices(settings.terrain.node_cells);
+        let indices = buffer_init(device, "terrain grid", bytemuck::cast_slice(&index_data), U::INDEX);
+        Self { pipeline, layout, uniforms, nodes, indices, quadrant_indices }
+    }
+
+    /// The bind group both terrain passes use (`BINDINGS`) over the height and imagery caches;
+    /// the caches are fixed for a renderer's life, so is this.
+    pub fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        heights: &TileCache,
+        imagery: &TileCache,
+        imagery_sampler: &wgpu::Sampler,
+    ) -> wgpu::BindGroup {
+        use wgpu::BindingResource as R;
+        BINDINGS.bind_group(
+            device,
+            &self.layout,
+            [
+                self.uniforms.as_entire_binding(),
+                self.nodes.as_entire_binding(),
+                R::TextureView(&heights.view),
+                R::TextureView(&imagery.view),
+                R::Sampler(imagery_sampler),
+                imagery.page_table.as_entire_binding(),
+            ],
+        )
+    }
+
+    /// Uploads the frame's uniforms and node instances (at most `MAX_NODES`; the rest are dropped,
+    /// coarse quadrants last, and counted by the caller).
+    pub fn prepare(
+        &self,
+        queue: &wgpu::Queue,
+        uniforms: &TerrainUniforms,
+        batches: &NodeBatches,
+    ) -> PreparedNodes {
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+        let mut all = Vec::with_capacity(batches.len());
+        let ranges = batches.by_quadrant.each_ref().map(|nodes| {
+            let start = all.len().min(MAX_NODES as usize);
+            all.extend_from_slice(&nodes[..nodes.len().min(MAX_NODES as usize - start)]);
+            start as u32..all.len() as u32
+        });
+        if !all.is_empty() {
+            queue.write_buffer(&self.nodes, 0, bytemuck::cast_slice(&all));
+        }
+        PreparedNodes { ranges }
+    }
+
+    /// The layout of `bind_group`, for the passes that draw this mesh.
+    pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// Pass 0: the mesh into a cleared depth target, nothing else.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        bind_group: &wgpu::BindGroup,
+        depth: &wgpu::TextureView,
+        nodes: &PreparedNodes,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("terrain"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                // Reversed-Z: 0 is infinitely far.
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        self.draw_mesh(&mut pass, bind_group, nodes);
+    }
+
+    /// Draws this frame's node instances with the pipeline already set on `pass`.
+    pub fn draw_mesh(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        bind_group: &wgpu::BindGroup,
+        nodes: &PreparedNodes,
+    ) {
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        for (indices, instances) in self.quadrant_indices.iter().zip(&nodes.ranges) {
+            if !instances.is_empty() {
+                pass.draw_indexed(indices.clone(), 0, instances.clone());
+            }
+        }
+    }
+}
