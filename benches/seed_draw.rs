@@ -39,7 +39,7 @@ fn impostors() -> PathBuf {
 /// and the seeds of the final TLM selected.
 fn renderer() -> Renderer {
     let mut settings = Settings::default();
-    settings.seeds.impostors = impostors().display().to_string();
+    settings.draw_seeds.impostors = impostors().display().to_string();
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter");
     eprintln!("adapter: {}", gpu.describe());
     let dataset = Dataset::open(&dataset_dir()).expect("open");

@@ -46,7 +46,8 @@ fn main() {
     let mut settings = Settings::default();
     settings.seeds.seeds_per_pattern = SEEDS_PER_PATTERN;
     settings.seeds.capacity = 1 << 21;
-    settings.tlm.radial_lod_m = [3000.0, 6000.0, 12000.0];
+    settings.tlm.radial_bands_m = [3000.0, 6000.0, 12000.0];
+    settings.draw_seeds.reach_m = [120.0, 3000.0, 6000.0, 12000.0];
     // The nc table with every density × 4 (forest 62,000 per km²): nearly every rank of a pattern
     // can grow a seed, so the checked seeds are real work and 4 M of them fit the 10 km dataset.
     let dense = dense_table(4.0);
@@ -92,7 +93,7 @@ fn main() {
                     .hypot((address[1] as f64 + 0.5) * cell_m - centre[1]))
                 .max(0.0);
                 let radial_lod =
-                    r.settings.tlm.radial_lod_m.iter().filter(|&&t| distance_m >= t).count() as u32;
+                    r.settings.tlm.radial_bands_m.iter().filter(|&&t| distance_m >= t).count() as u32;
                 SeedCellRef {
                     address,
                     pattern: cell_pattern([address[0] as i32, address[1] as i32], seed, patterns),

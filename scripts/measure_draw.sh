@@ -18,7 +18,7 @@ if ! $bin info --dataset "$nc" >/dev/null 2>&1; then
         --bands 3,2,1 --landcover $data/landuse_r.tif --classes nc --out "$nc" >/dev/null
 fi
 settings=$(mktemp --suffix .toml)
-printf '[seeds]\nimpostors = "data/impostors"\n' >"$settings"
+printf '[draw_seeds]\nimpostors = "data/impostors"\n' >"$settings"
 echo "## synthetic default dataset (default path)"
 $bin profile --dataset data/default --frames "$frames" --warmup 10 --settings "$settings" 2>/dev/null
 echo

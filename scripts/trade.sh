@@ -8,7 +8,7 @@
 #    reused while `terramp info` reads it): nc/ (DEM, Landsat bands 3,2,1, land use) and zion/ (DEM,
 #    NLCD) as data-tools/tests/support builds them, and the synthetic default (`synth --size 1024`).
 # 2. Bakes the 11 shared models into impostors (reused when present) and writes a settings layer
-#    that points `seeds.impostors` at them, so that every frame, the references' included, shows
+#    that points `draw_seeds.impostors` at them, so that every frame, the references' included, shows
 #    its trees.
 # 3. Sweeps each dataset along its default path (nc/ and zion/: the generated orbit; synthetic:
 #    config/paths/default.toml) into docs/trade/<name>/ (trade.csv, trade.json, trade.png,
@@ -70,7 +70,7 @@ if [[ ! -d "$impostors/Tree_3" ]]; then
     "$terramp_data" bake "${args[@]}" --out "$impostors" --texels 256 >/dev/null
 fi
 trees="$data/trees.toml"
-printf '# Written by scripts/trade.sh: draw the seeds with the baked impostors.\n[seeds]\nimpostors = "%s"\n' \
+printf '# Written by scripts/trade.sh: draw the seeds with the baked impostors.\n[draw_seeds]\nimpostors = "%s"\n' \
     "$(cd "$impostors" && pwd)" >"$trees"
 
 for name in ${SWEEP-synthetic nc zion}; do

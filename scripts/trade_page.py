@@ -27,7 +27,7 @@ deterministic.
 
 `terramp sweep --dataset DIR --out DIR [--presets fast,balanced,accurate] [--knob key=v1,v2,...]`,
 here at {first['resolution'][0]} × {first['resolution'][1]} with every frame showing its trees
-(`seeds.impostors` set by a settings layer over each preset):
+(`draw_seeds.impostors` set by a settings layer over each preset):
 
 - **Time**: each preset flies the dataset's default path in a fresh renderer: {warmup} warm-up frames,
   then {frames} timed frames spread along the whole path, with at most two frames in flight (the
@@ -89,5 +89,5 @@ for name, t in trades.items():
           f"{f['frame_ms'] - ms(f, 'draw_seeds'):.0f} against {a['frame_ms'] - ms(a, 'draw_seeds'):.0f} ms. "
           "The nearest trees cover most of the pixels, and every preset draws them alike (the same "
           "impostor LODs near the camera, at the same class density): no preset knob makes them "
-          "cheaper (`tlm.radial_lod_m` 500 → 250 m for the 17-plane LOD changed nothing measurable). "
+          "cheaper (the 17-plane LOD's reach, then `tlm.radial_lod_m`, now `draw_seeds.reach_m`, 500 → 250 m changed nothing measurable). "
           "Reaching 2× there needs a cheaper near-tree draw in pass 4, or fewer near trees.\n")

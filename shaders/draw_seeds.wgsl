@@ -17,7 +17,7 @@ struct DrawSeedsUniforms {
     clip_from_view_world: mat4x4<f32>,
     sun_dir: vec4<f32>,
     haze: vec4<f32>,
-    lod_reach_m: vec4<f32>,
+    draw_reach_m: vec4<f32>,
     inv_reference_height_m: f32,
     sink_fraction: f32,
     fade_fraction: f32,
@@ -75,7 +75,7 @@ fn band_fade(record: SeedRecord, lod: u32) -> f32 {
     let ground_rel = record.position_rel_m + vec3<f32>(0.0, 0.0, record.height_m * u.sink_fraction);
     let distance_m = length(ground_rel);
     let size_scale = min(1.0, record.height_m * u.inv_reference_height_m);
-    let reach = u.lod_reach_m[min(lod, SEED_LODS - 1u)] * size_scale;
+    let reach = u.draw_reach_m[min(lod, SEED_LODS - 1u)] * size_scale;
     // Without a band (fade_fraction 0) a seed is whole up to its reach, then the next LOD's.
     let width = max(reach * u.fade_fraction, 1e-6);
     return clamp((reach - distance_m) / width, 0.0, 1.0);

@@ -29,7 +29,7 @@ struct SeedUniforms {
     occlusion_tolerance_per_m: f32,
     inv_reference_height_m: f32,
     sink_fraction: f32,
-    radial_lod_m: vec4<f32>,
+    draw_reach_m: vec4<f32>,
     cell_in_samples: f32,
     cell_in_lcc_texels: f32,
     cell_in_imagery_texels: f32,
@@ -356,7 +356,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
         if lod >= SEED_LODS {
             return out;
         }
-        let reach = mul(u.radial_lod_m[lod], size_scale);
+        let reach = mul(u.draw_reach_m[lod], size_scale);
         if distance_sq < mul(reach, reach) {
             break;
         }

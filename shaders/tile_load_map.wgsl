@@ -22,7 +22,7 @@ struct TlmUniforms {
     near_m: f32,
     occlusion_tolerance_m: f32,
     imagery_scale_sq: f32,
-    radial_lod_sq_m2: vec4<f32>,
+    radial_band_sq_m2: vec4<f32>,
     screen_px: vec2<u32>,
     ndc_per_px: vec2<f32>,
     hiz_mips: u32,
@@ -33,6 +33,10 @@ struct TlmUniforms {
     patterns: u32,
     seed: u32,
     no_fuse: u32,
+    occlusion_tolerance_per_m: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
     height_lod_range_m: array<vec4<f32>, MAX_LEVELS / 4u>,
     height_levels: array<vec4<u32>, MAX_LEVELS>,
     rings_info: array<TlmRing, TLM_MAX_RINGS>,
@@ -161,8 +165,10 @@ fn occluded(lo: vec3<f32>, hi: vec3<f32>) -> bool {
         }
     }
     // Reversed-Z: view distance = near / depth. Culled when nearest_w − tolerance > near / depth,
-    // i.e. (nearest_w − tolerance) · depth > near; the sky (depth 0) never occludes.
-    return mul(nearest_w - u.occlusion_tolerance_m, farthest_depth) > u.near_m;
+    // i.e. (nearest_w − tolerance) · depth > near; the sky (depth 0) never occludes. The tolerance
+    // grows with distance as the seeds' does (`config::OcclusionTolerance`).
+    let tolerance_m = u.occlusion_tolerance_m + mul(u.occlusion_tolerance_per_m, nearest_w);
+    return mul(nearest_w - tolerance_m, farthest_depth) > u.near_m;
 }
 
 // floor(log2(footprint / texel0) + bias) at squared distance `d_sq`, clamped to the levels:
@@ -214,7 +220,7 @@ fn tlm_cell(ring: u32, cx: u32, cy: u32) -> TlmCell {
     cell.height_lod = pack_level_range(LevelRange(height_lod(near_sq), height_lod(far_sq)));
     cell.radial_lod = RADIAL_INACTIVE;
     for (var k = i32(TLM_RADIAL_BANDS) - 1; k >= 0; k -= 1) {
-        if near_sq < u.radial_lod_sq_m2[k] {
+        if near_sq < u.radial_band_sq_m2[k] {
             cell.radial_lod = u32(k);
         }
     }

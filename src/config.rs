@@ -14,9 +14,13 @@ use toml::{Table, Value};
 
 use crate::gpu::AdapterChoice;
 
+mod draw_seeds;
 mod seeds;
+mod tlm;
 
-pub use seeds::SeedSettings;
+pub use draw_seeds::DrawSeedsSettings;
+pub use seeds::{OcclusionTolerance, SeedSettings};
+pub use tlm::TlmSettings;
 
 const DEFAULTS: &str = include_str!("../config/default.toml");
 pub const PRESETS: &[(&str, &str)] = &[
@@ -35,6 +39,8 @@ pub enum SettingsError {
     Syntax { origin: String, message: String },
     #[error("{origin}: unknown key `{key}`")]
     UnknownKey { origin: String, key: String },
+    #[error("{origin}: `{key}` is gone: {instead}")]
+    Moved { origin: String, key: String, instead: &'static str },
     #[error("{origin}: `{key}` must be {expected}")]
     WrongType { origin: String, key: String, expected: &'static str },
     #[error("settings: `{key}` = {value}: {rule}")]
@@ -53,6 +59,7 @@ pub struct Settings {
     pub cache: CacheSettings,
     pub tlm: TlmSettings,
     pub seeds: SeedSettings,
+    pub draw_seeds: DrawSeedsSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -109,63 +116,6 @@ pub struct CacheSettings {
     pub loader_threads: u32,
     pub upload_tiles_per_frame: u32,
     pub upload_bytes_per_frame: u64,
-}
-
-/// The Tile Load Map (pass 1): camera-centred rings of cells, see `passes::tile_load_map`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TlmSettings {
-    pub cell_m: f64,
-    pub cells: u32,
-    pub max_rings: u32,
-    pub occlusion_tolerance_m: f64,
-    pub radial_lod_m: [f64; 3],
-    pub patterns: u32,
-    pub seed: u32,
-}
-
-impl TlmSettings {
-    fn validate(&self) -> Result<(), SettingsError> {
-        let max_rings = crate::gpu::layout::TLM_MAX_RINGS;
-        let r = self.radial_lod_m;
-        let checks: [(bool, &'static str, String, &'static str); 6] = [
-            (
-                self.cell_m.is_finite() && self.cell_m >= 1.0,
-                "tlm.cell_m",
-                self.cell_m.to_string(),
-                "a finite number of metres, at least 1",
-            ),
-            (
-                self.cells.is_multiple_of(2) && (8..=256).contains(&self.cells),
-                "tlm.cells",
-                self.cells.to_string(),
-                "an even number from 8 to 256",
-            ),
-            (
-                (1..=max_rings).contains(&self.max_rings),
-                "tlm.max_rings",
-                self.max_rings.to_string(),
-                "1 to 16",
-            ),
-            (
-                self.occlusion_tolerance_m >= 0.0 && self.occlusion_tolerance_m.is_finite(),
-                "tlm.occlusion_tolerance_m",
-                self.occlusion_tolerance_m.to_string(),
-                "0 or more metres",
-            ),
-            (
-                r[0] > 0.0 && r[0] <= r[1] && r[1] <= r[2] && r[2].is_finite(),
-                "tlm.radial_lod_m",
-                format!("{r:?}"),
-                "three increasing positive distances, metres",
-            ),
-            ((1..=255).contains(&self.patterns), "tlm.patterns", self.patterns.to_string(), "1 to 255"),
-        ];
-        match checks.into_iter().find(|(ok, ..)| !ok) {
-            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
-            None => Ok(()),
-        }
-    }
 }
 
 impl Default for Settings {
@@ -283,6 +233,7 @@ impl Settings {
         ];
         self.tlm.validate()?;
         self.seeds.validate()?;
+        self.draw_seeds.validate(&self.tlm)?;
         match checks.into_iter().find(|(ok, ..)| !ok) {
             Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
             None => Ok(()),
@@ -295,12 +246,31 @@ fn parse(origin: &str, text: &str) -> Result<Table, SettingsError> {
         .map_err(|e| SettingsError::Syntax { origin: origin.to_owned(), message: e.to_string() })
 }
 
+/// Keys of earlier releases, and what replaced them: a file that still sets one is told where the
+/// knob went rather than that it is unknown.
+const MOVED_KEYS: &[(&str, &str)] = &[
+    (
+        "tlm.radial_lod_m",
+        "it meant two things: the TLM's distance bands are now `tlm.radial_bands_m`, and the draw \
+         LODs' reaches `draw_seeds.reach_m` (the mesh's first, then the three billboard clouds')",
+    ),
+    ("seeds.mesh_m", "the real mesh's reach is now the first of `draw_seeds.reach_m`"),
+    ("seeds.fade_fraction", "use `draw_seeds.fade_fraction`"),
+    ("seeds.impostors", "use `draw_seeds.impostors`"),
+];
+
 /// Every key of `layer` must exist in `defaults`, with a table where the default has a table.
 fn check_keys(origin: &str, layer: &Table, defaults: &Table, prefix: &str) -> Result<(), SettingsError> {
     for (key, value) in layer {
         let full = format!("{prefix}{key}");
         match (defaults.get(key), value) {
-            (None, _) => return Err(SettingsError::UnknownKey { origin: origin.to_owned(), key: full }),
+            (None, _) => {
+                let origin = origin.to_owned();
+                return Err(match MOVED_KEYS.iter().find(|(old, _)| *old == full) {
+                    Some((_, instead)) => SettingsError::Moved { origin, key: full, instead },
+                    None => SettingsError::UnknownKey { origin, key: full },
+                });
+            }
             (Some(Value::Table(d)), Value::Table(v)) => check_keys(origin, v, d, &format!("{full}."))?,
             (Some(Value::Table(_)), _) => {
                 return Err(SettingsError::WrongType {
@@ -426,6 +396,39 @@ mod tests {
         }
         let s = with("[seeds]\nclass_table = \"nlcd\"\nsink_fraction = 0\n").unwrap().seeds;
         assert_eq!((s.class_table.as_str(), s.sink_fraction), ("nlcd", 0.0));
+    }
+
+    #[test]
+    fn draw_reaches_are_checked_against_the_tlm_bands() {
+        let d = Settings::default();
+        assert_eq!(d.draw_seeds.reach_m, [120.0, 700.0, 1400.0, 3000.0]);
+        assert_eq!((d.tlm.occlusion_tolerance_per_km, d.draw_seeds.fade_fraction), (0.0, 0.1));
+        for (bad, rule) in [
+            ("[draw_seeds]\nreach_m = [120.0, 700.0, 600.0, 3000.0]\n", "increasing"),
+            ("[draw_seeds]\nreach_m = [120.0, 700.0, 1400.0, 3500.0]\n", "tlm.radial_bands_m"),
+            ("[draw_seeds]\nfade_fraction = 0.6\n", "0 to 0.5"),
+            ("[tlm]\nocclusion_tolerance_per_km = -1.0\n", "0 or more"),
+        ] {
+            let err = with(bad).unwrap_err().to_string();
+            assert!(err.contains(rule), "{bad}: {err}");
+        }
+        let fast = Settings::preset("fast").unwrap();
+        assert_eq!((fast.tlm.radial_bands_m[2], fast.draw_seeds.reach_m[3]), (2000.0, 2000.0));
+    }
+
+    #[test]
+    fn keys_of_earlier_releases_name_their_replacements() {
+        let old = with("[tlm]\nradial_lod_m = [700.0, 1400.0, 3000.0]\n").unwrap_err().to_string();
+        assert!(old.contains("tlm.radial_bands_m") && old.contains("draw_seeds.reach_m"), "{old}");
+        assert!(old.contains("test.toml") && old.contains("`tlm.radial_lod_m`"), "{old}");
+        for (key, new) in [
+            ("mesh_m = 60.0", "draw_seeds.reach_m"),
+            ("fade_fraction = 0.1", "draw_seeds.fade_fraction"),
+            ("impostors = \"x\"", "draw_seeds.impostors"),
+        ] {
+            let err = with(&format!("[seeds]\n{key}\n")).unwrap_err().to_string();
+            assert!(err.contains(new), "{key}: {err}");
+        }
     }
 
     #[test]

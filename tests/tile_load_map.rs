@@ -204,7 +204,7 @@ fn assert_levels_match_f64(r: &Renderer, run: &Run, camera: &Camera, what: &str)
         let hi = DVec3::new(hi.x, hi.y, f64::from(height_m[1])) - run.camera_grid_m;
         let nearest = DVec3::ZERO.clamp(lo, hi).length();
         let farthest = lo.abs().max(hi.abs()).length();
-        let radial = s.tlm.radial_lod_m.iter().position(|&t| nearest < t).unwrap_or(3) as u32;
+        let radial = s.tlm.radial_bands_m.iter().position(|&t| nearest < t).unwrap_or(3) as u32;
         let hlod = |d: f64| run.lods.range_m.iter().position(|&range| d <= range).unwrap_or(0) as u32;
         let tlod = |d: f64| {
             imagery.map_or(0, |m| {
@@ -212,7 +212,7 @@ fn assert_levels_match_f64(r: &Renderer, run: &Run, camera: &Camera, what: &str)
                 level.floor().clamp(0.0, f64::from(m.pyramid.levels - 1)) as u32
             })
         };
-        let ambiguous = s.tlm.radial_lod_m.iter().any(|&t| near(nearest, t))
+        let ambiguous = s.tlm.radial_bands_m.iter().any(|&t| near(nearest, t))
             || run.lods.range_m.iter().any(|&t| near(nearest, t) || near(farthest, t))
             || imagery.is_some_and(|m| {
                 [nearest, farthest].iter().any(|&d| {
@@ -469,12 +469,12 @@ fn tlm_settings_are_checked_and_named() {
     let with = |text: &str| Settings::from_layers(&[("test.toml".into(), text.into())]);
     let defaults = Settings::default().tlm;
     assert_eq!((defaults.cell_m, defaults.cells, defaults.max_rings, defaults.patterns), (256.0, 64, 12, 16));
-    assert_eq!(defaults.radial_lod_m, [700.0, 1400.0, 3000.0]);
+    assert_eq!(defaults.radial_bands_m, [700.0, 1400.0, 3000.0]);
     for (text, key) in [
         ("[tlm]\ncells = 63\n", "tlm.cells"),
         ("[tlm]\nmax_rings = 17\n", "tlm.max_rings"),
         ("[tlm]\npatterns = 256\n", "tlm.patterns"),
-        ("[tlm]\nradial_lod_m = [700.0, 300.0, 3000.0]\n", "tlm.radial_lod_m"),
+        ("[tlm]\nradial_bands_m = [700.0, 300.0, 3000.0]\n", "tlm.radial_bands_m"),
         ("[tlm]\ncell_m = 0\n", "tlm.cell_m"),
     ] {
         let error = with(text).unwrap_err().to_string();

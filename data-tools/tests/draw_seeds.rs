@@ -1,6 +1,6 @@
 //! Pass 4 on `nc/` (DEM, Landsat, land use): the shared models are baked into impostors once per
 //! test process (`terramp-data bake`), and a view over forest near the lake is rendered with
-//! `seeds.impostors` set and with it empty. The trees change many pixels, make them darker or
+//! `draw_seeds.impostors` set and with it empty. The trees change many pixels, make them darker or
 //! greener, never stand behind the terrain (depth only grows nearer) and leave the sky well above
 //! the horizon alone. Under each pixel the bare frame's depth gives the ground and its land-cover
 //! class: most forest pixels show trees, and no pixel of open water does (water that no tree on
@@ -126,7 +126,7 @@ fn open_view(
 ) -> (Renderer, Camera, FrameReport) {
     settings.render.width = size[0];
     settings.render.height = size[1];
-    settings.seeds.impostors = impostors.to_owned();
+    settings.draw_seeds.impostors = impostors.to_owned();
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
     let ([x, y], yaw_deg) = pose;
@@ -354,7 +354,7 @@ fn lod_changes_cross_fade_instead_of_popping() {
     let dir = impostors().to_str().unwrap().to_owned();
     let run = |fade_fraction: f64| {
         let mut settings = Settings::default();
-        settings.seeds.fade_fraction = fade_fraction;
+        settings.draw_seeds.fade_fraction = fade_fraction;
         settings.seeds.reference_height_m = 40.0;
         let (mut r, camera, _) =
             open_view(Dataset::open(&path).unwrap(), settings, &dir, [320, 180], pose, [40.0, -12.0]);

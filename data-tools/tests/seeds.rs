@@ -198,7 +198,8 @@ fn nc_species_follow_the_land_cover() {
     let dataset = build_nc(&tmp.path().join("nc"));
     let mut settings = Settings::default();
     // Every seed of the block counts: no size-scaled distance cut, nothing hidden from above.
-    settings.tlm.radial_lod_m = [30000.0, 40000.0, 50000.0];
+    settings.tlm.radial_bands_m = [30000.0, 40000.0, 50000.0];
+    settings.draw_seeds.reach_m = [120.0, 30000.0, 40000.0, 50000.0];
     settings.seeds.reference_height_m = 0.01;
     settings.seeds.capacity = 1 << 21;
     let tiles = |p: Option<&terramp::dataset::LayerPack>| p.map_or(16, |l| l.pyramid.tile_count() as u32);

@@ -21,20 +21,33 @@ pub struct SeedSettings {
     pub reference_height_m: f64,
     pub sink_fraction: f64,
     pub ground_colour_radius_m: f64,
-    /// A seed of `reference_height_m` nearer than this is drawn with its real mesh (smaller seeds
-    /// in proportion, like the radial LODs); farther, with its billboard clouds.
-    pub mesh_m: f64,
-    /// The outer part of each LOD's reach over which a seed cross-fades into the next LOD (the
-    /// last LOD: fades out), as a fraction of the reach; 0 switches at once (pops).
-    pub fade_fraction: f64,
     /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
     pub class_table: String,
-    /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
-    /// selected but not drawn. Species whose model is not there are not drawn.
-    pub impostors: String,
+}
+
+/// How far behind the terrain's depth something must lie to count as hidden: `m` plus `per_km`
+/// for every kilometre of distance, because the terrain mesh (and its depth) is coarser far
+/// away. Seeds (`seeds.occlusion_tolerance_*`, their summits) and the Tile Load Map
+/// (`tlm.occlusion_tolerance_*`, its cells' boxes) use this one model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OcclusionTolerance {
+    pub m: f64,
+    pub per_km: f64,
+}
+
+impl OcclusionTolerance {
+    /// The per-metre slope, as the shaders take it.
+    pub fn per_m(&self) -> f64 {
+        self.per_km / 1000.0
+    }
 }
 
 impl SeedSettings {
+    /// The occlusion tolerance of a seed's summit.
+    pub fn occlusion(&self) -> OcclusionTolerance {
+        OcclusionTolerance { m: self.occlusion_tolerance_m, per_km: self.occlusion_tolerance_per_km }
+    }
+
     /// Most seeds per km² a class can ask for: one full pattern per ring-0 cell of `cell_m` metres.
     pub fn max_density_per_km2(&self, cell_m: f64) -> f64 {
         f64::from(self.seeds_per_pattern) / (cell_m * cell_m * 1e-6)
@@ -48,7 +61,7 @@ impl SeedSettings {
             let (key, rule) = ("seeds.occlusion_refine_steps", "0 or a power of two up to 65536");
             return Err(SettingsError::OutOfRange { key, value: steps.to_string(), rule });
         }
-        let ranges: [(&'static str, f64, f64, f64, &'static str); 11] = [
+        let ranges: [(&'static str, f64, f64, f64, &'static str); 9] = [
             ("seeds.seeds_per_pattern", s.seeds_per_pattern.into(), 64.0, 65536.0, "64 to 65536 seeds"),
             ("seeds.capacity", s.capacity.into(), 1.0, 16_777_216.0, "1 to 16777216 seeds"),
             ("seeds.frustum_epsilon", s.frustum_epsilon, 0.0, 1.0, "0 to 1 (NDC units)"),
@@ -58,8 +71,6 @@ impl SeedSettings {
             ("seeds.sink_fraction", s.sink_fraction, 0.0, 0.5, "0 to 0.5 of the seed's height"),
             ("seeds.ground_colour_radius_m", s.ground_colour_radius_m, 0.0, any, "0 or more metres"),
             ("seeds.density_scale", s.density_scale, 0.0, 1.0, "0 to 1 of the class table's densities"),
-            ("seeds.mesh_m", s.mesh_m, 0.0, any, "0 (never) or more metres"),
-            ("seeds.fade_fraction", s.fade_fraction, 0.0, 0.5, "0 to 0.5 of each LOD's reach"),
         ];
         // NaN and infinities fall outside every range.
         match ranges.into_iter().find(|(_, value, lo, hi, _)| !(*lo..=*hi).contains(value)) {

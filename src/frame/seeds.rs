@@ -4,7 +4,7 @@
 //! block table and keys. Each frame it feeds pass 3 the ring-0 cells of the latest Tile Load Map,
 //! has compaction group the survivors into one indirect draw per (species, LOD) on the GPU, and
 //! reads only pass 3's counters back, through a staging ring, never waiting: the counters a frame
-//! reports are a frame or two old. With `seeds.impostors` set, it also loads each species'
+//! reports are a frame or two old. With `draw_seeds.impostors` set, it also loads each species'
 //! impostor once, gives compaction the draw pass's templates, and has pass 4 draw the groups.
 
 use glam::DVec3;
@@ -56,7 +56,7 @@ pub(super) struct SeedStage {
     pub bind_group: wgpu::BindGroup,
     pub compact: CompactPass,
     compact_bind_group: wgpu::BindGroup,
-    /// Pass 4 and its bindings; `None` without `seeds.impostors`.
+    /// Pass 4 and its bindings; `None` without `draw_seeds.impostors`.
     draw: Option<(DrawSeedsPass, wgpu::BindGroup)>,
     /// The last frame's compaction size.
     compact_params: CompactParams,
@@ -116,7 +116,7 @@ impl SeedStage {
             compact.bind_group(device, &CompactInputs { blocks: pass.blocks(), keys: pass.keys() });
         let counters_ring =
             ReadbackRing::new(device, "seed counters", size_of::<SeedCounters>() as u64, DEFAULT_SLOTS);
-        let draw = match settings.seeds.impostors.as_str() {
+        let draw = match settings.draw_seeds.impostors.as_str() {
             "" => None,
             dir => {
                 let impostors = load_impostors(std::path::Path::new(dir), &table.species)?;
@@ -165,7 +165,7 @@ impl SeedStage {
     }
 
     /// Species drawn with an impostor, and species not drawn for want of one (all of them without
-    /// `seeds.impostors`).
+    /// `draw_seeds.impostors`).
     pub fn species_counts(&self) -> (usize, usize) {
         self.draw.as_ref().map_or((0, self.table.species.len()), |(draw, _)| draw.species_counts())
     }

@@ -122,8 +122,8 @@ gpu_struct! {
         /// (metres per pixel at 1 m · 2^lod_bias / level-0 texel edge)²: distance² times this is the
         /// squared texel footprint ratio whose halved log2 is the imagery level.
         pub imagery_scale_sq: f32,
-        /// Squared radial LOD thresholds (3 used, the 4th is +∞), m².
-        pub radial_lod_sq_m2: [f32; 4],
+        /// Squared `tlm.radial_bands_m` (`TLM_RADIAL_BANDS` used, the 4th is +∞), m².
+        pub radial_band_sq_m2: [f32; 4],
         /// Viewport (= depth target) size, pixels.
         pub screen_px: [u32; 2],
         /// NDC units per pixel (2 / width, 2 / height).
@@ -141,6 +141,10 @@ gpu_struct! {
         pub seed: u32,
         /// Always 0: OR-ed into every product so no compiler fuses it into an FMA (see the shader).
         pub no_fuse: u32,
+        /// A box is hidden when it lies more than `occlusion_tolerance_m + per_m × distance`
+        /// behind the depth (`config::OcclusionTolerance`, as the seeds').
+        pub occlusion_tolerance_per_m: f32,
+        pub _pad: [u32; 3],
         /// The terrain's CDLOD range of each LOD (`Lods::range_m`), metres, four per vec4.
         pub height_lod_range_m: [[f32; 4]; MAX_LEVELS as usize / 4],
         /// Height pyramid per level: first tile index, tiles along x, tiles along y, 0.
@@ -178,8 +182,8 @@ gpu_struct! {
         pub inv_reference_height_m: f32,
         /// Fraction of its height a seed's anchor sinks below the ground.
         pub sink_fraction: f32,
-        /// Radial LOD thresholds (3 used), metres.
-        pub radial_lod_m: [f32; 4],
+        /// Each draw LOD's reach (`draw_seeds.reach_m`), metres, for seeds of the reference height.
+        pub draw_reach_m: [f32; 4],
         /// A ring-0 cell's edge in level-0 height samples, in level-1 land-cover texels and in
         /// level-0 imagery texels.
         pub cell_in_samples: f32,
@@ -370,8 +374,8 @@ gpu_struct! {
         pub sun_dir: [f32; 4],
         /// Haze colour (linear RGB), and the distance that hides half of what is behind it (w).
         pub haze: [f32; 4],
-        /// Each draw LOD's reach, metres (`seeds::lod_reach_m`, scaled by each seed's size).
-        pub lod_reach_m: [f32; 4],
+        /// Each draw LOD's reach (`draw_seeds.reach_m`), metres, scaled by each seed's size.
+        pub draw_reach_m: [f32; 4],
         pub inv_reference_height_m: f32,
         pub sink_fraction: f32,
         /// The outer part of each LOD band over which a seed dithers out, as a fraction of its reach.

@@ -56,7 +56,7 @@ pub enum OracleError {
 /// What the oracle reads.
 pub struct OracleInputs<'a> {
     pub dataset: &'a Dataset,
-    /// Reads `tlm.cell_m`, `tlm.patterns`, `tlm.seed`, `tlm.radial_lod_m`,
+    /// Reads `tlm.cell_m`, `tlm.patterns`, `tlm.seed`, `draw_seeds.reach_m`,
     /// `seeds.reference_height_m` and `seeds.sink_fraction`.
     pub settings: &'a Settings,
     pub tables: &'a SeedTables,
@@ -79,7 +79,7 @@ pub struct OracleSeed {
     /// The bilinear ground height under the seed (its anchor sinks below it).
     pub ground_m: f64,
     pub height_m: f64,
-    /// Its draw LOD: the first `seeds::lod_reach_m` (scaled by size) the seed is within.
+    /// Its draw LOD: the first `draw_seeds.reach_m` (scaled by size) the seed is within.
     pub lod: u32,
 }
 
@@ -128,7 +128,7 @@ pub fn visible_seeds(inputs: &OracleInputs) -> Result<(Vec<OracleSeed>, OracleCo
     let extent_m = dataset.height.pyramid.size.map(|n| f64::from(n.max(1) - 1) * spacing_m);
     let eye = camera.position_m - DVec3::new(manifest.origin_m[0], manifest.origin_m[1], 0.0);
     let cell_m = settings.tlm.cell_m;
-    let reach_m = settings.tlm.radial_lod_m.iter().fold(0.0f64, |a, &b| a.max(b));
+    let reach_m = settings.draw_seeds.reach_m.iter().fold(0.0f64, |a, &b| a.max(b));
 
     // Ring-0 cells overlapping the height rectangle whose square comes within reach.
     let range = |c: f64, a: usize| {
@@ -284,8 +284,7 @@ impl View<'_> {
         let rel = DVec3::new(p.x, p.y, ground_m) - self.eye;
         let distance_m = rel.length();
         let scale = (height_m / seeds.reference_height_m).min(1.0);
-        let Some(lod) = crate::seeds::lod_reach_m(settings).iter().position(|&r| distance_m < r * scale)
-        else {
+        let Some(lod) = settings.draw_seeds.reach_m.iter().position(|&r| distance_m < r * scale) else {
             return Ok(Fate::Distance);
         };
         if !self.in_frustum(species, rel, height_m) {

@@ -396,7 +396,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
     let size_scale = (height_m * u.inv_reference_height_m).min(1.0);
     let lod = (0..SEED_LODS)
         .find(|&lod| {
-            let reach = u.radial_lod_m[lod as usize] * size_scale;
+            let reach = u.draw_reach_m[lod as usize] * size_scale;
             distance_sq < reach * reach
         })
         .ok_or(COUNT_DISTANCE)?;

@@ -93,7 +93,8 @@ fn occluded(u: &TlmUniforms, hiz: &HizMips, lo: [f32; 3], hi: [f32; 3]) -> bool 
             farthest_depth = farthest_depth.min(hiz.texel(level, x, y));
         }
     }
-    (nearest_w - u.occlusion_tolerance_m) * farthest_depth > u.near_m
+    let tolerance_m = u.occlusion_tolerance_m + u.occlusion_tolerance_per_m * nearest_w;
+    (nearest_w - tolerance_m) * farthest_depth > u.near_m
 }
 
 fn imagery_level(u: &TlmUniforms, d_sq: f32) -> u32 {
@@ -152,7 +153,7 @@ fn tlm_cell(
     cell.height_lod = LevelRange { min: height_lod(u, near_sq), max: height_lod(u, far_sq) }.pack();
     cell.radial_lod = RADIAL_INACTIVE;
     for k in (0..TLM_RADIAL_BANDS).rev() {
-        if near_sq < u.radial_lod_sq_m2[k as usize] {
+        if near_sq < u.radial_band_sq_m2[k as usize] {
             cell.radial_lod = k;
         }
     }

@@ -19,7 +19,7 @@ use thiserror::Error;
 use crate::classes::{ClassTable, MAX_SPECIES, MAX_SPECIES_PER_CLASS, SpeciesKind};
 use crate::dataset::lcc::LccCoding;
 use crate::gpu::gpu_types::{SeedClass, SeedSpecies};
-use crate::gpu::layout::{KIND_BUSH, KIND_ROCK, KIND_TREE, SEED_LODS, SEED_SALT, SEED_WORKGROUP};
+use crate::gpu::layout::{KIND_BUSH, KIND_ROCK, KIND_TREE, SEED_SALT, SEED_WORKGROUP};
 
 /// Cells one dispatch checks at most (a dispatch dimension's limit).
 pub const MAX_SEED_CELLS: u32 = 65535;
@@ -36,14 +36,6 @@ pub enum SeedError {
     TooDense { code: u8, name: String, density_per_km2: f64, max_per_km2: f64 },
     #[error("class table {scheme}: more than {MAX_SPECIES} species")]
     TooManySpecies { scheme: String },
-}
-
-/// How far each draw LOD reaches for a seed of `seeds.reference_height_m` or taller (smaller seeds
-/// in proportion): the mesh to `seeds.mesh_m` (never beyond the first radial threshold), then the
-/// billboard clouds to each `tlm.radial_lod_m` threshold. Beyond the last, a seed is not drawn.
-pub fn lod_reach_m(settings: &crate::config::Settings) -> [f64; SEED_LODS as usize] {
-    let [r0, r1, r2] = settings.tlm.radial_lod_m;
-    [settings.seeds.mesh_m.min(r0), r0, r1, r2]
 }
 
 /// Workgroups (block-table entries) pass 3 runs per cell when it checks `active_ranks` ranks.

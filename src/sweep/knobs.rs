@@ -1,7 +1,7 @@
 //! How it works: the points of a sweep. Each point is a preset plus, for every `--knob`, one of
 //! its values: the points are the cartesian product of the presets and the knobs' values, in the
 //! order given. A knob is a settings key with dots (`seeds.occlusion_tolerance_m`) and a list of
-//! values separated by commas, commas inside brackets excepted (`tlm.radial_lod_m=[500,1000,2000],
+//! values separated by commas, commas inside brackets excepted (`tlm.radial_bands_m=[500,1000,2000],
 //! [700,1400,3000]`). Each value becomes a one-key TOML layer over the preset (and over the user's
 //! settings file), so it goes through the same key and range checks as any settings file; a value
 //! that is not TOML (`fast`) is taken as a string.
@@ -139,7 +139,7 @@ mod tests {
             (k.key.as_str(), k.values.clone()),
             ("seeds.occlusion_tolerance_m", vec!["0.5".into(), "1".into(), "2".into()])
         );
-        let k: Knob = "tlm.radial_lod_m=[500,1000,2000],[700, 1400, 3000]".parse().unwrap();
+        let k: Knob = "tlm.radial_bands_m=[500,1000,2000],[700, 1400, 3000]".parse().unwrap();
         assert_eq!(k.values, ["[500,1000,2000]", "[700, 1400, 3000]"]);
         assert!("seeds".parse::<Knob>().is_err());
         assert!("frustum_epsilon=0".parse::<Knob>().is_err());
@@ -164,11 +164,13 @@ mod tests {
                 "accurate seeds.frustum_epsilon=0.05 terrain.triangle_px=3",
             ]
         );
-        let user =
-            ("user.toml".to_owned(), "[terrain]\ntriangle_px = 5.0\n[seeds]\nimpostors = \"x\"\n".to_owned());
+        let user = (
+            "user.toml".to_owned(),
+            "[terrain]\ntriangle_px = 5.0\n[draw_seeds]\nimpostors = \"x\"\n".to_owned(),
+        );
         let s = points[3].settings(Some(&user)).unwrap();
         assert_eq!(
-            (s.seeds.frustum_epsilon, s.terrain.triangle_px, s.seeds.impostors.as_str()),
+            (s.seeds.frustum_epsilon, s.terrain.triangle_px, s.draw_seeds.impostors.as_str()),
             (0.05, 3.0, "x")
         );
         assert_eq!(s.seeds.seeds_per_pattern, Settings::preset("accurate").unwrap().seeds.seeds_per_pattern);

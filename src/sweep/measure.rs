@@ -2,7 +2,7 @@
 //! renderer (own device, cold caches), so points do not inherit each other's resident tiles.
 //! - The reference: the accurate preset with caches as large as the layers and every tile pinned
 //!   (`pin_everything`); at each sample pose its frame is rendered until resolved and read back.
-//!   When seeds are drawn (`seeds.impostors` set), a second such renderer without impostors gives
+//!   When seeds are drawn (`draw_seeds.impostors` set), a second such renderer without impostors gives
 //!   the ground alone.
 //! - A point: the timed flight through `profile::Session` (one step per frame), its summary; then
 //!   at each sample pose the settled view's seeds go to the oracle and its frame is read back; with
@@ -60,7 +60,7 @@ pub(super) struct Measured {
 
 fn without_impostors(settings: &Settings) -> Settings {
     let mut s = settings.clone();
-    s.seeds.impostors.clear();
+    s.draw_seeds.impostors.clear();
     s
 }
 
@@ -111,7 +111,7 @@ impl Flight<'_> {
         };
         let none = |_: &Renderer, _: &Camera| Ok(());
         let frames = self.settle(&mut pinned(settings.clone())?, "reference", progress, none)?;
-        let grounds = match settings.seeds.impostors.is_empty() {
+        let grounds = match settings.draw_seeds.impostors.is_empty() {
             true => vec![None; frames.len()],
             false => {
                 let mut r = pinned(without_impostors(settings))?;
@@ -130,7 +130,7 @@ impl Flight<'_> {
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Measured, SweepError> {
         let label = point.label();
-        let draws_seeds = !settings.seeds.impostors.is_empty();
+        let draws_seeds = !settings.draw_seeds.impostors.is_empty();
         let mut renderer = self.renderer(settings.clone())?;
         let adapter = renderer.gpu.describe();
         let (timing, timing_note) = timing_of(&renderer);

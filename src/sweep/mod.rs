@@ -9,7 +9,7 @@
 //!   of each kept seed's ground height from the f64 bilinear DEM (`reference::accuracy`);
 //! - its ground (the frame without seeds) against the ground of an all-resident reference render:
 //!   the accurate preset with every tile of every layer pinned, from the same pose (PSNR);
-//! - its frame against that reference's frame, seeds drawn when `seeds.impostors` is set (PSNR and
+//! - its frame against that reference's frame, seeds drawn when `draw_seeds.impostors` is set (PSNR and
 //!   SSIM, `reference::image_metrics`).
 //!
 //! Seed counts add up over the sample poses (recall is over all their seeds); PSNR pools the
@@ -138,11 +138,11 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
     drop(dataset);
 
     let per_point = |s: &Settings| {
-        let grounds = if s.seeds.impostors.is_empty() { 0 } else { 1 };
+        let grounds = if s.draw_seeds.impostors.is_empty() { 0 } else { 1 };
         u64::from(options.warmup + options.frames) + u64::from(options.samples) * (1 + grounds)
     };
     let reference_steps =
-        u64::from(options.samples) * if reference_settings.seeds.impostors.is_empty() { 1 } else { 2 };
+        u64::from(options.samples) * if reference_settings.draw_seeds.impostors.is_empty() { 1 } else { 2 };
     progress(Progress::Total(reference_steps + settings.iter().map(per_point).sum::<u64>()));
 
     let flight = measure::Flight {

@@ -39,9 +39,9 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let mut settings = Settings::load(&args.preset, args.settings_file.as_deref())?;
     ensure_dataset(&args.dataset)?;
     let dataset = Dataset::open(&args.dataset)?;
-    if settings.seeds.impostors.is_empty() {
+    if settings.draw_seeds.impostors.is_empty() {
         let baked = ensure_impostors(&dataset, &settings, &args.impostors, &args.models)?;
-        settings.seeds.impostors = baked.map(|d| d.display().to_string()).unwrap_or_default();
+        settings.draw_seeds.impostors = baked.map(|d| d.display().to_string()).unwrap_or_default();
     }
     let gpu = Gpu::new(settings.gpu.adapter)?;
     let adapter = gpu.describe();

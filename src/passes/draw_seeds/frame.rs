@@ -40,10 +40,10 @@ pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms) -> DrawSeed
         clip_from_view_world: terrain.clip_from_view_world,
         sun_dir: terrain.sun_dir,
         haze: terrain.haze,
-        lod_reach_m: crate::seeds::lod_reach_m(settings).map(|r| r as f32),
+        draw_reach_m: settings.draw_seeds.reach_m.map(|r| r as f32),
         inv_reference_height_m: (1.0 / settings.seeds.reference_height_m) as f32,
         sink_fraction: settings.seeds.sink_fraction as f32,
-        fade_fraction: settings.seeds.fade_fraction as f32,
+        fade_fraction: settings.draw_seeds.fade_fraction as f32,
         ground_blend: GROUND_BLEND,
     }
 }

@@ -101,10 +101,10 @@ impl TlmFrame {
             frustum_planes: planes,
             camera_z_m: inputs.camera_grid_m.z as f32,
             near_m: camera.near_m as f32,
-            occlusion_tolerance_m: s.occlusion_tolerance_m as f32,
+            occlusion_tolerance_m: s.occlusion().m as f32,
             imagery_scale_sq: 0.0,
-            radial_lod_sq_m2: [0, 1, 2, 3]
-                .map(|k| s.radial_lod_m.get(k).map_or(f32::INFINITY, |r| (r * r) as f32)),
+            radial_band_sq_m2: [0, 1, 2, 3]
+                .map(|k| s.radial_bands_m.get(k).map_or(f32::INFINITY, |r| (r * r) as f32)),
             screen_px: [width, height],
             ndc_per_px: [(2.0 / f64::from(width)) as f32, (2.0 / f64::from(height)) as f32],
             hiz_mips: inputs.hiz_mips,
@@ -115,6 +115,8 @@ impl TlmFrame {
             patterns: s.patterns.max(1),
             seed: s.seed,
             no_fuse: 0,
+            occlusion_tolerance_per_m: s.occlusion().per_m() as f32,
+            _pad: [0; 3],
             height_lod_range_m: [[0.0; 4]; MAX_LEVELS as usize / 4],
             height_levels: page_levels(&lods.pyramid),
             rings_info: [TlmRing::default(); TLM_MAX_RINGS as usize],

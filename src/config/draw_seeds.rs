@@ -1,0 +1,58 @@
+//! How it works: the `[draw_seeds]` table: how far each draw LOD reaches (pass 3 assigns them,
+//! pass 4 draws them), the cross-fade between them, and the impostors pass 4 draws with;
+//! range-checked like the rest of the settings. See `config/default.toml` for what each buys.
+
+use serde::Deserialize;
+
+use super::{SettingsError, TlmSettings};
+use crate::gpu::layout::SEED_LODS;
+
+/// Drawing the seeds, see `config/default.toml` `[draw_seeds]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrawSeedsSettings {
+    /// How far each draw LOD reaches for a seed of `seeds.reference_height_m` or taller (smaller
+    /// seeds in proportion), metres: the real mesh, then the billboard clouds of 17, 8 and 2
+    /// planes. Beyond the last a seed is not drawn.
+    pub reach_m: [f64; SEED_LODS as usize],
+    /// The outer part of each LOD's reach over which a seed cross-fades into the next LOD (the
+    /// last LOD: fades out), as a fraction of the reach; 0 switches at once (pops).
+    pub fade_fraction: f64,
+    /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
+    /// selected but not drawn. Species whose model is not there are not drawn.
+    pub impostors: String,
+}
+
+impl DrawSeedsSettings {
+    pub(super) fn validate(&self, tlm: &TlmSettings) -> Result<(), SettingsError> {
+        let r = self.reach_m;
+        let last_band = tlm.radial_bands_m[tlm.radial_bands_m.len() - 1];
+        let checks: [(bool, &'static str, String, &'static str); 3] = [
+            (
+                r[0] >= 0.0
+                    && r[1] > 0.0
+                    && r.windows(2).all(|w| w[0] <= w[1])
+                    && r.iter().all(|v| v.is_finite()),
+                "draw_seeds.reach_m",
+                format!("{r:?}"),
+                "four increasing distances, metres (the first may be 0: no meshes)",
+            ),
+            (
+                r[r.len() - 1] <= last_band,
+                "draw_seeds.reach_m",
+                format!("{r:?}"),
+                "at most the last of tlm.radial_bands_m: seeds beyond it are never checked",
+            ),
+            (
+                (0.0..=0.5).contains(&self.fade_fraction),
+                "draw_seeds.fade_fraction",
+                self.fade_fraction.to_string(),
+                "0 to 0.5 of each LOD's reach",
+            ),
+        ];
+        match checks.into_iter().find(|(ok, ..)| !ok) {
+            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
+            None => Ok(()),
+        }
+    }
+}

@@ -1,0 +1,80 @@
+//! How it works: the `[tlm]` table (pass 1), range-checked like the rest of the settings; see
+//! `config/default.toml` for what each knob buys and costs.
+
+use serde::Deserialize;
+
+use super::SettingsError;
+use super::seeds::OcclusionTolerance;
+use crate::gpu::layout::{TLM_MAX_RINGS, TLM_RADIAL_BANDS};
+
+/// The Tile Load Map (pass 1): camera-centred rings of cells, see `passes::tile_load_map`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TlmSettings {
+    pub cell_m: f64,
+    pub cells: u32,
+    pub max_rings: u32,
+    /// A cell's box is occluded when it lies more than this far behind the terrain; the same
+    /// model as `seeds.occlusion_tolerance_*` (`OcclusionTolerance`).
+    pub occlusion_tolerance_m: f64,
+    pub occlusion_tolerance_per_km: f64,
+    /// The distance bands of ring-0 cells, metres: a cell whose nearest point lies in band k
+    /// reads land-cover level k for its seeds; beyond the last, its seeds are not checked.
+    pub radial_bands_m: [f64; TLM_RADIAL_BANDS as usize],
+    pub patterns: u32,
+    pub seed: u32,
+}
+
+impl TlmSettings {
+    /// The occlusion tolerance of a cell's box.
+    pub fn occlusion(&self) -> OcclusionTolerance {
+        OcclusionTolerance { m: self.occlusion_tolerance_m, per_km: self.occlusion_tolerance_per_km }
+    }
+
+    pub(super) fn validate(&self) -> Result<(), SettingsError> {
+        let r = self.radial_bands_m;
+        let checks: [(bool, &'static str, String, &'static str); 7] = [
+            (
+                self.cell_m.is_finite() && self.cell_m >= 1.0,
+                "tlm.cell_m",
+                self.cell_m.to_string(),
+                "a finite number of metres, at least 1",
+            ),
+            (
+                self.cells.is_multiple_of(2) && (8..=256).contains(&self.cells),
+                "tlm.cells",
+                self.cells.to_string(),
+                "an even number from 8 to 256",
+            ),
+            (
+                (1..=TLM_MAX_RINGS).contains(&self.max_rings),
+                "tlm.max_rings",
+                self.max_rings.to_string(),
+                "1 to 16",
+            ),
+            (
+                self.occlusion_tolerance_m >= 0.0 && self.occlusion_tolerance_m.is_finite(),
+                "tlm.occlusion_tolerance_m",
+                self.occlusion_tolerance_m.to_string(),
+                "0 or more metres",
+            ),
+            (
+                self.occlusion_tolerance_per_km >= 0.0 && self.occlusion_tolerance_per_km.is_finite(),
+                "tlm.occlusion_tolerance_per_km",
+                self.occlusion_tolerance_per_km.to_string(),
+                "0 or more metres per km",
+            ),
+            (
+                r[0] > 0.0 && r.windows(2).all(|w| w[0] <= w[1]) && r.iter().all(|v| v.is_finite()),
+                "tlm.radial_bands_m",
+                format!("{r:?}"),
+                "three increasing positive distances, metres",
+            ),
+            ((1..=255).contains(&self.patterns), "tlm.patterns", self.patterns.to_string(), "1 to 255"),
+        ];
+        match checks.into_iter().find(|(ok, ..)| !ok) {
+            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
+            None => Ok(()),
+        }
+    }
+}
