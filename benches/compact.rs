@@ -4,6 +4,7 @@
 //! submission and waits, so submission overhead is spread. Sizes whose keys or permutation exceed
 //! the adapter's largest storage binding are skipped with a note. Run with
 //! `WGPU_BACKEND=vulkan cargo bench --bench compact`.
+#![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 use std::time::{Duration, Instant};
 

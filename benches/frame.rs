@@ -2,11 +2,11 @@
 //! 1280 × 720, from the demo's first pose and a low grazing pose. Run with
 //! `WGPU_BACKEND=vulkan cargo bench --bench frame`; the dataset is synthesized into the target dir
 //! on first use.
+#![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
@@ -24,17 +24,7 @@ fn renderer() -> Renderer {
 }
 
 fn pose(renderer: &Renderer, above_m: f64, pitch_deg: f64) -> Camera {
-    let m = &renderer.dataset.manifest;
-    let [w, h] = m.extent_m();
-    let grid = [0.3 * w, 0.3 * h];
-    let ground = renderer.dataset.height_at(grid[0], grid[1], 0).expect("height");
-    Camera {
-        position_m: DVec3::new(m.origin_m[0] + grid[0], m.origin_m[1] + grid[1], ground + above_m),
-        yaw_deg: 45.0,
-        pitch_deg,
-        fov_deg: renderer.settings.render.fov_deg,
-        near_m: renderer.settings.render.near_m,
-    }
+    terramp_testkit::camera::over_fraction(renderer, [0.3, 0.3], above_m, 45.0, pitch_deg)
 }
 
 fn frame(c: &mut Criterion) {

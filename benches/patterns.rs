@@ -1,6 +1,7 @@
 //! Time to generate the seed patterns pass 3 uploads (Bridson candidates, then farthest-point
 //! ranking): 16 patterns of 2048 seeds (the default) and of 4096 (the accurate preset). Run with
 //! `cargo bench --bench patterns`.
+#![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use terramp::seeds::patterns::SeedPatterns;

@@ -4,6 +4,7 @@
 //! compaction, then with the draw too (`Renderer::replay_seed_passes`): each stage's cost is the
 //! difference from the one before. Throughput is in seeds checked per second. The nc table's models are baked from `../shared/data/models` into the target dir
 //! on first use. Run with `WGPU_BACKEND=vulkan cargo bench --bench seed_draw`.
+#![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 use std::path::{Path, PathBuf};
 

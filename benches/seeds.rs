@@ -5,6 +5,7 @@
 //! a square block of ring-0 cells around the camera (4096 seeds each; the nc table's densities ×4
 //! so that nearly every rank can grow a seed and is really checked). Prints a table; run with
 //! `WGPU_BACKEND=vulkan cargo bench --bench seeds`.
+#![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 use std::path::Path;
 use std::time::Instant;

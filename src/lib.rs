@@ -4,6 +4,7 @@
 //! a land-cover map, in the four passes of Amara, Meunier & Marsault (2007). See `DESIGN.md` in
 //! the shared folder for the architecture; `frame` reads as the list of passes.
 
+#[cfg(feature = "bake")]
 pub mod bake;
 pub mod camera;
 pub mod classes;
@@ -18,5 +19,7 @@ pub mod profile;
 pub mod reference;
 pub mod seeds;
 pub mod streaming;
+#[cfg(feature = "sweep")]
 pub mod sweep;
+#[cfg(feature = "synth")]
 pub mod synth;

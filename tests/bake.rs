@@ -1,14 +1,13 @@
 //! `terramp::bake` on the shared models: three LODs of 17, 8 and 2 planes each, every plane with
 //! something in its atlas rectangle down to the last mip, a bounding sphere holding every vertex
 //! of the glTF, and `terramp::impostor::load` reading it all back. Broken inputs are named.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::path::{Path, PathBuf};
 
-use common::shared_data;
 use terramp::bake::{BakeError, BakeOptions, bake_models};
 use terramp::impostor::{Impostor, MipChain, Plane};
+use terramp_testkit::shared_data;
 
 /// A fresh folder under the target's temporary folder, removed when dropped.
 struct TempDir(PathBuf);
@@ -122,7 +121,7 @@ fn baking_every_model_gives_three_lods_with_their_planes_and_non_empty_atlases()
     assert!(!models.is_empty(), "no .glb in {}", data.join("models").display());
     let out = TempDir::new("bake");
     // The caller's adapter, as the demo passes its own.
-    let gpu = common::gpu();
+    let gpu = terramp_testkit::gpu();
     let options = BakeOptions { texels: 256, ..Default::default() };
     let reports =
         bake_models(Some(&gpu), &models, out.path(), &options, true).unwrap_or_else(|e| panic!("{e}"));

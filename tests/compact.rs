@@ -2,8 +2,7 @@
 //! twin bit for bit (random inputs of many sizes, all kept, none kept, one group, every group,
 //! keys outside the groups), every record is drawn exactly once, in its group, in block order,
 //! and the indirect draws count each group and start where the group starts.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use terramp::gpu::Gpu;
 use terramp::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
@@ -24,7 +23,7 @@ struct Harness {
 
 impl Harness {
     fn new(limits: CompactLimits) -> Self {
-        let gpu = common::gpu();
+        let gpu = terramp_testkit::gpu();
         let pass = CompactPass::new(&gpu.device, limits).unwrap();
         let buffer = |label, bytes: u64| {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -222,7 +221,7 @@ fn draws_take_their_mesh_from_the_templates_and_runs_agree() {
 
 #[test]
 fn a_table_larger_than_the_limits_is_refused() {
-    let gpu = common::gpu();
+    let gpu = terramp_testkit::gpu();
     let pass = CompactPass::new(&gpu.device, CompactLimits { blocks: 100, records: 100 }).unwrap();
     assert!(pass.prepare(&gpu.queue, 101).is_err());
     let limits = CompactLimits { blocks: u32::MAX, records: 1 };

@@ -1,5 +1,5 @@
 //! The extremes of DESIGN.md ("Extremes the numbers must survive"), each a test on the software
-//! adapter over small synthetic datasets; every frame is audited (`common::audit`): depth, colour,
+//! adapter over small synthetic datasets; every frame is audited (`terramp_testkit::audit`): depth, colour,
 //! Tile Load Map and seed records read back and checked for non-finite or out-of-range values,
 //! holes and stray ground judged against rays cast through the f64 DEM.
 //!
@@ -19,8 +19,7 @@
 //! keys outside the draw groups (`tests/compact.rs`), no-adapter errors (`tests/render.rs`), and
 //! real data: DEM voids and nodata (`rainier/`, `zion/`) and hand-made cliffs in
 //! `data-tools/tests/extremes.rs`.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 #[path = "extremes/coordinates.rs"]
 mod coordinates;

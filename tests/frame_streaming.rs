@@ -1,8 +1,7 @@
 //! Streaming through whole frames on the software adapter: a fixed view converges to everything
 //! it needs and then looks like an all-resident reference; budgets and capacities hold over a
 //! flight; a corrupt tile is reported, stood in for by its ancestor, and the frames still render.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::path::{Path, PathBuf};
 
@@ -11,22 +10,13 @@ use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::frame::{FrameReport, Renderer};
 
-use common::{psnr, renderer, small_settings, synth_dataset};
+use terramp_testkit::camera::over_fraction;
+use terramp_testkit::{psnr, renderer, small_settings, synth_dataset};
 
 /// The view the convergence test looks at: low over the dataset's south-west quarter, looking
 /// north-east across it, so near tiles want fine imagery and far ones coarse.
 fn view(r: &Renderer) -> Camera {
-    let m = &r.dataset.manifest;
-    let [w, h] = m.extent_m();
-    let grid = [0.2 * w, 0.25 * h];
-    let ground = r.dataset.height_at(grid[0], grid[1], 0).unwrap();
-    Camera {
-        position_m: DVec3::new(m.origin_m[0] + grid[0], m.origin_m[1] + grid[1], ground + 60.0),
-        yaw_deg: 40.0,
-        pitch_deg: -8.0,
-        fov_deg: 60.0,
-        near_m: 0.1,
-    }
+    over_fraction(r, [0.2, 0.25], 60.0, 40.0, -8.0)
 }
 
 /// Settings that make streaming visible: a few uploads per frame, one loader thread.

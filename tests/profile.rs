@@ -1,8 +1,7 @@
 //! `terramp profile`: the JSON lists every pass the frames timed, with positive times; its seed
 //! counts are the log's; the Chrome trace parses and holds the passes; the CPU-timing fallback says
 //! so; the generated orbit stays over the dataset.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -57,7 +56,7 @@ fn is_profiled(record: &Value) -> bool {
 
 #[test]
 fn profile_json_trace_and_log_agree() {
-    let dataset = common::synth_dataset(SIZE, 7);
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     // No --path: the generated orbit, which stays over this small dataset's land cover.
     let run = profile(&dataset, "gpu", &[]);
     let json = &run.json;
@@ -135,7 +134,7 @@ fn profile_json_trace_and_log_agree() {
 
 #[test]
 fn without_timestamps_the_table_says_the_passes_were_timed_on_the_cpu() {
-    let dataset = common::synth_dataset(SIZE, 7);
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     let settings = std::env::temp_dir().join(format!("terramp-profile-cpu-{}.toml", std::process::id()));
     std::fs::write(&settings, "[gpu]\ntimestamps = false\n").unwrap();
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/paths/default.toml");
@@ -153,7 +152,7 @@ fn without_timestamps_the_table_says_the_passes_were_timed_on_the_cpu() {
 
 #[test]
 fn the_generated_orbit_stays_over_the_dataset() {
-    let dataset = terramp::dataset::Dataset::open(&common::synth_dataset(SIZE, 7)).unwrap();
+    let dataset = terramp::dataset::Dataset::open(&terramp_testkit::synth_dataset(SIZE, 7)).unwrap();
     // The default path's keyframes lie outside a 3 km dataset: the orbit replaces it.
     let (path, name) = terramp::profile::default_path(&dataset).unwrap();
     assert!(name.starts_with("orbit"), "{name}");

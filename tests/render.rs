@@ -1,30 +1,16 @@
 //! Terrain rendering on the software adapter: frames are not blank, keep their depth, have no
 //! holes between LODs, repeat exactly, and survive cameras outside the dataset.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::frame::Renderer;
 use terramp::gpu::TimeSource;
 
-use common::{renderer, small_settings, synth_dataset};
+use terramp_testkit::camera::over_fraction;
+use terramp_testkit::{renderer, small_settings, synth_dataset};
 
 /// A camera `above_m` over the ground at the dataset's centre.
-fn camera_over_centre(renderer: &Renderer, above_m: f64, yaw_deg: f64, pitch_deg: f64) -> Camera {
-    let m = &renderer.dataset.manifest;
-    let [w, h] = m.extent_m();
-    let grid = [0.5 * w, 0.5 * h];
-    let ground = renderer.dataset.height_at(grid[0], grid[1], 0).unwrap();
-    Camera {
-        position_m: DVec3::new(m.origin_m[0] + grid[0], m.origin_m[1] + grid[1], ground + above_m),
-        yaw_deg,
-        pitch_deg,
-        fov_deg: 60.0,
-        near_m: 0.1,
-    }
-}
-
 /// Depth rows, top first.
 fn depth_rows(renderer: &Renderer) -> Vec<Vec<f32>> {
     let width = renderer.settings.render.width as usize;
@@ -35,7 +21,7 @@ fn depth_rows(renderer: &Renderer) -> Vec<Vec<f32>> {
 fn frame_shows_ground_and_sky_and_keeps_depth() {
     let dataset = synth_dataset(300, 7);
     let mut r = renderer(&dataset, small_settings(160, 96));
-    let camera = camera_over_centre(&r, 300.0, 30.0, -10.0);
+    let camera = over_fraction(&r, [0.5, 0.5], 300.0, 30.0, -10.0);
     let report = r.render(&camera).unwrap();
     assert!(report.nodes_drawn > 0 && report.nodes_dropped == 0, "{report:?}");
     let rows = depth_rows(&r);
@@ -56,7 +42,7 @@ fn no_holes_below_the_horizon_across_lods() {
     settings.terrain.node_cells = 16;
     let mut r = renderer(&dataset, settings);
     for (yaw, pitch) in [(0.0, -25.0), (135.0, -40.0), (250.0, -15.0)] {
-        let camera = camera_over_centre(&r, 150.0, yaw, pitch);
+        let camera = over_fraction(&r, [0.5, 0.5], 150.0, yaw, pitch);
         r.render(&camera).unwrap();
         let rows = depth_rows(&r);
         for x in 0..rows[0].len() {
@@ -73,11 +59,11 @@ fn no_holes_below_the_horizon_across_lods() {
 fn the_same_view_renders_the_same_pixels() {
     let dataset = synth_dataset(300, 7);
     let mut r = renderer(&dataset, small_settings(128, 80));
-    let camera = camera_over_centre(&r, 200.0, 200.0, -20.0);
+    let camera = over_fraction(&r, [0.5, 0.5], 200.0, 200.0, -20.0);
     r.render_resolved(&camera, 200).unwrap();
     let first = r.read_colour().unwrap();
     // Move away and back: cache state differs, the resolved image must not.
-    r.render_resolved(&camera_over_centre(&r, 2000.0, 10.0, -60.0), 200).unwrap();
+    r.render_resolved(&over_fraction(&r, [0.5, 0.5], 2000.0, 10.0, -60.0), 200).unwrap();
     r.render_resolved(&camera, 200).unwrap();
     assert!(first == r.read_colour().unwrap());
 }
@@ -129,7 +115,7 @@ fn passes_are_timed_with_timestamps_or_on_the_cpu() {
         let mut settings = small_settings(96, 64);
         settings.gpu.timestamps = timestamps;
         let mut r = renderer(&dataset, settings);
-        let camera = camera_over_centre(&r, 300.0, 30.0, -10.0);
+        let camera = over_fraction(&r, [0.5, 0.5], 300.0, 30.0, -10.0);
         for _ in 0..3 {
             r.render(&camera).unwrap();
         }

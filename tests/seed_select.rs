@@ -2,8 +2,7 @@
 //! same order too), runs and paths agree, seeds sit on the DEM, a too-small output is flagged
 //! without corrupting what it keeps, and compaction's draw order is the same in every run and
 //! equals its twin's.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
 use terramp::camera::Camera;
@@ -11,28 +10,15 @@ use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SpeciesLod, seed_group};
 use terramp::reference::seed_select::SeedComparison;
+use terramp_testkit::camera::over_fraction;
 
 const SIZE: u32 = 1024;
 
-fn camera_at(r: &Renderer, fx: f64, fy: f64, up_m: f64, yaw_deg: f64, pitch_deg: f64) -> Camera {
-    let m = &r.dataset.manifest;
-    let [w, h] = m.extent_m();
-    let grid = [fx * w, fy * h];
-    let ground = r.dataset.height_at(grid[0], grid[1], 0).unwrap();
-    Camera {
-        position_m: DVec3::new(m.origin_m[0] + grid[0], m.origin_m[1] + grid[1], ground + up_m),
-        yaw_deg,
-        pitch_deg,
-        fov_deg: 60.0,
-        near_m: 0.1,
-    }
-}
-
 fn cameras(r: &Renderer) -> Vec<Camera> {
     vec![
-        camera_at(r, 0.3, 0.3, 40.0, 35.0, -10.0),
-        camera_at(r, 0.6, 0.5, 300.0, 200.0, -25.0),
-        camera_at(r, 0.5, 0.7, 3.0, 290.0, 2.0),
+        over_fraction(r, [0.3, 0.3], 40.0, 35.0, -10.0),
+        over_fraction(r, [0.6, 0.5], 300.0, 200.0, -25.0),
+        over_fraction(r, [0.5, 0.7], 3.0, 290.0, 2.0),
     ]
 }
 
@@ -43,8 +29,8 @@ fn sorted(mut records: Vec<SeedRecord>) -> Vec<SeedRecord> {
 
 #[test]
 fn gpu_seed_selection_equals_its_cpu_twin() {
-    let dataset = common::synth_dataset(SIZE, 7);
-    let mut r = common::renderer(&dataset, common::small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let mut r = terramp_testkit::renderer(&dataset, terramp_testkit::small_settings(320, 180));
     for (i, camera) in cameras(&r).iter().enumerate() {
         r.render_resolved(camera, 60).unwrap();
         let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
@@ -86,13 +72,13 @@ fn identities(records: &[SeedRecord]) -> Vec<([i32; 2], u32, u32)> {
 
 #[test]
 fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
-    let dataset = common::synth_dataset(SIZE, 7);
-    let settings = common::small_settings(320, 180);
-    let probe = common::renderer(&dataset, settings.clone());
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let settings = terramp_testkit::small_settings(320, 180);
+    let probe = terramp_testkit::renderer(&dataset, settings.clone());
     let camera = cameras(&probe)[0];
     drop(probe);
     let run = || {
-        let mut r = common::renderer(&dataset, settings.clone());
+        let mut r = terramp_testkit::renderer(&dataset, settings.clone());
         r.render_resolved(&camera, 60).unwrap();
         let output = r.read_seed_output().unwrap().unwrap();
         let compacted = r.read_compacted().unwrap().unwrap();
@@ -133,8 +119,8 @@ fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
 
 #[test]
 fn seeds_sit_on_the_bilinear_dem() {
-    let dataset = common::synth_dataset(SIZE, 7);
-    let mut r = common::renderer(&dataset, common::small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let mut r = terramp_testkit::renderer(&dataset, terramp_testkit::small_settings(320, 180));
     let camera = cameras(&r)[0];
     r.render_resolved(&camera, 60).unwrap();
     let (records, _) = r.read_seeds().unwrap().unwrap();
@@ -159,17 +145,17 @@ fn seeds_sit_on_the_bilinear_dem() {
 
 #[test]
 fn seeds_are_the_same_in_every_run_and_after_any_path() {
-    let dataset = common::synth_dataset(SIZE, 7);
-    let settings = common::small_settings(320, 180);
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let settings = terramp_testkit::small_settings(320, 180);
     let seeds_after = |path: &[Camera]| {
-        let mut r = common::renderer(&dataset, settings.clone());
+        let mut r = terramp_testkit::renderer(&dataset, settings.clone());
         for camera in &path[..path.len() - 1] {
             r.render(camera).unwrap();
         }
         r.render_resolved(path.last().unwrap(), 60).unwrap();
         sorted(r.read_seeds().unwrap().unwrap().0)
     };
-    let probe = common::renderer(&dataset, settings.clone());
+    let probe = terramp_testkit::renderer(&dataset, settings.clone());
     let [a, b, end] = <[Camera; 3]>::try_from(cameras(&probe)).unwrap();
     drop(probe);
     let direct = seeds_after(&[end]);
@@ -180,16 +166,16 @@ fn seeds_are_the_same_in_every_run_and_after_any_path() {
 
 #[test]
 fn overflow_is_flagged_counted_and_keeps_valid_records() {
-    let dataset = common::synth_dataset(SIZE, 7);
-    let mut settings = common::small_settings(320, 180);
-    let mut full = common::renderer(&dataset, settings.clone());
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let mut settings = terramp_testkit::small_settings(320, 180);
+    let mut full = terramp_testkit::renderer(&dataset, settings.clone());
     let camera = cameras(&full)[0];
     full.render_resolved(&camera, 60).unwrap();
     let (all, all_counters) = full.read_seeds().unwrap().unwrap();
     drop(full);
     let capacity = (all.len() / 3).max(1) as u32;
     settings.seeds.capacity = capacity;
-    let mut small = common::renderer(&dataset, settings);
+    let mut small = terramp_testkit::renderer(&dataset, settings);
     small.render_resolved(&camera, 60).unwrap();
     let (kept, counters) = small.read_seeds().unwrap().unwrap();
     assert_eq!(counters.selected, all_counters.selected);
@@ -209,7 +195,7 @@ fn overflow_is_flagged_counted_and_keeps_valid_records() {
 
 #[test]
 fn the_fly_log_counts_seeds_per_frame() {
-    let dataset = common::synth_dataset(SIZE, 7);
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     let out = std::env::temp_dir().join(format!("terramp-fly-seeds-{}", std::process::id()));
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/paths/default.toml");
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_terramp"))
@@ -250,11 +236,11 @@ fn classes_missing_from_the_table_grow_nothing() {
         [[class]]\ncode = 3\nname = \"herbaceous\"\nseeds = [{ species = \"bush\", per_km2 = 3000.0 }]\n";
     let path = std::env::temp_dir().join(format!("terramp-partial-table-{}.toml", std::process::id()));
     std::fs::write(&path, table).unwrap();
-    let dataset = common::synth_dataset(SIZE, 7);
-    let mut settings = common::small_settings(320, 180);
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let mut settings = terramp_testkit::small_settings(320, 180);
     settings.seeds.class_table = path.to_str().unwrap().to_owned();
-    let mut r = common::renderer(&dataset, settings);
-    let camera = camera_at(&r, 0.5, 0.5, 30.0, 120.0, -20.0);
+    let mut r = terramp_testkit::renderer(&dataset, settings);
+    let camera = over_fraction(&r, [0.5, 0.5], 30.0, 120.0, -20.0);
     r.render_resolved(&camera, 60).unwrap();
     let (records, counters) = r.read_seeds().unwrap().unwrap();
     assert!(!records.is_empty() && counters.class > 0, "{counters:?}");

@@ -2,6 +2,7 @@
 //! has the same size, field offsets and scalars in WGSL as in Rust; and every pass's binding table
 //! agrees with the `@group(0) @binding(n)` globals its shader's entry points use: name, kind,
 //! texture type, buffer size or element stride, access, and the stages that read it. No GPU needed.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
 use naga::{

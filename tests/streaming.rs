@@ -1,8 +1,7 @@
 //! Tile streaming on the software adapter: loader threads (priority, cancellation, errors,
 //! shutdown, never blocking) and the budgeted caches they feed (capacity, budget, eviction
 //! policy, convergence, priority order, failure memory, camera jumps).
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -116,7 +115,7 @@ fn rewrite_without(path: &Path, index: u64) {
 
 #[test]
 fn loader_serves_most_important_first_and_never_blocks() {
-    let dataset = open(&common::synth_dataset(600, 11));
+    let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     let pyramid = dataset.imagery.as_ref().unwrap().pyramid;
     let loader = Loader::new(dataset.clone(), 1).unwrap();
     // Priorities in a scrambled order; one worker must return them sorted.
@@ -158,7 +157,7 @@ fn loader_serves_most_important_first_and_never_blocks() {
 
 #[test]
 fn loader_reports_missing_tiles_and_shuts_down_cleanly() {
-    let source = common::synth_dataset(600, 11);
+    let source = terramp_testkit::synth_dataset(600, 11);
     let dir = copy_dataset(&source, "missing");
     // No land-cover layer, and one height tile never written (its index entry cleared).
     let manifest_path = dir.join("manifest.toml");
@@ -208,8 +207,8 @@ fn loader_reports_missing_tiles_and_shuts_down_cleanly() {
 
 #[test]
 fn budget_and_eviction_rules_hold_over_a_moving_view() {
-    let gpu = common::gpu();
-    let dataset = open(&common::synth_dataset(600, 11));
+    let gpu = terramp_testkit::gpu();
+    let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     let loader = Loader::new(dataset.clone(), 2).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 12);
     let mut heights = cache(&gpu, &dataset, LayerKind::Height, 6);
@@ -263,8 +262,8 @@ fn budget_and_eviction_rules_hold_over_a_moving_view() {
 
 #[test]
 fn fixed_view_converges_then_uploads_nothing() {
-    let gpu = common::gpu();
-    let dataset = open(&common::synth_dataset(600, 11));
+    let gpu = terramp_testkit::gpu();
+    let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     let loader = Loader::new(dataset.clone(), 2).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 24);
     let wanted: Vec<TileId> = wants(imagery.pyramid(), [1.0, 3.0], 0).into_iter().take(20).collect();
@@ -293,8 +292,8 @@ fn fixed_view_converges_then_uploads_nothing() {
 
 #[test]
 fn coarse_and_near_tiles_arrive_first() {
-    let gpu = common::gpu();
-    let dataset = open(&common::synth_dataset(600, 11));
+    let gpu = terramp_testkit::gpu();
+    let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     // One worker serves in strict priority order; one tile a frame makes the order visible.
     let loader = Loader::new(dataset.clone(), 1).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 48);
@@ -318,12 +317,12 @@ fn coarse_and_near_tiles_arrive_first() {
 
 #[test]
 fn corrupt_tiles_fail_once_and_their_ancestor_stands_in() {
-    let source = common::synth_dataset(600, 11);
+    let source = terramp_testkit::synth_dataset(600, 11);
     let dir = copy_dataset(&source, "corrupt");
     let clean = open(&source);
     let (ip, hp) = (clean.imagery.as_ref().unwrap().pyramid, clean.height.pyramid);
     let bad = TileId::new(0, 1, 1);
-    let gpu = common::gpu();
+    let gpu = terramp_testkit::gpu();
     let mut imagery = cache(&gpu, &clean, LayerKind::Imagery, 48);
     let mut heights = cache(&gpu, &clean, LayerKind::Height, 16);
     corrupt_tile(&dir, "imagery.pack", &ip, imagery.tile_bytes() as u64, bad);
@@ -364,8 +363,8 @@ fn corrupt_tiles_fail_once_and_their_ancestor_stands_in() {
 
 #[test]
 fn camera_jump_converges_within_the_budget() {
-    let gpu = common::gpu();
-    let dataset = open(&common::synth_dataset(600, 11));
+    let gpu = terramp_testkit::gpu();
+    let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     let loader = Loader::new(dataset.clone(), 2).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 16);
     let texel_m = dataset.manifest.imagery.as_ref().unwrap().texel_m;
@@ -396,8 +395,8 @@ fn camera_jump_converges_within_the_budget() {
 
 #[test]
 fn load_now_makes_the_view_resident_at_once() {
-    let gpu = common::gpu();
-    let dataset = open(&common::synth_dataset(600, 11));
+    let gpu = terramp_testkit::gpu();
+    let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     let mut heights = cache(&gpu, &dataset, LayerKind::Height, 16);
     let wanted = wants(heights.pyramid(), [0.0, 0.0], 0);
     let stats = heights.load_now(&gpu.queue, &wanted, 0, |id| dataset.height.tile_bytes(id));

@@ -2,8 +2,7 @@
 //! it writes trade.csv, trade.json and trade.png; the CSV and the JSON hold the same figures; every
 //! point has positive times and sensible errors; the accurate preset against its own all-resident
 //! reference is (nearly) identical, its PSNR capped to a finite number.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -13,7 +12,7 @@ use terramp::reference::image_metrics::PSNR_CAP_DB;
 
 #[test]
 fn sweep_writes_agreeing_csv_json_and_plot() {
-    let dataset = common::synth_dataset(300, 7);
+    let dataset = terramp_testkit::synth_dataset(300, 7);
     let out: PathBuf = std::env::temp_dir().join(format!("terramp-sweep-{}", std::process::id()));
     let output = Command::new(env!("CARGO_BIN_EXE_terramp"))
         .args(["sweep", "--presets", "fast,accurate", "--frames", "4", "--warmup", "2", "--samples", "2"])

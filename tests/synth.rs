@@ -1,5 +1,6 @@
 //! The synthetic dataset generator: determinism, exact height ranges, seamless tiles, valid
 //! classes, plausible imagery, odd and tiny sizes, and resolution consistency.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

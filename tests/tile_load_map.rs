@@ -2,246 +2,33 @@
 //! nests exactly, the depth pyramid equals a CPU min-reduction, the readback ring never waits and
 //! keeps frames in order, and the GPU pass equals its CPU twin bit for bit for many cameras, never
 //! culls a cell whose ground is on screen, and picks the levels an f64 computation picks.
-
-mod common;
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::time::{Duration, Instant};
 
-use glam::{DMat4, DVec3, DVec4};
-use terramp::camera::Camera;
+use glam::DVec3;
 use terramp::config::{Settings, TlmSettings};
 use terramp::frame::Renderer;
-use terramp::gpu::gpu_types::TlmCell;
-use terramp::gpu::layout::TileSpan;
+use terramp::gpu::layout::TLM_CULLED;
 use terramp::gpu::readback_ring::ReadbackRing;
 use terramp::gpu::{Profiler, TimeSource};
 use terramp::passes::depth_pyramid::frame::HizMips;
 use terramp::passes::depth_pyramid::gpu::DepthPyramid;
-use terramp::passes::terrain::select::Lods;
-use terramp::passes::tile_load_map::frame::{TlmFrame, TlmImagery, TlmInputs, height_tile_ranges};
+use terramp::passes::tile_load_map::frame::{TlmImagery, TlmInputs, height_tile_ranges};
 use terramp::passes::tile_load_map::gpu::TileLoadMapPass;
 use terramp::passes::tile_load_map::layout::TlmLayout;
 use terramp::reference::depth_pyramid::depth_pyramid;
 use terramp::reference::tile_load_map::{pattern_hash, tile_load_map};
-
-use common::{gpu, renderer, small_settings, synth_dataset};
+use terramp_testkit::camera::{at_grid as camera_at, over};
+use terramp_testkit::tlm::{
+    assert_gpu_equals_twin, assert_levels_match_f64, assert_no_false_culls, cell_height_range, run, run_with,
+    visible,
+};
+use terramp_testkit::{gpu, renderer, small_settings, synth_dataset};
 
 /// Small rings, so a few-km synthetic dataset needs several of them.
 fn tlm_settings(cell_m: f64, cells: u32) -> TlmSettings {
     TlmSettings { cell_m, cells, ..Settings::default().tlm }
-}
-
-struct Run {
-    layout: TlmLayout,
-    frame: TlmFrame,
-    lods: Lods,
-    ranges: Vec<[f32; 2]>,
-    hiz: HizMips,
-    gpu: Vec<TlmCell>,
-    twin: Vec<TlmCell>,
-    clip: DMat4,
-    camera_grid_m: DVec3,
-}
-
-/// Renders `camera`, then runs the depth pyramid and the TLM on its depth, and the twin.
-fn run(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]]) -> Run {
-    run_with(r, camera, ranges, None)
-}
-
-/// As `run`, but with `wall_m`, on a depth target cleared to a wall that far away instead.
-fn run_with(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]], wall_m: Option<f64>) -> Run {
-    r.render(camera).unwrap();
-    let s = r.settings.clone();
-    let (w, h) = (s.render.width, s.render.height);
-    let device = &r.gpu.device;
-    let hiz = DepthPyramid::new(device, w, h);
-    let pass = TileLoadMapPass::new(device, &s);
-    let ranges = ranges.to_vec();
-    let bindings = pass.bind_group(device, &ranges, &hiz);
-    let m = &r.dataset.manifest;
-    let camera_grid_m = camera.position_m - DVec3::new(m.origin_m[0], m.origin_m[1], 0.0);
-    let lods = Lods::for_view(&r.dataset, &s.terrain, camera, h);
-    let rect = TlmLayout::dataset_rect_m(&lods.pyramid, lods.spacing_m);
-    let layout = TlmLayout::new(&s.tlm, rect, [camera_grid_m.x, camera_grid_m.y]);
-    let imagery = TlmImagery::of(&r.dataset, &s.imagery);
-    let inputs = TlmInputs {
-        settings: &s.tlm,
-        layout: &layout,
-        camera,
-        camera_grid_m,
-        viewport_px: [w, h],
-        lods: &lods,
-        imagery,
-        hiz_mips: hiz.mips(),
-    };
-    let frame = pass.prepare(&r.gpu.queue, &inputs).unwrap();
-    let mut encoder = device.create_command_encoder(&Default::default());
-    let wall = wall_m.map(|distance_m| {
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("wall"),
-            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&Default::default());
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("wall"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear((camera.near_m / distance_m) as f32),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        view
-    });
-    let depth = wall.unwrap_or_else(|| r.depth_texture().create_view(&Default::default()));
-    hiz.encode(&mut encoder, &depth);
-    pass.encode(&mut encoder, &bindings, &frame);
-    r.gpu.queue.submit([encoder.finish()]);
-    let gpu_cells = pass.read_back(&r.gpu, &frame).unwrap();
-    let mips = hiz.read_back(&r.gpu).unwrap();
-    let twin = tile_load_map(&frame.uniforms, &frame.spans, &ranges, &mips);
-    let clip = camera.clip_from_view(w, h).unwrap() * camera.view_from_world();
-    Run { layout, frame, lods, ranges, hiz: mips, gpu: gpu_cells, twin, clip, camera_grid_m }
-}
-
-fn assert_gpu_equals_twin(run: &Run, what: &str) {
-    assert_eq!(run.gpu.len(), run.layout.cell_count(), "{what}");
-    let differ: Vec<_> = (0..run.gpu.len()).filter(|&i| run.gpu[i] != run.twin[i]).collect();
-    let show: Vec<_> =
-        differ.iter().take(5).map(|&i| (run.layout.cell_of(i), run.gpu[i], run.twin[i])).collect();
-    assert!(
-        differ.is_empty(),
-        "{what}: {} cells differ, e.g. (ring, x, y), GPU, twin: {show:?}",
-        differ.len()
-    );
-}
-
-fn visible(cells: &[TlmCell]) -> usize {
-    cells.iter().filter(|c| c.visibility != 0).count()
-}
-
-/// Every pixel showing ground lies in a cell the TLM keeps (no false culls), checked for points
-/// well inside a cell and within the dataset's height range (skirts hang below it).
-fn assert_no_false_culls(r: &Renderer, run: &Run, what: &str) {
-    let (w, h) = (r.settings.render.width, r.settings.render.height);
-    let depth = r.read_depth().unwrap();
-    let inverse = run.clip.inverse();
-    let [low, high] = [r.dataset.manifest.height.min_m, r.dataset.manifest.height.max_m].map(f64::from);
-    let mut checked = 0;
-    for (i, &d) in depth.iter().enumerate().filter(|(_, d)| **d > 0.0) {
-        let (px, py) = ((i as u32 % w) as f64 + 0.5, (i as u32 / w) as f64 + 0.5);
-        let ndc = DVec4::new(px / f64::from(w) * 2.0 - 1.0, 1.0 - py / f64::from(h) * 2.0, f64::from(d), 1.0);
-        let rel = inverse * ndc;
-        let p = run.camera_grid_m + rel.truncate() / rel.w;
-        if p.z < low - 1.0 || p.z > high + 1.0 {
-            continue;
-        }
-        let Some((ring, cx, cy)) = run.layout.locate([p.x, p.y]) else { continue };
-        let (min, max) = run.layout.cell_rect_m(ring, cx, cy);
-        let margin = (0..2).map(|a| (p[a] - min[a]).min(max[a] - p[a])).fold(f64::INFINITY, f64::min);
-        if margin < 1.0 {
-            continue;
-        }
-        let cell = run.gpu[run.layout.index(ring, cx, cy)];
-        assert!(
-            cell.visibility != 0,
-            "{what}: pixel ({px}, {py}) shows ground of culled cell {:?}",
-            (ring, cx, cy)
-        );
-        checked += 1;
-    }
-    assert!(checked > 0 || depth.iter().all(|&d| d == 0.0), "{what}: no pixel checked");
-}
-
-/// The union of the ranges of the height tiles the cell's column and row overlap.
-fn cell_height_range(run: &Run, ring: u32, cx: u32, cy: u32) -> [f32; 2] {
-    let u = &run.frame.uniforms;
-    let (sx, sy) = (
-        run.frame.spans[((ring * 2) * u.cells + cx) as usize],
-        run.frame.spans[((ring * 2 + 1) * u.cells + cy) as usize],
-    );
-    let level = u.height_levels[u.rings_info[ring as usize].height_level as usize];
-    let mut range = [f32::MAX, f32::MIN];
-    let (xs, ys) = (TileSpan::unpack(sx.height_tiles), TileSpan::unpack(sy.height_tiles));
-    for ty in ys.first..=ys.last {
-        for tx in xs.first..=xs.last {
-            let r = run.ranges[(level[0] + ty * level[1] + tx) as usize];
-            range = [range[0].min(r[0]), range[1].max(r[1])];
-        }
-    }
-    range
-}
-
-/// Radial, imagery and terrain levels of visible cells equal an f64 computation, away from the
-/// thresholds (where f32 and f64 may round to either side).
-fn assert_levels_match_f64(r: &Renderer, run: &Run, camera: &Camera, what: &str) {
-    let s = &r.settings;
-    let mpp = camera.metres_per_pixel(1.0, s.render.height);
-    let imagery = r.dataset.manifest.imagery.as_ref();
-    let near = |d: f64, t: f64| (d - t).abs() < 1e-3 * t.max(1.0);
-    let mut checked = 0;
-    for (i, cell) in run.gpu.iter().enumerate().filter(|(_, c)| c.visibility != 0) {
-        let (ring, cx, cy) = run.layout.cell_of(i);
-        let (min, max) = run.layout.cell_rect_m(ring, cx, cy);
-        let height_m = cell_height_range(run, ring, cx, cy);
-        let lo =
-            DVec3::new(min[0].max(run.layout.dataset_min_m[0]), min[1].max(run.layout.dataset_min_m[1]), 0.0);
-        let hi =
-            DVec3::new(max[0].min(run.layout.dataset_max_m[0]), max[1].min(run.layout.dataset_max_m[1]), 0.0);
-        let lo = DVec3::new(lo.x, lo.y, f64::from(height_m[0])) - run.camera_grid_m;
-        let hi = DVec3::new(hi.x, hi.y, f64::from(height_m[1])) - run.camera_grid_m;
-        let nearest = DVec3::ZERO.clamp(lo, hi).length();
-        let farthest = lo.abs().max(hi.abs()).length();
-        let radial = s.tlm.radial_bands_m.iter().position(|&t| nearest < t).unwrap_or(3) as u32;
-        let hlod = |d: f64| run.lods.range_m.iter().position(|&range| d <= range).unwrap_or(0) as u32;
-        let tlod = |d: f64| {
-            imagery.map_or(0, |m| {
-                let level = (mpp * d / m.texel_m).log2() + s.imagery.lod_bias;
-                level.floor().clamp(0.0, f64::from(m.pyramid.levels - 1)) as u32
-            })
-        };
-        let ambiguous = s.tlm.radial_bands_m.iter().any(|&t| near(nearest, t))
-            || run.lods.range_m.iter().any(|&t| near(nearest, t) || near(farthest, t))
-            || imagery.is_some_and(|m| {
-                [nearest, farthest].iter().any(|&d| {
-                    let level = (mpp * d / m.texel_m).log2() + s.imagery.lod_bias;
-                    (level - level.round()).abs() < 1e-3
-                })
-            });
-        if ambiguous {
-            continue;
-        }
-        assert_eq!(cell.radial_lod, radial, "{what}: radial LOD of {:?} at {nearest:.1} m", (ring, cx, cy));
-        assert_eq!(
-            cell.height_lod,
-            hlod(nearest) | hlod(farthest) << 8,
-            "{what}: height LOD of {:?}",
-            (ring, cx, cy)
-        );
-        let imagery_lod = if imagery.is_some() { tlod(nearest) | tlod(farthest) << 8 } else { 0 };
-        assert_eq!(cell.imagery_lod, imagery_lod, "{what}: imagery LOD of {:?}", (ring, cx, cy));
-        if ring == 0 {
-            let g = run.layout.global_address(ring, cx, cy);
-            let pattern = pattern_hash(g.x as i32 as u32, g.y as i32 as u32, s.tlm.seed) % s.tlm.patterns;
-            assert_eq!(cell.visibility, 1 + pattern, "{what}: pattern of {g:?}");
-        } else {
-            assert_eq!(cell.visibility, 1);
-        }
-        checked += 1;
-    }
-    assert!(checked > 0 || visible(&run.gpu) == 0, "{what}: nothing checked");
 }
 
 /// Grid position of the highest sample of a coarse level, with its height.
@@ -262,21 +49,6 @@ fn peak(r: &Renderer) -> DVec3 {
     best
 }
 
-fn camera_at(r: &Renderer, grid_m: DVec3, yaw_deg: f64, pitch_deg: f64) -> Camera {
-    let o = r.dataset.manifest.origin_m;
-    Camera {
-        position_m: grid_m + DVec3::new(o[0], o[1], 0.0),
-        yaw_deg,
-        pitch_deg,
-        fov_deg: 60.0,
-        near_m: 0.1,
-    }
-}
-
-fn ground(r: &Renderer, x: f64, y: f64) -> f64 {
-    r.dataset.height_at(x, y, 0).unwrap()
-}
-
 #[test]
 fn gpu_equals_twin_and_never_culls_what_is_on_screen() {
     let dataset = synth_dataset(600, 3);
@@ -293,13 +65,13 @@ fn gpu_equals_twin_and_never_culls_what_is_on_screen() {
     let to_peak = top - foot;
     let yaw = to_peak.x.atan2(to_peak.y).to_degrees();
     let cameras = [
-        ("high oblique", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 2500.0), 30.0, -35.0)),
-        ("low grazing", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 3.0), 200.0, -2.0)),
-        ("mountain", camera_at(&r, DVec3::new(foot.x, foot.y, ground(&r, foot.x, foot.y) + 5.0), yaw, 2.0)),
+        ("high oblique", over(&r, [cx, cy], 2500.0, 30.0, -35.0)),
+        ("low grazing", over(&r, [cx, cy], 3.0, 200.0, -2.0)),
+        ("mountain", over(&r, [foot.x, foot.y], 5.0, yaw, 2.0)),
         ("outside looking in", camera_at(&r, DVec3::new(-2000.0, -1500.0, top.z + 600.0), 50.0, -12.0)),
         ("sky", camera_at(&r, DVec3::new(cx, cy, top.z + 30.0), 80.0, 40.0)),
-        ("low, up the slopes", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 20.0), 80.0, 25.0)),
-        ("straight down", camera_at(&r, DVec3::new(cx, cy, ground(&r, cx, cy) + 800.0), 0.0, -90.0)),
+        ("low, up the slopes", over(&r, [cx, cy], 20.0, 80.0, 25.0)),
+        ("straight down", over(&r, [cx, cy], 800.0, 0.0, -90.0)),
     ];
     for (what, camera) in &cameras {
         let run = run(&mut r, camera, &ranges);
@@ -341,14 +113,14 @@ fn cells_behind_a_wall_are_occluded() {
     let mut r = renderer(&dataset, settings);
     let ranges = height_tile_ranges(&r.dataset);
     let [w, h] = r.dataset.manifest.extent_m();
-    let camera = camera_at(&r, DVec3::new(0.5 * w, 0.3 * h, ground(&r, 0.5 * w, 0.3 * h) + 60.0), 10.0, -6.0);
+    let camera = over(&r, [0.5 * w, 0.3 * h], 60.0, 10.0, -6.0);
     let (wall_m, tolerance_m) = (600.0, r.settings.tlm.occlusion_tolerance_m);
     let open = run(&mut r, &camera, &ranges);
     let walled = run_with(&mut r, &camera, &ranges, Some(wall_m));
     assert_gpu_equals_twin(&walled, "wall");
     let (mut kept, mut hidden) = (0, 0);
     for (i, (before, after)) in
-        open.gpu.iter().zip(&walled.gpu).enumerate().filter(|(_, (b, _))| b.visibility != 0)
+        open.gpu.iter().zip(&walled.gpu).enumerate().filter(|(_, (b, _))| b.visibility != TLM_CULLED)
     {
         // The box's nearest view depth (w), in f64: where it is clearly before or behind the wall,
         // the pass must agree.
@@ -369,7 +141,7 @@ fn cells_behind_a_wall_are_occluded() {
             assert_eq!(after, before, "cell {:?} before the wall", (ring, cx, cy));
             kept += 1;
         } else if nearest_w > wall_m + tolerance_m + 1.0 {
-            assert_eq!(after.visibility, 0, "cell {:?} behind the wall", (ring, cx, cy));
+            assert_eq!(after.visibility, TLM_CULLED, "cell {:?} behind the wall", (ring, cx, cy));
             hidden += 1;
         }
     }
@@ -382,8 +154,7 @@ fn default_settings_one_ring_over_a_small_dataset() {
     let dataset = synth_dataset(300, 7);
     let mut r = renderer(&dataset, small_settings(160, 96));
     let [w, h] = r.dataset.manifest.extent_m();
-    let camera =
-        camera_at(&r, DVec3::new(0.3 * w, 0.4 * h, ground(&r, 0.3 * w, 0.4 * h) + 150.0), 60.0, -15.0);
+    let camera = over(&r, [0.3 * w, 0.4 * h], 150.0, 60.0, -15.0);
     let ranges = height_tile_ranges(&r.dataset);
     let run = run(&mut r, &camera, &ranges);
     assert_eq!(run.layout.rings, 1, "a 3 km dataset fits in ring 0 (16 km)");
@@ -508,8 +279,7 @@ fn depth_pyramid_equals_a_cpu_min_reduction_at_odd_sizes() {
     for (w, h) in [(157, 93), (33, 7), (1, 5)] {
         let mut r = renderer(&dataset, small_settings(w, h));
         let [ew, eh] = r.dataset.manifest.extent_m();
-        let camera =
-            camera_at(&r, DVec3::new(0.5 * ew, 0.5 * eh, ground(&r, 0.5 * ew, 0.5 * eh) + 120.0), 20.0, -8.0);
+        let camera = over(&r, [0.5 * ew, 0.5 * eh], 120.0, 20.0, -8.0);
         r.render(&camera).unwrap();
         let hiz = DepthPyramid::new(&r.gpu.device, w, h);
         let mut encoder = r.gpu.device.create_command_encoder(&Default::default());
@@ -587,7 +357,7 @@ fn timings_at_1280x720() {
     let mut r = renderer(&dataset, Settings::default());
     let [w, h] = r.dataset.manifest.extent_m();
     let ranges = height_tile_ranges(&r.dataset);
-    let near = camera_at(&r, DVec3::new(0.2 * w, 0.2 * h, ground(&r, 0.2 * w, 0.2 * h) + 300.0), 45.0, -12.0);
+    let near = over(&r, [0.2 * w, 0.2 * h], 300.0, 45.0, -12.0);
     // 40 km south-west of the dataset: four rings to reach it.
     let far = camera_at(&r, DVec3::new(-40_000.0, -40_000.0, 3000.0), 45.0, -3.0);
     for camera in [near, far] {

@@ -1,15 +1,15 @@
 //! `terramp-data build` end to end: real GeoTIFFs from the shared data in, datasets out, opened
 //! with the runtime library and compared with what GDAL reads from the sources.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
 use std::path::Path;
 
 use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
-use support::{
-    TempDir, build, gdal_band, height_image, level_image, mask_image, north_first, number_before, shared_data,
-};
+use support::{build, gdal_band, height_image, level_image, mask_image, north_first, number_before};
 use terramp::dataset::{Dataset, DatasetError, PackError, TileId};
+use terramp_testkit::{TempDir, shared_data};
 
 /// Truth from `gdallocationinfo -valonly nc/elev_ned_30m.tif COL ROW`: (row, col, metres).
 const NC_KNOWN: [(u32, u32, f64); 5] = [

@@ -1,12 +1,14 @@
 //! `terramp-data build` on inputs made here with GDAL (no shared data needed): bad inputs fail
 //! clearly, naming the file; voids that straddle tiles are filled identically by every tile.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
 use std::path::{Path, PathBuf};
 
 use gdal::GeoTransform;
-use support::{TempDir, build, height_image, mask_image, run_build, write_geotiff};
+use support::{build, height_image, mask_image, run_build, write_geotiff};
+use terramp_testkit::TempDir;
 
 const NODATA: f64 = -9999.0;
 /// UTM 33N: a projected, metric CRS.

@@ -10,6 +10,7 @@
 //!
 //! The figure `docs/nc_trees.png` (960×540, accurate preset) comes from the ignored test:
 //! `WGPU_BACKEND=vulkan cargo test --release -p terramp-data-tools --test draw_seeds -- --ignored`.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
@@ -23,7 +24,8 @@ use terramp::dataset::Dataset;
 use terramp::frame::{FrameReport, Renderer};
 use terramp::gpu::{AdapterChoice, Gpu};
 
-use support::{TempDir, build_nc, shared_data};
+use support::{build_nc, tests_dir};
+use terramp_testkit::{TempDir, shared_data};
 
 const FOREST: u8 = 5;
 /// The test's view: metres above the forest, and pitch (degrees) down towards the lake: high
@@ -130,7 +132,7 @@ fn open_view(
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
     let ([x, y], yaw_deg) = pose;
-    let camera = support::camera_over(&r, [x, y, above_m, yaw_deg, pitch_deg]);
+    let camera = terramp_testkit::camera::over(&r, [x, y], above_m, yaw_deg, pitch_deg);
     r.render_resolved(&camera, 200).unwrap();
     let mut report = r.render(&camera).unwrap();
     for _ in 0..4 {
@@ -216,9 +218,9 @@ fn nc_forest_draws_trees() {
 
     let reopened = Dataset::open(&path).unwrap();
     trees_stand_on_forest_not_on_water(&reopened, &camera, size, &bare, &bare_depth, &trees);
-    support::check_reference(&trees, REFERENCE, MIN_PSNR_DB, tmp.path());
+    terramp_testkit::check_reference(&trees, &tests_dir(), REFERENCE, MIN_PSNR_DB, tmp.path());
     // Without the trees the frame is far from the reference: the tolerance cannot hide them.
-    let bare_db = support::psnr(&bare, &image::open(reference_path()).unwrap().to_rgba8());
+    let bare_db = terramp_testkit::psnr(&bare, &image::open(reference_path()).unwrap().to_rgba8());
     println!("the frame without trees: {bare_db:.1} dB against the reference");
     assert!(bare_db < MIN_PSNR_DB - 5.0, "the bare frame is {bare_db:.1} dB from the reference");
 }

@@ -10,6 +10,7 @@
 //!   renders without holes seen from below, from above and at exactly 89.9° incidence on the flat
 //!   ground, and no seed stands on its face.
 //! - A one-pixel DEM builds and renders.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
@@ -21,8 +22,9 @@ use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::{AdapterChoice, Gpu};
 
-use support::audit::{Audit, Dem, Tolerance, audit, camera_at};
-use support::{TempDir, build, build_zion, mask_image, shared_data, write_geotiff};
+use support::{build, build_zion, mask_image, write_geotiff};
+use terramp_testkit::audit::{Audit, Dem, Tolerance, audit, camera_at};
+use terramp_testkit::{TempDir, shared_data};
 
 fn renderer(dataset: Dataset, width: u32, height: u32) -> Renderer {
     let mut settings = Settings::default();

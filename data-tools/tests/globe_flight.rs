@@ -8,6 +8,7 @@
 //! anonymous resident memory (heap, and on a software adapter the GPU's own allocations) is no
 //! higher at the end of the flight than after the warm-up, within a small bound. Along the way
 //! every frame renders without a GPU error, draws terrain and has no tile that failed to load.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
@@ -19,7 +20,8 @@ use terramp::frame::Renderer;
 use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::path::CameraPath;
 
-use support::{TempDir, build, shared_data};
+use support::build;
+use terramp_testkit::{TempDir, shared_data};
 
 /// 7,500 km from the Alps to Everest, 5.5–12 km above the datum (see the file's comments).
 const PATH: &str = "../config/paths/globe.toml";

@@ -5,14 +5,16 @@
 //! it), so the builder reads them without warping and the truth is the raster as GDAL reads it,
 //! independently of the builder: level 1 is the source texel for texel, level 0 repeats each on its
 //! 2 × 2 children, level 2 packs the 4 it covers (the edge texel repeated past an odd size).
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
 use std::path::Path;
 
-use support::{TempDir, build, gdal_band, level_image, shared_data};
+use support::{build, gdal_band, level_image};
 use terramp::dataset::Dataset;
 use terramp::dataset::lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
+use terramp_testkit::{TempDir, shared_data};
 
 /// The source's classes, south row first, with the source's nodata as the table's nodata code.
 struct Truth {

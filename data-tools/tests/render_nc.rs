@@ -1,6 +1,7 @@
 //! The render of `nc/` (DEM, Landsat imagery, land cover) from a fixed camera is not blank and
 //! matches the reference image within a tolerance. Regenerate the reference after an intended
 //! change of the look with `TERRAMP_BLESS=1 cargo test -p terramp-data-tools --test render_nc`.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
@@ -10,7 +11,8 @@ use terramp::config::Settings;
 use terramp::frame::Renderer;
 use terramp::gpu::{AdapterChoice, Gpu};
 
-use support::{TempDir, build_nc, shared_data};
+use support::{build_nc, tests_dir};
+use terramp_testkit::{TempDir, shared_data};
 
 const REFERENCE: &str = "reference/nc_240x135.png";
 /// Rasterisers differ in the last bits of filtering and coverage; a broken frame is far below this.
@@ -46,5 +48,5 @@ fn nc_renders_like_its_reference() {
     let lower: Vec<u32> = image.pixels().skip(image.pixels().len() / 2).map(|p| u32::from(p[1])).collect();
     assert!(lower.iter().max().unwrap() - lower.iter().min().unwrap() > 40);
 
-    support::check_reference(&image, REFERENCE, MIN_PSNR_DB, dir.path());
+    terramp_testkit::check_reference(&image, &tests_dir(), REFERENCE, MIN_PSNR_DB, dir.path());
 }

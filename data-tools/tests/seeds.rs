@@ -4,6 +4,7 @@
 //! preset keeps at least 99 % of the visible seeds with at least 95 % precision; and on `nc/` the
 //! species follow the map: no trees on water or developed land, and each class's seed count
 //! matches its table density over the ground it covers.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
@@ -23,8 +24,10 @@ use terramp::reference::accuracy::{HeightError, SeedAgreement, SeedId, record_id
 use terramp::reference::oracle::{OracleInputs, visible_seeds};
 use terramp::reference::seed_select::SeedComparison;
 use terramp::seeds::cell_pattern;
+use terramp_testkit::camera::posed;
 
-use support::{TempDir, build_nc, build_zion, camera_over, shared_data};
+use support::{build_nc, build_zion};
+use terramp_testkit::{TempDir, shared_data};
 
 /// Named camera poses: grid x, y, height above the ground, yaw, pitch.
 type Poses<'a> = &'a [(&'a str, [f64; 5])];
@@ -46,7 +49,7 @@ fn worst_base_error_m(r: &Renderer, camera: &Camera, seeds: &[SeedRecord]) -> f6
 fn gpu_equals_twin(dataset: Dataset, views: Poses) {
     let mut r = renderer(dataset, Settings::default(), 320, 180);
     for &(what, pose) in views {
-        let camera = camera_over(&r, pose);
+        let camera = posed(&r, pose);
         r.render_resolved(&camera, 80).unwrap();
         let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
         let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
@@ -101,7 +104,7 @@ fn nc_and_zion_gpu_equals_twin() {
 
 /// Recall and precision of the GPU's seeds against the oracle's visible set from `pose`.
 fn recall_precision(r: &mut Renderer, what: &str, pose: [f64; 5]) -> (f64, f64, usize) {
-    let camera = camera_over(r, pose);
+    let camera = posed(r, pose);
     r.render_resolved(&camera, 80).unwrap();
     let (gpu, _) = r.read_seeds().unwrap().unwrap();
     let (tables, patterns) = r.seed_world().unwrap();
@@ -210,7 +213,7 @@ fn nc_species_follow_the_land_cover() {
     r.pin_everything().unwrap();
     let [w, h] = r.dataset.manifest.extent_m();
     // Straight down from high above the middle: a 16 × 16 block of cells (4 km) in full view.
-    let camera = camera_over(&r, [0.5 * w, 0.5 * h, 12000.0, 0.0, -89.9]);
+    let camera = posed(&r, [0.5 * w, 0.5 * h, 12000.0, 0.0, -89.9]);
     r.render_resolved(&camera, 40).unwrap();
     let cell_m = r.settings.tlm.cell_m;
     let first = [0.5 * w, 0.5 * h].map(|v| (v / cell_m).floor() as i64 - 8);

@@ -1,61 +1,20 @@
 //! The Tile Load Map on real data: `nc/` and `rainier/` are built into a temporary folder, rendered
 //! from several cameras on the software adapter, and the GPU pass must equal its CPU twin in every
 //! field of every cell (and keep some cells, and cull the sky).
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
 
-use glam::DVec3;
-use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
-use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::{AdapterChoice, Gpu};
-use terramp::passes::depth_pyramid::gpu::DepthPyramid;
-use terramp::passes::terrain::select::Lods;
-use terramp::passes::tile_load_map::frame::{TlmImagery, TlmInputs, height_tile_ranges};
-use terramp::passes::tile_load_map::gpu::TileLoadMapPass;
-use terramp::passes::tile_load_map::layout::TlmLayout;
-use terramp::reference::tile_load_map::tile_load_map;
+use terramp::passes::tile_load_map::frame::height_tile_ranges;
+use terramp_testkit::camera::posed;
+use terramp_testkit::tlm::{assert_gpu_equals_twin, run, visible};
+use terramp_testkit::{TempDir, shared_data};
 
-use support::{TempDir, build, shared_data};
-
-/// Renders `camera`, runs the depth pyramid and the TLM on its depth and the twin on the same
-/// inputs; returns (GPU cells, twin cells, rings).
-fn gpu_and_twin(r: &mut Renderer, camera: &Camera) -> (Vec<TlmCell>, Vec<TlmCell>, u32) {
-    r.render(camera).unwrap();
-    let s = r.settings.clone();
-    let (w, h) = (s.render.width, s.render.height);
-    let device = &r.gpu.device;
-    let hiz = DepthPyramid::new(device, w, h);
-    let pass = TileLoadMapPass::new(device, &s);
-    let ranges = height_tile_ranges(&r.dataset);
-    let bindings = pass.bind_group(device, &ranges, &hiz);
-    let m = &r.dataset.manifest;
-    let camera_grid_m = camera.position_m - DVec3::new(m.origin_m[0], m.origin_m[1], 0.0);
-    let lods = Lods::for_view(&r.dataset, &s.terrain, camera, h);
-    let rect = TlmLayout::dataset_rect_m(&lods.pyramid, lods.spacing_m);
-    let layout = TlmLayout::new(&s.tlm, rect, [camera_grid_m.x, camera_grid_m.y]);
-    let imagery = TlmImagery::of(&r.dataset, &s.imagery);
-    let inputs = TlmInputs {
-        settings: &s.tlm,
-        layout: &layout,
-        camera,
-        camera_grid_m,
-        viewport_px: [w, h],
-        lods: &lods,
-        imagery,
-        hiz_mips: hiz.mips(),
-    };
-    let frame = pass.prepare(&r.gpu.queue, &inputs).unwrap();
-    let mut encoder = device.create_command_encoder(&Default::default());
-    hiz.encode(&mut encoder, &r.depth_texture().create_view(&Default::default()));
-    pass.encode(&mut encoder, &bindings, &frame);
-    r.gpu.queue.submit([encoder.finish()]);
-    let gpu = pass.read_back(&r.gpu, &frame).unwrap();
-    let twin = tile_load_map(&frame.uniforms, &frame.spans, &ranges, &hiz.read_back(&r.gpu).unwrap());
-    (gpu, twin, layout.rings)
-}
+use support::build;
 
 fn check(dataset: Dataset, cameras: &[(&str, [f64; 5])]) {
     let mut settings = Settings::default();
@@ -63,15 +22,14 @@ fn check(dataset: Dataset, cameras: &[(&str, [f64; 5])]) {
     settings.render.height = 96;
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
+    let ranges = height_tile_ranges(&r.dataset);
     for &(what, pose) in cameras {
         // Positions are grid metres; heights above the ground there (clamped into the dataset).
-        let camera = support::camera_over(&r, pose);
-        let (gpu, twin, rings) = gpu_and_twin(&mut r, &camera);
-        let differ: Vec<usize> = (0..gpu.len()).filter(|&i| gpu[i] != twin[i]).collect();
-        let shown: Vec<_> = differ.iter().take(5).map(|&i| (i, gpu[i], twin[i])).collect();
-        assert!(differ.is_empty(), "{what}: {} cells differ (index, GPU, twin): {shown:?}", differ.len());
-        let visible = gpu.iter().filter(|c| c.visibility != 0).count();
-        println!("{what}: {rings} rings, {visible} of {} cells visible", gpu.len());
+        let camera = posed(&r, pose);
+        let run = run(&mut r, &camera, &ranges);
+        assert_gpu_equals_twin(&run, what);
+        let visible = visible(&run.gpu);
+        println!("{what}: {} rings, {visible} of {} cells visible", run.layout.rings, run.gpu.len());
         if what.contains("sky") {
             assert_eq!(visible, 0, "{what}");
         } else {

@@ -11,8 +11,8 @@ use terramp::gpu::gpu_types::SeedRecord;
 use terramp::seeds::cell_pattern;
 use terramp::synth::SynthParams;
 
-use crate::common::audit::{Dem, Tolerance, audit, camera_at};
-use crate::common::{self, small_settings};
+use terramp_testkit::audit::{Dem, Tolerance, audit, camera_at};
+use terramp_testkit::small_settings;
 
 const ORIGINS_M: [[f64; 2]; 3] = [[0.0, 0.0], [500_000.0, 5_000_000.0], [1e7, 1e7]];
 
@@ -52,8 +52,8 @@ fn worst_placement_error_m(r: &Renderer, seeds: &[SeedRecord], camera_grid_m: DV
 
 fn render(origin_m: [f64; 2], pose: [f64; 5]) -> Frame {
     let params = SynthParams { size: 256, seed: 7, origin_m, ..Default::default() };
-    let dataset = common::synth_dataset_with(&params);
-    let mut r = common::renderer(&dataset, small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset_with(&params);
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(320, 180));
     let dem = Dem::load(&r.dataset);
     let camera = camera(&r, &dem, pose);
     r.render_resolved(&camera, 60).unwrap();
@@ -79,7 +79,7 @@ fn utm_and_1e7_offsets_render_the_same_image_and_seeds() {
             let moved = render(*origin, pose);
             let differing =
                 at_origin.image.pixels().zip(moved.image.pixels()).filter(|(a, b)| a != b).count();
-            let psnr = common::psnr(&at_origin.image, &moved.image);
+            let psnr = terramp_testkit::psnr(&at_origin.image, &moved.image);
             // The same seeds, each at the same place relative to the dataset.
             let id = |s: &SeedRecord| (s.address, s.rank, s.species_lod);
             assert!(at_origin.seeds.iter().map(id).eq(moved.seeds.iter().map(id)), "{origin:?}: other seeds");
@@ -105,8 +105,8 @@ fn utm_and_1e7_offsets_render_the_same_image_and_seeds() {
 fn a_planet_size_dataset_places_seeds_to_the_centimetre_10_million_metres_out() {
     // 257 samples 39 km apart: 10 000 km on a side, the camera 5 000 km from the origin.
     let params = SynthParams { size: 257, seed: 3, spacing_m: 39_062.5, ..Default::default() };
-    let dataset = common::synth_dataset_with(&params);
-    let mut r = common::renderer(&dataset, small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset_with(&params);
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(320, 180));
     let dem = Dem::load(&r.dataset);
     let mut grown = 0;
     for (k, grid) in [[5.0e6, 5.0e6], [5.3e6, 4.7e6], [9.7e6, 9.8e6], [2.2e6, 7.9e6]].iter().enumerate() {

@@ -6,14 +6,14 @@ use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::synth::SynthParams;
 
-use crate::common::audit::{Dem, Tolerance, audit, camera_at};
-use crate::common::{self, small_settings};
+use terramp_testkit::audit::{Dem, Tolerance, audit, camera_at};
+use terramp_testkit::small_settings;
 
 #[test]
 fn cameras_outside_every_corner_and_edge_look_in() {
-    let dataset = common::synth_dataset(256, 7);
+    let dataset = terramp_testkit::synth_dataset(256, 7);
     // Sixteen views: a smaller frame keeps them quick.
-    let mut r = common::renderer(&dataset, small_settings(192, 108));
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(192, 108));
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let centre = [0.5 * span[0], 0.5 * span[1]];
@@ -48,8 +48,9 @@ fn cameras_outside_every_corner_and_edge_look_in() {
 #[test]
 fn datasets_of_one_sample_one_cell_and_one_tile_render() {
     for size in [1, 2, 257] {
-        let dataset = common::synth_dataset_with(&SynthParams { size, seed: 7, ..Default::default() });
-        let mut r = common::renderer(&dataset, small_settings(160, 90));
+        let dataset =
+            terramp_testkit::synth_dataset_with(&SynthParams { size, seed: 7, ..Default::default() });
+        let mut r = terramp_testkit::renderer(&dataset, small_settings(160, 90));
         assert_eq!(r.dataset.height.pyramid.tiles_at(0), [1, 1], "size {size}");
         let dem = Dem::load(&r.dataset);
         let span = dem.span_m();
@@ -76,10 +77,10 @@ fn datasets_of_one_sample_one_cell_and_one_tile_render() {
 fn grows_nothing(name: &str, text: &str) {
     let path = std::env::temp_dir().join(format!("terramp-extremes-{name}-{}.toml", std::process::id()));
     std::fs::write(&path, text).unwrap();
-    let dataset = common::synth_dataset(256, 7);
+    let dataset = terramp_testkit::synth_dataset(256, 7);
     let mut settings = small_settings(320, 180);
     settings.seeds.class_table = path.to_str().unwrap().to_owned();
-    let mut r = common::renderer(&dataset, settings);
+    let mut r = terramp_testkit::renderer(&dataset, settings);
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let camera = camera_at(&r, &dem, [0.4 * span[0], 0.4 * span[1]], 30.0, 60.0, -15.0);

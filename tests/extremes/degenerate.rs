@@ -8,13 +8,14 @@ use terramp::camera::{Camera, CameraError, MAX_COORDINATE_M, MIN_FOV_DEG, MIN_NE
 use terramp::dataset::Dataset;
 use terramp::frame::{GROUND_CLEARANCE_NEAR, RenderError, Renderer};
 
-use crate::common::audit::{Dem, Tolerance, audit, camera_at};
-use crate::common::{self, small_settings};
+use terramp_testkit::audit::{Dem, Tolerance, audit, camera_at};
+use terramp_testkit::small_settings;
 
 #[test]
 fn viewports_of_no_area_or_too_large_are_errors() {
-    let dataset = common::synth_dataset(64, 7);
-    let open = |w, h| Renderer::new(common::gpu(), Dataset::open(&dataset).unwrap(), small_settings(w, h));
+    let dataset = terramp_testkit::synth_dataset(64, 7);
+    let open =
+        |w, h| Renderer::new(terramp_testkit::gpu(), Dataset::open(&dataset).unwrap(), small_settings(w, h));
     for (w, h) in [(0, 180), (320, 0), (0, 0)] {
         assert!(matches!(open(w, h), Err(RenderError::Camera(CameraError::Viewport(..)))), "{w}×{h}");
     }
@@ -46,8 +47,8 @@ fn silhouette(dem: &Dem, eye: DVec3, yaw_deg: f64) -> (f64, [f64; 2]) {
 
 #[test]
 fn fields_of_view_near_0_and_180_render_or_are_refused() {
-    let dataset = common::synth_dataset(256, 7);
-    let mut r = common::renderer(&dataset, small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset(256, 7);
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(320, 180));
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let level = camera_at(&r, &dem, [0.3 * span[0], 0.3 * span[1]], 20.0, 45.0, 0.0);
@@ -121,8 +122,8 @@ fn the_narrowest_field_of_view_keeps_pixels_in_place_in_f32() {
 
 #[test]
 fn non_finite_and_absurd_cameras_are_errors_and_the_renderer_goes_on() {
-    let dataset = common::synth_dataset(256, 7);
-    let mut r = common::renderer(&dataset, small_settings(160, 90));
+    let dataset = terramp_testkit::synth_dataset(256, 7);
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(160, 90));
     let dem = Dem::load(&r.dataset);
     let good = camera_at(&r, &dem, [800.0, 900.0], 30.0, 60.0, -10.0);
     r.render_resolved(&good, 60).unwrap();
@@ -164,8 +165,8 @@ fn non_finite_and_absurd_cameras_are_errors_and_the_renderer_goes_on() {
 
 #[test]
 fn a_camera_inside_the_terrain_is_lifted_above_it() {
-    let dataset = common::synth_dataset(256, 7);
-    let mut r = common::renderer(&dataset, small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset(256, 7);
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(320, 180));
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let spot = [0.55 * span[0], 0.45 * span[1]];

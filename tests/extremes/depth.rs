@@ -14,8 +14,8 @@ use terramp::gpu::Gpu;
 use terramp::passes::DEPTH_FORMAT;
 use wgpu::util::DeviceExt;
 
-use crate::common::audit::{Dem, Tolerance, audit, camera_at};
-use crate::common::{self, small_settings};
+use terramp_testkit::audit::{Dem, Tolerance, audit, camera_at};
+use terramp_testkit::small_settings;
 
 const NEAR_M: f64 = 0.1;
 const FAR_M: f64 = 500_000.0;
@@ -218,7 +218,7 @@ impl Quads {
 
 #[test]
 fn two_surfaces_close_together_resolve_from_20_cm_to_500_km() {
-    let gpu = common::gpu();
+    let gpu = terramp_testkit::gpu();
     let quads = Quads::new(&gpu.device);
     let clip = level_camera().clip_from_view_world(SIZE_PX, SIZE_PX).unwrap();
     let (near, far) = ([255.0, 0.0, 0.0, 255.0].map(|v| v / 255.0), [0.0, 1.0, 0.0, 1.0]);
@@ -243,8 +243,8 @@ fn two_surfaces_close_together_resolve_from_20_cm_to_500_km() {
 
 #[test]
 fn cameras_2_m_and_100_km_and_500_km_up_see_ground_and_sky_where_they_must() {
-    let dataset = common::synth_dataset(256, 7);
-    let mut r = common::renderer(&dataset, small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset(256, 7);
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(320, 180));
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let centre = [0.5 * span[0], 0.5 * span[1]];

@@ -6,8 +6,8 @@
 
 use terramp::synth::SynthParams;
 
-use crate::common::audit::{Dem, Tolerance, audit, camera_at};
-use crate::common::{self, small_settings};
+use terramp_testkit::audit::{Dem, Tolerance, audit, camera_at};
+use terramp_testkit::small_settings;
 
 /// The longest run of flat water samples along x (start sample, length in samples).
 fn longest_lake_run(dem: &Dem, water_m: f64) -> ([u32; 2], u32) {
@@ -28,8 +28,8 @@ fn longest_lake_run(dem: &Dem, water_m: f64) -> ([u32; 2], u32) {
 #[test]
 fn grazing_and_horizontal_views_keep_every_buffer_finite_and_the_ground_whole() {
     let params = SynthParams { size: 256, seed: 7, ..Default::default() };
-    let dataset = common::synth_dataset_with(&params);
-    let mut r = common::renderer(&dataset, small_settings(320, 180));
+    let dataset = terramp_testkit::synth_dataset_with(&params);
+    let mut r = terramp_testkit::renderer(&dataset, small_settings(320, 180));
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let ([i, j], run) = longest_lake_run(&dem, params.water_level_m);

@@ -1,8 +1,9 @@
-//! Helpers for the `terramp-data build` tests: the shared data, temporary folders, running the
-//! binary, writing and reading rasters with GDAL, built layers level by level, and (from the
-//! library's tests) frame audits.
+//! Helpers for the `terramp-data` tests that need GDAL or the binary: running `build`, building the
+//! shared samples, writing and reading rasters with GDAL, built layers level by level. Everything
+//! else (the shared data, temporary folders, cameras, the audit, image checks) is the workspace's
+//! test kit, `terramp_testkit`.
 
-#![allow(dead_code)]
+#![allow(dead_code, reason = "each test binary uses a part of these helpers")]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -11,46 +12,7 @@ use gdal::raster::{Buffer, GdalType};
 use gdal::spatial_ref::SpatialRef;
 use gdal::{DriverManager, GeoTransform};
 use terramp::dataset::{Dataset, Pyramid, Sampling, TileId};
-
-/// Frame audits shared with the library's extreme-case tests (`tests/extremes.rs`).
-#[path = "../../../tests/common/audit.rs"]
-pub mod audit;
-
-/// `<workspace root>/../shared/data`, or `None` (after saying why) when it is absent. On CI its
-/// absence is a failure, never a silent skip.
-pub fn shared_data() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    if std::env::var("CI").as_deref() == Ok("true") {
-        panic!("the shared data is missing at {} (required on CI)", dir.display());
-    }
-    eprintln!("skipping: no shared data at {}", dir.display());
-    None
-}
-
-/// A temporary folder, removed when dropped.
-pub struct TempDir(PathBuf);
-
-impl TempDir {
-    pub fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("terramp-data-build-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-
-    pub fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+use terramp_testkit::shared_data;
 
 /// Writes a one-band GeoTIFF of `size` values (row by row from the north) in EPSG `epsg`.
 pub fn write_geotiff<T: GdalType + Copy>(
@@ -182,48 +144,7 @@ pub fn number_before(text: &str, label: &str) -> u64 {
     text[start..end].parse().unwrap()
 }
 
-/// PSNR of `a` against `b` over RGB, dB (infinite when equal).
-pub fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    let squared: f64 = a
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..3).map(move |c| (f64::from(p[c]) - f64::from(q[c])).powi(2)))
-        .sum();
-    let mse = squared / (3 * a.width() * a.height()) as f64;
-    if mse == 0.0 { f64::INFINITY } else { 10.0 * (255.0f64.powi(2) / mse).log10() }
-}
-
-/// Compares `image` with the reference `tests/<name>` (PSNR at least `min_db`), or rewrites the
-/// reference when `TERRAMP_BLESS=1`. A mismatch saves the image beside `keep_dir` for inspection.
-pub fn check_reference(image: &image::RgbaImage, name: &str, min_db: f64, keep_dir: &Path) -> f64 {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join(name);
-    if std::env::var("TERRAMP_BLESS").is_ok_and(|v| v == "1") {
-        image.save(&path).unwrap();
-        return f64::INFINITY;
-    }
-    let reference = image::open(&path).unwrap().to_rgba8();
-    let db = psnr(image, &reference);
-    println!("{name}: {db:.1} dB against the reference");
-    if db < min_db {
-        let actual = keep_dir.join("actual.png");
-        image.save(&actual).unwrap();
-        panic!("the render differs from {name}: PSNR {db:.1} dB < {min_db} dB (saved {})", actual.display());
-    }
-    db
-}
-
-/// A camera at grid (`x`, `y`), `above_m` over the ground there, 60° field of view.
-pub fn camera_over(
-    r: &terramp::frame::Renderer,
-    [x, y, above_m, yaw_deg, pitch_deg]: [f64; 5],
-) -> terramp::camera::Camera {
-    let origin = r.dataset.manifest.origin_m;
-    let ground = r.dataset.height_at(x, y, 0).unwrap();
-    terramp::camera::Camera {
-        position_m: glam::DVec3::new(origin[0] + x, origin[1] + y, ground + above_m),
-        yaw_deg,
-        pitch_deg,
-        fov_deg: 60.0,
-        near_m: 0.1,
-    }
+/// This crate's `tests/` folder, where the reference images live.
+pub fn tests_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests")
 }

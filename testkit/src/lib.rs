@@ -1,0 +1,21 @@
+//! Shared test support of the terramp workspace (a dev-dependency of `terramp` and
+//! `terramp-data-tools`): where the shared real data lives (`data`), synthetic datasets built
+//! once per test process (`datasets`), a GPU and renderers (`setup`), cameras (`camera`), the
+//! frame audit against rays through the f64 DEM (`audit`), the Tile Load Map's GPU-vs-twin
+//! harness (`tlm`) and golden-image comparison (`images`, over the library's metrics).
+//!
+//! Tests fail by panicking, so this crate unwraps freely.
+#![allow(clippy::unwrap_used, reason = "test support: a failure is a panic that names it")]
+
+pub mod audit;
+pub mod camera;
+pub mod data;
+pub mod datasets;
+pub mod images;
+pub mod setup;
+pub mod tlm;
+
+pub use data::{TempDir, shared_data};
+pub use datasets::{synth_dataset, synth_dataset_with};
+pub use images::{check_reference, psnr};
+pub use setup::{gpu, renderer, small_settings};

@@ -1,0 +1,27 @@
+//! The software adapter tests run on (CI forces `WGPU_BACKEND=vulkan`), settings sized for tests,
+//! and renderers over a dataset folder.
+
+use std::path::Path;
+
+use terramp::config::Settings;
+use terramp::dataset::Dataset;
+use terramp::frame::Renderer;
+use terramp::gpu::{AdapterChoice, Gpu};
+
+/// The adapter tests run on: a hardware GPU if there is one, else lavapipe.
+pub fn gpu() -> Gpu {
+    Gpu::new(AdapterChoice::Auto).expect("tests need a GPU adapter; install mesa-vulkan-drivers")
+}
+
+/// The default settings with a `width` × `height` viewport.
+pub fn small_settings(width: u32, height: u32) -> Settings {
+    let mut settings = Settings::default();
+    settings.render.width = width;
+    settings.render.height = height;
+    settings
+}
+
+/// A renderer over the dataset in `dataset`.
+pub fn renderer(dataset: &Path, settings: Settings) -> Renderer {
+    Renderer::new(gpu(), Dataset::open(dataset).unwrap(), settings).unwrap()
+}
