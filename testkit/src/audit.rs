@@ -1,5 +1,5 @@
-//! Frame audits for the extreme-case tests (`tests/extremes.rs`, `data-tools/tests/extremes.rs`,
-//! which includes this file by path): every GPU output of the last frame is read back and checked
+//! Frame audits for the extreme-case tests (`tests/extremes.rs`, `data-tools/tests/extremes.rs`):
+//! every GPU output of the last frame is read back and checked
 //! (depth, colour, the Tile Load Map, pass 3's records and counters), and the frame's coverage is
 //! judged against rays cast through the full-resolution DEM in f64.
 //!
@@ -95,8 +95,8 @@ impl Dem {
     }
 
     /// Height of the finest terrain mesh at (x, y): two triangles per cell, the diagonal
-    /// alternating like a checkerboard (`terramp::terrain::grid_indices`), south-west to north-east
-    /// on even cells.
+    /// alternating like a checkerboard (`terramp::passes::terrain::frame::grid_indices`),
+    /// south-west to north-east on even cells.
     pub fn mesh_height_m(&self, x_m: f64, y_m: f64) -> f64 {
         let ([i, j], [u, v], [h00, h10, h01, h11]) = self.cell(x_m, y_m);
         match ((i + j) % 2 == 0, u >= v, u + v <= 1.0) {
