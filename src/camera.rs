@@ -26,30 +26,43 @@ pub const MAX_COORDINATE_M: f64 = 4e9;
 /// push far depths into f32 denormals, which GPUs flush to 0, the sky.
 pub const MIN_NEAR_M: f64 = 1e-6;
 
+/// Why a camera cannot be used: a value the f32 GPU side could not carry, or a pose that does not
+/// parse.
 #[derive(Debug, Error, PartialEq)]
 pub enum CameraError {
+    /// A coordinate, angle, field of view or near plane is NaN or infinite (its name: "x", "yaw",
+    /// "near"…).
     #[error("camera: {0} is not a finite number")]
     NotFinite(&'static str),
+    /// The vertical field of view, degrees, is below `MIN_FOV_DEG` or not below 180°.
     #[error("camera: field of view {0}° must be at least {MIN_FOV_DEG}° and below 180°")]
     Fov(f64),
+    /// The near plane, metres, is below `MIN_NEAR_M` (zero and negative included).
     #[error("camera: near plane {0} m must be at least {MIN_NEAR_M} m")]
     Near(f64),
+    /// A coordinate of the position (its name, its value in metres) is beyond `MAX_COORDINATE_M`.
     #[error("camera: {0} = {1} m is beyond ±{MAX_COORDINATE_M} m")]
     TooFar(&'static str, f64),
+    /// A projection was asked for a viewport (width × height, pixels) with no pixels.
     #[error("camera: viewport {0}×{1} has no area")]
     Viewport(u32, u32),
+    /// A pose given as text is not five comma-separated numbers.
     #[error("camera: `{0}` is not X,Y,Z,YAW,PITCH (five numbers: metres, metres, metres, degrees, degrees)")]
     Parse(String),
 }
 
+/// A pinhole camera in the dataset CRS, in f64; the GPU gets camera-relative matrices from it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     /// Position in the dataset CRS, metres (z: height above the datum).
     pub position_m: DVec3,
+    /// Compass heading of the view, degrees clockwise from north (90 = east).
     pub yaw_deg: f64,
+    /// Elevation of the view direction above the horizon, degrees (negative looks down).
     pub pitch_deg: f64,
     /// Vertical field of view, degrees.
     pub fov_deg: f64,
+    /// Near plane, metres (at least `MIN_NEAR_M`); the far plane is at infinity.
     pub near_m: f64,
 }
 
@@ -69,6 +82,8 @@ impl Camera {
         Ok(camera)
     }
 
+    /// Refuses what the f32 GPU side cannot carry: non-finite numbers, a field of view or near
+    /// plane out of range, coordinates beyond `MAX_COORDINATE_M`.
     pub fn validate(&self) -> Result<(), CameraError> {
         let named = [
             ("x", self.position_m.x),

@@ -27,24 +27,87 @@ const BUILTIN: &[(&str, &str)] = &[
     ("nlcd", include_str!("../config/classes/nlcd.toml")),
 ];
 
+/// Why a class table could not be loaded; each names the table and the class, species or key at
+/// fault.
 #[derive(Debug, Error)]
 pub enum ClassTableError {
+    /// The name is neither a built-in table nor a file that could be read (the name, the I/O
+    /// error).
     #[error("class table `{0}` is neither a built-in table ({builtins}) nor a readable file: {1}", builtins = builtin_names())]
     NotFound(String, std::io::Error),
+    /// The text is not valid TOML, or not of the table's shape (an unknown key, a missing one, an
+    /// unknown species `kind`).
     #[error("class table {origin}: {message}")]
-    Parse { origin: String, message: String },
+    Parse {
+        /// The `origin` given to `ClassTable::parse`: a built-in name or the file's path.
+        origin: String,
+        /// The TOML parser's message.
+        message: String,
+    },
+    /// Two classes have the same code.
     #[error("class table {origin}: code {code} is listed twice")]
-    Duplicate { origin: String, code: u8 },
+    Duplicate {
+        /// The table, as in `Parse`.
+        origin: String,
+        /// The land-cover code listed twice.
+        code: u8,
+    },
+    /// Two species have the same name.
     #[error("class table {origin}: species `{name}` is listed twice")]
-    DuplicateSpecies { origin: String, name: String },
+    DuplicateSpecies {
+        /// The table, as in `Parse`.
+        origin: String,
+        /// The species name listed twice.
+        name: String,
+    },
+    /// The table lists more than `MAX_SPECIES` species.
     #[error("class table {origin}: {count} species, at most {max} allowed", max = MAX_SPECIES)]
-    TooManySpecies { origin: String, count: usize },
+    TooManySpecies {
+        /// The table, as in `Parse`.
+        origin: String,
+        /// How many species it lists.
+        count: usize,
+    },
+    /// A class has more than `MAX_SPECIES_PER_CLASS` seed rules.
     #[error("class table {origin}: class {code} ({class}) has {count} seed rules, at most {max} allowed", max = MAX_SPECIES_PER_CLASS)]
-    TooManyRules { origin: String, code: u8, class: String, count: usize },
+    TooManyRules {
+        /// The table, as in `Parse`.
+        origin: String,
+        /// The class's land-cover code.
+        code: u8,
+        /// The class's name.
+        class: String,
+        /// How many seed rules it lists.
+        count: usize,
+    },
+    /// A seed rule names a species the table does not have, or one its class already lists.
     #[error("class table {origin}: class {code} ({class}), seeds.species = `{species}`: {problem}")]
-    BadRule { origin: String, code: u8, class: String, species: String, problem: &'static str },
+    BadRule {
+        /// The table, as in `Parse`.
+        origin: String,
+        /// The class's land-cover code.
+        code: u8,
+        /// The class's name.
+        class: String,
+        /// The species the rule names.
+        species: String,
+        /// What is wrong with it, in words.
+        problem: &'static str,
+    },
+    /// A species' number (height, radius, altitude, slope) or a rule's density is out of range.
     #[error("class table {origin}: {place}, `{key}` = {value}: must be {rule}")]
-    OutOfRange { origin: String, place: String, key: &'static str, value: String, rule: &'static str },
+    OutOfRange {
+        /// The table, as in `Parse`.
+        origin: String,
+        /// Where the key is, e.g. "species `pine`" or "class 5 (forest), species `pine`".
+        place: String,
+        /// The key, e.g. `height_m` or `per_km2`.
+        key: &'static str,
+        /// The offending value, as text.
+        value: String,
+        /// The range it must lie in, in words.
+        rule: &'static str,
+    },
 }
 
 fn builtin_names() -> String {
@@ -53,16 +116,24 @@ fn builtin_names() -> String {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
+/// What a species is (`kind` in the table: "tree", "bush" or "rock"); pass 3 carries it to the
+/// GPU with the species.
 pub enum SpeciesKind {
+    /// A tree: the tallest seeds (3 to 28 m in the built-in tables), on slopes up to 40° there.
     Tree,
+    /// A bush or shrub: low vegetation (0.5 to 3 m in the built-in tables), on slopes up to 50° there.
     Bush,
+    /// A rock or boulder (0.3 to 2 m in the built-in tables); not vegetation, so up to 70° there.
     Rock,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// One thing that can grow (`[[species]]` in the table): its model, its size and where it grows.
 pub struct Species {
+    /// Unique within the table; the classes' seed rules refer to it by this name.
     pub name: String,
+    /// Whether it is a tree, a bush or a rock; sent to the GPU with it (`SeedSpecies::kind`).
     pub kind: SpeciesKind,
     /// Model stem in ../shared/data/models (e.g. "Pine_1"), for the drawing pass.
     pub model: String,
@@ -83,7 +154,9 @@ fn any_altitude_m() -> [f32; 2] {
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// One species in a class and its density: how many of the pattern's seeds it takes, by rank.
 pub struct SeedRule {
+    /// The `Species::name` it grows.
     pub species: String,
     /// Seeds per km².
     pub per_km2: f32,
@@ -91,9 +164,14 @@ pub struct SeedRule {
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// One land-cover class (`[[class]]`): a code of the scheme and what grows there.
 pub struct Class {
+    /// The code the land-cover rasters use for this class.
     pub code: u8,
+    /// Human-readable name, e.g. "forest"; recorded in the dataset's manifest.
     pub name: String,
+    /// What grows on it, drawn in this order from each pattern's seed ranks (at most
+    /// `MAX_SPECIES_PER_CLASS`); empty means no seeds.
     #[serde(default)]
     pub seeds: Vec<SeedRule>,
 }
@@ -102,11 +180,14 @@ pub struct Class {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClassTable {
+    /// The classification scheme, e.g. "nc" or "nlcd", as a dataset's land-cover layer names it.
     pub scheme: String,
     /// The code that means "no data" in the source rasters of this scheme.
     pub nodata_code: u8,
+    /// The scheme's classes (`[[class]]`), codes unique; codes absent mean "no class", no seeds.
     #[serde(rename = "class")]
     pub classes: Vec<Class>,
+    /// What can grow (`[[species]]`, at most `MAX_SPECIES`); pass 3 indexes them in this order.
     #[serde(default)]
     pub species: Vec<Species>,
 }
@@ -122,6 +203,7 @@ impl ClassTable {
         Self::parse(&text, name_or_path)
     }
 
+    /// Parses and validates a table's TOML text; `origin` (a name or path) labels the errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self, ClassTableError> {
         let table: ClassTable = toml::from_str(text)
             .map_err(|e| ClassTableError::Parse { origin: origin.to_owned(), message: e.to_string() })?;
@@ -134,14 +216,17 @@ impl ClassTable {
         self.classes.iter().map(|c| ClassName { code: c.code, name: c.name.clone() }).collect()
     }
 
+    /// Whether `code` is one of the table's classes (otherwise it means "no class").
     pub fn contains(&self, code: u8) -> bool {
         self.classes.iter().any(|c| c.code == code)
     }
 
+    /// The class with land-cover code `code`, if the table has one.
     pub fn class(&self, code: u8) -> Option<&Class> {
         self.classes.iter().find(|c| c.code == code)
     }
 
+    /// Position of the species named `name` in `species`: its index in the GPU's species table.
     pub fn species_index(&self, name: &str) -> Option<usize> {
         self.species.iter().position(|s| s.name == name)
     }

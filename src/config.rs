@@ -23,76 +23,153 @@ pub use seeds::{OcclusionTolerance, SeedSettings};
 pub use tlm::TlmSettings;
 
 const DEFAULTS: &str = include_str!("../config/default.toml");
+/// The named presets (`--preset`) and their TOML text, compiled in from `config/presets/`; each is
+/// a layer over the defaults.
 pub const PRESETS: &[(&str, &str)] = &[
     ("fast", include_str!("../config/presets/fast.toml")),
     ("balanced", include_str!("../config/presets/balanced.toml")),
     ("accurate", include_str!("../config/presets/accurate.toml")),
 ];
 
+/// Why the settings could not be loaded; each names the file (or preset) and the full key at fault.
 #[derive(Debug, Error)]
 pub enum SettingsError {
+    /// The preset asked for is not one of `PRESETS`.
     #[error("unknown preset `{0}`: expected fast, balanced or accurate")]
     UnknownPreset(String),
+    /// The user's settings file could not be read.
     #[error("{origin}: {source}")]
-    Read { origin: String, source: std::io::Error },
+    Read {
+        /// The file's path, as given.
+        origin: String,
+        /// The I/O error from reading the file.
+        source: std::io::Error,
+    },
+    /// A layer is not valid TOML.
     #[error("{origin}: not valid TOML: {message}")]
-    Syntax { origin: String, message: String },
+    Syntax {
+        /// The layer: a file's path, `preset NAME` or `config/default.toml`.
+        origin: String,
+        /// The TOML parser's message (line, column and what it expected).
+        message: String,
+    },
+    /// A layer sets a key that `config/default.toml` does not have (a misspelling, usually).
     #[error("{origin}: unknown key `{key}`")]
-    UnknownKey { origin: String, key: String },
+    UnknownKey {
+        /// The layer that sets the key, as in `Syntax`.
+        origin: String,
+        /// The full dotted key, e.g. `render.fovv`.
+        key: String,
+    },
+    /// A layer sets a key of an earlier release; the error says which key replaced it.
     #[error("{origin}: `{key}` is gone: {instead}")]
-    Moved { origin: String, key: String, instead: &'static str },
+    Moved {
+        /// The layer that sets the key, as in `Syntax`.
+        origin: String,
+        /// The full dotted key of the earlier release, e.g. `tlm.radial_lod_m`.
+        key: String,
+        /// Where the knob went, naming its replacement key(s).
+        instead: &'static str,
+    },
+    /// A layer gives a key a value of another kind than its default (a string for a number, a
+    /// value for a table); an integer where a number is expected is accepted.
     #[error("{origin}: `{key}` must be {expected}")]
-    WrongType { origin: String, key: String, expected: &'static str },
+    WrongType {
+        /// The layer that sets the key, as in `Syntax`.
+        origin: String,
+        /// The full dotted key.
+        key: String,
+        /// The kind the default has, in words ("an integer", "a table").
+        expected: &'static str,
+    },
+    /// The merged settings hold a value outside its range (checked after every layer is merged).
     #[error("settings: `{key}` = {value}: {rule}")]
-    OutOfRange { key: &'static str, value: String, rule: &'static str },
+    OutOfRange {
+        /// The full dotted key, e.g. `render.fov_deg`.
+        key: &'static str,
+        /// The offending value, as text.
+        value: String,
+        /// The range the key must lie in, in words.
+        rule: &'static str,
+    },
+    /// The merged table does not deserialise into `Settings` (e.g. an unknown `gpu.adapter` name).
     #[error("settings: {0}")]
     Shape(String),
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// Every user setting: `config/default.toml`, then a preset, then the user's file, merged and
+/// range-checked. One field per table of that file.
 pub struct Settings {
+    /// `[gpu]`: the adapter and how passes are timed.
     pub gpu: GpuSettings,
+    /// `[render]`: output size, projection, sun and haze.
     pub render: RenderSettings,
+    /// `[terrain]`: the LOD rings of the terrain mesh.
     pub terrain: TerrainSettings,
+    /// `[imagery]`: level choice and filtering of the aerial imagery.
     pub imagery: ImagerySettings,
+    /// `[cache]`: GPU tile slots, loader threads and upload budgets (pass 2).
     pub cache: CacheSettings,
+    /// `[tlm]`: the Tile Load Map (pass 1).
     pub tlm: TlmSettings,
+    /// `[seeds]`: seed selection (pass 3).
     pub seeds: SeedSettings,
+    /// `[draw_seeds]`: the draw LODs' reaches, their cross-fade and the impostors (pass 4).
     pub draw_seeds: DrawSeedsSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// The `[gpu]` table, see `config/default.toml`.
 pub struct GpuSettings {
+    /// Which adapter to run on: auto, hardware or software; `TERRAMP_ADAPTER` overrides it.
     pub adapter: AdapterChoice,
+    /// Time passes with GPU timestamp queries where the adapter has them; false times them on the
+    /// CPU (submit and wait), which serialises the frame.
     pub timestamps: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// The `[render]` table, see `config/default.toml`.
 pub struct RenderSettings {
+    /// Output width, pixels (1 to 16384).
     pub width: u32,
+    /// Output height, pixels (1 to 16384).
     pub height: u32,
+    /// Vertical field of view, degrees (0 < fov < 180).
     pub fov_deg: f64,
+    /// Near plane, metres; depth is reversed-Z with an infinite far plane, so small costs nothing.
     pub near_m: f64,
+    /// Compass azimuth the sun shines from, degrees clockwise from north.
     pub sun_azimuth_deg: f64,
+    /// Sun elevation above the horizon, degrees (-90 to 90).
     pub sun_elevation_deg: f64,
+    /// Distance at which haze hides half of the ground colour, metres.
     pub haze_half_distance_m: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// The `[terrain]` table, see `config/default.toml`.
 pub struct TerrainSettings {
+    /// Grid cells per side of one terrain node (a power of two from 8 to 256).
     pub node_cells: u32,
+    /// Target on-screen length of a triangle edge at the far end of each LOD ring, pixels.
     pub triangle_px: f64,
+    /// Fraction of each LOD ring over which vertices morph into the next coarser grid (0 < f < 1).
     pub morph_fraction: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// The `[imagery]` table, see `config/default.toml`.
 pub struct ImagerySettings {
+    /// Imagery level bias, log2 of texels per pixel: -1 one level finer, +1 one coarser.
     pub lod_bias: f64,
+    /// Anisotropic filtering, 1 (off) to 16, or 0 for automatic (see `anisotropy_on`).
     pub anisotropy: u16,
 }
 
@@ -109,12 +186,20 @@ impl ImagerySettings {
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
+/// The `[cache]` table (pass 2's texture caches), see `config/default.toml`. The slot counts fix
+/// the caches' GPU memory; each cache needs at least 16 (its coarse levels are pinned).
 pub struct CacheSettings {
+    /// Height tile slots on the GPU (259² × 4 bytes, 262 KiB each).
     pub height_slots: u32,
+    /// Imagery tile slots on the GPU (528² × 4 bytes with mips, 1.45 MiB each).
     pub imagery_slots: u32,
+    /// Land-cover tile slots on the GPU (512² bytes, 256 KiB each), read by seeds near the camera.
     pub landcover_slots: u32,
+    /// Threads reading tiles from the packs off the render thread (1 to 64).
     pub loader_threads: u32,
+    /// Most tiles each cache uploads in one frame, most important first (at least 1).
     pub upload_tiles_per_frame: u32,
+    /// Most bytes each cache uploads in one frame (at least 1 MiB); one tile always goes.
     pub upload_bytes_per_frame: u64,
 }
 

@@ -13,35 +13,64 @@ use thiserror::Error;
 
 use crate::camera::Camera;
 
+/// Why a camera path could not be loaded; each names the file.
 #[derive(Debug, Error)]
 pub enum PathError {
+    /// The path file could not be read.
     #[error("{path}: {source}")]
-    Read { path: String, source: std::io::Error },
+    Read {
+        /// The file's path, as given.
+        path: String,
+        /// The I/O error from reading it.
+        source: std::io::Error,
+    },
+    /// The text is not valid TOML, or not a list of `[[key]]` keyframes (an unknown or missing key).
     #[error("{path}: {message}")]
-    Parse { path: String, message: String },
+    Parse {
+        /// The file's path, or the name given to `CameraPath::parse`.
+        path: String,
+        /// The TOML parser's message.
+        message: String,
+    },
+    /// The file has no keyframe.
     #[error("{path}: a path needs at least one keyframe")]
-    Empty { path: String },
+    Empty {
+        /// The file, as in `Parse`.
+        path: String,
+    },
+    /// A keyframe holds NaN or an infinity.
     #[error("{path}: keyframe {index} has a value that is not a finite number")]
-    NotFinite { path: String, index: usize },
+    NotFinite {
+        /// The file, as in `Parse`.
+        path: String,
+        /// The keyframe's position in the file, from 0.
+        index: usize,
+    },
 }
 
+/// One pose the flight passes through (`[[key]]` in the file).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Keyframe {
     /// Position in the dataset CRS: east, north, height above the datum, metres.
     pub at: [f64; 3],
+    /// Compass heading, degrees clockwise from north; the flight turns the short way to the next.
     pub yaw_deg: f64,
+    /// Elevation of the view above the horizon, degrees (negative looks down).
     pub pitch_deg: f64,
 }
 
+/// A camera flight: keyframes joined by a Catmull-Rom spline, sampled by `camera_at`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraPath {
+    /// The keyframes in flight order, at least one; equally spaced in the path's parameter.
     #[serde(rename = "key")]
     pub keys: Vec<Keyframe>,
 }
 
 impl CameraPath {
+    /// Reads and checks a path file (`config/paths/*.toml`).
     pub fn load(path: &Path) -> Result<Self, PathError> {
         let name = path.display().to_string();
         let text =
@@ -49,6 +78,7 @@ impl CameraPath {
         Self::parse(&text, &name)
     }
 
+    /// Parses and checks a path's TOML text; `name` labels the errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, PathError> {
         let path: CameraPath = toml::from_str(text)
             .map_err(|e| PathError::Parse { path: name.to_owned(), message: e.to_string() })?;

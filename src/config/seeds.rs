@@ -10,16 +10,32 @@ use super::SettingsError;
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SeedSettings {
+    /// Seeds in each generic pattern (64 to 65536); a pattern covers one ring-0 TLM cell, so this
+    /// bounds every class's density (see `max_density_per_km2`).
     pub seeds_per_pattern: u32,
+    /// Seed records pass 3 can output per frame (1 to 16777216); seeds beyond it are dropped and
+    /// counted as overflow.
     pub capacity: u32,
+    /// Margin of the frustum test, NDC units (0 to 1): each side plane moves out by this fraction
+    /// of the half-screen, so swaying seeds at the edge do not pop.
     pub frustum_epsilon: f64,
+    /// Constant part of the summit's occlusion tolerance, metres behind the terrain depth.
     pub occlusion_tolerance_m: f64,
+    /// Part of the summit's occlusion tolerance that grows with distance, metres per km.
     pub occlusion_tolerance_per_km: f64,
+    /// Most DEM samples of the march that settles a summit on a terrain silhouette (0, or a power
+    /// of two up to 65536); 0 trusts the depth pixel.
     pub occlusion_refine_steps: u32,
     /// Every class's density is scaled by this (rank thinning: exactly that fraction).
     pub density_scale: f64,
+    /// Seed height, metres, drawn out to the full `draw_seeds.reach_m`; smaller seeds' reaches
+    /// shrink in proportion.
     pub reference_height_m: f64,
+    /// How far a seed's anchor sinks into the ground, as a fraction of its height (0 to 0.5), so
+    /// no gap shows under trunks on slopes.
     pub sink_fraction: f64,
+    /// Radius around a seed in which its ground colour is sampled from the imagery, metres; 0
+    /// samples the seed's own point.
     pub ground_colour_radius_m: f64,
     /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
     pub class_table: String,
@@ -31,7 +47,9 @@ pub struct SeedSettings {
 /// (`tlm.occlusion_tolerance_*`, its cells' boxes) use this one model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OcclusionTolerance {
+    /// The constant part, metres.
     pub m: f64,
+    /// The part that grows with distance from the camera, metres per km.
     pub per_km: f64,
 }
 

@@ -11,17 +11,24 @@ use crate::gpu::layout::{TLM_MAX_RINGS, TLM_RADIAL_BANDS};
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TlmSettings {
+    /// Edge of a ring-0 cell, metres: the size of a seed pattern and the grain at which tiles are
+    /// asked for; ring k's cells are 2^k times larger. See `config/default.toml` `[tlm]`.
     pub cell_m: f64,
+    /// Cells per ring side (even, 8 to 256); ring 0 spans `cells × cell_m` metres.
     pub cells: u32,
+    /// Most rings (1 to 16); only as many as cover the dataset from the camera are used.
     pub max_rings: u32,
     /// A cell's box is occluded when it lies more than this far behind the terrain; the same
     /// model as `seeds.occlusion_tolerance_*` (`OcclusionTolerance`).
     pub occlusion_tolerance_m: f64,
+    /// Part of a cell's occlusion tolerance that grows with distance, metres per km.
     pub occlusion_tolerance_per_km: f64,
     /// The distance bands of ring-0 cells, metres: a cell whose nearest point lies in band k
     /// reads land-cover level k for its seeds; beyond the last, its seeds are not checked.
     pub radial_bands_m: [f64; TLM_RADIAL_BANDS as usize],
+    /// Seed patterns P (1 to 255); each ring-0 cell shows one, picked by a hash of its position.
     pub patterns: u32,
+    /// The germ of that hash: another value, another (equally deterministic) forest.
     pub seed: u32,
 }
 

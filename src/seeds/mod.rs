@@ -27,15 +27,32 @@ pub const MAX_SEED_CELLS: u32 = 65535;
 /// frame); a frame checks no more cells than fill it (`max_cells`).
 pub const MAX_SEED_BLOCKS: u32 = 1 << 20;
 
+/// Why `SeedTables::new` refuses a class table for this dataset and these settings.
 #[derive(Debug, Error)]
 pub enum SeedError {
+    /// A class's total density (after `seeds.density_scale`) needs more seeds per ring-0 cell than
+    /// a pattern holds.
     #[error(
         "class {code} ({name}) asks for {density_per_km2} seeds per km²; the patterns hold {max_per_km2:.0} \
          (seeds.seeds_per_pattern / tlm.cell_m²): raise seeds.seeds_per_pattern or lower the density"
     )]
-    TooDense { code: u8, name: String, density_per_km2: f64, max_per_km2: f64 },
+    TooDense {
+        /// The class's land-cover code.
+        code: u8,
+        /// The class's name.
+        name: String,
+        /// Seeds per km² it asks for, summed over its rules and scaled.
+        density_per_km2: f64,
+        /// Seeds per km² the patterns hold: `seeds.seeds_per_pattern / tlm.cell_m²`.
+        max_per_km2: f64,
+    },
+    /// The table has more species than the GPU's species table holds (`MAX_SPECIES`); parsed
+    /// tables are checked already, so only a table built in code gets here.
     #[error("class table {scheme}: more than {MAX_SPECIES} species")]
-    TooManySpecies { scheme: String },
+    TooManySpecies {
+        /// The table's `ClassTable::scheme`.
+        scheme: String,
+    },
 }
 
 /// Workgroups (block-table entries) pass 3 runs per cell when it checks `active_ranks` ranks.
@@ -94,6 +111,8 @@ pub fn species_of_rank(class: &SeedClass, rank: u32) -> Option<u32> {
 /// The per-dataset tables of pass 3: species, and per land-cover palette index its seeds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeedTables {
+    /// The class table's species in its order (a rule's species index points here): height and
+    /// altitude ranges in metres, steepest slope, crown radius, kind.
     pub species: Vec<SeedSpecies>,
     /// Indexed by palette index (0: bare ground, no seeds).
     pub classes: Vec<SeedClass>,

@@ -47,7 +47,9 @@ const SHRINK: f64 = 0.95;
 /// P generic patterns of blue-noise seed positions, each sorted by rank (index = rank).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeedPatterns {
+    /// How many patterns there are, P (`tlm.patterns`, 1 to 255).
     pub count: u32,
+    /// Seeds in each pattern (`seeds.seeds_per_pattern`); all P patterns hold the same number.
     pub seeds_per_pattern: u32,
     /// pattern p's seed of rank r at p * seeds_per_pattern + r, unit square
     pub positions_unit: Vec<[f32; 2]>,
