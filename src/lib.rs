@@ -1,10 +1,13 @@
 //! terramp amplifies real terrain on the GPU.
 //!
 //! It streams a large DEM with its aerial imagery and populates the ground with seeds chosen from
-//! a land-cover map, in the four passes of Amara, Meunier & Marsault (2007). See `DESIGN.md` in
-//! the shared folder for the architecture; `frame` reads as the list of passes.
-
+//! a land-cover map, in the four passes of Amara, Meunier & Marsault (2007). `ARCHITECTURE.md` at
+//! the repository's root is the map of the code: the passes and their folders (`passes`, with
+//! their twins in `reference`), one frame's data flow (`frame`), the layers modules may import
+//! from, and where constants (`gpu::layout`) and GPU types (`gpu::gpu_types`) live. The design
+//! behind it is `DESIGN.md` in the shared folder.
 #![warn(missing_docs)]
+
 #[cfg(feature = "bake")]
 pub mod bake;
 pub mod camera;

@@ -32,6 +32,8 @@ pub enum Reduce {
 
 /// A texel type a pack can store.
 pub trait Texel: bytemuck::Pod + Send + Sync {
+    /// One texel of the coarser level (or mip) from the 2 × 2 texels beneath it by `rule`,
+    /// `block[dx + 2·dy]` the one at offset (dx, dy).
     fn reduce(rule: Reduce, block: [Self; 4]) -> Self;
 
     /// The value range recorded in the pack index for a tile of these texels, if the type has one.
@@ -74,20 +76,45 @@ impl Texel for [u8; 4] {
 /// (grid space: y grows north). Sources return texels row by row, southernmost row first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Window {
+    /// Westmost texel column of the window.
     pub x0: u32,
+    /// Southmost texel row of the window.
     pub y0: u32,
+    /// Texel columns, west to east.
     pub width: u32,
+    /// Texel rows, south to north.
     pub height: u32,
 }
 
+/// Why a layer's pack could not be written.
 #[derive(Debug, Error)]
 pub enum LayerError {
+    /// Creating, writing, reading back or finishing the pack failed.
     #[error(transparent)]
     Pack(#[from] PackError),
+    /// The source could not deliver a window (e.g. a failed GDAL read).
     #[error("reading {layer} window {window:?}: {message}")]
-    Source { layer: &'static str, window: Window, message: String },
+    Source {
+        /// The layer being written, e.g. "height".
+        layer: &'static str,
+        /// The window asked of the source, in texels of its grid.
+        window: Window,
+        /// The source's own message.
+        message: String,
+    },
+    /// The source returned another number of texels than the window holds.
     #[error("{layer}: source returned {actual} texels for window {window:?}, expected {expected}")]
-    SourceSize { layer: &'static str, window: Window, expected: usize, actual: usize },
+    SourceSize {
+        /// The layer being written, e.g. "height".
+        layer: &'static str,
+        /// The window asked of the source, in texels of its grid.
+        window: Window,
+        /// Texels in the window, `width × height`.
+        expected: usize,
+        /// Texels the source returned.
+        actual: usize,
+    },
+    /// The land cover's LCC coding is invalid, or the source gave a code outside its palette.
     #[error(transparent)]
     Lcc(#[from] LccError),
 }
@@ -95,10 +122,13 @@ pub enum LayerError {
 /// What is stored for one layer.
 #[derive(Debug, Clone, Copy)]
 pub struct LayerSpec {
+    /// The layer's name in progress and error messages, e.g. "height".
     pub name: &'static str,
+    /// The layer's tile quadtree, which numbers the pack's tiles.
     pub pyramid: Pyramid,
     /// Mip levels stored in each tile (1 = mip 0 only).
     pub mips: u32,
+    /// How coarser levels and mips are made from the texels beneath them.
     pub reduce: Reduce,
 }
 
@@ -120,10 +150,12 @@ impl LayerSpec {
         Self { name: "imagery", pyramid, mips: IMAGERY_MIPS, reduce: Reduce::Mean }
     }
 
+    /// Texels of one stored tile, every mip included (`mip_extent(m)`² each).
     pub fn tile_texels(&self) -> usize {
         (0..self.mips).map(|m| (self.pyramid.mip_extent(m) as usize).pow(2)).sum()
     }
 
+    /// Payload bytes of one stored tile of `T` texels, mips included: the pack's tile size.
     pub fn tile_bytes<T: Texel>(&self) -> u64 {
         (self.tile_texels() * size_of::<T>()) as u64
     }

@@ -36,18 +36,45 @@ pub const LCC_BARE_INDEX: u32 = 0;
 const SCAN_WINDOW_TEXELS: u32 = 1024;
 const LAYER_NAME: &str = "land cover";
 
+/// Why an LCC coding could not be made or is invalid, or a code could not be written with it.
 #[derive(Debug, Error)]
 pub enum LccError {
+    /// `LccCoding::for_codes` finds more distinct codes than the 32-bit word's palette holds (255).
     #[error("{count} distinct land-cover codes: the widest LCC word (32 bits) holds at most 255")]
-    TooManyCodes { count: usize },
+    TooManyCodes {
+        /// Distinct codes found.
+        count: usize,
+    },
+    /// A coding (from a manifest) has a word width other than 8, 16 or 32 bits.
     #[error("LCC words of {word_bits} bits: use 8, 16 or 32")]
-    WordBits { word_bits: u32 },
+    WordBits {
+        /// The width it gives, bits.
+        word_bits: u32,
+    },
+    /// A coding's palette has more codes than its word's level-2 sub-codes can address.
     #[error("LCC palette of {count} codes does not fit {word_bits}-bit words (at most {max})")]
-    PaletteTooLong { count: usize, word_bits: u32, max: usize },
+    PaletteTooLong {
+        /// Codes in the palette.
+        count: usize,
+        /// The coding's word width, bits.
+        word_bits: u32,
+        /// Codes that width addresses: 2^(word_bits / 4) − 1, index 0 being reserved.
+        max: usize,
+    },
+    /// A coding's palette is not strictly ascending (a repeated code, or one out of order).
     #[error("LCC palette is not sorted and unique: code {code} at entry {entry}")]
-    PaletteOrder { entry: usize, code: u8 },
+    PaletteOrder {
+        /// Position in `palette` of the first code not above the one before it.
+        entry: usize,
+        /// That code.
+        code: u8,
+    },
+    /// While writing, the source gives a code the palette lacks: it changed since `scan_codes`.
     #[error("land-cover code {code} is not in the LCC palette (did the source change after the scan?)")]
-    NotInPalette { code: u8 },
+    NotInPalette {
+        /// The source code missing from the palette.
+        code: u8,
+    },
 }
 
 /// One dataset's LCC coding: its word width and palette.
@@ -102,6 +129,7 @@ impl LccCoding {
         self.word_bits / 4
     }
 
+    /// Bytes of one stored word (1, 2 or 4), the same at every level.
     pub fn word_bytes(&self) -> usize {
         (self.word_bits / 8) as usize
     }
@@ -171,6 +199,7 @@ pub fn lcc_pyramid(source_size: [u32; 2]) -> Pyramid {
 /// How many source texels carry each code.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CodeCounts {
+    /// Source texels carrying each code, indexed by the code.
     pub texels: [u64; 256],
 }
 

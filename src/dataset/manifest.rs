@@ -13,24 +13,32 @@ use crate::dataset::lcc::LccCoding;
 
 /// Version 2: land cover is the LCC quadtree of palette indices (`crate::dataset::lcc`).
 pub const FORMAT_VERSION: u32 = 2;
+/// File name of the manifest in a dataset folder; a build writes it last, so it marks a complete one.
 pub const MANIFEST_FILE: &str = "manifest.toml";
 
+/// The contents of `manifest.toml`: where grid space sits in the CRS, and each layer's pack and shape.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Manifest {
+    /// The dataset format this manifest follows; `Dataset::open` reads only `FORMAT_VERSION`.
     pub format_version: u32,
     /// A short name for logs (the DEM file's stem, or "synthetic").
     pub name: String,
+    /// The metric CRS that `origin_m` is in.
     pub crs: Crs,
     /// CRS coordinates (metres) of grid sample (0, 0): the south-west height sample.
     pub origin_m: [f64; 2],
+    /// The DEM, which every dataset has; it defines grid space.
     pub height: HeightLayer,
+    /// The aerial imagery; absent in a dataset built without it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub imagery: Option<CellLayer>,
+    /// The land cover; absent in a dataset built without it (the ground is then bare everywhere).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub landcover: Option<LandcoverLayer>,
 }
 
+/// The dataset's coordinate reference system, metric, and where it came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Crs {
@@ -40,14 +48,19 @@ pub struct Crs {
     pub note: String,
 }
 
+/// The DEM: f32 heights in metres, sampled at grid vertices `spacing_m` apart.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HeightLayer {
+    /// File name of the height pack, in the dataset folder.
     pub pack: String,
     /// Distance between level-0 samples, metres.
     pub spacing_m: f64,
+    /// The heights' tile quadtree (`Sampling::Vertex`), shared by the validity mask.
     pub pyramid: Pyramid,
+    /// Lowest height sample of the dataset, metres: the bound of a tile whose own range is unknown.
     pub min_m: f32,
+    /// Highest height sample of the dataset, metres: the bound of a tile whose own range is unknown.
     pub max_m: f32,
     /// Samples with no source value that were filled: voids and nodata in the source, and, for a
     /// reprojected DEM, the grid's corners beyond the source's edge. Equals the zeros of the mask.
@@ -57,12 +70,15 @@ pub struct HeightLayer {
     pub valid_mask_pack: Option<String>,
 }
 
+/// A layer of cell-area texels (imagery, land cover) over the DEM's pixel-area extent.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CellLayer {
+    /// File name of the layer's pack, in the dataset folder.
     pub pack: String,
     /// Texel edge at level 0, metres.
     pub texel_m: f64,
+    /// The layer's tile quadtree (`Sampling::Cell`), in texels of this layer.
     pub pyramid: Pyramid,
     /// Mips stored per tile.
     pub mips: u32,
@@ -77,6 +93,7 @@ pub struct CellLayer {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LandcoverLayer {
+    /// Pack, texel size and pyramid, as for any cell layer (flattened into the same TOML table).
     #[serde(flatten)]
     pub layer: CellLayer,
     /// The word width and palette of the texels: what turns a stored word back into a code.
@@ -102,9 +119,12 @@ impl Manifest {
     }
 }
 
+/// One class of the land-cover scheme as the manifest records it, from the class table.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClassName {
+    /// The source's land-cover code of the class.
     pub code: u8,
+    /// The class's name in the scheme's class table, e.g. "forest".
     pub name: String,
 }

@@ -40,33 +40,79 @@ pub use crate::gpu::layout::{
     CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS, LANDCOVER_BORDER,
 };
 
+/// Why a dataset could not be opened, or a build could not stage or publish it.
 #[derive(Debug, Error)]
 pub enum DatasetError {
+    /// Reading the manifest, or creating, writing or renaming a file or folder of a build, failed.
     #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file or folder the operation was on.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The folder has no `manifest.toml`: at `Dataset::open`, or when a build would replace a
+    /// folder that is not a dataset (it may be the user's).
     #[error(
         "{path}: no dataset here (no {MANIFEST_FILE}); build one with `terramp-data build` or `terramp-data synth`"
     )]
-    NotADataset { path: PathBuf },
+    NotADataset {
+        /// The folder without a manifest.
+        path: PathBuf,
+    },
+    /// The manifest does not parse as this format, or its land-cover layer is inconsistent (an
+    /// invalid LCC coding, or not 3 levels, 1 mip and no border).
     #[error("{path}: bad manifest: {message}")]
-    Manifest { path: PathBuf, message: String },
+    Manifest {
+        /// The manifest file.
+        path: PathBuf,
+        /// What is wrong, from the TOML parser or the land-cover checks.
+        message: String,
+    },
+    /// The manifest's `format_version` is not `FORMAT_VERSION`: the dataset must be rebuilt.
     #[error("{path}: dataset format version {found}, this build reads version {FORMAT_VERSION}; rebuild it")]
-    Version { path: PathBuf, found: u32 },
+    Version {
+        /// The manifest file.
+        path: PathBuf,
+        /// The version the manifest declares.
+        found: u32,
+    },
+    /// Serialising the manifest to TOML failed at `Staging::commit`; holds the serialiser's message.
     #[error("writing the manifest: {0}")]
     ManifestWrite(String),
+    /// A build's output path has no final component usable as a folder name (none, or not UTF-8).
     #[error("{path}: not a usable output folder name")]
-    BadOutput { path: PathBuf },
+    BadOutput {
+        /// The output path as given.
+        path: PathBuf,
+    },
+    /// A pack's tile count or payload size disagrees with the pyramid, mips and texel size the
+    /// manifest describes for its layer.
     #[error(
         "{path}: pack holds {found} tiles of {found_bytes} bytes, the manifest describes {expected} of {expected_bytes}"
     )]
-    PackShape { path: PathBuf, found: u64, found_bytes: u64, expected: u64, expected_bytes: u64 },
+    PackShape {
+        /// The pack file.
+        path: PathBuf,
+        /// Tiles the pack's header holds.
+        found: u64,
+        /// Payload bytes per tile in the pack's header.
+        found_bytes: u64,
+        /// Tiles the manifest's pyramid numbers.
+        expected: u64,
+        /// Payload bytes per tile the manifest implies: texels of all mips × bytes per texel.
+        expected_bytes: u64,
+    },
+    /// A pack failed its checks at open (magic, version, length or index checksum).
     #[error(transparent)]
     Pack(#[from] PackError),
 }
 
 /// One layer's pack with the pyramid that addresses it.
 pub struct LayerPack {
+    /// The tile quadtree that numbers the pack's tiles, as the manifest gives it.
     pub pyramid: Pyramid,
+    /// Mips stored per tile: the imagery's count, 1 for heights, the mask and land cover.
     pub mips: u32,
     pack: Pack,
 }
@@ -118,16 +164,24 @@ impl LayerPack {
 
 /// An opened dataset.
 pub struct Dataset {
+    /// The dataset folder, as given to `open`.
     pub dir: PathBuf,
+    /// The parsed `manifest.toml`: frame, CRS and the description of every layer.
     pub manifest: Manifest,
+    /// The heights: f32 metres at grid vertices, one mip per tile.
     pub height: LayerPack,
     /// 1 where the DEM had a value, 0 where it was filled; absent when nothing was filled.
     pub valid_mask: Option<LayerPack>,
+    /// The aerial imagery, RGBA8 sRGB texels with their mips; absent when the dataset has none.
     pub imagery: Option<LayerPack>,
+    /// The land cover's LCC quadtree of palette-index words (read through `lcc_coding`); absent
+    /// when the dataset has none.
     pub landcover: Option<LayerPack>,
 }
 
 impl Dataset {
+    /// Opens the dataset in folder `dir`: checks the manifest (its version first), then maps every
+    /// pack and checks its header, length and shape against it. Tile checksums wait for each read.
     pub fn open(dir: &Path) -> Result<Self, DatasetError> {
         let manifest_path = dir.join(MANIFEST_FILE);
         if !manifest_path.exists() {

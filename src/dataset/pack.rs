@@ -22,6 +22,8 @@ use memmap2::Mmap;
 use thiserror::Error;
 
 const MAGIC: &[u8; 8] = b"TRMPPACK";
+/// Version of the pack layout in the header; `Pack::open` refuses any other, so an old pack is
+/// rebuilt, never misread.
 pub const PACK_VERSION: u32 = 2;
 const HEADER_BYTES: u64 = 64;
 const INDEX_ENTRY_BYTES: u64 = 16;
@@ -29,30 +31,95 @@ const DATA_ALIGN: u64 = 4096;
 /// Index entry state of a tile that the builder wrote.
 const TILE_PRESENT: u32 = 1;
 
+/// Why a pack could not be written or opened, or could not hand out a tile.
 #[derive(Debug, Error)]
 pub enum PackError {
+    /// Creating, sizing, mapping, reading or writing the pack file failed.
     #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The pack file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The file is too short for a header, or its magic or header checksum is wrong: not a pack,
+    /// or one whose header is damaged.
     #[error("{path}: not a terramp pack (bad magic or header checksum)")]
-    NotAPack { path: PathBuf },
+    NotAPack {
+        /// The file opened as a pack.
+        path: PathBuf,
+    },
+    /// The header's layout version is not `PACK_VERSION`: the dataset must be rebuilt.
     #[error(
         "{path}: pack format version {found}, this build reads version {PACK_VERSION}; rebuild the dataset"
     )]
-    Version { path: PathBuf, found: u32 },
+    Version {
+        /// The pack file.
+        path: PathBuf,
+        /// The version the header declares.
+        found: u32,
+    },
+    /// At open, the file is shorter than its header's tile count and tile size imply (a build or
+    /// a copy cut short).
     #[error("{path}: truncated: {actual} bytes, the header promises {expected}")]
-    Truncated { path: PathBuf, expected: u64, actual: u64 },
+    Truncated {
+        /// The pack file.
+        path: PathBuf,
+        /// File length the header implies, bytes.
+        expected: u64,
+        /// File length on disk, bytes.
+        actual: u64,
+    },
+    /// At open, the tile index fails the checksum stored in the header.
     #[error("{path}: the tile index is corrupt (checksum mismatch)")]
-    CorruptIndex { path: PathBuf },
+    CorruptIndex {
+        /// The pack file.
+        path: PathBuf,
+    },
+    /// A tile's payload fails its CRC-32 when read: that tile alone is unusable.
     #[error("{path}: tile {index} is corrupt (checksum mismatch)")]
-    Corrupt { path: PathBuf, index: u64 },
+    Corrupt {
+        /// The pack file.
+        path: PathBuf,
+        /// The tile's position in the pack (`Pyramid::tile_index`).
+        index: u64,
+    },
+    /// A tile the builder never wrote is read, from a pack or back through `PackWriter::read_tile`.
     #[error("{path}: tile {index} was never written")]
-    Missing { path: PathBuf, index: u64 },
+    Missing {
+        /// The pack file.
+        path: PathBuf,
+        /// The tile's position in the pack (`Pyramid::tile_index`).
+        index: u64,
+    },
+    /// A tile past the pack's tile count is asked for, or a `TileId` outside the layer's pyramid.
     #[error("{path}: tile {index} is out of range (the pack holds {count})")]
-    OutOfRange { path: PathBuf, index: u64, count: u64 },
+    OutOfRange {
+        /// The pack file.
+        path: PathBuf,
+        /// The position asked for; `u64::MAX` for a `TileId` outside the pyramid.
+        index: u64,
+        /// Tiles the pack holds.
+        count: u64,
+    },
+    /// A payload given to `PackWriter::write_tile` is not the pack's tile size.
     #[error("{path}: tile payload is {actual} bytes, the pack stores {expected}")]
-    PayloadSize { path: PathBuf, expected: u64, actual: u64 },
+    PayloadSize {
+        /// The pack file.
+        path: PathBuf,
+        /// Bytes per tile the pack stores.
+        expected: u64,
+        /// Bytes of the payload given.
+        actual: u64,
+    },
+    /// A tile of a layer the dataset does not have is asked for (land cover in a dataset without).
     #[error("{path}: the dataset has no {layer} layer")]
-    NoLayer { path: PathBuf, layer: &'static str },
+    NoLayer {
+        /// The dataset folder.
+        path: PathBuf,
+        /// The missing layer's name for the message, e.g. "land-cover".
+        layer: &'static str,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -128,6 +195,8 @@ fn unpack_range(bits: u64) -> Option<[f32; 2]> {
 }
 
 impl PackWriter {
+    /// Creates (or truncates) the pack at `path`, sized for `tile_count` tiles of `tile_bytes`
+    /// bytes each, every tile unwritten until `write_tile`.
     pub fn create(path: &Path, tile_bytes: u64, tile_count: u64) -> Result<Self, PackError> {
         let header = Header { tile_bytes, tile_count, index_crc: 0 };
         let file = File::options()
@@ -143,6 +212,7 @@ impl PackWriter {
         Ok(Self { file, path: path.to_owned(), header, index, ranges })
     }
 
+    /// The pack file being written, for messages.
     pub fn path(&self) -> &Path {
         &self.path
     }
@@ -221,6 +291,8 @@ pub struct Pack {
 }
 
 impl Pack {
+    /// Maps the pack at `path` read-only and checks its header, version, length and index checksum;
+    /// tile payloads are checked when read.
     pub fn open(path: &Path) -> Result<Self, PackError> {
         let file = File::open(path).map_err(io(path))?;
         // SAFETY: packs are written once by the builder and never modified in place; a dataset is
@@ -243,14 +315,17 @@ impl Pack {
         Ok(Self { map, path: path.to_owned(), header })
     }
 
+    /// The mapped pack file, for messages.
     pub fn path(&self) -> &Path {
         &self.path
     }
 
+    /// Payload bytes of every tile, all mips included.
     pub fn tile_bytes(&self) -> u64 {
         self.header.tile_bytes
     }
 
+    /// Tiles the pack holds, all levels together.
     pub fn tile_count(&self) -> u64 {
         self.header.tile_count
     }

@@ -24,12 +24,16 @@ pub enum Sampling {
 /// A tile address in a layer's quadtree.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct TileId {
+    /// Quadtree level, 0 the finest.
     pub level: u32,
+    /// Tile column at its level, counted east from the west edge.
     pub x: u32,
+    /// Tile row at its level, counted north from the south edge.
     pub y: u32,
 }
 
 impl TileId {
+    /// Tile (`x`, `y`) of `level`; `const`, so tiles can be named in constants.
     pub const fn new(level: u32, x: u32, y: u32) -> Self {
         Self { level, x, y }
     }
@@ -49,6 +53,7 @@ pub struct Pyramid {
     pub tile: u32,
     /// Texels copied from the neighbours on each side of a stored tile.
     pub border: u32,
+    /// Whether values sit at grid vertices (heights) or cover cells (imagery, land cover).
     pub sampling: Sampling,
     /// Levels stored, level 0 the finest; the last one is a single tile.
     pub levels: u32,
@@ -80,6 +85,7 @@ impl Pyramid {
         })
     }
 
+    /// Tiles per axis at `level`, at least one, the last ones partial at the east and north edges.
     pub fn tiles_at(&self, level: u32) -> [u32; 2] {
         self.steps_at(level).map(|n| n.div_ceil(self.tile).max(1))
     }
@@ -95,6 +101,7 @@ impl Pyramid {
         self.tile_extent() >> mip
     }
 
+    /// Tiles of all levels together: the tile count of the layer's pack.
     pub fn tile_count(&self) -> u64 {
         (0..self.levels).map(|l| self.level_tile_count(l)).sum()
     }
@@ -117,6 +124,7 @@ impl Pyramid {
         Some(before + u64::from(id.y) * u64::from(nx) + u64::from(id.x))
     }
 
+    /// Every tile of the pyramid in pack order: level by level, south row first, west to east.
     pub fn tiles(&self) -> impl Iterator<Item = TileId> + '_ {
         (0..self.levels).flat_map(move |level| {
             let [nx, ny] = self.tiles_at(level);

@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 use super::DatasetError;
 use super::manifest::{MANIFEST_FILE, Manifest};
 
+/// A dataset build in progress: a hidden sibling folder that `commit` renames onto the output and
+/// that dropping uncommitted removes.
 pub struct Staging {
     out: PathBuf,
     staging: PathBuf,
