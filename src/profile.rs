@@ -33,20 +33,32 @@ pub mod trace;
 pub use session::{Session, default_path, fly, orbit_path, timing_of};
 pub use summary::{Meta, Summary};
 
+/// Why a profiled flight, or writing what it measured, failed.
 #[derive(Debug, Error)]
 pub enum ProfileError {
+    /// A frame failed to render.
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// Waiting for the GPU between frames or at the end, or draining the profiler, failed.
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// A height tile could not be read while laying out the default orbit path.
     #[error(transparent)]
     Pack(#[from] crate::dataset::PackError),
+    /// The embedded default camera path does not parse.
     #[error(transparent)]
     Path(#[from] crate::path::PathError),
+    /// A line of the per-frame JSON log (`fly`'s `log`) could not be written.
     #[error("writing the frame log: {0}")]
     Log(std::io::Error),
+    /// An output file (the Chrome trace) could not be created or written.
     #[error("writing {path}: {source}")]
-    Write { path: String, source: std::io::Error },
+    Write {
+        /// The file being written, as given.
+        path: String,
+        /// What the file system said.
+        source: std::io::Error,
+    },
 }
 
 /// When one profiled frame ran.
@@ -63,11 +75,17 @@ pub struct FrameSample {
 /// Pass 3's counters of one frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct SeedSample {
+    /// The renderer's frame number the counters are from (they arrive a frame or two later).
     pub frame: u64,
+    /// Ring-0 cells pass 3 checked.
     pub cells: u32,
+    /// Ranks checked in each cell: the first seeds of its pattern, those some class can grow.
     pub ranks: u32,
+    /// Seeds checked, `cells × ranks`.
     pub checked: u32,
+    /// Seeds that passed every cull, overflow included.
     pub selected: u32,
+    /// Selected seeds left out because the record buffer (`seeds.capacity`) was full.
     pub overflow: u32,
 }
 

@@ -41,61 +41,109 @@ pub use tools::Replay;
 /// Linear-RGB colour of the sky, also the haze the distance fades into.
 const SKY_LINEAR: [f64; 3] = [0.42, 0.55, 0.75];
 
+/// Why a renderer could not be made, or a frame (or a tool's readback) could not run.
 #[derive(Debug, Error)]
 pub enum RenderError {
+    /// The GPU failed: an error scope caught something, or a wait or a readback failed.
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// The camera (a coordinate, its field of view or near plane) or the viewport is out of range.
     #[error(transparent)]
     Camera(#[from] CameraError),
+    /// A tile pack could not be read, as when a tool snapshots the caches for a CPU twin.
     #[error(transparent)]
     Pack(#[from] PackError),
+    /// The imagery pyramid is deeper than the levels the shaders' per-level tables hold.
     #[error("the dataset has {levels} imagery levels; at most {MAX_LEVELS} are supported")]
-    TooManyLevels { levels: u32 },
+    TooManyLevels {
+        /// Levels of the dataset's imagery pyramid.
+        levels: u32,
+    },
+    /// The tile loader could not start its threads, or lacks a layer it was asked for.
     #[error(transparent)]
     Loader(#[from] LoaderError),
+    /// The Tile Load Map cannot cover this dataset or view: too many height levels, rings that do
+    /// not fit its pass, or a camera it cannot project.
     #[error(transparent)]
     Tlm(#[from] TlmError),
+    /// The land cover's class table (its scheme's, or `seeds.class_table`) could not be loaded.
     #[error(transparent)]
     ClassTable(#[from] crate::classes::ClassTableError),
+    /// The species tables cannot be built from the class table: a class too dense for the
+    /// patterns, or too many species.
     #[error(transparent)]
     Seeds(#[from] crate::seeds::SeedError),
+    /// Compaction does not fit this adapter (too many blocks, a buffer too large for one binding),
+    /// or its readback found a bad block.
     #[error(transparent)]
     Compact(#[from] crate::passes::compact::CompactError),
+    /// Pass 4 could not be set up: `draw_seeds.impostors` missing or unreadable, an impostor short
+    /// of LODs, or an adapter without the features it needs.
     #[error(transparent)]
     DrawSeeds(#[from] crate::passes::draw_seeds::DrawSeedsError),
+    /// `seeds.capacity` asks for a record buffer larger than this adapter can bind at once.
     #[error("seeds.capacity = {capacity} records does not fit one GPU buffer binding here (at most {max})")]
-    SeedCapacity { capacity: u32, max: u32 },
+    SeedCapacity {
+        /// Records asked for by `seeds.capacity`.
+        capacity: u32,
+        /// Most records one storage-buffer binding of this adapter holds.
+        max: u32,
+    },
+    /// `pin_everything` was asked of a layer with more tiles than its cache has slots.
     #[error("the {layer} cache has {slots} slots; the whole layer is {tiles} tiles")]
-    DoesNotFit { layer: &'static str, tiles: u64, slots: usize },
+    DoesNotFit {
+        /// The layer that does not fit: `height`, `imagery` or `land-cover`.
+        layer: &'static str,
+        /// Tiles in the whole layer, all levels.
+        tiles: u64,
+        /// Slots of the layer's cache (`cache.*_slots`).
+        slots: usize,
+    },
+    /// `render.width` or `render.height` exceeds the adapter's largest 2D texture.
     #[error("a {width}×{height} viewport is larger than this adapter's {max}-pixel targets")]
-    ViewportTooLarge { width: u32, height: u32, max: u32 },
+    ViewportTooLarge {
+        /// Viewport width asked for, pixels.
+        width: u32,
+        /// Viewport height asked for, pixels.
+        height: u32,
+        /// The adapter's largest texture side, pixels.
+        max: u32,
+    },
 }
 
 /// What one frame did, for logs and tests.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct FrameReport {
+    /// Index of this frame since the renderer was made, from 0.
     pub frame: u64,
+    /// Terrain nodes drawn, each one instance over its height tile or a resident ancestor's.
     pub nodes_drawn: usize,
     /// Nodes selected but not drawn because their height tile did not fit or could not be read.
     pub nodes_dropped: usize,
+    /// The height cache's streaming this frame.
     pub height: CacheStats,
+    /// The imagery cache's streaming this frame (all zero without imagery).
     pub imagery: CacheStats,
+    /// The land-cover cache's streaming this frame (all zero without land cover).
     pub landcover: CacheStats,
     /// The frame whose Tile Load Map drove this frame's streaming (`None` before the first one
-    /// arrives), its visible cells and the seed patterns it uses.
+    /// arrives).
     pub tlm_frame: Option<u64>,
+    /// Cells that Tile Load Map found visible (0 before the first one arrives).
     pub tlm_visible_cells: usize,
+    /// Distinct seed patterns that Tile Load Map's cells use.
     pub tlm_patterns: usize,
     /// TLM readbacks skipped so far because every staging buffer was still in flight.
     pub tlm_readbacks_skipped: u64,
-    /// Ring-0 cells whose seeds this frame checks (and how many beyond the dispatch limit were
-    /// left out).
+    /// Ring-0 cells whose seeds this frame checks.
     pub seed_cells: usize,
+    /// Near, visible cells left out of pass 3 because they were beyond its dispatch limit.
     pub seed_cells_dropped: usize,
     /// Pass 3's counters of the latest frame whose counters have arrived (a frame or two old).
     pub seeds: Option<SeedReport>,
-    /// Species drawn with an impostor, and species not drawn (no `seeds.impostors`, or no model).
+    /// Species drawn with an impostor.
     pub seed_species_drawn: usize,
+    /// Species selected but not drawn (no `draw_seeds.impostors`, or no model for them).
     pub seed_species_undrawn: usize,
     /// Metres the camera was lifted by because it was under the ground (0 when it was not).
     pub camera_lifted_m: f64,
@@ -136,10 +184,16 @@ struct Targets {
     depth_view: wgpu::TextureView,
 }
 
+/// The GPU resources of one dataset (caches, loader threads, passes, targets) and the state carried
+/// from frame to frame; `render` runs one frame.
 pub struct Renderer {
+    /// The device and queue every pass records on and submits to.
     pub gpu: Gpu,
+    /// The dataset streamed, shared with the loader threads.
     pub dataset: Arc<Dataset>,
+    /// The settings the renderer was made with; passes read them every frame.
     pub settings: Settings,
+    /// Times every pass and the CPU steps of each frame (GPU timestamps where the adapter has them).
     pub profiler: Profiler,
     terrain: TerrainPass,
     terrain_bindings: wgpu::BindGroup,
@@ -164,6 +218,8 @@ pub struct Renderer {
 }
 
 impl Renderer {
+    /// Makes the targets, caches (pinned tiles loaded now), loader threads and passes for
+    /// `dataset`; fails when the viewport, the caches or the seeds do not fit this adapter.
     pub fn new(gpu: Gpu, dataset: Dataset, settings: Settings) -> Result<Self, RenderError> {
         let dataset = Arc::new(dataset);
         let targets = Targets::new(&gpu.device, &settings)?;

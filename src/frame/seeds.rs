@@ -32,9 +32,11 @@ use super::{Caches, RenderError};
 pub struct SeedReport {
     /// The frame these counters are from.
     pub frame: u64,
-    /// Cells checked, and ranks checked in each (`checked = cells × ranks`).
+    /// Cells checked (`checked = cells × ranks`).
     pub cells: u32,
+    /// Ranks checked in each cell: the first seeds of its pattern, those some class can grow.
     pub ranks: u32,
+    /// What pass 3 counted: seeds selected, overflowed, checked, and culled by each test.
     #[serde(flatten)]
     pub counters: SeedCounters,
 }

@@ -218,6 +218,7 @@ impl Renderer {
 /// How far `Renderer::replay_seed_passes` goes after the terrain's depth.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Replay {
+    /// The terrain's depth only.
     Depth,
     /// Pass 3 and compaction.
     Select,

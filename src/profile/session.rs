@@ -33,6 +33,8 @@ pub const DEFAULT_PATH_TOML: &str = include_str!("../../config/paths/default.tom
 /// Height of the orbit above the highest ground under its arc, metres.
 const ORBIT_CLEARANCE_M: f64 = 120.0;
 
+/// A profiled flight in progress: renders frames through `renderer`, at most `FRAMES_IN_FLIGHT`
+/// on the GPU at once, and records each profiled frame's wall time, pass timings and seed counters.
 pub struct Session<'r> {
     renderer: &'r mut Renderer,
     warmup: u32,
@@ -60,6 +62,7 @@ impl<'r> Session<'r> {
         }
     }
 
+    /// The renderer being profiled, for its settings and latest timings between frames.
     pub fn renderer(&self) -> &Renderer {
         self.renderer
     }

@@ -9,9 +9,13 @@ use serde::Serialize;
 /// Summary statistics of one series of timings, in milliseconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Stat {
+    /// Median (the mean of the two middle samples for an even count), ms.
     pub median_ms: f64,
+    /// 95th percentile, nearest rank: always a measured sample, ms.
     pub p95_ms: f64,
+    /// Arithmetic mean, ms.
     pub mean_ms: f64,
+    /// Slowest sample, ms.
     pub max_ms: f64,
     /// Samples the figures are computed from.
     pub samples: usize,

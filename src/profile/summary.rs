@@ -37,31 +37,42 @@ pub const SCHEMA: &str = "terramp-profile/1";
 /// What was profiled, and how.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Meta {
+    /// The GPU adapter: name, backend, device type and driver (`Gpu::describe`).
     pub adapter: String,
     /// How GPU passes were timed.
     pub timing: TimeSource,
     /// Why, in words (for the table).
     pub timing_note: String,
+    /// Viewport rendered, `[width, height]` in pixels.
     pub resolution: [u32; 2],
+    /// The settings preset the run started from (in a sweep, the variant's label).
     pub preset: String,
     /// The settings file, if one overrode the preset.
     pub settings: Option<String>,
+    /// The dataset's folder.
     pub dataset: String,
     /// The camera path file, or a description of the generated one.
     pub path: String,
+    /// Warm-up frames rendered before the profiled ones and left out of every figure.
     pub warmup: u32,
 }
 
+/// How many frames the figures cover (`"frames"` in the JSON).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Frames {
+    /// Warm-up frames rendered first and not profiled.
     pub warmup: u32,
+    /// Profiled frames, those with a wall time.
     pub profiled: usize,
+    /// The renderer's number of the first profiled frame (`None` when none was).
     pub first: Option<u64>,
+    /// The renderer's number of the last profiled frame (`None` when none was).
     pub last: Option<u64>,
     /// Profiled frames whose GPU timings arrived.
     pub with_gpu_timings: usize,
 }
 
+/// Frames per second over the profiled frames' wall times (`"fps"` in the JSON).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Fps {
     /// 1000 / the median frame wall time.
@@ -70,45 +81,66 @@ pub struct Fps {
     pub mean: f64,
 }
 
+/// One row of the table: one timed label's statistics over the profiled frames where it ran.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PassStats {
+    /// The profiler's label for the scope: a pass (`terrain`, `seed_select`, …) or CPU work.
     pub label: String,
+    /// How it was timed: GPU timestamps, a CPU wait per pass, or plain CPU work.
     pub source: TimeSource,
+    /// Its per-frame time (the sum of its scopes in the frame), ms.
     #[serde(flatten)]
     pub stat: Stat,
 }
 
+/// Per-frame totals (`"totals"` in the JSON); `None` where no profiled frame had a sample.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Totals {
+    /// Sum of each frame's GPU passes (timestamped or CPU-waited), ms.
     pub gpu: Option<Stat>,
+    /// Sum of each frame's CPU work (LOD selection, streaming, TLM analysis), ms.
     pub cpu: Option<Stat>,
+    /// Frame wall time, start to the next frame's start, waits for the GPU included, ms.
     pub frame_wall: Option<Stat>,
 }
 
+/// Pass 3's counters over the profiled frames (`"seeds"` in the JSON).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Seeds {
     /// Profiled frames whose counters arrived.
     pub frames: usize,
+    /// Median seeds checked per frame (`None` when no counters arrived).
     pub checked_median: Option<f64>,
+    /// Median seeds selected per frame, overflow included (`None` when no counters arrived).
     pub selected_median: Option<f64>,
     /// Frames whose output buffer overflowed.
     pub overflow_frames: usize,
+    /// Each profiled frame's counters, in frame order.
     pub per_frame: Vec<SeedSample>,
 }
 
+/// A profiled flight reduced to the figures of the table and the JSON of `--json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
+    /// Always `SCHEMA`, so readers can tell the layout.
     pub schema: &'static str,
+    /// What was profiled, and how (its fields sit at the top level of the JSON).
     #[serde(flatten)]
     pub meta: Meta,
+    /// How many frames the figures cover.
     pub frames: Frames,
+    /// Frames per second; `None` when no profiled frame has a positive wall time.
     pub fps: Option<Fps>,
+    /// One row per timed label: GPU passes first, then CPU work, each in frame order.
     pub passes: Vec<PassStats>,
+    /// Per-frame GPU, CPU and wall-time totals.
     pub totals: Totals,
+    /// Pass 3's seeds per frame.
     pub seeds: Seeds,
 }
 
 impl Summary {
+    /// Reduces `recording` to per-label statistics, totals, frames per second and seeds per frame.
     pub fn new(recording: &Recording, meta: Meta) -> Self {
         let mut order: Vec<(String, TimeSource)> = Vec::new();
         let mut samples: HashMap<String, Vec<f64>> = HashMap::new();

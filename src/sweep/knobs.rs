@@ -13,7 +13,9 @@ use crate::config::{PRESETS, Settings, SettingsError};
 /// One `--knob key=v1,v2,...`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Knob {
+    /// The settings key, with dots (`seeds.occlusion_tolerance_m`).
     pub key: String,
+    /// Its values, each as TOML text (or a bare string), in the order given.
     pub values: Vec<String>,
 }
 
@@ -74,6 +76,7 @@ fn layer_text(key: &str, value: &str) -> String {
 /// A preset and the knob values that override it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Point {
+    /// The preset the point starts from (`fast`, `balanced`, `accurate`).
     pub preset: String,
     /// (key, value) pairs, in the order of the `--knob` arguments.
     pub knobs: Vec<(String, String)>,

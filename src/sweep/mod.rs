@@ -35,30 +35,53 @@ use crate::profile::ProfileError;
 pub use knobs::{Knob, Point, points};
 pub use report::{SCHEMA, Trade, TradePoint};
 
+/// Why a sweep, or writing its outputs, failed.
 #[derive(Debug, Error)]
 pub enum SweepError {
+    /// A point's settings (preset, settings file or knob value) do not load or check.
     #[error(transparent)]
     Settings(#[from] SettingsError),
+    /// The dataset's folder or manifest could not be opened.
     #[error(transparent)]
     Dataset(#[from] DatasetError),
+    /// A point's timed flight failed.
     #[error(transparent)]
     Profile(#[from] ProfileError),
+    /// A renderer could not be made, or a settled or reference frame failed.
     #[error(transparent)]
     Render(#[from] crate::frame::RenderError),
+    /// No adapter, or the GPU failed outside a frame.
     #[error(transparent)]
     Gpu(#[from] crate::gpu::GpuError),
+    /// A height tile could not be read for the default path or the seeds' height error.
     #[error(transparent)]
     Pack(#[from] crate::dataset::PackError),
+    /// The exact oracle could not list the visible seeds of a sample pose.
     #[error(transparent)]
     Oracle(#[from] crate::reference::oracle::OracleError),
+    /// A frame and its reference cannot be compared: different sizes, or too small for SSIM.
     #[error(transparent)]
     Image(#[from] crate::reference::image_metrics::ImageMetricError),
+    /// The camera path file (`--path`) does not load or parse.
     #[error(transparent)]
     Path(#[from] crate::path::PathError),
+    /// Reading the settings file, or creating or writing an output, failed.
     #[error("{what}: {source}")]
-    Io { what: String, source: std::io::Error },
+    Io {
+        /// What was being done, naming the file (`writing out/trade.csv`).
+        what: String,
+        /// What the file system said.
+        source: std::io::Error,
+    },
+    /// Drawing or saving `trade.png` failed.
     #[error("plotting {path}: {message}")]
-    Plot { path: String, message: String },
+    Plot {
+        /// The image being drawn.
+        path: String,
+        /// What the plotting library said.
+        message: String,
+    },
+    /// The options ask for nothing to measure: no frames, no samples or no presets.
     #[error("sweep: {0}")]
     Options(String),
 }
@@ -66,20 +89,25 @@ pub enum SweepError {
 /// What to sweep, and how.
 #[derive(Debug, Clone)]
 pub struct SweepOptions {
+    /// The dataset's folder; every point and the reference open it afresh.
     pub dataset: PathBuf,
     /// Camera path file; `None` takes `profile::default_path`.
     pub path: Option<PathBuf>,
+    /// Presets to measure (`fast`, `balanced`, `accurate`), each crossed with every knob value.
     pub presets: Vec<String>,
+    /// Settings keys to vary, one `--knob` each; the points are their cartesian product.
     pub knobs: Vec<Knob>,
     /// A settings file laid over every point's preset and over the reference (before the knobs).
     pub settings: Option<PathBuf>,
     /// Timed frames per point, spread evenly along the path, after `warmup` frames at its start.
     pub frames: u32,
+    /// Untimed frames per point at the path's start, so caches fill and shaders compile first.
     pub warmup: u32,
     /// Poses along the path where accuracy is measured, at t = (i + ½) / samples.
     pub samples: u32,
-    /// Overrides of `render.width` and `render.height`.
+    /// Override of `render.width` for every point and the reference, pixels.
     pub width: Option<u32>,
+    /// Override of `render.height` for every point and the reference, pixels.
     pub height: Option<u32>,
 }
 
@@ -92,10 +120,13 @@ pub enum Progress<'a> {
     Step(&'a str),
 }
 
-/// The file names `write_outputs` uses in its folder.
+/// File `write_outputs` puts the table in, as CSV, one row per point.
 pub const CSV_FILE: &str = "trade.csv";
+/// File `write_outputs` puts the whole `Trade` in, as JSON (schema `terramp-trade/1`).
 pub const JSON_FILE: &str = "trade.json";
+/// File `write_outputs` draws the speed/accuracy plot in.
 pub const PLOT_FILE: &str = "trade.png";
+/// File `write_outputs` puts the tables in, as Markdown.
 pub const MARKDOWN_FILE: &str = "trade.md";
 
 /// Runs the sweep: the reference, then every point. Fails before rendering anything when a point's

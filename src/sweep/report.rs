@@ -33,17 +33,24 @@ use crate::reference::accuracy::{HeightError, SeedAgreement};
 /// The version of the JSON layout.
 pub const SCHEMA: &str = "terramp-trade/1";
 
+/// A sweep's figures: every point's speed and accuracy over the same path and sample poses.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Trade {
+    /// Always `SCHEMA`, so readers can tell the layout.
     pub schema: &'static str,
+    /// The GPU adapter the points ran on (`Gpu::describe`).
     pub adapter: String,
     /// How GPU passes were timed, in words.
     pub timing: String,
+    /// The dataset's folder.
     pub dataset: String,
     /// The camera path file, or a description of the generated one.
     pub path: String,
+    /// Viewport of every point and the reference, `[width, height]` in pixels.
     pub resolution: [u32; 2],
+    /// Untimed frames each point renders at the path's start.
     pub warmup: u32,
+    /// Timed frames each point renders, spread evenly along the path.
     pub frames: u32,
     /// Path parameters of the sample poses.
     pub sample_t: Vec<f64>,
@@ -51,18 +58,24 @@ pub struct Trade {
     pub reference: String,
     /// The settings file laid over every preset, if any.
     pub settings: Option<String>,
+    /// One per preset × knob values, in the order of `knobs::points`.
     pub points: Vec<TradePoint>,
 }
 
+/// One point of the sweep: its timings over the flight and its accuracy at the sample poses.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TradePoint {
+    /// The preset, then ` key=value` for each knob (`Point::label`).
     pub label: String,
+    /// The preset the point starts from.
     pub preset: String,
+    /// The knob values laid over the preset, by settings key.
     pub knobs: BTreeMap<String, String>,
     /// Median wall time of a timed frame (start to the next frame's start), ms.
     pub frame_ms: f64,
-    /// Median sums of a frame's GPU passes and of its CPU work, ms.
+    /// Median sum of a timed frame's GPU passes, ms (`None` when no GPU timings arrived).
     pub gpu_ms: Option<f64>,
+    /// Median sum of a timed frame's CPU work (LOD selection, streaming, TLM analysis), ms.
     pub cpu_ms: Option<f64>,
     /// 1000 / `frame_ms`.
     pub fps: Option<f64>,
@@ -72,32 +85,50 @@ pub struct TradePoint {
     pub passes: Vec<PassTime>,
     /// Over all sample poses; `None` without land cover.
     pub seeds: Option<SeedFigures>,
-    /// Over all sample poses: PSNR of the pooled squared error, mean SSIM.
+    /// The ground (the frame without seeds) against the reference's, over all sample poses: PSNR
+    /// of the pooled squared error, dB (capped at `image_metrics::PSNR_CAP_DB`).
     pub ground_psnr_db: f64,
+    /// The frame against the reference's frame, over all sample poses: PSNR of the pooled
+    /// squared error, dB (capped at `image_metrics::PSNR_CAP_DB`).
     pub frame_psnr_db: f64,
+    /// The frame against the reference's frame: mean SSIM over the sample poses (1 = identical).
     pub frame_ssim: f64,
+    /// The same figures at each sample pose, in path order.
     pub samples: Vec<SampleFigures>,
 }
 
+/// One pass's median time at one point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PassTime {
+    /// The profiler's label for the pass or CPU step (`seed_select`, `streaming`, …).
     pub label: String,
+    /// How it was timed: GPU timestamps, a CPU wait per pass, or plain CPU work.
     pub source: TimeSource,
+    /// Median over the timed frames where it ran, ms.
     pub median_ms: f64,
 }
 
+/// How the seeds pass 3 kept agree with the exact oracle's visible seeds, and how high they stand.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SeedFigures {
+    /// Seeds the oracle sees.
     pub visible: u64,
+    /// Seeds pass 3 kept.
     pub kept: u64,
+    /// Seeds both kept and visible.
     pub common: u64,
+    /// Visible seeds kept, % (100 when nothing is visible).
     pub recall_pct: f64,
+    /// Kept seeds that are visible, % (100 when nothing is kept).
     pub precision_pct: f64,
+    /// Largest distance of a kept seed's ground height from the f64 bilinear DEM, metres.
     pub height_error_max_m: f64,
+    /// Mean distance of the kept seeds' ground heights from the f64 bilinear DEM, metres.
     pub height_error_mean_m: f64,
 }
 
 impl SeedFigures {
+    /// The figures of `agreement` and `height`, as percentages and metres.
     pub fn of(agreement: &SeedAgreement, height: &HeightError) -> Self {
         Self {
             visible: agreement.visible,
@@ -111,12 +142,18 @@ impl SeedFigures {
     }
 }
 
+/// A point's accuracy at one sample pose.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SampleFigures {
+    /// The pose's path parameter, 0 to 1.
     pub t: f64,
+    /// The ground (the frame without seeds) against the reference's, PSNR in dB.
     pub ground_psnr_db: f64,
+    /// The frame against the reference's frame, PSNR in dB.
     pub frame_psnr_db: f64,
+    /// The frame against the reference's frame, SSIM (1 = identical).
     pub frame_ssim: f64,
+    /// The seeds against the oracle at this pose; `None` without land cover.
     pub seeds: Option<SeedFigures>,
 }
 
