@@ -53,22 +53,64 @@ pub const MANIFEST_FILE: &str = "impostor.toml";
 /// The real mesh's name inside a model's folder.
 pub const MESH_FILE: &str = "mesh.bin";
 
+/// Why an impostor could not be saved, loaded or listed; each names the file or model at fault.
 #[derive(Debug, Error)]
 pub enum ImpostorError {
+    /// A file or folder of the store could not be read, written, created, renamed or listed.
     #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The file or folder the operation was on.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// `impostor.toml` is not TOML, or lacks or mistypes a key of this format version.
     #[error("{path}: malformed impostor manifest: {source}")]
-    Manifest { path: PathBuf, source: Box<toml::de::Error> },
+    Manifest {
+        /// The manifest's path.
+        path: PathBuf,
+        /// The parser's error, boxed so that every `Result` stays small.
+        source: Box<toml::de::Error>,
+    },
+    /// The manifest or `mesh.bin` was written by another format version: bake the model again.
     #[error(
         "{path}: impostor format version {found}, this build reads version {expected}: bake the model again"
     )]
-    Version { path: PathBuf, found: u32, expected: u32 },
+    Version {
+        /// The file whose version differs.
+        path: PathBuf,
+        /// The version the file declares.
+        found: u32,
+        /// The version this build reads and writes ([`FORMAT_VERSION`]).
+        expected: u32,
+    },
+    /// An atlas or material PNG could not be written, opened or decoded.
     #[error("{path}: {source}")]
-    Image { path: PathBuf, source: image::ImageError },
+    Image {
+        /// The PNG's path.
+        path: PathBuf,
+        /// The `image` crate's error.
+        source: image::ImageError,
+    },
+    /// A file reads but holds the wrong thing: `mesh.bin` with a bad magic, length, checksum or
+    /// index, a mip of the wrong size, or counts that disagree with the manifest.
     #[error("{path}: {reason}")]
-    Invalid { path: PathBuf, reason: String },
+    Invalid {
+        /// The offending file (the manifest for a wrong list of mip files).
+        path: PathBuf,
+        /// What is wrong with it, for the message.
+        reason: String,
+    },
+    /// An impostor breaks a rule the draw passes rely on (plain name, level sizes, atlas
+    /// rectangles inside the atlas, submeshes and indices in range): checked on save and on load.
     #[error("impostor {name:?}: {reason}")]
-    Inconsistent { name: String, reason: String },
+    Inconsistent {
+        /// The impostor's model name.
+        name: String,
+        /// Which rule it breaks, for the message.
+        reason: String,
+    },
+    /// The manifest could not be serialised to TOML; holds the serialiser's message.
     #[error("writing an impostor manifest: {0}")]
     ManifestWrite(String),
 }
@@ -94,6 +136,7 @@ pub struct ImpostorLod {
     /// The fit's tolerance: every triangle drawn on a plane lies within this of it, except the
     /// few the planes could not cover, which go to the nearest plane.
     pub epsilon_m: f32,
+    /// The cloud's textured planes: corners in model space, rectangles in [`Self::atlas`].
     pub planes: Vec<Plane>,
     /// RGBA8 sRGB, straight alpha, one level per mip.
     pub atlas: MipChain,
@@ -104,9 +147,11 @@ pub struct ImpostorLod {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct PlaneVertex {
+    /// A corner of the plane in model space (metres, +Y up, base at y = 0).
     pub position_model_m: [f32; 3],
     /// The plane's front normal (the atlas image reads correctly from this side).
     pub normal_model: [f32; 3],
+    /// The corner's place on the LOD's atlas: uv in [0, 1], (0, 0) at the image's top left.
     pub uv_atlas: [f32; 2],
 }
 
@@ -137,7 +182,9 @@ impl ImpostorLod {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct MeshVertex {
+    /// Model space (metres, +Y up, base at y = 0), the glTF's node transforms applied.
     pub position_model_m: [f32; 3],
+    /// Unit vertex normal in model space (computed from the faces when the glTF has none).
     pub normal_model: [f32; 3],
     /// Base-colour texture coordinates ((0, 0) at the image's top left, repeating).
     pub uv: [f32; 2],
@@ -146,10 +193,14 @@ pub struct MeshVertex {
 /// The real mesh: one vertex buffer, one index buffer, one submesh per material.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Mesh {
+    /// Every triangle primitive's vertices, all in one buffer.
     pub vertices: Vec<MeshVertex>,
     /// Triangle lists, counter-clockwise front faces.
     pub indices: Vec<u32>,
+    /// One range of [`Self::indices`] per material that draws anything, in material order.
     pub submeshes: Vec<Submesh>,
+    /// Indexed by [`Submesh::material`]; a plain white `default` is added for primitives the glTF
+    /// gives no material.
     pub materials: Vec<Material>,
 }
 
@@ -167,12 +218,15 @@ impl Mesh {
 /// A glTF metallic-roughness material reduced to what foliage and rocks use.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
+    /// The glTF material's name (`material{K}` when it has none), for messages and the manifest.
     pub name: String,
     /// Linear RGBA, multiplied with the texture.
     pub base_color_factor: [f32; 4],
+    /// Whether the texture's alpha cuts texels out ([`AlphaMode::Mask`]) or is ignored.
     pub alpha_mode: AlphaMode,
     /// For [`AlphaMode::Mask`]: texels below this alpha are cut out.
     pub alpha_cutoff: f32,
+    /// Both faces are meant to be seen (glTF `doubleSided`), as for leaves.
     pub double_sided: bool,
     /// RGBA8 sRGB, straight alpha, with mips; `None` for a plain colour.
     pub texture: Option<MipChain>,

@@ -40,8 +40,10 @@ use thiserror::Error;
 /// Why no planes could be fitted.
 #[derive(Debug, Error, Clone, Copy, PartialEq, Eq)]
 pub enum FitError {
+    /// The LOD asks for 0 planes.
     #[error("a billboard cloud needs at least one plane")]
     NoPlanes,
+    /// The model's triangles add up to no area: there are none, or all are degenerate.
     #[error("the model has no triangle with an area")]
     NoArea,
 }

@@ -69,42 +69,87 @@ pub struct BakeReport {
     pub name: String,
     /// The impostor's folder (`out/<name>`).
     pub folder: PathBuf,
+    /// Triangles of the model's mesh: every triangle primitive of its scene.
     pub triangles: usize,
+    /// Wall-clock time to bake and save this model, in seconds (reading it not included).
     pub seconds: f64,
 }
 
+/// Why baking stopped; each names the option or the model file at fault.
 #[derive(Debug, Error)]
 pub enum BakeError {
+    /// [`BakeOptions::planes`] is empty or holds a 0; holds the list given.
     #[error("planes {0:?}: baking needs one or more plane counts (one per LOD), each at least 1")]
     Planes(Vec<usize>),
+    /// [`BakeOptions::texels`] is not a power of two from 64 to 8192; holds the value given.
     #[error("texels {0}: an atlas must be a power of two from 64 to 8192 texels wide")]
     Texels(u32),
+    /// A model path is not a file; holds the path.
     #[error("{0}: no such model file")]
     NoSuchModel(PathBuf),
+    /// A model file's stem is empty, hidden (starts with `.`) or not UTF-8, so it cannot name an
+    /// impostor's folder; holds the path.
     #[error("{0}: cannot name an impostor after this file")]
     Unnamed(PathBuf),
+    /// Two model files share a stem, so their impostors would share a folder; holds the name.
     #[error("two models are named {0:?}: each impostor is named after its file")]
     SameName(String),
     // Boxed, as `Lod`'s: the rarely built large errors keep every `Result` small.
+    /// A model file could not be read as a glTF mesh (found before any GPU work).
     #[error("{path}: {source}")]
-    Model { path: PathBuf, source: Box<ModelError> },
+    Model {
+        /// The model file.
+        path: PathBuf,
+        /// What is wrong with it.
+        source: Box<ModelError>,
+    },
+    /// No GPU could be opened to bake on (only tried when none is passed in).
     #[error("opening a GPU to bake on: {0}")]
     Gpu(#[from] GpuError),
+    /// One LOD of a model could not be fitted, packed or rendered.
     #[error("baking {path}: LOD {lod}: {source}")]
-    Lod { path: PathBuf, lod: usize, source: Box<LodError> },
+    Lod {
+        /// The model file.
+        path: PathBuf,
+        /// The LOD's index, 0 the finest: its place in [`BakeOptions::planes`].
+        lod: usize,
+        /// What went wrong with it.
+        source: Box<LodError>,
+    },
+    /// The baked impostor could not be written to its folder.
     #[error("saving the impostor of {path}: {source}")]
-    Save { path: PathBuf, source: ImpostorError },
+    Save {
+        /// The model file it was baked from.
+        path: PathBuf,
+        /// The impostor store's error.
+        source: ImpostorError,
+    },
 }
 
 /// Why one LOD of a model could not be baked.
 #[derive(Debug, Error)]
 pub enum LodError {
+    /// No planes could be fitted to the model's triangles.
     #[error(transparent)]
     Fit(#[from] FitError),
+    /// The fit gave another number of planes than the LOD asks for.
     #[error("the model gives {found} planes, not {wanted} (too few triangles?)")]
-    PlaneCount { found: usize, wanted: usize },
+    PlaneCount {
+        /// Planes the fit gave.
+        found: usize,
+        /// Planes the LOD asks for: its entry of [`BakeOptions::planes`].
+        wanted: usize,
+    },
+    /// The planes' rectangles do not fit the atlas even at the smallest texel density, one
+    /// aligned cell each.
     #[error("{planes} planes do not fit a {texels}-texel atlas: raise the atlas size (texels)")]
-    Pack { planes: usize, texels: u32 },
+    Pack {
+        /// Planes of the LOD.
+        planes: usize,
+        /// The atlas's width and height in texels ([`BakeOptions::texels`]).
+        texels: u32,
+    },
+    /// The atlas could not be rendered on the GPU.
     #[error(transparent)]
     Render(#[from] RenderError),
 }

@@ -16,28 +16,68 @@ use crate::impostor::{AlphaMode, Material, Mesh, MeshVertex, MipChain, Submesh, 
 /// What makes a model unreadable. The error carrying it names the model's file.
 #[derive(Debug, Error)]
 pub enum ModelError {
+    /// The model file could not be read.
     #[error("reading it: {0}")]
     Read(#[source] std::io::Error),
+    /// The file does not parse as glTF (JSON `.gltf` or binary `.glb`).
     #[error("not a valid glTF model: {0}")]
     NotGltf(#[source] gltf::Error),
+    /// A buffer or image is embedded as a `data:` URI, which the baker does not decode.
     #[error("unusable glTF model: embedded data URIs are not supported: use a .glb")]
     DataUri,
+    /// A buffer or image file that the model refers to beside it could not be read.
     #[error("unusable glTF model: reading {file}: {source}")]
-    Beside { file: PathBuf, source: std::io::Error },
+    Beside {
+        /// That file, resolved against the model's folder.
+        file: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// A buffer refers to the `.glb` binary chunk and the file has none.
     #[error("unusable glTF model: the binary chunk is missing")]
     NoBinaryChunk,
+    /// A buffer's data is shorter than its declared `byteLength`.
     #[error("unusable glTF model: buffer {index} holds {found} bytes, {declared} declared")]
-    ShortBuffer { index: usize, found: usize, declared: usize },
+    ShortBuffer {
+        /// The buffer's glTF index.
+        index: usize,
+        /// Bytes its data holds.
+        found: usize,
+        /// Bytes its `byteLength` declares.
+        declared: usize,
+    },
+    /// An image's buffer view names no buffer or reaches outside its buffer.
     #[error("unusable glTF model: image {image}: {problem}")]
-    ImageView { image: usize, problem: &'static str },
+    ImageView {
+        /// The image's glTF index.
+        image: usize,
+        /// Which of the two, for the message.
+        problem: &'static str,
+    },
+    /// An image (PNG or JPEG) could not be decoded.
     #[error("unusable glTF model: image {image}: decoding: {source}")]
-    ImageDecode { image: usize, source: image::ImageError },
+    ImageDecode {
+        /// The image's glTF index.
+        image: usize,
+        /// The `image` crate's error.
+        source: image::ImageError,
+    },
+    /// The file has no scene to take the meshes from.
     #[error("unusable glTF model: the file has no scene")]
     NoScene,
+    /// A triangle primitive has no `POSITION` attribute.
     #[error("unusable glTF model: mesh {mesh}: a primitive without positions")]
-    NoPositions { mesh: usize },
+    NoPositions {
+        /// The glTF index of the mesh holding the primitive.
+        mesh: usize,
+    },
+    /// A primitive's index count is not a multiple of 3, or an index points past its vertices.
     #[error("unusable glTF model: mesh {mesh}: bad triangle indices")]
-    BadIndices { mesh: usize },
+    BadIndices {
+        /// The glTF index of the mesh holding the primitive.
+        mesh: usize,
+    },
+    /// The scene holds no triangle at all (non-triangle primitives are skipped).
     #[error("unusable glTF model: no triangles")]
     NoTriangles,
 }

@@ -20,12 +20,21 @@ use crate::impostor::{AlphaMode, Mesh, MeshVertex, MipChain, TexelRect};
 /// Why an atlas could not be rendered.
 #[derive(Debug, Error)]
 pub enum RenderError {
+    /// The atlas is wider than the adapter's largest 2D texture.
     #[error("an atlas of {atlas} texels exceeds the adapter's limit of {limit}")]
-    TooLarge { atlas: u32, limit: u32 },
+    TooLarge {
+        /// The atlas's width and height in texels.
+        atlas: u32,
+        /// The adapter's `max_texture_dimension_2d`, in texels.
+        limit: u32,
+    },
+    /// No plane of the LOD has a triangle to draw on it.
     #[error("no triangle to draw")]
     NothingToDraw,
+    /// Copying the rendered atlas back to the CPU failed.
     #[error("reading the atlas back: {0}")]
     Readback(#[source] GpuError),
+    /// The GPU reported an error (a validation error, say) while rendering the atlas.
     #[error("baking an atlas: {0}")]
     Gpu(#[source] GpuError),
 }

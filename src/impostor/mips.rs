@@ -23,10 +23,12 @@ pub struct MipChain {
 }
 
 impl MipChain {
+    /// Levels held, level 0 included.
     pub fn mip_count(&self) -> u32 {
         self.levels.len() as u32
     }
 
+    /// Level `level`'s width and height in texels.
     pub fn level_size(&self, level: u32) -> [u32; 2] {
         mip_size(self.size, level)
     }
@@ -40,9 +42,13 @@ pub fn mip_size(size: [u32; 2], level: u32) -> [u32; 2] {
 /// A rectangle of texels at level 0.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TexelRect {
+    /// Left edge, in texels from the image's left.
     pub x: u32,
+    /// Top edge, in texels from the image's top row.
     pub y: u32,
+    /// Texels across, from `x` rightwards.
     pub width: u32,
+    /// Texels down, from `y`.
     pub height: u32,
 }
 
