@@ -13,40 +13,56 @@ use wgpu::{ShaderStages, TextureSampleType, TextureViewDimension};
 pub enum BindingKind {
     /// A uniform buffer holding one value of `bytes`.
     Uniform {
+        /// Size of the value, bytes (`size_of` of the Rust twin of its WGSL type).
         bytes: u64,
     },
     /// A storage buffer holding one value of `bytes` (a struct, or a fixed-size array), or with
     /// `runtime_array` a runtime-sized array of elements of `bytes`.
     Storage {
+        /// Declared `var<storage, read>`; else `read_write`.
         read_only: bool,
+        /// Size of the value, or with `runtime_array` of one element, bytes.
         bytes: u64,
+        /// The WGSL global is a runtime-sized `array<T>`, whose length the bound buffer decides.
         runtime_array: bool,
     },
+    /// A sampled (or loaded) texture, never multisampled.
     Texture {
+        /// What reading it returns: float (filterable or not), unsigned integer or depth.
         sample_type: TextureSampleType,
+        /// The view dimension the shader declares (2D, or a 2D array for the tile caches).
         dimension: TextureViewDimension,
     },
+    /// A storage texture the shader only writes (`texture_storage_2d<format, write>`).
     StorageTexture {
+        /// The texel format the shader declares and the bound view must have.
         format: wgpu::TextureFormat,
+        /// The view dimension the shader declares.
         dimension: TextureViewDimension,
     },
+    /// A sampler of this binding type (filtering, non-filtering or comparison).
     Sampler(wgpu::SamplerBindingType),
 }
 
 /// One binding of a bind group: its number, the WGSL global it binds, who sees it, what it is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Binding {
+    /// Its number, the `n` of `@group(0) @binding(n)`.
     pub binding: u32,
     /// The name of the WGSL global (`var<...> name: ...`).
     pub name: &'static str,
+    /// The shader stages that see it: must include the stage of every entry point that uses it.
     pub visibility: ShaderStages,
+    /// What it binds, with the size, type or format the WGSL declaration must match.
     pub kind: BindingKind,
 }
 
 /// Storage access of a buffer binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Access {
+    /// `var<storage, read>`: the shader only reads the buffer.
     Read,
+    /// `var<storage, read_write>`: the shader writes the buffer (and may read it).
     ReadWrite,
 }
 
@@ -134,7 +150,9 @@ impl Binding {
 /// A bind group's bindings, in the order its resources are given.
 #[derive(Debug, Clone, Copy)]
 pub struct BindingTable<const N: usize> {
+    /// Debug label of the bind group layout and of every bind group built from the table.
     pub label: &'static str,
+    /// The bindings, in the order `bind_group` takes their resources.
     pub bindings: [Binding; N],
 }
 
@@ -178,7 +196,10 @@ impl<const N: usize> BindingTable<N> {
 /// `tests/shaders.rs` checks against the WGSL.
 #[derive(Debug, Clone, Copy)]
 pub struct PipelineBindings {
+    /// The shader whose `@group(0)` globals the table binds.
     pub shader: &'static super::shaders::WgslSource,
+    /// The entry points of `shader` the pipeline runs: every global they use must be in the table.
     pub entry_points: &'static [&'static str],
+    /// The table's bindings (`BindingTable::bindings`).
     pub bindings: &'static [Binding],
 }

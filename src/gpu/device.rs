@@ -19,7 +19,9 @@ pub enum AdapterChoice {
     /// A hardware GPU if there is one, else a software adapter.
     #[default]
     Auto,
+    /// Any adapter but a software rasteriser (discrete first, then integrated, then virtual).
     Hardware,
+    /// A software rasteriser only (Mesa lavapipe on Linux), even where a GPU is present.
     Software,
 }
 
@@ -47,30 +49,53 @@ impl AdapterChoice {
     }
 }
 
+/// What to install when no adapter is usable, and the variables that force an adapter kind or a
+/// backend: the tail of `GpuError::NoAdapter`'s message.
 pub const INSTALL_HINT: &str = "terramp needs a GPU adapter. With no GPU driver, install Mesa's software Vulkan \
 driver: `sudo apt-get install mesa-vulkan-drivers libvulkan1` (Debian/Ubuntu). Force one kind with \
 TERRAMP_ADAPTER=software|hardware, and a backend with WGPU_BACKEND=vulkan.";
 
+/// Why the GPU could not be opened, or what went wrong on it since the last check.
 #[derive(Debug, Error)]
 pub enum GpuError {
+    /// No adapter of the kind asked for is present (or wgpu sees none at all).
     #[error("no {wanted} GPU adapter found (adapters seen: {seen}). {INSTALL_HINT}")]
-    NoAdapter { wanted: &'static str, seen: String },
+    NoAdapter {
+        /// The kind asked for: `usable` (any), `hardware` or `software`.
+        wanted: &'static str,
+        /// Every adapter wgpu listed, as name and backend, or `none`.
+        seen: String,
+    },
+    /// `TERRAMP_ADAPTER` holds something other than auto, hardware or software.
     #[error("TERRAMP_ADAPTER={0:?}: expected auto, hardware or software")]
     BadChoice(String),
+    /// The chosen adapter refused a device with terramp's features and limits.
     #[error("the adapter {adapter} refused a device: {source}")]
-    Device { adapter: String, source: wgpu::RequestDeviceError },
+    Device {
+        /// The adapter's name.
+        adapter: String,
+        /// wgpu's reason.
+        source: wgpu::RequestDeviceError,
+    },
+    /// wgpu raised errors (validation, out of memory) since the last `Gpu::check`, joined with
+    /// `; `; also a readback that failed or never arrived.
     #[error("GPU error: {0}")]
     Validation(String),
+    /// Waiting for the device, or polling it, failed.
     #[error("waiting for the GPU: {0}")]
     Poll(#[from] wgpu::PollError),
+    /// A staging buffer of a readback could not be mapped.
     #[error("reading a GPU buffer back: {0}")]
     Map(#[from] wgpu::BufferAsyncError),
 }
 
 /// The device terramp renders with, and what it can do.
 pub struct Gpu {
+    /// The logical device every pass creates its buffers, textures and pipelines on.
     pub device: wgpu::Device,
+    /// The device's queue: uploads and submissions.
     pub queue: wgpu::Queue,
+    /// The chosen adapter: name, backend, device type and driver (`describe` prints them).
     pub info: wgpu::AdapterInfo,
     /// GPU timestamps can be written inside encoders (else the profiler times on the CPU).
     pub has_timestamps: bool,
@@ -78,6 +103,8 @@ pub struct Gpu {
 }
 
 impl Gpu {
+    /// Picks an adapter by `choice` (`TERRAMP_ADAPTER` overrides it; hardware first, Vulkan before
+    /// other backends) and opens a headless device on it whose GPU errors `check` reports.
     pub fn new(choice: AdapterChoice) -> Result<Self, GpuError> {
         let choice = choice.with_env()?;
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());

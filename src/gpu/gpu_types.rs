@@ -23,7 +23,10 @@ gpu_struct! {
         pub camera_grid_m: [f32; 4],
         /// Height range of the dataset (min, max), then grid cells per node, then 1 if imagery exists.
         pub height_range_m: [f32; 2],
+        /// Grid cells along a node's edge, the same at every LOD: a node draws (node_cells + 3)²
+        /// vertices, its skirt ring included.
         pub node_cells: u32,
+        /// 1 when the dataset has imagery, which the ground pass blends over its relief tint; else 0.
         pub has_imagery: u32,
         /// Imagery: grid-space position of texel (0, 0)'s south-west corner (xy), level-0 texel edge
         /// in metres (z), level-of-detail bias in log2 texels (w).
@@ -32,6 +35,7 @@ gpu_struct! {
         pub imagery_levels: [[u32; 4]; MAX_LEVELS as usize],
         /// Imagery levels stored, then padding.
         pub imagery_level_count: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 3],
     }
 }
@@ -51,6 +55,7 @@ gpu_struct! {
         pub sample_offset: [f32; 2],
         /// Vertices morph into the coarser grid between these distances from the camera, metres.
         pub morph_start_m: f32,
+        /// Where the morph is complete: the LOD's range (`Lods::range_m`), metres from the camera.
         pub morph_end_m: f32,
         /// Cells of the node inside the dataset; vertices beyond are clamped onto its edge.
         pub cells_inside: [f32; 2],
@@ -102,6 +107,7 @@ gpu_struct! {
         pub origin_cell: [i32; 2],
         /// Height pyramid level whose tiles bound the heights of the ring's cells.
         pub height_level: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: u32,
     }
 }
@@ -118,6 +124,8 @@ gpu_struct! {
         pub camera_z_m: f32,
         /// Near plane, metres: reversed-Z depth is `near_m / view distance`.
         pub near_m: f32,
+        /// How far a box may lie behind the depth and still be visible, metres, before it grows with
+        /// distance (`tlm.occlusion_tolerance_m`).
         pub occlusion_tolerance_m: f32,
         /// (metres per pixel at 1 m · 2^lod_bias / level-0 texel edge)²: distance² times this is the
         /// squared texel footprint ratio whose halved log2 is the imagery level.
@@ -128,27 +136,32 @@ gpu_struct! {
         pub screen_px: [u32; 2],
         /// NDC units per pixel (2 / width, 2 / height).
         pub ndc_per_px: [f32; 2],
+        /// Mips of the depth pyramid: the occlusion test reads none coarser than `hiz_mips - 1`.
         pub hiz_mips: u32,
         /// Imagery levels (0: no imagery).
         pub imagery_levels: u32,
         /// Entries of `height_lod_range_m` in use (the terrain's LOD count).
         pub height_lod_count: u32,
+        /// Rings in use this frame (at most `TLM_MAX_RINGS`): the dispatch's z extent.
         pub rings: u32,
         /// Cells per ring side.
         pub cells: u32,
         /// Seed patterns P (visibility of a ring-0 cell is 1 + hash % P).
         pub patterns: u32,
+        /// The world's seed number (`tlm.seed`): the germ of every ring-0 cell's pattern hash.
         pub seed: u32,
         /// Always 0: OR-ed into every product so no compiler fuses it into an FMA (see the shader).
         pub no_fuse: u32,
         /// A box is hidden when it lies more than `occlusion_tolerance_m + per_m × distance`
         /// behind the depth (`config::OcclusionTolerance`, as the seeds').
         pub occlusion_tolerance_per_m: f32,
+        /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 3],
         /// The terrain's CDLOD range of each LOD (`Lods::range_m`), metres, four per vec4.
         pub height_lod_range_m: [[f32; 4]; MAX_LEVELS as usize / 4],
         /// Height pyramid per level: first tile index, tiles along x, tiles along y, 0.
         pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
+        /// Each ring's origin and height level, the first `rings` in use.
         pub rings_info: [TlmRing; TLM_MAX_RINGS as usize],
     }
 }
@@ -177,6 +190,8 @@ gpu_struct! {
         pub screen_px: [u32; 2],
         /// A summit is hidden when it lies more than `tolerance_m + per_m × distance` behind the depth.
         pub occlusion_tolerance_m: f32,
+        /// How much that tolerance grows per metre of the summit's distance
+        /// (`seeds.occlusion_tolerance_per_km` / 1000).
         pub occlusion_tolerance_per_m: f32,
         /// 1 / the height that sees the full radial LOD distances, 1/m.
         pub inv_reference_height_m: f32,
@@ -187,7 +202,9 @@ gpu_struct! {
         /// A ring-0 cell's edge in level-0 height samples, in level-1 land-cover texels and in
         /// level-0 imagery texels.
         pub cell_in_samples: f32,
+        /// A ring-0 cell's edge in level-1 land-cover texels (0 without land cover).
         pub cell_in_lcc_texels: f32,
+        /// A ring-0 cell's edge in level-0 imagery texels (0 without imagery).
         pub cell_in_imagery_texels: f32,
         /// Ground-colour sampling radius, level-0 imagery texels.
         pub ground_radius_texels: f32,
@@ -201,11 +218,14 @@ gpu_struct! {
         pub seed: u32,
         /// Level-0 height samples along x and y.
         pub height_size: [u32; 2],
+        /// Levels of the height pyramid (at most `MAX_LEVELS`): where the walk up to a resident
+        /// level stops.
         pub height_level_count: u32,
         /// Bits per level-2 sub-code of the land-cover coding (2, 4 or 8); 0: no land cover.
         pub lcc_sub_bits: u32,
         /// Level-1 land-cover texels along x and y.
         pub lcc_size: [u32; 2],
+        /// Levels of the imagery pyramid (at most `MAX_LEVELS`); 0 without imagery.
         pub imagery_level_count: u32,
         /// Edge of a ring-0 cell, metres.
         pub cell_m: f32,
@@ -215,16 +235,21 @@ gpu_struct! {
         pub ndc_per_px: [f32; 2],
         /// The camera in level-0 height samples: integer part, remainder.
         pub camera_sample: [i32; 2],
+        /// The remainder of the camera's position, in [0, 1) level-0 height samples.
         pub camera_sample_frac: [f32; 2],
         /// Most samples of the DEM march that settles a summit near a silhouette (0: no march; the
         /// summit's own pixel decides).
         pub refine_max_steps: u32,
         /// Ranks checked per cell: none beyond the densest class's last rank limit grows anything.
         pub active_ranks: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 2],
         /// Page tables per level (first entry, tiles along x, tiles along y, 0).
         pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
+        /// The land-cover page table per LCC level, laid out as `height_levels` (0 without land
+        /// cover).
         pub lcc_levels: [[u32; 4]; 4],
+        /// The imagery page table per level, laid out as `height_levels` (0 without imagery).
         pub imagery_levels: [[u32; 4]; MAX_LEVELS as usize],
     }
 }
@@ -241,16 +266,21 @@ gpu_struct! {
         pub address: [i32; 2],
         /// Corner in level-0 height samples: integer part, remainder.
         pub height_sample: [i32; 2],
+        /// The remainder of that corner, in [0, 1) samples.
         pub height_frac: [f32; 2],
         /// Corner in level-1 land-cover texels (the source's).
         pub lcc_texel: [i32; 2],
+        /// The remainder of that corner, in [0, 1) texels.
         pub lcc_frac: [f32; 2],
         /// Corner in level-0 imagery texels.
         pub imagery_texel: [i32; 2],
+        /// The remainder of that corner, in [0, 1) texels.
         pub imagery_frac: [f32; 2],
         /// Its seed pattern, and the land-cover level its radial LOD asked the streaming for.
         pub pattern: u32,
+        /// The land-cover level its seeds read first: its radial LOD, at most `LCC_LEVELS - 1`.
         pub lcc_level: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 2],
     }
 }
@@ -267,7 +297,9 @@ gpu_struct! {
         pub max_slope_tan_sq: f32,
         /// Bounding-sphere radius per metre of height.
         pub radius_per_height: f32,
+        /// What it is: `KIND_TREE`, `KIND_BUSH` or `KIND_ROCK`.
         pub kind: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: u32,
     }
 }
@@ -278,7 +310,10 @@ gpu_struct! {
     /// none when r is beyond them all: thinning by rank keeps every density blue noise.
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
     pub struct SeedClass {
+        /// Per rule k, the seeds per cell that rules 0 to k grow together (cumulative densities ×
+        /// cell area); 0 for an unused rule, which no rank is below.
         pub rank_limit: [f32; MAX_SPECIES_PER_CLASS as usize],
+        /// The species (index into the species table) each rule grows.
         pub species: [u32; MAX_SPECIES_PER_CLASS as usize],
     }
 }
@@ -293,6 +328,7 @@ gpu_struct! {
         pub height_m: f32,
         /// Global ring-0 cell and rank in its pattern: the seed's identity.
         pub address: [i32; 2],
+        /// Its rank in its cell's pattern (also what shifts its dither pattern when drawn).
         pub rank: u32,
         /// Species, draw LOD and the levels it was read from: a `layout::SpeciesLod`.
         pub species_lod: u32,
@@ -312,8 +348,11 @@ gpu_struct! {
     /// overflow included; records hold `min(selected, capacity)`.
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default, serde::Serialize)]
     pub struct SeedCounters {
+        /// Seeds that passed every test, overflow included.
         pub selected: u32,
+        /// Selected seeds that found the record buffer full and were not written.
         pub overflow: u32,
+        /// Seeds checked: every active rank of every cell dispatched.
         pub checked: u32,
         /// Culled: no class, or a class whose density leaves this rank out (or outside the dataset).
         pub class: u32,
@@ -321,7 +360,9 @@ gpu_struct! {
         pub rule: u32,
         /// Beyond the radial LOD distance for its size.
         pub distance: u32,
+        /// Culled: the bounding sphere lies outside the view frustum (beyond `frustum_epsilon`).
         pub frustum: u32,
+        /// Culled: the summit lies more than the occlusion tolerance behind the terrain's depth.
         pub occlusion: u32,
     }
 }
@@ -333,7 +374,9 @@ gpu_struct! {
     /// workgroup that kept nothing or found the buffer full; `offset` is then 0).
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default)]
     pub struct SeedBlock {
+        /// Index in the record buffer of the workgroup's first survivor.
         pub offset: u32,
+        /// Survivors recorded from `offset` on.
         pub count: u32,
     }
 }
@@ -344,10 +387,15 @@ gpu_struct! {
     /// the draw pass uploads) `instance_count` and `first_instance` are ignored.
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default)]
     pub struct SeedDrawArgs {
+        /// Indices of the group's geometry (its LOD's mesh or billboard cloud).
         pub index_count: u32,
+        /// Seeds drawn: the group's survivors, as compaction counted them.
         pub instance_count: u32,
+        /// Where the geometry's indices start in the draw pass's index buffer.
         pub first_index: u32,
+        /// Added to every index: where the geometry's vertices start in the vertex buffer.
         pub base_vertex: i32,
+        /// The group's first draw slot in compaction's `order` (`INDIRECT_FIRST_INSTANCE`).
         pub first_instance: u32,
     }
 }
@@ -358,7 +406,9 @@ gpu_struct! {
     pub struct CompactParams {
         /// Entries of the block table to compact, and the chunks (workgroups) they make.
         pub blocks: u32,
+        /// Chunks of `COMPACT_CHUNK` entries (rounded up): the workgroups of `reduce` and `scatter`.
         pub chunks: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 2],
     }
 }
@@ -376,7 +426,11 @@ gpu_struct! {
         pub haze: [f32; 4],
         /// Each draw LOD's reach (`draw_seeds.reach_m`), metres, scaled by each seed's size.
         pub draw_reach_m: [f32; 4],
+        /// 1 / the seed height that gets the full reaches, 1/m: a smaller seed's reach shrinks with
+        /// its height.
         pub inv_reference_height_m: f32,
+        /// Fraction of its height a seed's anchor was sunk by (pass 3's), undone to measure its
+        /// distance.
         pub sink_fraction: f32,
         /// The outer part of each LOD band over which a seed dithers out, as a fraction of its reach.
         pub fade_fraction: f32,
@@ -394,9 +448,11 @@ gpu_struct! {
     pub struct SeedMaterial {
         /// Linear RGBA, multiplied with the texel.
         pub base_colour: [f32; 4],
+        /// Layer of the seed texture array it samples (with `MATERIAL_TEXTURED`).
         pub layer: u32,
         /// Fragments with alpha below this are cut out (below 0: opaque).
         pub alpha_cutoff: f32,
+        /// Draw LOD of its geometry: a draw whose seeds are of another LOD is their cross-fade.
         pub lod: u32,
         /// `MATERIAL_TEXTURED` | `MATERIAL_REPEAT` (wrap texture coordinates, else clamp).
         pub flags: u32,
@@ -408,9 +464,13 @@ gpu_struct! {
     /// the draw pass uploads it; `material` indexes its `SeedMaterial` table.
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
     pub struct SeedVertex {
+        /// Position, model space, metres; scaled to the seed's height when drawn.
         pub position_model_m: [f32; 3],
+        /// Unit normal, model space.
         pub normal_model: [f32; 3],
+        /// Texture coordinates in its material's layer (wrapped or clamped per `MATERIAL_REPEAT`).
         pub uv: [f32; 2],
+        /// Index into the draw pass's `SeedMaterial` table.
         pub material: u32,
     }
 }

@@ -44,7 +44,9 @@ macro_rules! wgsl_constants {
 /// One field of a packed word: its name and width in bits (fields are packed from bit 0 up).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BitField {
+    /// The field's name, the same in the Rust struct and the WGSL struct.
     pub name: &'static str,
+    /// Its width in bits; it sits just above the fields before it.
     pub bits: u32,
 }
 
@@ -56,6 +58,7 @@ pub struct PackedWord {
     pub name: &'static str,
     /// The snake-case name of its pack and unpack functions.
     pub function: &'static str,
+    /// Its fields, from bit 0 up.
     pub fields: &'static [BitField],
 }
 
@@ -116,6 +119,8 @@ pub const fn mask(bits: u32) -> u32 {
 wgsl_constants! { dataset_constants:
     /// Height tiles: 256 cells (257 shared-edge samples) plus a 1-sample border for normals.
     pub const HEIGHT_TILE_CELLS: u32 = 256;
+    /// Samples of border on each side of a height tile, so normals are central differences at its
+    /// edges too.
     pub const HEIGHT_BORDER: u32 = 1;
     /// Samples along a stored height tile's edge, borders included.
     pub const HEIGHT_TILE_EXTENT: u32 = HEIGHT_TILE_CELLS + 1 + 2 * HEIGHT_BORDER;
@@ -124,12 +129,15 @@ wgsl_constants! { dataset_constants:
     /// Imagery carries an 8-texel border, enough for trilinear and anisotropic filtering down its
     /// 4 stored mips (8, 4, 2, 1 texels of border).
     pub const IMAGERY_BORDER: u32 = 8;
+    /// Mips stored per imagery tile, mip 0 included.
     pub const IMAGERY_MIPS: u32 = 4;
     /// Texels along a stored imagery tile's edge (mip 0), borders included.
     pub const IMAGERY_TILE_EXTENT: u32 = CELL_TILE_TEXELS + 2 * IMAGERY_BORDER;
+    /// Texels along an imagery tile's edge, borders excluded: the ground one tile covers.
     pub const IMAGERY_TILE_TEXELS: u32 = CELL_TILE_TEXELS;
     /// Land cover is read texel by texel (nearest), so it needs no border.
     pub const LANDCOVER_BORDER: u32 = 0;
+    /// Texels along a land-cover tile's edge (there is no border).
     pub const LCC_TILE_TEXELS: u32 = CELL_TILE_TEXELS;
     /// Levels of the LCC quadtree (paper § 4.1): 0 duplicates each source texel onto its four
     /// children, 1 is the source, 2 packs four level-1 classes into sub-codes.
@@ -192,7 +200,9 @@ packed_word! {
     /// A range of levels, finest first: `TlmCell::imagery_lod` (the imagery levels a cell's pixels
     /// need) and `TlmCell::height_lod` (the terrain LODs at its nearest and farthest points).
     pub struct LevelRange as level_range {
+        /// The finest level: the one at the cell's nearest point.
         min: 8,
+        /// The coarsest level: the one at the cell's farthest point.
         max: 8,
     }
 }
@@ -200,7 +210,9 @@ packed_word! {
 packed_word! {
     /// `TlmSpan::height_tiles`: the first and last height tile a column (row) overlaps.
     pub struct TileSpan as tile_span {
+        /// Index along x (y) of the first tile it overlaps, within its level.
         first: 16,
+        /// Index along x (y) of the last tile it overlaps, inclusive.
         last: 16,
     }
 }
@@ -232,17 +244,27 @@ wgsl_constants! { seed_constants:
     pub const SEED_DRAWS: u32 = 2 * SEED_GROUPS;
     /// Indices into `SeedCounters` (as an array of u32): where a seed's outcome is counted.
     pub const COUNT_SELECTED: u32 = 0;
+    /// `SeedCounters::overflow`: selected, but the record buffer was full.
     pub const COUNT_OVERFLOW: u32 = 1;
+    /// `SeedCounters::checked`: every seed pass 3 looked at.
     pub const COUNT_CHECKED: u32 = 2;
+    /// `SeedCounters::class`: culled for its land-cover class (none, or none at its rank).
     pub const COUNT_CLASS: u32 = 3;
+    /// `SeedCounters::rule`: culled by its species' altitude or slope rule.
     pub const COUNT_RULE: u32 = 4;
+    /// `SeedCounters::distance`: beyond the radial LOD distance for its size.
     pub const COUNT_DISTANCE: u32 = 5;
+    /// `SeedCounters::frustum`: its bounding sphere lies outside the view frustum.
     pub const COUNT_FRUSTUM: u32 = 6;
+    /// `SeedCounters::occlusion`: its summit lies behind the terrain's depth.
     pub const COUNT_OCCLUSION: u32 = 7;
+    /// Counters in `SeedCounters`: its length as an array of u32.
     pub const SEED_COUNTERS: u32 = 8;
     /// `SeedSpecies::kind` codes.
     pub const KIND_TREE: u32 = 0;
+    /// `SeedSpecies::kind` of a bush.
     pub const KIND_BUSH: u32 = 1;
+    /// `SeedSpecies::kind` of a rock.
     pub const KIND_ROCK: u32 = 2;
     /// Pixels around a summit's whose farthest terrain depth decides its occlusion (1: a 3 × 3
     /// block), so a summit within a pixel of a silhouette is kept.

@@ -26,15 +26,22 @@ const MAX_PENDING_FRAMES: usize = 4;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TimeSource {
+    /// GPU timestamp queries written around the pass inside its encoder.
     GpuTimestamps,
+    /// CPU wall time of the pass submitted on its own and waited for (no timestamps).
     CpuWait,
+    /// CPU wall time of CPU work timed with `Profiler::cpu`.
     Cpu,
 }
 
+/// How long one pass or CPU scope of a frame took.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct PassTiming {
+    /// The label given to `Profiler::pass` or `Profiler::cpu`.
     pub label: String,
+    /// Its duration, milliseconds.
     pub ms: f64,
+    /// How the duration was measured.
     pub source: TimeSource,
 }
 
@@ -42,7 +49,9 @@ pub struct PassTiming {
 /// the driver's); else on the profiler's CPU clock (`Profiler::now_ms`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ScopeTiming {
+    /// The scope's label, duration and source.
     pub timing: PassTiming,
+    /// When it started, milliseconds, on the clock its source implies (see above).
     pub start_ms: f64,
 }
 
@@ -51,6 +60,7 @@ pub struct ScopeTiming {
 pub struct FrameTimings {
     /// `end_frame` calls before this frame's.
     pub frame: u64,
+    /// Its timed scopes, each with its start.
     pub scopes: Vec<ScopeTiming>,
 }
 
@@ -60,6 +70,8 @@ impl FrameTimings {
     }
 }
 
+/// Times a frame's passes (GPU timestamps, or CPU waits without them) and its CPU work, and hands
+/// each frame's timings back once they are all in.
 pub struct Profiler {
     timestamps: Option<GpuProfiler>,
     /// The origin of the CPU clock.
@@ -99,6 +111,7 @@ impl Profiler {
         }
     }
 
+    /// Passes are timed with GPU timestamp queries; false: with CPU waits, which serialise the frame.
     pub fn uses_gpu_timestamps(&self) -> bool {
         self.timestamps.is_some()
     }

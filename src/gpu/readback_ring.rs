@@ -22,6 +22,7 @@ pub const DEFAULT_SLOTS: usize = 3;
 pub struct Readback<Tag> {
     /// What the caller gave `encode_copy` with this copy.
     pub tag: Tag,
+    /// The copied bytes, as many as `encode_copy` was asked for.
     pub bytes: Vec<u8>,
 }
 
@@ -156,6 +157,8 @@ impl<Tag> ReadbackRing<Tag> {
         self.order.len()
     }
 
+    /// Size of each staging buffer, bytes (as asked, rounded up to wgpu's copy alignment): the
+    /// largest copy `encode_copy` accepts.
     pub fn capacity_bytes(&self) -> u64 {
         self.capacity_bytes
     }

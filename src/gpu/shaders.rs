@@ -22,7 +22,9 @@ pub const BLOCKS: &str = include_str!("../../shaders/shared/blocks.wgsl");
 /// first.
 #[derive(Debug, Clone, Copy)]
 pub struct WgslSource {
+    /// The pass's name: its shader file is `shaders/<name>.wgsl`, and the module is labelled so.
     pub name: &'static str,
+    /// The WGSL texts joined after the prelude: shared parts, then the pass's own file.
     pub parts: &'static [&'static str],
 }
 

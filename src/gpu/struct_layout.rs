@@ -9,23 +9,31 @@
 /// A scalar as both sides store it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ScalarKind {
+    /// A 32-bit float: `f32`, or a component of a WGSL float vector or matrix.
     F32,
+    /// A 32-bit unsigned integer: `u32` (in WGSL also `atomic<u32>`).
     U32,
+    /// A 32-bit signed integer: `i32`.
     I32,
 }
 
 /// One field of a GPU struct as Rust lays it out.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FieldLayout {
+    /// The field's name, which the WGSL field shares.
     pub name: &'static str,
+    /// Byte offset of the field from the start of the struct (`offset_of!`).
     pub offset: usize,
 }
 
 /// The memory of a GPU struct.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct StructLayout {
+    /// The struct's name, which its WGSL twin shares.
     pub name: &'static str,
+    /// Size of the struct, bytes (`size_of`, trailing padding included).
     pub size: usize,
+    /// Its fields in declaration order, each with its byte offset.
     pub fields: Vec<FieldLayout>,
     /// Every scalar, by offset.
     pub leaves: Vec<(usize, ScalarKind)>,

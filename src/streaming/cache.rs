@@ -19,6 +19,8 @@ use super::residency::{CacheStats, Placement, Residency, UploadBudget};
 use crate::dataset::{PackError, Pyramid, TileId};
 use crate::gpu::layout::{PAGE_EMPTY, page_entry};
 
+/// One layer's GPU tile cache: a texture array with a tile in each of its fixed number of slots,
+/// the page table that maps the layer's tiles to slots, and the policy that fills them.
 pub struct TileCache {
     label: &'static str,
     pyramid: Pyramid,
@@ -26,7 +28,9 @@ pub struct TileCache {
     texel_bytes: u32,
     format: wgpu::TextureFormat,
     texture: wgpu::Texture,
+    /// A 2D-array view of every slot, all mips: what the passes bind to read tiles.
     pub view: wgpu::TextureView,
+    /// The page table as a storage buffer: one `u32` per tile of the pyramid.
     pub page_table: wgpu::Buffer,
     page_table_cpu: Vec<u32>,
     /// Page-table entries changed since the last write to the GPU.
@@ -35,6 +39,8 @@ pub struct TileCache {
 }
 
 impl TileCache {
+    /// An empty cache of `slots` tiles of `layer`, each `pyramid.tile_extent()` texels square with
+    /// `mips` mips of `format`; every page-table entry starts `PAGE_EMPTY`.
     pub fn new(
         device: &wgpu::Device,
         label: &'static str,
@@ -89,6 +95,7 @@ impl TileCache {
         &self.page_table_cpu
     }
 
+    /// The slot (texture-array layer) holding `id`; `None` while it is not resident.
     pub fn slot_of(&self, id: TileId) -> Option<u32> {
         self.residency.slot_of(id)
     }
@@ -99,6 +106,7 @@ impl TileCache {
         self.residency.resident_ancestor(id)
     }
 
+    /// Every resident tile with its slot, in no particular order.
     pub fn resident_tiles(&self) -> impl Iterator<Item = (TileId, u32)> + '_ {
         self.residency.resident_tiles()
     }
@@ -108,18 +116,22 @@ impl TileCache {
         self.residency.is_failed(id)
     }
 
+    /// Slots in the cache: the most tiles resident at once.
     pub fn capacity(&self) -> usize {
         self.residency.capacity()
     }
 
+    /// The dataset layer whose tiles the cache holds.
     pub fn layer(&self) -> LayerKind {
         self.residency.layer()
     }
 
+    /// Texel format of the texture array, as the layer's packs store texels.
     pub fn format(&self) -> wgpu::TextureFormat {
         self.format
     }
 
+    /// The layer's tile quadtree, whose tile order the page table follows.
     pub fn pyramid(&self) -> &Pyramid {
         &self.pyramid
     }

@@ -27,12 +27,16 @@ use crate::dataset::{Dataset, LayerPack, PackError, TileId};
 /// Which of the dataset's tile layers a request reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 pub enum LayerKind {
+    /// The DEM's height tiles (samples, with a border for normals).
     Height,
+    /// The aerial imagery's tiles, with their mips and filtering border.
     Imagery,
+    /// The land-cover map's tiles (palette indices, in the levels of the LCC quadtree).
     Landcover,
 }
 
 impl LayerKind {
+    /// The layer's lower-case name, as logs and reports write it.
     pub fn name(self) -> &'static str {
         match self {
             Self::Height => "height",
@@ -48,12 +52,21 @@ impl std::fmt::Display for LayerKind {
     }
 }
 
+/// Why the loader could not start, or why a tile could not be read.
 #[derive(Debug, Error)]
 pub enum LoaderError {
+    /// The operating system refused to start a worker thread.
     #[error("starting loader thread {index}: {source}")]
-    Spawn { index: usize, source: std::io::Error },
+    Spawn {
+        /// The worker's number (its thread is named `terramp-loader-<index>`).
+        index: usize,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// A request named a layer the dataset does not have.
     #[error("the dataset has no {0} layer")]
     NoLayer(LayerKind),
+    /// The layer's pack could not give the tile: missing, corrupt or out of range.
     #[error(transparent)]
     Pack(#[from] PackError),
 }
@@ -61,7 +74,9 @@ pub enum LoaderError {
 /// One tile the render thread wants read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TileRequest {
+    /// The layer to read it from.
     pub layer: LayerKind,
+    /// The tile: its level, x and y in the layer's pyramid.
     pub id: TileId,
     /// Lower is more important: the tile's rank in its cache's wanted list (coarse levels first,
     /// then nearest). Ties go to heights, then imagery, then land cover, then submission order.
@@ -71,8 +86,11 @@ pub struct TileRequest {
 /// One tile read: its payload (all mips, checksum verified), or why it could not be read.
 #[derive(Debug)]
 pub struct Loaded {
+    /// The layer it was requested from.
     pub layer: LayerKind,
+    /// The tile requested.
     pub id: TileId,
+    /// The payload, owned and shared without copying, or the error the cache remembers it by.
     pub result: Result<Arc<[u8]>, LoaderError>,
 }
 
@@ -202,6 +220,7 @@ impl Loader {
         self.shared.reported.lock().unwrap_or_else(PoisonError::into_inner).len()
     }
 
+    /// Worker threads reading tiles (at least one).
     pub fn threads(&self) -> usize {
         self.workers.len()
     }

@@ -28,6 +28,7 @@ use crate::dataset::TileId;
 pub struct CacheStats {
     /// Distinct tiles the frame wants.
     pub needed: usize,
+    /// Tiles resident after the frame's uploads, wanted or not.
     pub resident: usize,
     /// Wanted tiles that are resident.
     pub needed_resident: usize,
@@ -37,10 +38,13 @@ pub struct CacheStats {
     pub in_flight: usize,
     /// Arrived and waiting for a later frame's upload budget.
     pub staged: usize,
+    /// Tiles written into slots this frame, within the upload budget.
     pub uploaded: usize,
+    /// Resident tiles whose slot went to an arrival this frame.
     pub evicted: usize,
     /// Tiles found unusable this frame (each is counted once, ever).
     pub failed: usize,
+    /// Bytes of this frame's uploads, all mips.
     pub bytes_uploaded: u64,
     /// Arrivals thrown away: no longer wanted, or no slot without evicting something more needed.
     pub dropped: usize,
@@ -49,11 +53,15 @@ pub struct CacheStats {
 /// How much one frame may upload to one cache. The first tile of a frame always goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct UploadBudget {
+    /// Most tiles uploaded in a frame (`cache.upload_tiles_per_frame`).
     pub tiles: usize,
+    /// Most bytes uploaded in a frame (`cache.upload_bytes_per_frame`); a tile that would pass it
+    /// waits for a later frame.
     pub bytes: u64,
 }
 
 impl UploadBudget {
+    /// No limit: every arrived tile goes up at once (tools and tests).
     pub const UNLIMITED: Self = Self { tiles: usize::MAX, bytes: u64::MAX };
 }
 

@@ -14,6 +14,7 @@ use crate::dataset::{Pyramid, TileId};
 pub struct AreaWant {
     /// Rectangle in the layer's own frame: metres east/north of its texel (0, 0) corner.
     pub min_m: [f64; 2],
+    /// The rectangle's north-east corner, in the same frame, metres (`min_m` is its south-west).
     pub max_m: [f64; 2],
     /// Finest and coarsest level wanted.
     pub levels: [u32; 2],
