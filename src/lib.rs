@@ -4,6 +4,7 @@
 //! a land-cover map, in the four passes of Amara, Meunier & Marsault (2007). See `DESIGN.md` in
 //! the shared folder for the architecture; `frame` reads as the list of passes.
 
+#![warn(missing_docs)]
 #[cfg(feature = "bake")]
 pub mod bake;
 pub mod camera;
