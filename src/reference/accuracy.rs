@@ -19,6 +19,7 @@ use crate::reference::oracle::OracleSeed;
 /// A seed's identity: its ring-0 cell and its rank in the cell's pattern.
 pub type SeedId = ([i64; 2], u32);
 
+/// The identity of a record pass 3 wrote: its global ring-0 cell and rank, widened to the oracle's.
 pub fn record_id(record: &SeedRecord) -> SeedId {
     ([i64::from(record.address[0]), i64::from(record.address[1])], record.rank)
 }
@@ -35,6 +36,7 @@ pub struct SeedAgreement {
 }
 
 impl SeedAgreement {
+    /// The agreement of pass 3's records (or its twin's) with the oracle's visible seeds of one view.
     pub fn of(kept: &[SeedRecord], visible: &[OracleSeed]) -> Self {
         Self::of_ids(kept.iter().map(record_id), visible.iter().map(|s| (s.address, s.rank)))
     }
@@ -65,10 +67,12 @@ impl SeedAgreement {
         self.visible - self.common
     }
 
+    /// Kept seeds the oracle does not see: hidden or out-of-range ones the GPU kept anyway.
     pub fn extra(&self) -> u64 {
         self.kept - self.common
     }
 
+    /// Adds another view's counts, so ratios are over all the seeds of a flight, not a mean of views'.
     pub fn add(&mut self, other: &Self) {
         self.visible += other.visible;
         self.kept += other.kept;
@@ -79,8 +83,11 @@ impl SeedAgreement {
 /// The distance between kept seeds' ground heights and the f64 bilinear DEM, metres.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct HeightError {
+    /// Largest error of any seed, metres.
     pub max_m: f64,
+    /// Sum of the errors, metres: kept rather than a mean so that views add up (`mean_m`).
     pub sum_m: f64,
+    /// Seeds measured.
     pub seeds: u64,
 }
 
@@ -104,6 +111,7 @@ impl HeightError {
         if self.seeds == 0 { 0.0 } else { self.sum_m / self.seeds as f64 }
     }
 
+    /// Adds another view's errors: the larger maximum, the summed sums and counts.
     pub fn add(&mut self, other: &Self) {
         self.max_m = self.max_m.max(other.max_m);
         self.sum_m += other.sum_m;

@@ -20,14 +20,23 @@ pub const PSNR_CAP_DB: f64 = 100.0;
 
 /// Side of the SSIM window, pixels, and its Gaussian's standard deviation.
 pub const SSIM_WINDOW_PX: usize = 11;
+/// Standard deviation of the SSIM window's Gaussian weights, pixels.
 pub const SSIM_SIGMA_PX: f64 = 1.5;
 const SSIM_C1: f64 = (0.01 * 255.0) * (0.01 * 255.0);
 const SSIM_C2: f64 = (0.03 * 255.0) * (0.03 * 255.0);
 
+/// Why two images could not be compared.
 #[derive(Debug, Error, PartialEq, Eq)]
 pub enum ImageMetricError {
+    /// The two images differ in width or height.
     #[error("images of different sizes: {a:?} and {b:?}")]
-    SizeMismatch { a: (u32, u32), b: (u32, u32) },
+    SizeMismatch {
+        /// The first image's (width, height), pixels.
+        a: (u32, u32),
+        /// The second image's (width, height), pixels.
+        b: (u32, u32),
+    },
+    /// SSIM was asked of images narrower or shorter than its window (`SSIM_WINDOW_PX`).
     #[error("SSIM needs images of at least {SSIM_WINDOW_PX} × {SSIM_WINDOW_PX} pixels; got {0:?}")]
     TooSmall((u32, u32)),
 }

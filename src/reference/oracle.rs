@@ -38,32 +38,51 @@ use ground::{DemWindow, LandcoverTiles};
 /// The fraction of an eye→summit segment, at the summit's end, the occlusion test ignores.
 pub const SEGMENT_END_SKIP: f64 = 1e-6;
 
+/// Why the oracle could not judge a view.
 #[derive(Debug, Error)]
 pub enum OracleError {
+    /// The camera is invalid or has no projection for the viewport.
     #[error("oracle: {0}")]
     Camera(#[from] CameraError),
+    /// A height or land-cover tile of the dataset's pack could not be read.
     #[error("oracle: {0}")]
     Pack(#[from] PackError),
+    /// The seed patterns given are fewer than `tlm.patterns`, or their positions do not fill
+    /// `count × seeds_per_pattern`.
     #[error(
         "oracle: the patterns hold {count} patterns of {seeds_per_pattern} seeds in {positions} positions; \
          tlm.patterns asks for {wanted}"
     )]
-    Patterns { count: u32, seeds_per_pattern: u32, positions: usize, wanted: u32 },
+    Patterns {
+        /// Patterns the set holds.
+        count: u32,
+        /// Seeds (ranks) per pattern.
+        seeds_per_pattern: u32,
+        /// Unit-square positions it holds in all.
+        positions: usize,
+        /// Patterns `tlm.patterns` asks for.
+        wanted: u32,
+    },
+    /// A ring-0 cell within reach has an address beyond i32, which the seeds' hash (and the GPU)
+    /// cannot name.
     #[error("oracle: ring-0 cell ({0}, {1}) has no 32-bit address (tlm.cell_m too small for this dataset)")]
     Address(i64, i64),
 }
 
 /// What the oracle reads.
 pub struct OracleInputs<'a> {
+    /// The dataset whose level-0 heights and level-1 land cover define the ground and the classes.
     pub dataset: &'a Dataset,
     /// Reads `tlm.cell_m`, `tlm.patterns`, `tlm.seed`, `draw_seeds.reach_m`,
     /// `seeds.reference_height_m` and `seeds.sink_fraction`.
     pub settings: &'a Settings,
+    /// The class and species tables: which species a rank of a class grows, its rules and sizes.
     pub tables: &'a SeedTables,
     /// The ranks judged per cell are `patterns.seeds_per_pattern`.
     pub patterns: &'a SeedPatterns,
     /// `position_m` in CRS metres; grid space is that minus (`origin_m`, 0).
     pub camera: &'a Camera,
+    /// The view's size, pixels: with the camera, the projection.
     pub viewport_px: [u32; 2],
 }
 
@@ -72,12 +91,15 @@ pub struct OracleInputs<'a> {
 pub struct OracleSeed {
     /// Global ring-0 cell address.
     pub address: [i64; 2],
+    /// Its rank in its cell's pattern: with the address, its identity.
     pub rank: u32,
     /// Index into `SeedTables::species`.
     pub species: u32,
+    /// Where it stands, grid space, metres.
     pub position_grid_m: [f64; 2],
     /// The bilinear ground height under the seed (its anchor sinks below it).
     pub ground_m: f64,
+    /// Its height (its size), metres.
     pub height_m: f64,
     /// Its draw LOD: the first `draw_seeds.reach_m` (scaled by size) the seed is within.
     pub lod: u32,
@@ -86,12 +108,19 @@ pub struct OracleSeed {
 /// Seeds judged, and where each went: every candidate lands in exactly one other field.
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct OracleCounts {
+    /// Every seed of every ring-0 cell within reach: `seeds_per_pattern` per cell.
     pub candidates: u64,
+    /// Culled by class: outside the dataset, no class, or a class whose density leaves this rank out.
     pub class: u64,
+    /// Culled by the species' altitude or slope rule.
     pub rule: u64,
+    /// Beyond every `draw_seeds.reach_m` scaled by the seed's size.
     pub distance: u64,
+    /// Bounding sphere outside one of the view's five planes.
     pub frustum: u64,
+    /// Eye→summit segment passes below the terrain (or the eye is underground).
     pub occlusion: u64,
+    /// Survived every cull: the seeds returned.
     pub visible: u64,
 }
 

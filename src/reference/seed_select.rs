@@ -30,9 +30,11 @@ pub use compare::SeedComparison;
 /// each resident slot.
 #[derive(Debug, Clone, Default)]
 pub struct TwinCache<T> {
+    /// The page table as last uploaded: per tile of the pyramid, `page_entry(slot)`, or `PAGE_EMPTY`.
     pub page_table: Vec<u32>,
     /// Edge of a slot's mip 0, texels.
     pub extent: u32,
+    /// Each resident slot's mip-0 texels, row-major, border included.
     pub slots: HashMap<u32, Vec<T>>,
 }
 
@@ -61,10 +63,15 @@ impl<T: Copy> TwinCache<T> {
 
 /// Everything pass 3 reads, on the CPU.
 pub struct SeedTwinInputs<'a> {
+    /// The frame's uniforms and cells, as uploaded.
     pub frame: &'a SeedFrame,
+    /// Every pattern's seed positions in its cell, unit square, pattern by pattern and rank by rank.
     pub patterns_unit: &'a [[f32; 2]],
+    /// The class and species tables, as uploaded.
     pub tables: &'a SeedTables,
+    /// The height cache: samples in metres.
     pub heights: &'a TwinCache<f32>,
+    /// The land-cover cache: packed class words, as stored.
     pub landcover: &'a TwinCache<u32>,
     /// Imagery texels as stored: RGBA8, sRGB-encoded.
     pub imagery: &'a TwinCache<[u8; 4]>,
@@ -74,14 +81,20 @@ pub struct SeedTwinInputs<'a> {
 
 /// Everything pass 3 read in one frame, owned: what `Renderer::seed_snapshot` captures.
 pub struct SeedSnapshot {
+    /// The frame's uniforms and cells.
     pub frame: SeedFrame,
+    /// Every pattern's seed positions in its cell, unit square.
     pub patterns_unit: Vec<[f32; 2]>,
+    /// The class and species tables.
     pub tables: SeedTables,
+    /// The three caches, as resident that frame.
     pub caches: TwinCaches,
+    /// Terrain depth (reversed-Z), top row first.
     pub depth: Vec<f32>,
 }
 
 impl SeedSnapshot {
+    /// The snapshot as the twin's inputs, borrowed.
     pub fn inputs(&self) -> SeedTwinInputs<'_> {
         SeedTwinInputs {
             frame: &self.frame,
@@ -97,8 +110,11 @@ impl SeedSnapshot {
 
 /// Snapshots of the three caches pass 3 reads.
 pub struct TwinCaches {
+    /// Height samples, metres.
     pub heights: TwinCache<f32>,
+    /// Land-cover class words, as stored.
     pub landcover: TwinCache<u32>,
+    /// Imagery texels: RGBA8, sRGB-encoded.
     pub imagery: TwinCache<[u8; 4]>,
 }
 

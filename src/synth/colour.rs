@@ -25,6 +25,8 @@ const LOT_M: [f64; 2] = [14.0, 17.0];
 /// Sampling stream of the colour noises, apart from the terrain's.
 const STREAM: u32 = 40;
 
+/// Paints the synthetic world's imagery: RGBA8 sRGB texels from the ground's class, cover texture and
+/// hillshade, with its sRGB table and noises built once per dataset.
 pub struct Painter {
     to_srgb: Vec<u8>,
     palette: Palette,
@@ -38,6 +40,8 @@ pub struct Painter {
 }
 
 impl Painter {
+    /// The painter of the world `terrain` made from `seed`: its colour noises, the street grid's salt
+    /// and the roofs' shadow offset in that world's field frame.
     pub fn new(seed: u64, terrain: &Terrain) -> Self {
         let (to_srgb, palette) = (srgb_table(), Palette::default());
         let [cos, sin] = terrain.frame();

@@ -40,10 +40,12 @@ pub const IMAGERY_PER_SPACING: u32 = 4;
 pub const LANDCOVER_PER_SPACING: u32 = 2;
 /// Largest `size`: imagery is 4× finer and its texel indices must fit in u32.
 pub const MAX_SIZE: u32 = 1 << 20;
+/// The synthetic dataset's CRS (WKT): a local metric frame with no geodetic meaning.
 pub const CRS_DEFINITION: &str = "LOCAL_CS[\"terramp synthetic\",UNIT[\"metre\",1]]";
 const CLASS_SCHEME: &str = "nc";
 const LANDCOVER_NODATA: u8 = 255;
 
+/// What a synthetic dataset is made from: its size, seed, sample spacing, CRS origin and lake level.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SynthParams {
     /// DEM samples per side.
@@ -72,26 +74,37 @@ impl SynthParams {
     }
 }
 
+/// Why a synthetic dataset could not be written.
 #[derive(Debug, Error)]
 pub enum SynthError {
+    /// `size` is 0 or above `MAX_SIZE` samples per side.
     #[error("synthetic size {0}: use 1 to {MAX_SIZE} samples per side")]
     Size(u32),
+    /// `spacing_m` is not a positive, finite number of metres.
     #[error("spacing {0} m: must be a positive, finite number of metres")]
     Spacing(f64),
+    /// `origin_m` or `water_level_m` is NaN or infinite.
     #[error("origin {0:?} / water level {1} m: must be finite")]
     NotFinite([f64; 2], f64),
+    /// The output folder could not be staged or the finished dataset committed.
     #[error(transparent)]
     Dataset(#[from] DatasetError),
+    /// Writing a layer's pack failed.
     #[error(transparent)]
     Layer(#[from] LayerError),
+    /// The built-in class table of the land-cover scheme could not be loaded.
     #[error(transparent)]
     Classes(#[from] ClassTableError),
+    /// The land-cover codes could not be coded or written as an LCC layer.
     #[error(transparent)]
     Lcc(#[from] LccError),
 }
 
+/// File name of the height layer's pack in the dataset folder.
 pub const HEIGHT_PACK: &str = "height.pack";
+/// File name of the imagery layer's pack in the dataset folder.
 pub const IMAGERY_PACK: &str = "imagery.pack";
+/// File name of the land-cover layer's pack in the dataset folder.
 pub const LANDCOVER_PACK: &str = "landcover.pack";
 
 /// Writes the synthetic dataset described by `params` to `out` (atomically replacing a dataset

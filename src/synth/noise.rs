@@ -15,14 +15,19 @@ use std::ops::{Add, Mul, Sub};
 /// (north), per metre.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Field {
+    /// The field's value at the point (for the relief, metres above the water).
     pub v: f64,
+    /// Its derivative towards grid x (east), per metre.
     pub dx: f64,
+    /// Its derivative towards grid y (north), per metre.
     pub dy: f64,
 }
 
 impl Field {
+    /// Zero everywhere: the neutral start of a sum.
     pub const ZERO: Field = Field { v: 0.0, dx: 0.0, dy: 0.0 };
 
+    /// A field of value `v` everywhere: flat, zero gradient.
     pub const fn constant(v: f64) -> Field {
         Field { v, dx: 0.0, dy: 0.0 }
     }
@@ -33,10 +38,12 @@ impl Field {
         (self.dx * self.dx + self.dy * self.dy).sqrt()
     }
 
+    /// Absolute value, the gradient mirrored where the value is negative (the ridged noise's fold).
     pub fn abs(self) -> Field {
         if self.v < 0.0 { Field { v: -self.v, dx: -self.dx, dy: -self.dy } } else { self }
     }
 
+    /// The field times itself, gradient by the product rule.
     pub fn square(self) -> Field {
         self * self
     }

@@ -20,12 +20,19 @@ use super::noise::{Field, Octave, floor, hash2, mix32, salt, unit};
 
 /// Land-cover codes of the built-in `nc` class table.
 pub mod code {
+    /// Towns: roofs on a street grid, in flat lowland blobs.
     pub const DEVELOPED: u8 = 1;
+    /// Crop parcels on the rotated field grid of the flat lowlands.
     pub const AGRICULTURE: u8 = 2;
+    /// Meadow: above the tree line, in forest clearings and as pasture parcels.
     pub const HERBACEOUS: u8 = 3;
+    /// Shrubs: a band beneath the tree line, and around clearings and on steep woodland.
     pub const SHRUBLAND: u8 = 4;
+    /// Forest, the default cover of the land, and woodlot parcels.
     pub const FOREST: u8 = 5;
+    /// Lakes: everywhere the relief lies below the water surface.
     pub const WATER: u8 = 6;
+    /// Bare ground: sand on low flat shores, rock and scree on cliffs and above the tree line.
     pub const SEDIMENT: u8 = 7;
 }
 
@@ -65,6 +72,7 @@ mod stream {
 /// Where a point lies in its field parcel.
 #[derive(Debug, Clone, Copy)]
 pub struct Parcel {
+    /// The parcel's (or its strip's) hash: picks its crop and colour, the same for every point of it.
     pub hash: u32,
     /// Position inside the parcel along the grid's two axes, metres from its corner.
     pub in_m: [f64; 2],
@@ -79,9 +87,11 @@ pub struct Parcel {
 pub struct Ground {
     /// Height above the water surface (negative: depth), with its gradient.
     pub relief: Field,
+    /// Its land-cover code (`code`, the `nc` scheme).
     pub class: u8,
     /// Smooth noise in about [-1, 1] that jittered the class edges; colour reuses it.
     pub jitter: f32,
+    /// The field parcel it lies in (used by fields and towns alike).
     pub parcel: Parcel,
 }
 
@@ -96,10 +106,13 @@ pub struct Terrain {
     parcel_salt: u32,
     /// cos and sin of the field grid's angle.
     frame: [f64; 2],
+    /// Height of the lakes' surface, metres: the relief is relative to it.
     pub water_level_m: f64,
 }
 
 impl Terrain {
+    /// The world of `seed` around a water surface at `water_level_m`: every octave salted once, so
+    /// any point can then be evaluated alone.
     pub fn new(seed: u64, water_level_m: f64) -> Self {
         let relief =
             std::array::from_fn(|i| Octave::new(seed, stream::RELIEF, i as u32, RELIEF_WAVELENGTH_M, 2.0));

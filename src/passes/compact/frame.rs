@@ -8,7 +8,9 @@ use crate::seeds::block_capacity;
 /// What a compaction pass is sized for: block-table entries and records.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CompactLimits {
+    /// Block-table entries one run may compact (`seeds::block_capacity`): what pass 3 can fill.
     pub blocks: u32,
+    /// Seed records the record buffer holds (`seeds.capacity`): the length of the permutation `order`.
     pub records: u32,
 }
 

@@ -37,10 +37,14 @@ pub const BINDINGS: BindingTable<7> = BindingTable {
 
 /// The buffers compaction reads: pass 3's block table and keys (or a test's).
 pub struct CompactInputs<'a> {
+    /// Pass 3's block table: one `SeedBlock` (offset, count in the record buffer) per workgroup.
     pub blocks: &'a wgpu::Buffer,
+    /// Each record's draw group (species × `SEED_LODS` + radial LOD), parallel to the records.
     pub keys: &'a wgpu::Buffer,
 }
 
+/// Pass 4a on the GPU: pipelines, binding table and buffers built once in `new`; each frame `prepare`
+/// writes the run's constants and `encode` records its four dispatches.
 pub struct CompactPass {
     reduce: wgpu::ComputePipeline,
     scan: wgpu::ComputePipeline,
@@ -184,6 +188,8 @@ impl CompactPass {
         &self.args
     }
 
+    /// What the pass was sized for in `new`: the most blocks `prepare` takes, and the length of
+    /// the permutation.
     pub fn limits(&self) -> CompactLimits {
         self.limits
     }

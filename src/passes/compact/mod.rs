@@ -34,16 +34,44 @@ use crate::gpu::layout::SEED_WORKGROUP;
 /// Blocks one compaction takes at most (chunks are dispatched along one dimension).
 pub const MAX_COMPACT_BLOCKS: u32 = 65535 * crate::gpu::layout::COMPACT_CHUNK;
 
+/// Why a compaction pass could not be built or run, or its CPU twin refused its input.
 #[derive(Debug, Error)]
 pub enum CompactError {
+    /// The pass is built for more blocks than one dispatch dimension reaches (`new`), or a run asks
+    /// for more blocks than it was built for (`prepare`).
     #[error("{blocks} blocks: one compaction takes at most {max} (`seeds.seeds_per_pattern` too large?)")]
-    TooManyBlocks { blocks: u64, max: u64 },
+    TooManyBlocks {
+        /// Block-table entries asked for.
+        blocks: u64,
+        /// The most it takes: `MAX_COMPACT_BLOCKS` in `new`, the built limits in `prepare`.
+        max: u64,
+    },
+    /// In `new`: a buffer of the pass exceeds the device's `max_storage_buffer_binding_size`.
     #[error("compaction's {what} needs {bytes} bytes; one buffer binding holds at most {max} here")]
-    TooLarge { what: &'static str, bytes: u64, max: u64 },
+    TooLarge {
+        /// Which buffer: the chunk table or the permutation.
+        what: &'static str,
+        /// Bytes it needs.
+        bytes: u64,
+        /// The largest storage binding the device allows, in bytes.
+        max: u64,
+    },
+    /// In the CPU twin: a block reaches beyond the keys or holds more than a workgroup's records,
+    /// which the GPU would not read.
     #[error(
         "block {block}: {count} records at {offset} reach beyond the {records} keys, or beyond {SEED_WORKGROUP} a block"
     )]
-    BadBlock { block: usize, offset: u32, count: u32, records: usize },
+    BadBlock {
+        /// Its index in the block table.
+        block: usize,
+        /// Its first record, as an index into the record buffer.
+        offset: u32,
+        /// Records it claims.
+        count: u32,
+        /// Keys given: the records there are.
+        records: usize,
+    },
+    /// The GPU failed underneath (device, validation or readback).
     #[error(transparent)]
     Gpu(#[from] GpuError),
 }

@@ -4,7 +4,9 @@
 /// A depth pyramid on the CPU: level sizes and texels (top row first) of every level.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HizMips {
+    /// Width and height of each level in texels, level 0 (half the depth target) first.
     pub sizes: Vec<[u32; 2]>,
+    /// Each level's texels, row-major: the minimum reversed-Z depth (farthest surface) they cover.
     pub levels: Vec<Vec<f32>>,
 }
 

@@ -13,6 +13,7 @@ use crate::gpu::{Gpu, GpuError};
 
 use super::frame::{HizMips, level_sizes};
 
+/// The pyramid's texel format: one reversed-Z depth per texel, which storage textures can write.
 pub const HIZ_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// The depth pyramid's shader.
@@ -43,6 +44,8 @@ pub const FROM_MIP: BindingTable<2> = BindingTable {
     ],
 };
 
+/// The Hi-Z pyramid on the GPU: its texture, per-mip views, pipelines and mip-to-mip bind groups built
+/// once in `new` for one target size; `encode` records the reduction of each frame's depth.
 pub struct DepthPyramid {
     // Kept to build the bind group over the depth view `encode` is given (a view only lives as
     // long as its caller's frame; the mip-to-mip bind groups are built once, here).
@@ -142,6 +145,7 @@ impl DepthPyramid {
         &self.view
     }
 
+    /// Levels in the pyramid, down to 1 × 1 texel.
     pub fn mips(&self) -> u32 {
         self.sizes.len() as u32
     }

@@ -28,16 +28,21 @@ const CLOUD_LODS: usize = SEED_LODS as usize - 1;
 
 /// Everything uploaded for the species.
 pub struct SeedAssets {
+    /// Every species' four LODs of geometry in one vertex buffer, positions in model space (metres).
     pub vertices: Vec<SeedVertex>,
+    /// Triangle lists into `vertices`, relative to each piece's `base_vertex` (its template's).
     pub indices: Vec<u32>,
     /// `SEED_DRAWS` draws: the groups' own, then their cross-fades into the next LOD.
     pub templates: Vec<SeedDrawArgs>,
+    /// The material table the vertices index: base colour, texture layer, alpha cut-out and LOD.
     pub materials: Vec<SeedMaterial>,
     /// 1 / each species' model height (top above base), per metre; 0 for species not drawn.
     pub inv_model_height_m: Vec<f32>,
     /// Each layer's mips at the common size, in layer order.
     pub layers: Vec<Vec<Vec<u8>>>,
+    /// Edge of every layer's level 0, texels (the largest source, at most `MAX_LAYER_TEXELS`).
     pub size: u32,
+    /// Mip levels of every layer: the shortest atlas chain's, so no mip mixes two planes.
     pub mips: u32,
 }
 

@@ -46,10 +46,14 @@ pub const BINDINGS: BindingTable<8> = BindingTable {
 
 /// What the draw reads from the earlier passes: pass 3's records and compaction's order.
 pub struct DrawSeedsInputs<'a> {
+    /// Pass 3's seed records (`SeedRecord`), in the blocks its workgroups wrote.
     pub records: &'a wgpu::Buffer,
+    /// Compaction's permutation, draw slot → record index.
     pub order: &'a wgpu::Buffer,
 }
 
+/// Pass 4b on the GPU: the species' geometry, materials and texture array uploaded and the pipeline
+/// built once in `new`; each frame `prepare` writes the constants and `encode` records the draws.
 pub struct DrawSeedsPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,

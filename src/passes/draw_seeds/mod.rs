@@ -32,18 +32,35 @@ use crate::impostor::ImpostorError;
 
 pub use assets::MAX_LAYER_TEXELS;
 
+/// Why the species' impostors could not be loaded, laid out or uploaded for the seed draw.
 #[derive(Debug, Error)]
 pub enum DrawSeedsError {
+    /// The impostor folder (`seeds.impostors`) given is not a directory.
     #[error("seeds.impostors = {0:?} is not a folder (bake one with `terramp-data bake`)")]
     NoFolder(PathBuf),
+    /// A model the class table names is in the folder but could not be read.
     #[error(transparent)]
     Impostor(#[from] ImpostorError),
+    /// An impostor was baked with fewer billboard clouds than draw LODs 1 to 3 need.
     #[error("impostor {model:?} has {lods} billboard-cloud LODs; the seed draw needs {}", SEED_LODS - 1)]
-    TooFewLods { model: String, lods: usize },
+    TooFewLods {
+        /// The model's name, as the class table gives it.
+        model: String,
+        /// Billboard-cloud LODs it has.
+        lods: usize,
+    },
+    /// The adapter lacks `INDIRECT_FIRST_INSTANCE`, which every group's draw needs to start at its
+    /// slots of the permutation.
     #[error("this GPU cannot start indirect draws at an instance (INDIRECT_FIRST_INSTANCE): no seeds")]
     NoFirstInstance,
+    /// The atlases and mesh textures take more layers than the device's texture arrays hold.
     #[error("{layers} atlas layers; this GPU holds at most {max} in a texture array")]
-    TooManyLayers { layers: u32, max: u32 },
+    TooManyLayers {
+        /// Layers the species need.
+        layers: u32,
+        /// The device's `max_texture_array_layers`.
+        max: u32,
+    },
 }
 
 #[cfg(test)]

@@ -11,6 +11,8 @@ use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 pub const SHADER: WgslSource =
     WgslSource { name: "ground", parts: &[TERRAIN_MESH, include_str!("../../../shaders/ground.wgsl")] };
 
+/// Pass 2 on the GPU: its pipeline (depth-equal, no depth write) and imagery sampler built once in
+/// `new`; `encode` records each frame's clear to the sky and the shaded redraw of the terrain's nodes.
 pub struct GroundPass {
     pipeline: wgpu::RenderPipeline,
     sampler: wgpu::Sampler,

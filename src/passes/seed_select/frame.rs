@@ -14,19 +14,28 @@ use crate::streaming::page_levels;
 /// A ring-0 TLM cell whose seeds are wanted: its global address, pattern and radial LOD.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SeedCellRef {
+    /// Global ring-0 address (x, y), in cells from grid space's origin: with a rank, a seed's identity.
     pub address: [i64; 2],
+    /// The seed pattern the TLM hashed for it.
     pub pattern: u32,
+    /// The TLM's radial band its nearest point lies in: the land-cover level its seeds read.
     pub radial_lod: u32,
 }
 
 /// What a frame's seed selection needs from the CPU.
 pub struct SeedInputs<'a> {
+    /// The `[seeds]`, `[tlm]` and `[draw_seeds]` settings the uniforms are taken from.
     pub settings: &'a Settings,
+    /// The dataset whose height, land-cover and imagery grids the cells' corners are placed in.
     pub dataset: &'a Dataset,
+    /// The frame's camera: its projection gives the frustum test and the near plane.
     pub camera: &'a Camera,
     /// Camera position in grid space, metres.
     pub camera_grid_m: DVec3,
+    /// The depth target's size, pixels.
     pub viewport_px: [u32; 2],
+    /// The TLM's visible ring-0 cells in its order (`LoadMaps::seed_cells`); the farthest are dropped
+    /// beyond `seeds::max_cells`.
     pub cells: &'a [SeedCellRef],
     /// Ranks worth checking (`SeedTables::active_ranks`).
     pub active_ranks: u32,
@@ -35,7 +44,9 @@ pub struct SeedInputs<'a> {
 /// One frame's uniforms and cells: what the shader reads, and what the twin replays.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeedFrame {
+    /// The frame's constants, lengths pre-divided into each layer's texels.
     pub uniforms: SeedUniforms,
+    /// The cells kept, each corner as integer texels and a remainder in every layer's grid.
     pub cells: Vec<SeedCell>,
     /// Cells beyond `seeds::max_cells` (the farthest in the TLM's order) that were left out.
     pub cells_dropped: usize,
@@ -47,9 +58,11 @@ pub struct SeedOutput {
     /// The record buffer's filled part (`min(selected, capacity)` records), and each record's
     /// draw group (`seeds::seed_group`).
     pub records: Vec<SeedRecord>,
+    /// Each record's draw group (species × `SEED_LODS` + radial LOD), parallel to `records`.
     pub keys: Vec<u32>,
     /// One entry per workgroup, cell by cell (`SeedFrame::blocks`).
     pub blocks: Vec<SeedBlock>,
+    /// What the pass checked, culled (by reason), selected and dropped for want of room.
     pub counters: SeedCounters,
 }
 
@@ -74,6 +87,8 @@ fn split(value: f64) -> (i32, f32) {
 }
 
 impl SeedFrame {
+    /// The frame's uniforms and cells from the camera, settings and TLM cells, in f64 and rounded once;
+    /// fails when the camera has no projection for the viewport.
     pub fn new(inputs: &SeedInputs) -> Result<Self, CameraError> {
         let (s, dataset, camera) = (inputs.settings, inputs.dataset, inputs.camera);
         let [width, height] = inputs.viewport_px;

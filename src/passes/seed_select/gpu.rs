@@ -63,6 +63,8 @@ pub const BINDINGS: BindingTable<16> = BindingTable {
     ],
 };
 
+/// Pass 3 on the GPU: pipeline, binding table, patterns, species tables and output buffers built once
+/// in `new`; each frame `prepare` uploads the uniforms and cells and `encode` records the dispatch.
 pub struct SeedSelectPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -81,9 +83,13 @@ pub struct SeedSelectPass {
 
 /// The caches and depth pass 3 reads.
 pub struct SeedSources<'a> {
+    /// The height cache: page table and tiles the seeds' ground heights and slopes are read from.
     pub heights: &'a TileCache,
+    /// The land-cover cache: the classes that choose each seed's species.
     pub landcover: &'a TileCache,
+    /// The imagery cache: the ground colour each seed takes on.
     pub imagery: &'a TileCache,
+    /// The terrain's reversed-Z depth target, for the occlusion test.
     pub depth: &'a wgpu::TextureView,
 }
 
@@ -200,6 +206,7 @@ impl SeedSelectPass {
         &self.counters
     }
 
+    /// Records the record buffer holds (`seeds.capacity`); survivors beyond it count as overflow.
     pub fn capacity(&self) -> u32 {
         self.capacity
     }
@@ -214,6 +221,7 @@ impl SeedSelectPass {
         &self.blocks
     }
 
+    /// Entries of the block table (`seeds::block_capacity` for `seeds.seeds_per_pattern`).
     pub fn block_capacity(&self) -> u32 {
         self.block_capacity
     }

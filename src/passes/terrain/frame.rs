@@ -17,14 +17,18 @@ use super::select::{Lods, NodeId, Selected};
 /// Node instances of one frame, grouped by quadrant.
 #[derive(Default)]
 pub struct NodeBatches {
+    /// Each quadrant's instances (south-west, south-east, north-west, north-east: the grid's index
+    /// ranges' order); a node drawing several quadrants appears in each.
     pub by_quadrant: [Vec<TerrainNode>; 4],
 }
 
 impl NodeBatches {
+    /// Instances over all quadrants: one draw instance each, so a node may count up to four times.
     pub fn len(&self) -> usize {
         self.by_quadrant.iter().map(Vec::len).sum()
     }
 
+    /// No quadrant has an instance: the frame draws no terrain.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }

@@ -48,6 +48,8 @@ pub const BINDINGS: BindingTable<6> = BindingTable {
     ],
 };
 
+/// Pass 0 on the GPU: depth-only pipeline, binding table, grid index buffer and node buffer built once
+/// in `new`; each frame `prepare` uploads uniforms and instances and `encode` records the depth draw.
 pub struct TerrainPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
@@ -60,8 +62,11 @@ pub struct TerrainPass {
 /// Everything a pass needs to draw this frame's terrain mesh.
 #[derive(Clone, Copy)]
 pub struct MeshDraw<'a> {
+    /// The pass owning the grid's index buffer and its quadrant ranges.
     pub terrain: &'a TerrainPass,
+    /// The terrain bind group (`BINDINGS`) over the height and imagery caches.
     pub bind_group: &'a wgpu::BindGroup,
+    /// This frame's uploaded instance ranges, quadrant by quadrant.
     pub nodes: &'a PreparedNodes,
 }
 
@@ -79,6 +84,8 @@ pub struct PreparedNodes {
 }
 
 impl TerrainPass {
+    /// Builds the depth-only pipeline, the uniform and node buffers (`MAX_NODES`) and the index
+    /// buffer of the `terrain.node_cells`² grid, once for a renderer's life.
     pub fn new(device: &wgpu::Device, settings: &Settings) -> Self {
         let module = SHADER.module(device);
         let layout = BINDINGS.layout(device);

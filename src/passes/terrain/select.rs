@@ -20,28 +20,38 @@ use crate::dataset::{Dataset, HEIGHT_BORDER, HEIGHT_TILE_CELLS, Pyramid, TileId}
 /// A node of the terrain quadtree: LOD `lod`, position (`x`, `y`) in nodes of that LOD.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct NodeId {
+    /// Its LOD: 0 the finest, whose vertices are level-0 height samples.
     pub lod: u32,
+    /// Column, in nodes of that LOD east of grid space's origin.
     pub x: u32,
+    /// Row, in nodes of that LOD north of grid space's origin.
     pub y: u32,
 }
 
 /// A node to draw and which of its quadrants (bit `qy * 2 + qx`, south-west first).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Selected {
+    /// The node drawn.
     pub node: NodeId,
+    /// The quadrants it draws itself (bits as above); its finer children draw the others.
     pub quadrants: u8,
 }
 
+/// `Selected::quadrants` of a node drawn whole.
 pub const ALL_QUADRANTS: u8 = 0b1111;
 
 /// The geometry of the node quadtree and its LOD rings.
 #[derive(Debug, Clone)]
 pub struct Lods {
+    /// Grid cells along a node's side (`terrain.node_cells`), the same at every LOD.
     pub cells: u32,
+    /// Level-0 height sample spacing, metres: a LOD-0 cell's edge.
     pub spacing_m: f64,
+    /// The height pyramid: one LOD per level.
     pub pyramid: Pyramid,
     /// Per LOD: distance up to which it is drawn, and where its morph starts, metres.
     pub range_m: Vec<f64>,
+    /// Per LOD: distance at which its vertices start morphing towards the coarser LOD, metres.
     pub morph_start_m: Vec<f64>,
 }
 
@@ -94,6 +104,7 @@ impl Lods {
         )
     }
 
+    /// Edge of a node of LOD `lod`, metres.
     pub fn node_m(&self, lod: u32) -> f64 {
         self.spacing_m * f64::from(1u32 << lod) * f64::from(self.cells)
     }
@@ -103,6 +114,7 @@ impl Lods {
         self.pyramid.size_at(lod).map(|n| n.saturating_sub(1).max(1))
     }
 
+    /// Nodes of LOD `lod` along each axis needed to cover the dataset (the last may be partly outside).
     pub fn nodes_at(&self, lod: u32) -> [u32; 2] {
         self.steps(lod).map(|n| n.div_ceil(self.cells))
     }
@@ -220,6 +232,7 @@ pub struct NodeBounds {
 }
 
 impl NodeBounds {
+    /// No range known yet; nodes whose tile cannot be read get `fallback_m` (min, max), metres.
     pub fn new(fallback_m: [f32; 2]) -> Self {
         Self { known: HashMap::new(), fallback_m }
     }

@@ -33,6 +33,7 @@ pub struct LoadMaps {
     pub patterns: Vec<(u32, u32)>,
     /// The ring-0 cells whose seeds pass 3 checks, in TLM order.
     pub seed_cells: Vec<SeedCellRef>,
+    /// Cells of any ring the TLM found visible.
     pub visible_cells: usize,
 }
 

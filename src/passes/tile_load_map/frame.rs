@@ -44,6 +44,7 @@ pub fn height_tile_ranges(dataset: &Dataset) -> Vec<[f32; 2]> {
 pub struct TlmImagery {
     /// Texel edge at level 0, metres.
     pub texel_m: f64,
+    /// Levels of its pyramid, 0 the finest.
     pub levels: u32,
     /// `imagery.lod_bias`, log2 texels.
     pub lod_bias: f64,
@@ -62,8 +63,11 @@ impl TlmImagery {
 
 /// What one frame's TLM is computed from.
 pub struct TlmInputs<'a> {
+    /// The `[tlm]` settings: radial bands, patterns, seed and occlusion tolerance.
     pub settings: &'a TlmSettings,
+    /// The frame's rings around the camera.
     pub layout: &'a TlmLayout,
+    /// The frame's camera: its projection gives the frustum planes and the imagery footprint.
     pub camera: &'a Camera,
     /// Camera position in grid space (CRS position − `Manifest::origin_m`), metres.
     pub camera_grid_m: DVec3,
@@ -71,18 +75,24 @@ pub struct TlmInputs<'a> {
     pub viewport_px: [u32; 2],
     /// The terrain's LODs this frame (ranges, height pyramid and spacing).
     pub lods: &'a Lods,
+    /// The dataset's imagery, `None` without: cells then ask for no imagery levels.
     pub imagery: Option<TlmImagery>,
+    /// Levels of the depth pyramid the occlusion test may read.
     pub hiz_mips: u32,
 }
 
 /// One frame's TLM inputs as the GPU (and the twin) read them.
 #[derive(Debug, Clone)]
 pub struct TlmFrame {
+    /// The frame's constants: matrix, frustum planes, LOD ranges and each ring's origin.
     pub uniforms: TlmUniforms,
+    /// Columns then rows of every ring, camera-relative (`TlmLayout::spans`).
     pub spans: Vec<TlmSpan>,
 }
 
 impl TlmFrame {
+    /// The frame's uniforms and spans, in f64 and rounded once; fails when the camera has no projection
+    /// for the viewport or the dataset has more height levels than the pass supports.
     pub fn new(inputs: &TlmInputs) -> Result<Self, TlmError> {
         let (camera, layout, lods, s) = (inputs.camera, inputs.layout, inputs.lods, inputs.settings);
         let [width, height] = inputs.viewport_px;
@@ -142,6 +152,7 @@ impl TlmFrame {
         Ok(Self { uniforms: u, spans })
     }
 
+    /// Cells the pass writes this frame: `cells`² per ring used.
     pub fn cell_count(&self) -> usize {
         (self.uniforms.rings * self.uniforms.cells * self.uniforms.cells) as usize
     }

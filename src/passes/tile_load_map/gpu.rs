@@ -45,6 +45,9 @@ pub struct TlmBindings {
     _height_ranges: wgpu::Buffer,
 }
 
+/// Pass 1 on the GPU: its pipeline, binding table and buffers, sized for `tlm.max_rings` rings of
+/// `tlm.cells`² cells, built once in `new`; each frame `prepare` uploads the uniforms and spans and
+/// `encode` records the dispatch.
 pub struct TileLoadMapPass {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -56,6 +59,8 @@ pub struct TileLoadMapPass {
 }
 
 impl TileLoadMapPass {
+    /// Builds the pipeline and the uniform, span and output buffers for the largest layout the
+    /// `[tlm]` settings allow (built once; a frame's layout may use fewer rings).
     pub fn new(device: &wgpu::Device, settings: &Settings) -> Self {
         let (cells, max_rings) = (settings.tlm.cells, settings.tlm.max_rings.clamp(1, TLM_MAX_RINGS));
         let module = SHADER.module(device);

@@ -12,6 +12,7 @@ use crate::gpu::layout::{TLM_MAX_RINGS, TLM_SPAN_COVERED, TLM_SPAN_INSIDE, TileS
 /// The rings of one frame, in grid space (f64).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TlmLayout {
+    /// Rings used: as many as cover the dataset from the camera, at most `tlm.max_rings`.
     pub rings: u32,
     /// Cells per ring side.
     pub cells: u32,
@@ -21,14 +22,18 @@ pub struct TlmLayout {
     pub origin_cell: Vec<[i64; 2]>,
     /// The dataset's height samples span [min, max] of grid space, metres.
     pub dataset_min_m: [f64; 2],
+    /// The north-east end of that span, metres.
     pub dataset_max_m: [f64; 2],
 }
 
 /// A cell's global address: ring and position in cells of that ring, from the grid origin.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct CellAddress {
+    /// Its ring: 0 innermost, cells of edge `cell_m · 2^ring`.
     pub ring: u32,
+    /// Column, in cells of that ring east of grid space's origin.
     pub x: i64,
+    /// Row, in cells of that ring north of grid space's origin.
     pub y: i64,
 }
 
@@ -84,6 +89,8 @@ impl TlmLayout {
         ([a.x as f64 * c, a.y as f64 * c], [(a.x + 1) as f64 * c, (a.y + 1) as f64 * c])
     }
 
+    /// The global address of cell (`cx`, `cy`) of `ring`: the same square of ground whichever
+    /// frame's layout names it.
     pub fn global_address(&self, ring: u32, cx: u32, cy: u32) -> CellAddress {
         let [x, y] = self.origin_cell[ring as usize];
         CellAddress { ring, x: x + i64::from(cx), y: y + i64::from(cy) }

@@ -29,14 +29,27 @@ use thiserror::Error;
 use crate::camera::CameraError;
 use crate::gpu::layout::MAX_LEVELS;
 
+/// Why a frame's Tile Load Map could not be computed or dispatched.
 #[derive(Debug, Error)]
 pub enum TlmError {
+    /// The camera has no projection for the viewport.
     #[error(transparent)]
     Camera(#[from] CameraError),
+    /// The dataset's height pyramid has more levels (or LODs) than `MAX_LEVELS`.
     #[error("the TLM supports at most {MAX_LEVELS} height levels; this dataset has {0}")]
     TooManyLevels(u32),
+    /// A frame's layout has more rings, or another number of cells per side, than the pass was built for.
     #[error(
         "the layout has {rings} rings of {cells}² cells; the pass was built for {max_rings} of {pass_cells}²"
     )]
-    LayoutMismatch { rings: u32, cells: u32, max_rings: u32, pass_cells: u32 },
+    LayoutMismatch {
+        /// Rings of the frame's layout.
+        rings: u32,
+        /// Cells per ring side in the frame's layout.
+        cells: u32,
+        /// Rings the pass was built for.
+        max_rings: u32,
+        /// Cells per ring side the pass was built for.
+        pass_cells: u32,
+    },
 }

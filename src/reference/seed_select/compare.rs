@@ -9,9 +9,11 @@ use crate::gpu::gpu_types::SeedRecord;
 /// How two seed sets differ, keyed by identity (cell address, rank).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SeedComparison {
+    /// Seeds both sets hold.
     pub common: usize,
     /// In the twin's set, not in the GPU's; and the reverse.
     pub only_twin: Vec<([i32; 2], u32)>,
+    /// In the GPU's set, not in the twin's.
     pub only_gpu: Vec<([i32; 2], u32)>,
     /// Common seeds whose species, LOD, levels or jitter differ.
     pub mismatched: Vec<([i32; 2], u32)>,
@@ -22,6 +24,7 @@ pub struct SeedComparison {
 }
 
 impl SeedComparison {
+    /// Compares pass 3's records with its twin's, in any order; each `only_*` list keeps its own set's order.
     pub fn of(gpu: &[SeedRecord], twin: &[SeedRecord]) -> Self {
         let key = |r: &SeedRecord| (r.address, r.rank);
         let gpu_by_key: HashMap<_, _> = gpu.iter().map(|r| (key(r), r)).collect();
