@@ -119,11 +119,12 @@ fn builtin_names() -> String {
 /// What a species is (`kind` in the table: "tree", "bush" or "rock"); pass 3 carries it to the
 /// GPU with the species.
 pub enum SpeciesKind {
-    /// A tree: the tallest seeds (3 to 28 m in the built-in tables), on slopes up to 40° there.
+    /// A tree (pass 3 hands the kind on as `SeedSpecies::kind`; sizes and slopes are the
+    /// species' own).
     Tree,
-    /// A bush or shrub: low vegetation (0.5 to 3 m in the built-in tables), on slopes up to 50° there.
+    /// A bush or shrub: low vegetation.
     Bush,
-    /// A rock or boulder (0.3 to 2 m in the built-in tables); not vegetation, so up to 70° there.
+    /// A rock or boulder: not vegetation.
     Rock,
 }
 

@@ -8,7 +8,6 @@
 //! behind it is `DESIGN.md` in the shared folder.
 #![warn(missing_docs)]
 
-#![warn(missing_docs)]
 #[cfg(feature = "bake")]
 pub mod bake;
 pub mod camera;

@@ -271,7 +271,7 @@ impl Dataset {
 
     /// Land-cover tile `id`'s words widened to u32, south row first (palette indices at levels 0
     /// and 1, packed sub-codes at level 2: see `LccCoding::decode`). A dataset without land cover
-    /// answers `PackError::OutOfRange` with a count of 0.
+    /// answers `PackError::NoLayer`.
     pub fn landcover_words(&self, id: TileId) -> Result<Vec<u32>, PackError> {
         let (layer, coding) = self.landcover_layer()?;
         let bytes = layer.tile_bytes(id)?;

@@ -4,9 +4,9 @@
 //! frame sees it, to `GROUND_CLEARANCE_NEAR` near planes above the ground, and the frame reports by
 //! how much. The ground is the higher of the two surfaces over the level-0 cell under the camera:
 //! the bilinear one seeds stand on and the two triangles the finest mesh draws (the diagonal
-//! alternating like a checkerboard, as `terrain::grid_indices` lays it out). On a coarse DEM they
-//! part by metres. Only a camera over the dataset can be under it; the height tile's range from
-//! the pack index rules out almost every camera without reading a sample.
+//! alternating like a checkerboard, as `passes::terrain::frame::grid_indices` lays it out). On a
+//! coarse DEM they part by metres. Only a camera over the dataset can be under it; the height
+//! tile's range from the pack index rules out almost every camera without reading a sample.
 
 use glam::DVec3;
 

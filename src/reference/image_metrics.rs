@@ -8,7 +8,7 @@
 //!   values, as MATLAB's `ssim` on `rgb2gray`), with the paper's standard choices: an 11 × 11
 //!   Gaussian window of σ = 1.5 (normalised), K1 = 0.01, K2 = 0.03, L = 255, so C1 = (K1·L)² and
 //!   C2 = (K2·L)². Local means, variances and the covariance are Gaussian-weighted moments
-//!   (E[x²] − E[x]², computed in f64 by a separable filter), over the "valid" window positions only
+//!   (E\[x²\] − E\[x\]², computed in f64 by a separable filter), over the "valid" window positions only
 //!   (no padding), and the index is the mean of the SSIM map. Identical images give exactly 1.
 
 use thiserror::Error;
