@@ -7,12 +7,14 @@
 //! reports are a frame or two old. With `draw_seeds.impostors` set, it also loads each species'
 //! impostor once, gives compaction the draw pass's templates, and has pass 4 draw the groups.
 
+use std::path::Path;
+
 use glam::DVec3;
 
 use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::config::Settings;
-use crate::dataset::Dataset;
+use crate::dataset::{Dataset, LandcoverLayer};
 use crate::gpu::gpu_types::{CompactParams, SeedCounters, SeedRecord, TerrainUniforms};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError};
@@ -89,28 +91,8 @@ impl SeedStage {
             depth,
         };
         let device = &gpu.device;
-        let name = match settings.seeds.class_table.as_str() {
-            "" => landcover.scheme.as_str(),
-            name => name,
-        };
-        let record_bytes = size_of::<SeedRecord>() as u64;
-        let max_bytes = device.limits().max_storage_buffer_binding_size;
-        if u64::from(settings.seeds.capacity) * record_bytes > max_bytes {
-            return Err(RenderError::SeedCapacity {
-                capacity: settings.seeds.capacity,
-                max: (max_bytes / record_bytes) as u32,
-            });
-        }
-        let table = ClassTable::load(name)?;
-        let seeds_per_pattern = settings.seeds.seeds_per_pattern;
-        let tables = SeedTables::new(
-            &table,
-            &landcover.coding,
-            settings.tlm.cell_m,
-            seeds_per_pattern,
-            settings.seeds.density_scale,
-        )?;
-        let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds_per_pattern, settings.tlm.seed);
+        check_capacity(device, settings.seeds.capacity)?;
+        let (table, tables, patterns) = seeded_world(settings, landcover)?;
         let pass = SeedSelectPass::new(device, settings, &patterns, &tables);
         let bind_group = pass.bind_group(device, &sources);
         let mut compact = CompactPass::new(device, CompactLimits::from(settings))?;
@@ -120,14 +102,7 @@ impl SeedStage {
             ReadbackRing::new(device, "seed counters", size_of::<SeedCounters>() as u64, DEFAULT_SLOTS);
         let draw = match settings.draw_seeds.impostors.as_str() {
             "" => None,
-            dir => {
-                let impostors = load_impostors(std::path::Path::new(dir), &table.species)?;
-                let draw = DrawSeedsPass::new(device, &gpu.queue, &impostors)?;
-                compact.set_templates(&gpu.queue, draw.templates());
-                let inputs = DrawSeedsInputs { records: pass.records(), order: compact.order() };
-                let bind_group = draw.bind_group(device, &inputs);
-                Some((draw, bind_group))
-            }
+            dir => Some(draw_pass(gpu, Path::new(dir), &table, &pass, &mut compact)?),
         };
         Ok(Some(Self {
             table,
@@ -220,6 +195,56 @@ impl SeedStage {
         }
         Ok(())
     }
+}
+
+/// Fails when `seeds.capacity` records do not fit one storage binding of `device`.
+fn check_capacity(device: &wgpu::Device, capacity: u32) -> Result<(), RenderError> {
+    let record_bytes = size_of::<SeedRecord>() as u64;
+    let max_bytes = device.limits().max_storage_buffer_binding_size;
+    if u64::from(capacity) * record_bytes > max_bytes {
+        return Err(RenderError::SeedCapacity { capacity, max: (max_bytes / record_bytes) as u32 });
+    }
+    Ok(())
+}
+
+/// The class table the land cover's scheme names (or `seeds.class_table`), its species tables for
+/// the land cover's coding, and the P generic patterns: what exists, the same for every frame.
+fn seeded_world(
+    settings: &Settings,
+    landcover: &LandcoverLayer,
+) -> Result<(ClassTable, SeedTables, SeedPatterns), RenderError> {
+    let name = match settings.seeds.class_table.as_str() {
+        "" => landcover.scheme.as_str(),
+        name => name,
+    };
+    let table = ClassTable::load(name)?;
+    let seeds = &settings.seeds;
+    let tables = SeedTables::new(
+        &table,
+        &landcover.coding,
+        settings.tlm.cell_m,
+        seeds.seeds_per_pattern,
+        seeds.density_scale,
+    )?;
+    let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds.seeds_per_pattern, settings.tlm.seed);
+    Ok((table, tables, patterns))
+}
+
+/// Pass 4 over the impostors in `dir` of `table`'s species, bound to pass 3's records and
+/// compaction's order; compaction takes its draw templates.
+fn draw_pass(
+    gpu: &Gpu,
+    dir: &Path,
+    table: &ClassTable,
+    pass: &SeedSelectPass,
+    compact: &mut CompactPass,
+) -> Result<(DrawSeedsPass, wgpu::BindGroup), RenderError> {
+    let impostors = load_impostors(dir, &table.species)?;
+    let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors)?;
+    compact.set_templates(&gpu.queue, draw.templates());
+    let bind_group =
+        draw.bind_group(&gpu.device, &DrawSeedsInputs { records: pass.records(), order: compact.order() });
+    Ok((draw, bind_group))
 }
 
 /// The inputs of a frame's seed selection.

@@ -1,0 +1,118 @@
+use super::*;
+
+fn with(text: &str) -> Result<Settings, SettingsError> {
+    Settings::from_layers(&[("test.toml".into(), text.into())])
+}
+
+#[test]
+fn defaults_and_every_preset_load() {
+    let defaults = Settings::default();
+    assert_eq!(Settings::preset("balanced").unwrap(), defaults);
+    let fast = Settings::preset("fast").unwrap();
+    let accurate = Settings::preset("accurate").unwrap();
+    assert!(fast.terrain.triangle_px > defaults.terrain.triangle_px);
+    assert!(accurate.terrain.triangle_px < defaults.terrain.triangle_px);
+    assert!(matches!(Settings::preset("ludicrous"), Err(SettingsError::UnknownPreset(_))));
+}
+
+#[test]
+fn user_layers_override_only_their_keys() {
+    let s = with("[render]\nwidth = 64\nfov_deg = 90\n").unwrap();
+    assert_eq!((s.render.width, s.render.fov_deg), (64, 90.0));
+    assert_eq!(s.render.height, Settings::default().render.height);
+}
+
+#[test]
+fn errors_name_the_key() {
+    let unknown = with("[render]\nfovv = 3.0\n").unwrap_err().to_string();
+    assert!(unknown.contains("render.fovv") && unknown.contains("test.toml"), "{unknown}");
+    let wrong = with("[render]\nwidth = \"wide\"\n").unwrap_err().to_string();
+    assert!(wrong.contains("render.width") && wrong.contains("integer"), "{wrong}");
+    let range = with("[render]\nfov_deg = 180.0\n").unwrap_err().to_string();
+    assert!(range.contains("render.fov_deg"), "{range}");
+    let cells = with("[terrain]\nnode_cells = 48\n").unwrap_err().to_string();
+    assert!(cells.contains("terrain.node_cells"), "{cells}");
+    let adapter = with("[gpu]\nadapter = \"quantum\"\n").unwrap_err().to_string();
+    assert!(adapter.contains("quantum"), "{adapter}");
+    let syntax = with("[render\n").unwrap_err().to_string();
+    assert!(syntax.contains("test.toml"), "{syntax}");
+}
+
+#[test]
+fn seed_settings_are_range_checked() {
+    let s = Settings::default().seeds;
+    assert_eq!((s.seeds_per_pattern, s.capacity, s.class_table.as_str()), (2048, 262_144, ""));
+    assert!((s.max_density_per_km2(256.0) - 31_250.0).abs() < 1e-6);
+    let fast = Settings::preset("fast").unwrap().seeds;
+    let accurate = Settings::preset("accurate").unwrap().seeds;
+    assert!(fast.seeds_per_pattern < s.seeds_per_pattern && s.seeds_per_pattern < accurate.seeds_per_pattern);
+    assert!(accurate.occlusion_tolerance_m < s.occlusion_tolerance_m);
+    for (bad, key) in [
+        ("seeds_per_pattern = 63", "seeds.seeds_per_pattern"),
+        ("seeds_per_pattern = 65537", "seeds.seeds_per_pattern"),
+        ("capacity = 0", "seeds.capacity"),
+        ("capacity = 16777217", "seeds.capacity"),
+        ("frustum_epsilon = 1.5", "seeds.frustum_epsilon"),
+        ("frustum_epsilon = -0.1", "seeds.frustum_epsilon"),
+        ("occlusion_tolerance_m = -1.0", "seeds.occlusion_tolerance_m"),
+        ("occlusion_tolerance_per_km = -1.0", "seeds.occlusion_tolerance_per_km"),
+        ("occlusion_refine_steps = 300", "seeds.occlusion_refine_steps"),
+        ("reference_height_m = 0.0", "seeds.reference_height_m"),
+        ("sink_fraction = 0.6", "seeds.sink_fraction"),
+        ("ground_colour_radius_m = -2.0", "seeds.ground_colour_radius_m"),
+        ("class_table = 3", "seeds.class_table"),
+    ] {
+        let err = with(&format!("[seeds]\n{bad}\n")).unwrap_err().to_string();
+        assert!(err.contains(key), "{bad}: {err}");
+    }
+    let s = with("[seeds]\nclass_table = \"nlcd\"\nsink_fraction = 0\n").unwrap().seeds;
+    assert_eq!((s.class_table.as_str(), s.sink_fraction), ("nlcd", 0.0));
+}
+
+#[test]
+fn draw_reaches_are_checked_against_the_tlm_bands() {
+    let d = Settings::default();
+    assert_eq!(d.draw_seeds.reach_m, [120.0, 700.0, 1400.0, 3000.0]);
+    assert_eq!((d.tlm.occlusion_tolerance_per_km, d.draw_seeds.fade_fraction), (0.0, 0.1));
+    for (bad, rule) in [
+        ("[draw_seeds]\nreach_m = [120.0, 700.0, 600.0, 3000.0]\n", "increasing"),
+        ("[draw_seeds]\nreach_m = [120.0, 700.0, 1400.0, 3500.0]\n", "tlm.radial_bands_m"),
+        ("[draw_seeds]\nfade_fraction = 0.6\n", "0 to 0.5"),
+        ("[tlm]\nocclusion_tolerance_per_km = -1.0\n", "0 or more"),
+    ] {
+        let err = with(bad).unwrap_err().to_string();
+        assert!(err.contains(rule), "{bad}: {err}");
+    }
+    let fast = Settings::preset("fast").unwrap();
+    assert_eq!((fast.tlm.radial_bands_m[2], fast.draw_seeds.reach_m[3]), (2000.0, 2000.0));
+}
+
+#[test]
+fn keys_of_earlier_releases_name_their_replacements() {
+    let old = with("[tlm]\nradial_lod_m = [700.0, 1400.0, 3000.0]\n").unwrap_err().to_string();
+    assert!(old.contains("tlm.radial_bands_m") && old.contains("draw_seeds.reach_m"), "{old}");
+    assert!(old.contains("test.toml") && old.contains("`tlm.radial_lod_m`"), "{old}");
+    for (key, new) in [
+        ("mesh_m = 60.0", "draw_seeds.reach_m"),
+        ("fade_fraction = 0.1", "draw_seeds.fade_fraction"),
+        ("impostors = \"x\"", "draw_seeds.impostors"),
+    ] {
+        let err = with(&format!("[seeds]\n{key}\n")).unwrap_err().to_string();
+        assert!(err.contains(new), "{key}: {err}");
+    }
+}
+
+#[test]
+fn builtin_class_tables_fit_every_preset() {
+    for (preset, _) in PRESETS {
+        let s = Settings::preset(preset).unwrap();
+        let max_per_km2 = s.seeds.max_density_per_km2(s.tlm.cell_m);
+        for name in ["nc", "nlcd"] {
+            let table = crate::classes::ClassTable::load(name).unwrap();
+            for class in &table.classes {
+                let density = f64::from(table.density_per_km2(class.code));
+                assert!(density <= max_per_km2, "{preset}: {name} {} {density} > {max_per_km2}", class.code);
+            }
+        }
+    }
+}

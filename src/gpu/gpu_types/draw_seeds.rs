@@ -1,0 +1,67 @@
+//! The seed draw's structs (pass 4b): per-frame constants, materials and vertices.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::gpu::struct_layout::gpu_struct;
+
+gpu_struct! {
+    /// Per-frame constants of the seed-drawing pass. WGSL: `DrawSeedsUniforms` in
+    /// `shaders/draw_seeds.wgsl`.
+    #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+    pub struct DrawSeedsUniforms {
+        /// The terrain's: clip space from camera-relative world space.
+        pub clip_from_view_world: [[f32; 4]; 4],
+        /// Unit vector towards the sun, w unused.
+        pub sun_dir: [f32; 4],
+        /// Haze colour (linear RGB), and the distance that hides half of what is behind it (w).
+        pub haze: [f32; 4],
+        /// Each draw LOD's reach (`draw_seeds.reach_m`), metres, scaled by each seed's size.
+        pub draw_reach_m: [f32; 4],
+        /// 1 / the seed height that gets the full reaches, 1/m: a smaller seed's reach shrinks with
+        /// its height.
+        pub inv_reference_height_m: f32,
+        /// Fraction of its height a seed's anchor was sunk by (pass 3's), undone to measure its
+        /// distance.
+        pub sink_fraction: f32,
+        /// The outer part of each LOD band over which a seed dithers out, as a fraction of its reach.
+        pub fade_fraction: f32,
+        /// How much of the ground colour the seeds take on (0 to 1).
+        pub ground_blend: f32,
+    }
+}
+
+gpu_struct! {
+    /// How a seed vertex is coloured: a base colour times (when `flags` has `MATERIAL_TEXTURED`) a
+    /// layer of the seed texture array, alpha-tested, and the draw LOD of the geometry it belongs to
+    /// (0 the mesh, 1 to 3 the billboard clouds), which tells a group's own draw from its cross-fade.
+    /// WGSL: `SeedMaterial` in `shaders/draw_seeds.wgsl`.
+    #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+    pub struct SeedMaterial {
+        /// Linear RGBA, multiplied with the texel.
+        pub base_colour: [f32; 4],
+        /// Layer of the seed texture array it samples (with `MATERIAL_TEXTURED`).
+        pub layer: u32,
+        /// Fragments with alpha below this are cut out (below 0: opaque).
+        pub alpha_cutoff: f32,
+        /// Draw LOD of its geometry: a draw whose seeds are of another LOD is their cross-fade.
+        pub lod: u32,
+        /// `MATERIAL_TEXTURED` | `MATERIAL_REPEAT` (wrap texture coordinates, else clamp).
+        pub flags: u32,
+    }
+}
+
+gpu_struct! {
+    /// A vertex of a seed's mesh or billboard cloud, model space (metres, +Y up, base at y = 0), as
+    /// the draw pass uploads it; `material` indexes its `SeedMaterial` table.
+    #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+    pub struct SeedVertex {
+        /// Position, model space, metres; scaled to the seed's height when drawn.
+        pub position_model_m: [f32; 3],
+        /// Unit normal, model space.
+        pub normal_model: [f32; 3],
+        /// Texture coordinates in its material's layer (wrapped or clamped per `MATERIAL_REPEAT`).
+        pub uv: [f32; 2],
+        /// Index into the draw pass's `SeedMaterial` table.
+        pub material: u32,
+    }
+}
