@@ -7,6 +7,7 @@
 use glam::DVec3;
 
 use crate::camera::{Camera, Frustum};
+use crate::gpu::gpu_types::TerrainUniforms;
 use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms};
 use crate::passes::terrain::gpu::PreparedNodes;
 use crate::passes::terrain::select::{Lods, Selected, select};
@@ -54,8 +55,8 @@ impl Renderer {
         let selected = self.select_nodes(&view);
         self.stream(&view, &selected, report);
         let (layout, tlm) = self.prepare_tlm(&view)?;
-        let nodes = self.prepare_terrain(&view, &selected, report);
-        self.prepare_seeds(&view, report)?;
+        let (nodes, terrain) = self.prepare_terrain(&view, &selected, report);
+        self.prepare_seeds(&view, &terrain, report)?;
         Ok(FramePlan { layout, camera_grid_m: view.grid_m, tlm, nodes })
     }
 
@@ -130,13 +131,14 @@ impl Renderer {
     }
 
     /// The terrain's instances (each node over its own height tile, or its finest resident
-    /// ancestor) and the uniforms both terrain passes read.
+    /// ancestor) and the uniforms both terrain passes read, uploaded; the uniforms are returned
+    /// for pass 4, which draws with the same matrix, sun and haze.
     fn prepare_terrain(
         &mut self,
         view: &View,
         selected: &[Selected],
         report: &mut FrameReport,
-    ) -> PreparedNodes {
+    ) -> (PreparedNodes, TerrainUniforms) {
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
         let floor_m = dataset.manifest.height.min_m;
         let (batches, dropped) =
@@ -147,15 +149,17 @@ impl Renderer {
         report.nodes_dropped = dropped;
         let clip = view.clip_from_view_world.as_mat4();
         let uniforms = terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR);
-        let nodes = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
-        if let Some(stage) = &self.seeds {
-            stage.prepare_draw(&self.gpu, &self.settings, &uniforms);
-        }
-        nodes
+        (self.terrain.prepare(&self.gpu.queue, &uniforms, &batches), uniforms)
     }
 
-    /// Pass 3's cells: those the latest TLM found near and visible.
-    fn prepare_seeds(&mut self, view: &View, report: &mut FrameReport) -> Result<(), RenderError> {
+    /// Pass 3's cells (those the latest TLM found near and visible), and pass 4's constants (the
+    /// terrain's matrix, sun and haze).
+    fn prepare_seeds(
+        &mut self,
+        view: &View,
+        terrain: &TerrainUniforms,
+        report: &mut FrameReport,
+    ) -> Result<(), RenderError> {
         let Some(stage) = self.seeds.as_mut() else { return Ok(()) };
         let cells = self.load_maps.as_ref().map_or(&[][..], |m| &m.seed_cells[..]);
         let ranks = stage.tables.active_ranks();
@@ -164,6 +168,7 @@ impl Renderer {
         let frame = stage.prepare(&self.gpu, &inputs)?;
         report.seed_cells = frame.cells.len();
         report.seed_cells_dropped = frame.cells_dropped;
+        stage.prepare_draw(&self.gpu, &self.settings, terrain);
         (report.seed_species_drawn, report.seed_species_undrawn) = stage.species_counts();
         Ok(())
     }
