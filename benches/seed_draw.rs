@@ -56,7 +56,7 @@ fn renderer() -> Renderer {
         fov_deg: renderer.settings.render.fov_deg,
         near_m: renderer.settings.render.near_m,
     };
-    renderer.render_resolved(&camera, 200).expect("resolve");
+    renderer.render_resolved(&camera).expect("resolve");
     for _ in 0..3 {
         renderer.render(&camera).expect("render");
     }

@@ -74,7 +74,7 @@ fn main() {
         fov_deg: 60.0,
         near_m: 0.1,
     };
-    r.render_resolved(&camera, 30).expect("render");
+    r.render_resolved(&camera).expect("render");
     let cell_m = r.settings.tlm.cell_m;
     // Pass 3 checks only the ranks some class can grow (the densest class's share of a pattern).
     let ranks = r.seed_world().expect("land cover").0.active_ranks();

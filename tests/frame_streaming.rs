@@ -32,7 +32,7 @@ fn a_fixed_view_converges_to_the_all_resident_picture() {
     let dataset = synth_dataset(1200, 11);
     let mut streamed = renderer(&dataset, trickle(192, 108));
     let camera = view(&streamed);
-    let (report, frames) = streamed.render_resolved(&camera, 400).unwrap();
+    let (report, frames) = streamed.render_resolved(&camera).unwrap();
     assert!(streamed.is_resolved(&report), "not resolved after {frames} frames: {report:?}");
     assert!(frames > 2, "with 2 uploads a frame, streaming takes several frames ({frames})");
     for stats in [&report.height, &report.imagery] {
@@ -47,7 +47,7 @@ fn a_fixed_view_converges_to_the_all_resident_picture() {
     all.cache.landcover_slots = 160;
     let mut reference = renderer(&dataset, all);
     reference.pin_everything().unwrap();
-    reference.render_resolved(&camera, 50).unwrap();
+    reference.render_resolved(&camera).unwrap();
     let db = psnr(&streamed.read_colour().unwrap(), &reference.read_colour().unwrap());
     println!("converged after {frames} frames; PSNR against all-resident: {db:.1} dB");
     // The Tile Load Map asks for at least the levels the pixels use, so the pictures agree.

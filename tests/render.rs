@@ -60,11 +60,11 @@ fn the_same_view_renders_the_same_pixels() {
     let dataset = synth_dataset(300, 7);
     let mut r = renderer(&dataset, small_settings(128, 80));
     let camera = over_fraction(&r, [0.5, 0.5], 200.0, 200.0, -20.0);
-    r.render_resolved(&camera, 200).unwrap();
+    r.render_resolved(&camera).unwrap();
     let first = r.read_colour().unwrap();
     // Move away and back: cache state differs, the resolved image must not.
-    r.render_resolved(&over_fraction(&r, [0.5, 0.5], 2000.0, 10.0, -60.0), 200).unwrap();
-    r.render_resolved(&camera, 200).unwrap();
+    r.render_resolved(&over_fraction(&r, [0.5, 0.5], 2000.0, 10.0, -60.0)).unwrap();
+    r.render_resolved(&camera).unwrap();
     assert!(first == r.read_colour().unwrap());
 }
 

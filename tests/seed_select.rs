@@ -10,6 +10,7 @@ use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SpeciesLod, seed_group};
 use terramp::reference::seed_select::SeedComparison;
+use terramp::reference::worst::max_or_nan;
 use terramp_testkit::camera::over_fraction;
 
 const SIZE: u32 = 1024;
@@ -32,7 +33,7 @@ fn gpu_seed_selection_equals_its_cpu_twin() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     let mut r = terramp_testkit::renderer(&dataset, terramp_testkit::small_settings(320, 180));
     for (i, camera) in cameras(&r).iter().enumerate() {
-        r.render_resolved(camera, 60).unwrap();
+        r.render_resolved(camera).unwrap();
         let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
         let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
         let diff = SeedComparison::of(&gpu, &twin);
@@ -50,7 +51,17 @@ fn gpu_seed_selection_equals_its_cpu_twin() {
         assert!(diff.mismatched.is_empty(), "view {i}: {:?}", diff.mismatched);
         // Same f32 operations in the same order: positions agree to the bit; colours decode
         // sRGB texels (the driver's table against the formula) and may round one step apart.
+        assert!(diff.non_finite.is_empty(), "view {i}: not finite: {:?}", diff.non_finite);
         assert_eq!(diff.max_length_error_m, 0.0, "view {i}");
+        // A NaN in one field of one GPU record fails the comparison (`f32::max` would drop it).
+        let mut poisoned = gpu.clone();
+        poisoned[gpu.len() / 2].ground_m = f32::NAN;
+        let bad = SeedComparison::of(&poisoned, &twin);
+        assert!(
+            bad.max_length_error_m.is_nan() && bad.non_finite.len() == 1,
+            "view {i}: {:?}",
+            bad.non_finite
+        );
         assert!(diff.max_colour_error <= 1, "view {i}: {}", diff.max_colour_error);
         // Read in block-table order, the GPU's records come in the twin's order, whatever order
         // the blocks landed in; the block tables agree entry for entry.
@@ -79,7 +90,7 @@ fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
     drop(probe);
     let run = || {
         let mut r = terramp_testkit::renderer(&dataset, settings.clone());
-        r.render_resolved(&camera, 60).unwrap();
+        r.render_resolved(&camera).unwrap();
         let output = r.read_seed_output().unwrap().unwrap();
         let compacted = r.read_compacted().unwrap().unwrap();
         // Compaction's twin over the GPU's own block table: the same permutation, bit for bit.
@@ -113,6 +124,7 @@ fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
     assert_eq!(twin.args, compacted.args);
     assert_eq!(identities(&twin_drawn), identities(&drawn));
     let diff = SeedComparison::of(&drawn, &twin_drawn);
+    assert!(diff.non_finite.is_empty(), "not finite: {:?}", diff.non_finite);
     assert_eq!(diff.max_length_error_m, 0.0);
     assert!(diff.max_colour_error <= 1, "{}", diff.max_colour_error);
 }
@@ -122,7 +134,7 @@ fn seeds_sit_on_the_bilinear_dem() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     let mut r = terramp_testkit::renderer(&dataset, terramp_testkit::small_settings(320, 180));
     let camera = cameras(&r)[0];
-    r.render_resolved(&camera, 60).unwrap();
+    r.render_resolved(&camera).unwrap();
     let (records, _) = r.read_seeds().unwrap().unwrap();
     assert!(records.len() > 100, "{} seeds", records.len());
     let origin = r.dataset.manifest.origin_m;
@@ -132,7 +144,7 @@ fn seeds_sit_on_the_bilinear_dem() {
         let x = camera_grid.x + f64::from(record.position_rel_m[0]);
         let y = camera_grid.y + f64::from(record.position_rel_m[1]);
         let exact_m = r.dataset.height_at(x, y, 0).unwrap();
-        worst_m = worst_m.max((f64::from(record.ground_m) - exact_m).abs());
+        worst_m = max_or_nan(worst_m, (f64::from(record.ground_m) - exact_m).abs());
         assert_eq!(
             SpeciesLod::unpack(record.species_lod).height_level,
             0,
@@ -152,7 +164,7 @@ fn seeds_are_the_same_in_every_run_and_after_any_path() {
         for camera in &path[..path.len() - 1] {
             r.render(camera).unwrap();
         }
-        r.render_resolved(path.last().unwrap(), 60).unwrap();
+        r.render_resolved(path.last().unwrap()).unwrap();
         sorted(r.read_seeds().unwrap().unwrap().0)
     };
     let probe = terramp_testkit::renderer(&dataset, settings.clone());
@@ -170,13 +182,13 @@ fn overflow_is_flagged_counted_and_keeps_valid_records() {
     let mut settings = terramp_testkit::small_settings(320, 180);
     let mut full = terramp_testkit::renderer(&dataset, settings.clone());
     let camera = cameras(&full)[0];
-    full.render_resolved(&camera, 60).unwrap();
+    full.render_resolved(&camera).unwrap();
     let (all, all_counters) = full.read_seeds().unwrap().unwrap();
     drop(full);
     let capacity = (all.len() / 3).max(1) as u32;
     settings.seeds.capacity = capacity;
     let mut small = terramp_testkit::renderer(&dataset, settings);
-    small.render_resolved(&camera, 60).unwrap();
+    small.render_resolved(&camera).unwrap();
     let (kept, counters) = small.read_seeds().unwrap().unwrap();
     assert_eq!(counters.selected, all_counters.selected);
     assert_eq!(kept.len(), capacity as usize);
@@ -241,7 +253,7 @@ fn classes_missing_from_the_table_grow_nothing() {
     settings.seeds.class_table = path.to_str().unwrap().to_owned();
     let mut r = terramp_testkit::renderer(&dataset, settings);
     let camera = over_fraction(&r, [0.5, 0.5], 30.0, 120.0, -20.0);
-    r.render_resolved(&camera, 60).unwrap();
+    r.render_resolved(&camera).unwrap();
     let (records, counters) = r.read_seeds().unwrap().unwrap();
     assert!(!records.is_empty() && counters.class > 0, "{counters:?}");
     let m = &r.dataset.manifest;

@@ -6,7 +6,7 @@
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use terramp::dataset::pack::{Pack, PackWriter};
 use terramp::dataset::{Dataset, IMAGERY_MIPS, Manifest, Pyramid, TileId};
@@ -42,12 +42,14 @@ fn wants(p: &Pyramid, centre: [f64; 2], finest: u32) -> Vec<TileId> {
     tiles
 }
 
+/// A guard against a hung loader, not a measure: every wait ends as soon as its condition holds.
+const HANG_GUARD: Duration = Duration::from_secs(120);
+
+/// Frames a loop may render before it calls the loader stuck (each frame waits for a read).
+const FRAME_GUARD: u64 = 100_000;
+
 fn wait_idle(loader: &Loader) {
-    let start = Instant::now();
-    while !loader.is_idle() {
-        assert!(start.elapsed() < Duration::from_secs(20), "the loader never went idle");
-        std::thread::sleep(Duration::from_millis(1));
-    }
+    assert!(loader.wait_idle(HANG_GUARD), "the loader did not go idle in {HANG_GUARD:?}: hung?");
 }
 
 /// One frame as the render thread runs it: wants, one submit, drain, uploads.
@@ -127,12 +129,10 @@ fn loader_serves_most_important_first_and_never_blocks() {
             priority: ((i * 17) % tiles.len()) as u32,
         })
         .collect();
-    let start = Instant::now();
     loader.submit(&requests);
     let early = loader.try_recv_all();
-    let returned_in = start.elapsed();
-    assert!(!loader.is_idle(), "submit waited for the reads");
-    assert!(returned_in < Duration::from_millis(200), "submit + try_recv_all took {returned_in:?}");
+    // Had submit (or the drain) waited for the reads, one worker would be done with them all.
+    assert!(!loader.is_idle() && early.len() < tiles.len(), "submit waited for the reads");
     wait_idle(&loader);
     let mut loaded = early;
     loaded.extend(loader.try_recv_all());
@@ -195,14 +195,15 @@ fn loader_reports_missing_tiles_and_shuts_down_cleanly() {
     assert!(loader.try_recv_all()[0].result.is_err());
     assert_eq!(loader.failures(), 3);
 
-    // Dropping a loader with a full queue discards it and joins the workers promptly.
+    // Closing a loader with a full queue discards the queue and joins the workers, which finish
+    // at most the tile each is reading: most of the queue is still there to discard (to empty half
+    // of it, two workers would have to copy and checksum some 30 MB between these two lines).
     let pyramid = manifest.imagery.as_ref().unwrap().pyramid;
     let busy = Loader::new(open(&dir), 2).unwrap();
     let all: Vec<TileRequest> = pyramid.tiles().map(|id| ask(LayerKind::Imagery, id)).collect();
     busy.submit(&all);
-    let start = Instant::now();
-    drop(busy);
-    assert!(start.elapsed() < Duration::from_secs(2), "shutdown took {:?}", start.elapsed());
+    let discarded = busy.close();
+    assert!(discarded > all.len() / 2, "{discarded} of {} requests discarded", all.len());
 }
 
 #[test]
@@ -274,8 +275,8 @@ fn fixed_view_converges_then_uploads_nothing() {
         if stats[0].needed_resident == wanted.len() {
             break;
         }
-        assert!(n < 3000, "not converged after {n} frames: {:?}", stats[0]);
-        std::thread::sleep(Duration::from_millis(2));
+        assert!(n < FRAME_GUARD, "not converged after {n} frames: {:?}", stats[0]);
+        loader.wait_for_progress(HANG_GUARD);
         n += 1;
     }
     for k in 1..=20 {
@@ -300,14 +301,14 @@ fn coarse_and_near_tiles_arrive_first() {
     let wanted = wants(imagery.pyramid(), [4.5, 0.5], 0);
     let budget = UploadBudget { tiles: 1, bytes: 1 };
     let mut order = Vec::new();
-    for n in 0..2000 {
+    for n in 0..FRAME_GUARD {
         let before = resident(&imagery);
         frame(&gpu, &loader, &mut [(&mut imagery, &wanted, budget)], n, false);
         order.extend(resident(&imagery).difference(&before).copied());
         if order.len() == wanted.len() {
             break;
         }
-        std::thread::sleep(Duration::from_millis(1));
+        loader.wait_for_progress(HANG_GUARD);
     }
     assert_eq!(order, wanted, "uploads follow the wanted order");
     assert!(order.windows(2).all(|w| w[0].level >= w[1].level));

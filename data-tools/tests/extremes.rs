@@ -44,7 +44,7 @@ fn render_and_audit(
     tol: Tolerance,
     min_ground: usize,
 ) -> Audit {
-    r.render_resolved(camera, 120).unwrap();
+    r.render_resolved(camera).unwrap();
     let a = audit(r, camera, dem, tol, 4);
     println!("{what}: {a:?}");
     a.assert_sound(what);

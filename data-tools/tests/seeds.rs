@@ -50,7 +50,7 @@ fn gpu_equals_twin(dataset: Dataset, views: Poses) {
     let mut r = renderer(dataset, Settings::default(), 320, 180);
     for &(what, pose) in views {
         let camera = posed(&r, pose);
-        r.render_resolved(&camera, 80).unwrap();
+        r.render_resolved(&camera).unwrap();
         let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
         let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
         let diff = SeedComparison::of(&gpu, &twin);
@@ -72,6 +72,7 @@ fn gpu_equals_twin(dataset: Dataset, views: Poses) {
         assert_eq!(gpu_counters, twin_counters, "{what}");
         assert!(diff.only_gpu.is_empty() && diff.only_twin.is_empty(), "{what}: {diff:?}");
         assert!(diff.mismatched.is_empty(), "{what}: {:?}", diff.mismatched);
+        assert!(diff.non_finite.is_empty(), "{what}: not finite: {:?}", diff.non_finite);
         assert_eq!(diff.max_length_error_m, 0.0, "{what}");
         assert!(diff.max_colour_error <= 1, "{what}");
         assert!(base_mm <= 10.0, "{what}: a seed's base is {base_mm} mm off the DEM");
@@ -105,7 +106,7 @@ fn nc_and_zion_gpu_equals_twin() {
 /// Recall and precision of the GPU's seeds against the oracle's visible set from `pose`.
 fn recall_precision(r: &mut Renderer, what: &str, pose: [f64; 5]) -> (f64, f64, usize) {
     let camera = posed(r, pose);
-    r.render_resolved(&camera, 80).unwrap();
+    r.render_resolved(&camera).unwrap();
     let (gpu, _) = r.read_seeds().unwrap().unwrap();
     let (tables, patterns) = r.seed_world().unwrap();
     let viewport_px = [r.settings.render.width, r.settings.render.height];
@@ -214,7 +215,7 @@ fn nc_species_follow_the_land_cover() {
     let [w, h] = r.dataset.manifest.extent_m();
     // Straight down from high above the middle: a 16 × 16 block of cells (4 km) in full view.
     let camera = posed(&r, [0.5 * w, 0.5 * h, 12000.0, 0.0, -89.9]);
-    r.render_resolved(&camera, 40).unwrap();
+    r.render_resolved(&camera).unwrap();
     let cell_m = r.settings.tlm.cell_m;
     let first = [0.5 * w, 0.5 * h].map(|v| (v / cell_m).floor() as i64 - 8);
     let (seed, patterns) = (r.settings.tlm.seed, r.settings.tlm.patterns);

@@ -280,7 +280,7 @@ fn render_one(dataset_dir: &Path, settings: Settings, camera: &Camera, out: &Pat
     let mut renderer = open_renderer(dataset_dir, settings)?;
     let start = Instant::now();
     // One finished picture: keep rendering while tiles stream in.
-    let (report, frames) = renderer.render_resolved(camera, 500)?;
+    let (report, frames) = renderer.render_resolved(camera)?;
     let image = renderer.read_colour()?;
     let elapsed = start.elapsed();
     save_png(&image, out)?;

@@ -36,7 +36,7 @@ mod tools;
 
 pub use clearance::GROUND_CLEARANCE_NEAR;
 pub use seeds::SeedReport;
-pub use tools::Replay;
+pub use tools::{RESOLVE_GUARD_FRAMES, Replay};
 
 /// Linear-RGB colour of the sky, also the haze the distance fades into.
 const SKY_LINEAR: [f64; 3] = [0.42, 0.55, 0.75];
@@ -98,6 +98,13 @@ pub enum RenderError {
         tiles: u64,
         /// Slots of the layer's cache (`cache.*_slots`).
         slots: usize,
+    },
+    /// `Renderer::render_resolved` rendered `frames` frames and the view still had tiles to load:
+    /// a reader or the GPU is stuck.
+    #[error("the view did not resolve in {frames} frames: tiles still loading (a stuck reader?)")]
+    Unresolved {
+        /// Frames rendered.
+        frames: u32,
     },
     /// `render.width` or `render.height` exceeds the adapter's largest 2D texture.
     #[error("a {width}×{height} viewport is larger than this adapter's {max}-pixel targets")]

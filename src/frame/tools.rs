@@ -18,6 +18,15 @@ use crate::streaming::{CacheStats, TileCache};
 
 use super::{FrameReport, RenderError, Renderer};
 
+/// Frames `Renderer::render_resolved` renders at most before it calls a view stuck: far more than
+/// any view needs (every frame uploads a tile or waits for the loaders to read one), so only a hang
+/// reaches it.
+pub const RESOLVE_GUARD_FRAMES: u32 = 100_000;
+
+/// How long `render_resolved` waits for the loaders between two frames, at most: a guard against a
+/// hung reader (the wait ends as soon as a tile is read or nothing is left to read).
+const LOADER_WAIT: Duration = Duration::from_secs(30);
+
 impl Renderer {
     /// Loads every tile of the dataset now (heights, imagery, land cover) and pins it, for
     /// all-resident reference renders. Fails when a layer does not fit its cache.
@@ -64,27 +73,25 @@ impl Renderer {
             && self.loader.is_idle()
     }
 
-    /// Renders `camera` frame after frame until everything it needs is resident (at most
-    /// `max_frames`), for single frames and references. Returns the last frame's report and the
-    /// number of frames it took.
-    pub fn render_resolved(
-        &mut self,
-        camera: &Camera,
-        max_frames: u32,
-    ) -> Result<(FrameReport, u32), RenderError> {
+    /// Renders `camera` frame after frame until everything it needs is resident, for single
+    /// frames and references. Between frames it waits for the GPU (so the frame's Tile Load Map
+    /// arrives in the next) and for the loaders to deliver something new, so the view resolves by
+    /// state in the same frames on a fast or a loaded machine. Returns the last frame's report and
+    /// the number of frames it took; `RenderError::Unresolved` if `RESOLVE_GUARD_FRAMES` pass first
+    /// (something is stuck).
+    pub fn render_resolved(&mut self, camera: &Camera) -> Result<(FrameReport, u32), RenderError> {
         let first = self.frame;
-        let mut frames = 0;
-        loop {
+        for frames in 1..=RESOLVE_GUARD_FRAMES {
             let report = self.render(camera)?;
-            frames += 1;
             // Resolved only once a Tile Load Map of this very view has driven the streaming.
             let informed = report.tlm_frame.is_some_and(|f| f >= first);
-            if (informed && self.is_resolved(&report)) || frames >= max_frames {
+            if informed && self.is_resolved(&report) {
                 return Ok((report, frames));
             }
-            // The loader threads are reading: give them the core rather than spin.
-            std::thread::sleep(Duration::from_millis(2));
+            self.gpu.wait()?;
+            self.loader.wait_for_progress(LOADER_WAIT);
         }
+        Err(RenderError::Unresolved { frames: RESOLVE_GUARD_FRAMES })
     }
 
     /// The last frame's colour, as an sRGB image.
@@ -148,8 +155,33 @@ impl Renderer {
             patterns_unit: stage.patterns.positions_unit.clone(),
             tables: stage.tables.clone(),
             caches,
-            depth: self.read_depth()?,
+            depth: self.terrain_depth()?,
         }))
+    }
+
+    /// The last frame's terrain depth alone (reversed-Z, top row first): what pass 3 culled
+    /// against, before pass 4 drew the trees into the depth target. The terrain pass is recorded
+    /// again over the last frame's instances into a scratch target (the renderer's own are left
+    /// as they are), and read back, waiting for the GPU. Before a first frame, the depth target.
+    pub fn terrain_depth(&self) -> Result<Vec<f32>, RenderError> {
+        let Some(last) = &self.last else { return self.read_depth() };
+        let depth = &self.targets.depth;
+        let scratch = self.gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("terrain depth, for the twins"),
+            size: depth.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: depth.format(),
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        let view = scratch.create_view(&Default::default());
+        self.terrain.encode(&mut encoder, &self.terrain_bindings, &view, &last.nodes);
+        self.gpu.queue.submit([encoder.finish()]);
+        let bytes = read_texture(&self.gpu, &scratch, wgpu::TextureAspect::DepthOnly, 4)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
     /// Pass 3 replayed by its CPU twin over the last frame's inputs, in canonical order.

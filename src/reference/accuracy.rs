@@ -15,6 +15,7 @@ use serde::Serialize;
 use crate::dataset::{Dataset, PackError};
 use crate::gpu::gpu_types::SeedRecord;
 use crate::reference::oracle::OracleSeed;
+use crate::reference::worst::max_or_nan;
 
 /// A seed's identity: its ring-0 cell and its rank in the cell's pattern.
 pub type SeedId = ([i64; 2], u32);
@@ -83,12 +84,14 @@ impl SeedAgreement {
 /// The distance between kept seeds' ground heights and the f64 bilinear DEM, metres.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct HeightError {
-    /// Largest error of any seed, metres.
+    /// Largest error of any seed, metres; NaN when a seed's error is not finite (`non_finite`).
     pub max_m: f64,
     /// Sum of the errors, metres: kept rather than a mean so that views add up (`mean_m`).
     pub sum_m: f64,
     /// Seeds measured.
     pub seeds: u64,
+    /// Seeds whose position or ground height is not finite (their error cannot be measured).
+    pub non_finite: u64,
 }
 
 impl HeightError {
@@ -98,24 +101,31 @@ impl HeightError {
         for s in seeds {
             let x = camera_grid_m.x + f64::from(s.position_rel_m[0]);
             let y = camera_grid_m.y + f64::from(s.position_rel_m[1]);
-            let error_m = (f64::from(s.ground_m) - dataset.height_at(x, y, 0)?).abs();
-            out.max_m = out.max_m.max(error_m);
-            out.sum_m += error_m;
             out.seeds += 1;
+            if !(x.is_finite() && y.is_finite() && s.ground_m.is_finite()) {
+                out.non_finite += 1;
+                out.max_m = f64::NAN;
+                continue;
+            }
+            let error_m = (f64::from(s.ground_m) - dataset.height_at(x, y, 0)?).abs();
+            out.max_m = max_or_nan(out.max_m, error_m);
+            out.sum_m += error_m;
         }
         Ok(out)
     }
 
-    /// The mean error, metres (0 without seeds).
+    /// The mean error of the seeds measured, metres (0 without any).
     pub fn mean_m(&self) -> f64 {
-        if self.seeds == 0 { 0.0 } else { self.sum_m / self.seeds as f64 }
+        let measured = self.seeds - self.non_finite;
+        if measured == 0 { 0.0 } else { self.sum_m / measured as f64 }
     }
 
     /// Adds another view's errors: the larger maximum, the summed sums and counts.
     pub fn add(&mut self, other: &Self) {
-        self.max_m = self.max_m.max(other.max_m);
+        self.max_m = max_or_nan(self.max_m, other.max_m);
         self.sum_m += other.sum_m;
         self.seeds += other.seeds;
+        self.non_finite += other.non_finite;
     }
 }
 

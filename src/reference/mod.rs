@@ -3,7 +3,8 @@
 //! GPU == CPU exactly for integer outputs. The exact oracle used to measure accuracy (f64, full
 //! resolution) is separate from these twins: a twin reproduces the GPU, the oracle judges it.
 //! `accuracy` (seeds against the oracle) and `image_metrics` (PSNR, SSIM of frames against
-//! all-resident references) are what the speed trade (`sweep`) reports.
+//! all-resident references) are what the speed trade (`sweep`) reports; `worst` takes error
+//! maxima that never drop a NaN.
 
 pub mod accuracy;
 pub mod compact;
@@ -12,3 +13,4 @@ pub mod image_metrics;
 pub mod oracle;
 pub mod seed_select;
 pub mod tile_load_map;
+pub mod worst;

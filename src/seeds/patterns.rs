@@ -394,11 +394,9 @@ mod tests {
     }
 
     #[test]
-    fn generation_is_fast_enough() {
-        let start = std::time::Instant::now();
+    fn the_accurate_presets_patterns_are_generated_whole() {
+        // How long it takes is `benches/patterns.rs`'s to say, not a test's.
         let patterns = SeedPatterns::generate(16, 4096, 1);
-        let elapsed = start.elapsed();
         assert_eq!(patterns.positions_unit.len(), 16 * 4096);
-        assert!(elapsed.as_secs_f64() < 5.0, "16 × 4096 seeds took {elapsed:?}");
     }
 }

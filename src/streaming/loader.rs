@@ -18,6 +18,7 @@ use std::cmp::{Ordering, Reverse};
 use std::collections::{BinaryHeap, HashMap, HashSet};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender};
 use thiserror::Error;
@@ -133,6 +134,8 @@ struct Queue {
 struct Shared {
     queue: Mutex<Queue>,
     wake: Condvar,
+    /// Notified whenever a worker finishes a read (its result is on the channel).
+    settled: Condvar,
     /// Tiles already reported unusable, so each is logged once however often it is asked for.
     reported: Mutex<HashSet<(LayerKind, TileId)>>,
 }
@@ -157,6 +160,7 @@ impl Loader {
         let shared = Arc::new(Shared {
             queue: Mutex::new(Queue::default()),
             wake: Condvar::new(),
+            settled: Condvar::new(),
             reported: Mutex::new(HashSet::new()),
         });
         let (sender, results) = crossbeam_channel::unbounded();
@@ -210,6 +214,55 @@ impl Loader {
         queue.pending.is_empty() && queue.reading == 0
     }
 
+    /// Waits until a result is ready for `try_recv_all` or nothing is left to read, at most
+    /// `timeout` (a guard against a hang, not a measure: the condition decides). True when the
+    /// condition holds. For tools that want a view resolved, never the frame.
+    pub fn wait_for_progress(&self, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        let mut queue = self.shared.queue();
+        loop {
+            // Checked under the lock a finishing worker takes after sending: no wake-up is lost.
+            if !self.results.is_empty() || (queue.pending.is_empty() && queue.reading == 0) {
+                return true;
+            }
+            let Some(left) = deadline.checked_duration_since(Instant::now()) else { return false };
+            queue = self.shared.settled.wait_timeout(queue, left).unwrap_or_else(PoisonError::into_inner).0;
+        }
+    }
+
+    /// Waits until nothing is queued or being read (every result is then ready for
+    /// `try_recv_all`), at most `timeout`, a guard against a hang. True when idle.
+    pub fn wait_idle(&self, timeout: Duration) -> bool {
+        let deadline = Instant::now() + timeout;
+        let mut queue = self.shared.queue();
+        while !(queue.pending.is_empty() && queue.reading == 0) {
+            let Some(left) = deadline.checked_duration_since(Instant::now()) else { return false };
+            queue = self.shared.settled.wait_timeout(queue, left).unwrap_or_else(PoisonError::into_inner).0;
+        }
+        true
+    }
+
+    /// Stops the workers, discarding every request not yet started, and joins them (each finishes
+    /// at most the tile it is reading). Returns how many requests were discarded. Dropping the
+    /// loader does the same.
+    pub fn close(mut self) -> usize {
+        self.shut_down()
+    }
+
+    fn shut_down(&mut self) -> usize {
+        let discarded = {
+            let mut queue = self.shared.queue();
+            queue.shutdown = true;
+            std::mem::take(&mut queue.pending).len()
+        };
+        self.shared.wake.notify_all();
+        for worker in self.workers.drain(..) {
+            // A worker that panicked has nothing left to clean up; the others exit on `shutdown`.
+            let _ = worker.join();
+        }
+        discarded
+    }
+
     /// Requests queued and not yet started.
     pub fn queued(&self) -> usize {
         self.shared.queue().pending.len()
@@ -228,12 +281,7 @@ impl Loader {
 
 impl Drop for Loader {
     fn drop(&mut self) {
-        self.shared.queue().shutdown = true;
-        self.shared.wake.notify_all();
-        for worker in self.workers.drain(..) {
-            // A worker that panicked has nothing left to clean up; the others exit on `shutdown`.
-            let _ = worker.join();
-        }
+        self.shut_down();
     }
 }
 
@@ -260,6 +308,7 @@ fn work(shared: &Shared, dataset: &Dataset, results: &Sender<Loaded>) {
         // The receiver lives as long as the `Loader`, which joins us before dropping it.
         let _ = results.send(Loaded { layer: request.layer, id: request.id, result });
         shared.queue().reading -= 1;
+        shared.settled.notify_all();
     }
 }
 

@@ -27,9 +27,6 @@ use crate::reference::accuracy::{HeightError, SeedAgreement};
 use crate::reference::image_metrics::{capped_psnr_db, mse, psnr_of_mse, ssim};
 use crate::reference::oracle::{OracleInputs, visible_seeds};
 
-/// Frames a pose may take to settle (every tile it asks for resident).
-const MAX_RESOLVE_FRAMES: u32 = 300;
-
 pub(super) struct Flight<'a> {
     pub dataset_dir: &'a Path,
     pub path: &'a CameraPath,
@@ -82,7 +79,7 @@ impl Flight<'_> {
         let mut images = Vec::with_capacity(self.poses.len());
         for (i, (t, camera)) in self.poses.iter().enumerate() {
             progress(Progress::Step(&format!("{what}: pose {} of {} (t = {t:.2})", i + 1, self.poses.len())));
-            renderer.render_resolved(camera, MAX_RESOLVE_FRAMES)?;
+            renderer.render_resolved(camera)?;
             each(renderer, camera)?;
             images.push(renderer.read_colour()?);
         }

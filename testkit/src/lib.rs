@@ -17,5 +17,5 @@ pub mod tlm;
 
 pub use data::{TempDir, shared_data};
 pub use datasets::{synth_dataset, synth_dataset_with};
-pub use images::{check_reference, psnr};
+pub use images::{Golden, psnr};
 pub use setup::{gpu, renderer, small_settings};

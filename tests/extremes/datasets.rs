@@ -35,7 +35,7 @@ fn cameras_outside_every_corner_and_edge_look_in() {
                 near_m: 0.1,
             };
             let what = format!("({dx}, {dy}) {away_m} m out, {z_m:.0} m high");
-            let (report, _) = r.render_resolved(&camera, 60).unwrap();
+            let (report, _) = r.render_resolved(&camera).unwrap();
             assert_eq!(report.camera_lifted_m, 0.0, "{what}: outside the dataset there is no ground");
             let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 3);
             println!("{what}: {a:?}");
@@ -63,7 +63,7 @@ fn datasets_of_one_sample_one_cell_and_one_tile_render() {
         ];
         for (what, camera) in views {
             let what = format!("size {size}, {what}");
-            let (report, _) = r.render_resolved(&camera, 60).unwrap();
+            let (report, _) = r.render_resolved(&camera).unwrap();
             assert!(report.nodes_drawn > 0 && report.nodes_dropped == 0, "{what}: {report:?}");
             let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 0.1 * span[0]), 4);
             println!("{what}: {a:?}");
@@ -84,7 +84,7 @@ fn grows_nothing(name: &str, text: &str) {
     let dem = Dem::load(&r.dataset);
     let span = dem.span_m();
     let camera = camera_at(&r, &dem, [0.4 * span[0], 0.4 * span[1]], 30.0, 60.0, -15.0);
-    let (report, _) = r.render_resolved(&camera, 60).unwrap();
+    let (report, _) = r.render_resolved(&camera).unwrap();
     let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 4);
     println!("{name}: {report:?}\n{a:?}");
     a.assert_sound(name);

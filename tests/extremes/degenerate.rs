@@ -7,6 +7,7 @@ use glam::DVec3;
 use terramp::camera::{Camera, CameraError, MAX_COORDINATE_M, MIN_FOV_DEG, MIN_NEAR_M};
 use terramp::dataset::Dataset;
 use terramp::frame::{GROUND_CLEARANCE_NEAR, RenderError, Renderer};
+use terramp::reference::worst::max_or_nan;
 
 use terramp_testkit::audit::{Dem, Tolerance, audit, camera_at};
 use terramp_testkit::small_settings;
@@ -24,7 +25,7 @@ fn viewports_of_no_area_or_too_large_are_errors() {
     let mut r = open(1, 1).unwrap();
     let dem = Dem::load(&r.dataset);
     let camera = camera_at(&r, &dem, [300.0, 300.0], 50.0, 0.0, -45.0);
-    r.render_resolved(&camera, 30).unwrap();
+    r.render_resolved(&camera).unwrap();
     assert_eq!(r.read_depth().unwrap().len(), 1);
     assert!(r.read_depth().unwrap()[0] > 0.0, "the one pixel looks at the ground");
 }
@@ -78,7 +79,7 @@ fn fields_of_view_near_0_and_180_render_or_are_refused() {
         ("179.999°", wide, 0.05, false),
     ];
     for (what, camera, height_m, judged) in views {
-        r.render_resolved(&camera, 60).unwrap();
+        r.render_resolved(&camera).unwrap();
         let a = audit(&r, &camera, &dem, Tolerance::flat(height_m, 20.0), 4);
         println!("{what}: {a:?}");
         a.assert_sound(what);
@@ -102,7 +103,8 @@ fn worst_f32_misplacement_px(fov_deg: f64) -> f64 {
             let point = (near.truncate() / near.w).normalize() * 1000.0;
             let p = clip_f32 * point.as_vec3().extend(1.0);
             let (x, y) = (f64::from(p.x / p.w), f64::from(p.y / p.w));
-            worst_px = worst_px.max(((x - ndc[0]) * 960.0).abs()).max(((y - ndc[1]) * 540.0).abs());
+            worst_px =
+                max_or_nan(max_or_nan(worst_px, ((x - ndc[0]) * 960.0).abs()), ((y - ndc[1]) * 540.0).abs());
         }
     }
     worst_px
@@ -126,7 +128,7 @@ fn non_finite_and_absurd_cameras_are_errors_and_the_renderer_goes_on() {
     let mut r = terramp_testkit::renderer(&dataset, small_settings(160, 90));
     let dem = Dem::load(&r.dataset);
     let good = camera_at(&r, &dem, [800.0, 900.0], 30.0, 60.0, -10.0);
-    r.render_resolved(&good, 60).unwrap();
+    r.render_resolved(&good).unwrap();
     let before = r.read_colour().unwrap();
     let position = |x, y, z| Camera { position_m: DVec3::new(x, y, z), ..good };
     let (nan, inf) = (f64::NAN, f64::INFINITY);
@@ -151,7 +153,7 @@ fn non_finite_and_absurd_cameras_are_errors_and_the_renderer_goes_on() {
             Err(RenderError::Camera(error)) => assert_eq!(error, expected),
             other => panic!("{camera:?}: {other:?}"),
         }
-        assert!(r.render_resolved(&camera, 1).is_err());
+        assert!(r.render_resolved(&camera).is_err());
     }
     // Far but legal: nothing to see, nothing broken.
     for camera in [position(MAX_COORDINATE_M, -MAX_COORDINATE_M, 1e6), Camera { pitch_deg: 1e300, ..good }] {
@@ -159,7 +161,7 @@ fn non_finite_and_absurd_cameras_are_errors_and_the_renderer_goes_on() {
         let depth = r.read_depth().unwrap();
         assert!(depth.iter().all(|d| d.is_finite() && (0.0..=1.0).contains(d)), "{camera:?}");
     }
-    r.render_resolved(&good, 60).unwrap();
+    r.render_resolved(&good).unwrap();
     assert!(r.read_colour().unwrap() == before, "the renderer changed after the bad cameras");
 }
 
@@ -173,7 +175,7 @@ fn a_camera_inside_the_terrain_is_lifted_above_it() {
     let clearance_m = GROUND_CLEARANCE_NEAR * 0.1;
     for below_m in [0.05, 20.0, 5000.0] {
         let buried = camera_at(&r, &dem, spot, -below_m, 120.0, -10.0);
-        let (report, _) = r.render_resolved(&buried, 60).unwrap();
+        let (report, _) = r.render_resolved(&buried).unwrap();
         let lifted_m = report.camera_lifted_m;
         assert!((lifted_m - (below_m + clearance_m)).abs() < 1e-3, "{below_m} m under: lifted {lifted_m} m");
         // The frame is the one seen from the lifted camera, and it is sound.
@@ -183,7 +185,7 @@ fn a_camera_inside_the_terrain_is_lifted_above_it() {
         println!("{below_m} m under: {a:?}");
         a.assert_sound(&format!("{below_m} m under"));
         assert!(a.expect_ground > 100, "{a:?}");
-        let (report, _) = r.render_resolved(&lifted, 60).unwrap();
+        let (report, _) = r.render_resolved(&lifted).unwrap();
         assert!(report.camera_lifted_m < 1e-9, "lifted again by {} m", report.camera_lifted_m);
         assert!(r.read_colour().unwrap() == image, "{below_m} m under: not the lifted camera's frame");
     }

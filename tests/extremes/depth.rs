@@ -278,7 +278,7 @@ fn cameras_2_m_and_100_km_and_500_km_up_see_ground_and_sky_where_they_must() {
         ),
     ];
     for (what, camera, height_m, sky) in views {
-        r.render_resolved(&camera, 60).unwrap();
+        r.render_resolved(&camera).unwrap();
         let a = audit(&r, &camera, &dem, Tolerance::flat(height_m, 20.0), 4);
         println!("{what}: {a:?}");
         a.assert_sound(what);

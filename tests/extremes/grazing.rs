@@ -48,7 +48,7 @@ fn grazing_and_horizontal_views_keep_every_buffer_finite_and_the_ground_whole() 
         ("horizontal, 30 m up", camera_at(&r, &dem, [0.2 * span[0], 0.8 * span[1]], 30.0, 160.0, 0.0)),
     ];
     for (what, camera) in views {
-        r.render_resolved(&camera, 60).unwrap();
+        r.render_resolved(&camera).unwrap();
         let a = audit(&r, &camera, &dem, Tolerance::flat(0.05, 20.0), 4);
         println!("{what}: {a:?}");
         a.assert_sound(what);

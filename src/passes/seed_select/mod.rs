@@ -19,3 +19,6 @@
 
 pub mod frame;
 pub mod gpu;
+
+#[cfg(test)]
+mod tests;
