@@ -35,24 +35,25 @@ impl<Tag> Readback<Tag> {
 
 type MapStatus = Arc<OnceLock<Result<(), wgpu::BufferAsyncError>>>;
 
-enum Slot {
+/// A staging buffer's state; a copy's tag travels with it until `try_take` hands it back.
+enum Slot<Tag> {
     Free,
     /// A copy is recorded but its encoder is not known to be submitted yet.
     Recorded {
         bytes: u64,
+        tag: Tag,
     },
     Mapping {
         bytes: u64,
         status: MapStatus,
+        tag: Tag,
     },
 }
 
 /// A ring of staging buffers whose copies carry a `Tag`.
 pub struct ReadbackRing<Tag> {
     buffers: Vec<wgpu::Buffer>,
-    slots: Vec<Slot>,
-    /// The tag of each slot holding a copy.
-    tags: Vec<Option<Tag>>,
+    slots: Vec<Slot<Tag>>,
     /// Slots holding a frame, oldest first.
     order: VecDeque<usize>,
     capacity_bytes: u64,
@@ -74,8 +75,7 @@ impl<Tag> ReadbackRing<Tag> {
             })
             .collect::<Vec<_>>();
         let slots = buffers.iter().map(|_| Slot::Free).collect();
-        let tags = buffers.iter().map(|_| None).collect();
-        Self { buffers, slots, tags, order: VecDeque::new(), capacity_bytes, skipped: 0 }
+        Self { buffers, slots, order: VecDeque::new(), capacity_bytes, skipped: 0 }
     }
 
     /// Records a copy of the first `bytes` of `source`, tagged `tag`, into a free staging
@@ -96,8 +96,7 @@ impl<Tag> ReadbackRing<Tag> {
         if bytes > 0 {
             encoder.copy_buffer_to_buffer(source, 0, &self.buffers[index], 0, bytes);
         }
-        self.slots[index] = Slot::Recorded { bytes };
-        self.tags[index] = Some(tag);
+        self.slots[index] = Slot::Recorded { bytes, tag };
         self.order.push_back(index);
         true
     }
@@ -105,7 +104,8 @@ impl<Tag> ReadbackRing<Tag> {
     /// Call after submitting the encoder(s) holding the copies: starts mapping them.
     pub fn submitted(&mut self) {
         for (slot, buffer) in self.slots.iter_mut().zip(&self.buffers) {
-            if let Slot::Recorded { bytes } = *slot {
+            if let Slot::Recorded { .. } = slot {
+                let Slot::Recorded { bytes, tag } = std::mem::replace(slot, Slot::Free) else { continue };
                 let status: MapStatus = Arc::default();
                 let sink = Arc::clone(&status);
                 if bytes > 0 {
@@ -115,7 +115,7 @@ impl<Tag> ReadbackRing<Tag> {
                 } else {
                     let _ = sink.set(Ok(()));
                 }
-                *slot = Slot::Mapping { bytes, status };
+                *slot = Slot::Mapping { bytes, status, tag };
             }
         }
     }
@@ -124,16 +124,13 @@ impl<Tag> ReadbackRing<Tag> {
     pub fn try_take(&mut self, device: &wgpu::Device) -> Result<Option<Readback<Tag>>, GpuError> {
         device.poll(wgpu::PollType::Poll)?;
         let Some(&index) = self.order.front() else { return Ok(None) };
-        let Slot::Mapping { bytes, status } = &self.slots[index] else { return Ok(None) };
-        let Some(result) = status.get() else { return Ok(None) };
-        let (bytes, result) = (*bytes, result.clone());
+        let Slot::Mapping { status, .. } = &self.slots[index] else { return Ok(None) };
+        let Some(result) = status.get().cloned() else { return Ok(None) };
         self.order.pop_front();
-        self.slots[index] = Slot::Free;
-        let tag = self.tags[index].take();
-        result?;
-        let Some(tag) = tag else {
-            return Err(GpuError::Validation("a readback slot held a copy without its tag".into()));
+        let Slot::Mapping { bytes, tag, .. } = std::mem::replace(&mut self.slots[index], Slot::Free) else {
+            return Ok(None);
         };
+        result?;
         if bytes == 0 {
             return Ok(Some(Readback { tag, bytes: Vec::new() }));
         }

@@ -140,6 +140,12 @@ struct Shared {
     reported: Mutex<HashSet<(LayerKind, TileId)>>,
 }
 
+impl Queue {
+    fn is_idle(&self) -> bool {
+        self.pending.is_empty() && self.reading == 0
+    }
+}
+
 impl Shared {
     fn queue(&self) -> MutexGuard<'_, Queue> {
         // A worker panicking mid-read leaves the queue consistent (it only pops and counts).
@@ -210,32 +216,28 @@ impl Loader {
 
     /// Nothing queued and nothing being read: every result is ready for `try_recv_all`.
     pub fn is_idle(&self) -> bool {
-        let queue = self.shared.queue();
-        queue.pending.is_empty() && queue.reading == 0
+        self.shared.queue().is_idle()
     }
 
     /// Waits until a result is ready for `try_recv_all` or nothing is left to read, at most
     /// `timeout` (a guard against a hang, not a measure: the condition decides). True when the
     /// condition holds. For tools that want a view resolved, never the frame.
     pub fn wait_for_progress(&self, timeout: Duration) -> bool {
-        let deadline = Instant::now() + timeout;
-        let mut queue = self.shared.queue();
-        loop {
-            // Checked under the lock a finishing worker takes after sending: no wake-up is lost.
-            if !self.results.is_empty() || (queue.pending.is_empty() && queue.reading == 0) {
-                return true;
-            }
-            let Some(left) = deadline.checked_duration_since(Instant::now()) else { return false };
-            queue = self.shared.settled.wait_timeout(queue, left).unwrap_or_else(PoisonError::into_inner).0;
-        }
+        self.wait_until(timeout, |queue| !self.results.is_empty() || queue.is_idle())
     }
 
     /// Waits until nothing is queued or being read (every result is then ready for
     /// `try_recv_all`), at most `timeout`, a guard against a hang. True when idle.
     pub fn wait_idle(&self, timeout: Duration) -> bool {
+        self.wait_until(timeout, Queue::is_idle)
+    }
+
+    /// Waits until `done` holds of the queue, at most `timeout`. The condition is checked under
+    /// the lock a finishing worker takes after sending its result, so no wake-up is lost.
+    fn wait_until(&self, timeout: Duration, done: impl Fn(&Queue) -> bool) -> bool {
         let deadline = Instant::now() + timeout;
         let mut queue = self.shared.queue();
-        while !(queue.pending.is_empty() && queue.reading == 0) {
+        while !done(&queue) {
             let Some(left) = deadline.checked_duration_since(Instant::now()) else { return false };
             queue = self.shared.settled.wait_timeout(queue, left).unwrap_or_else(PoisonError::into_inner).0;
         }
