@@ -60,6 +60,8 @@ struct VertexOut {
     @location(5) @interpolate(flat) ground: vec4<f32>,
     // Dither thresholds this draw keeps, [x, y), and the seed's shift of the dither pattern (z).
     @location(6) @interpolate(flat) keep: vec3<f32>,
+    // The seed's record: what the ground truth's id buffer names.
+    @location(7) @interpolate(flat) record: u32,
 }
 
 // Model space (x, y up, z) to world (x east, y north, z up), turned by `angle` about the vertical.
@@ -90,6 +92,7 @@ fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     let material = materials[in.material];
     let fade = band_fade(record, lod);
     var out: VertexOut;
+    out.record = order[instance];
     // The group's own geometry keeps thresholds below the fade, the next LOD's the rest.
     out.keep = vec3<f32>(0.0, fade, f32(record.rank & 15u));
     if material.lod != lod {
@@ -125,8 +128,8 @@ fn bayer4(pixel: vec2<u32>, shift: u32) -> f32 {
     return (f32(m[(p.y & 3u) * 4u + (p.x & 3u)]) + 0.5) / 16.0;
 }
 
-@fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+// The fragment's lit, hazed colour, or discarded (alpha test, dither).
+fn shade(in: VertexOut) -> vec4<f32> {
     let material = materials[in.material];
     // Derivatives in uniform control flow; the samplers differ only in wrapping (the mesh's
     // textures repeat, the atlases must not bleed across their edge).
@@ -157,4 +160,21 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let lit = albedo * (sun + sky);
     let haze = 1.0 - exp2(-length(in.rel_m) / u.haze.w);
     return vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0);
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in);
+}
+
+struct TruthOut {
+    @location(0) colour: vec4<f32>,
+    @location(1) seed: u32,
+}
+
+// The ground truth's draw (`truth`): every seed its full mesh, never faded (its uniforms reach
+// everywhere), each fragment also writing its seed's id, the record index + 1 (0 is no seed).
+@fragment
+fn fs_truth(in: VertexOut) -> TruthOut {
+    return TruthOut(shade(in), in.record + 1u);
 }

@@ -27,3 +27,4 @@ pub mod streaming;
 pub mod sweep;
 #[cfg(feature = "synth")]
 pub mod synth;
+pub mod truth;

@@ -104,7 +104,7 @@ const LAYERS: &[&[&str]] = &[
     &["passes", "bake"],
     &["reference"],
     &["frame"],
-    &["profile"],
+    &["profile", "truth"],
     &["sweep"],
 ];
 

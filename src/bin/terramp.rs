@@ -1,5 +1,5 @@
 //! The `terramp` command line: render a frame of a dataset, fly the demo or a path, profile the
-//! passes, measure the speed trade, describe a dataset.
+//! passes, measure the speed trade, render the ground truth, describe a dataset.
 
 // Under `terramp/`, not beside this file: every `src/bin/*.rs` is a binary of its own.
 #[path = "terramp/demo.rs"]
@@ -22,6 +22,8 @@ use terramp::profile::{Meta, Summary};
 // Crate roots look for modules beside themselves: this one keeps its own in src/bin/terramp/.
 #[path = "terramp/sweep.rs"]
 mod sweep;
+#[path = "terramp/truth.rs"]
+mod truth;
 
 #[derive(Parser)]
 #[command(
@@ -97,6 +99,9 @@ enum Command {
         #[command(flatten)]
         settings: SettingsArgs,
     },
+    /// The ground truth of one view: every seed the land cover grows, as its full mesh, every
+    /// tile at its finest level, supersampled, with a per-sample seed id and depth.
+    Truth(truth::TruthArgs),
     /// Fly a camera path (config/paths/*.toml) and write the frames and a log: one JSON object per
     /// frame in `log.jsonl` (tiles needed, resident, uploaded, evicted, failed, bytes uploaded;
     /// seeds checked, selected, culled by class, rule, distance, frustum and occlusion, overflow;
@@ -199,6 +204,7 @@ fn main() -> Result<()> {
             profile(&dataset, path.as_deref(), frames, warmup, (width, height), &settings, &outputs)
         }
         Command::Sweep(args) => args.run(),
+        Command::Truth(args) => args.run(),
         Command::Info { dataset } => info(&dataset),
     }
 }

@@ -14,6 +14,7 @@ use thiserror::Error;
 use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::{Dataset, PackError, TileId};
+use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::layout::MAX_LEVELS;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
@@ -168,6 +169,7 @@ struct TlmTag {
 struct LastFrame {
     tlm: TlmFrame,
     nodes: PreparedNodes,
+    terrain: TerrainUniforms,
 }
 
 /// The three tile caches, with the tiles each keeps resident for good.
@@ -331,7 +333,7 @@ impl Renderer {
         plan: prepare::FramePlan,
         report: &mut FrameReport,
     ) -> Result<(), RenderError> {
-        let prepare::FramePlan { layout, camera_grid_m, tlm, nodes } = plan;
+        let prepare::FramePlan { layout, camera_grid_m, tlm, nodes, terrain } = plan;
         let tag = TlmTag { frame: self.frame, layout, camera_grid_m };
         self.tlm_readback.encode_copy(&mut encoder, self.tlm.output(), tlm.output_bytes(), tag);
         if let Some(stage) = self.seeds.as_mut() {
@@ -355,7 +357,7 @@ impl Renderer {
             self.last_timings = timings;
         }
         self.gpu.check()?;
-        self.last = Some(LastFrame { tlm, nodes });
+        self.last = Some(LastFrame { tlm, nodes, terrain });
         self.frame += 1;
         Ok(())
     }

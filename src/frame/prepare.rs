@@ -26,6 +26,8 @@ pub(super) struct FramePlan {
     pub camera_grid_m: DVec3,
     pub tlm: TlmFrame,
     pub nodes: PreparedNodes,
+    /// The terrain's uniforms: its matrix, sun and haze, which everything drawn over it shares.
+    pub terrain: TerrainUniforms,
 }
 
 /// The camera, as this frame's passes see it.
@@ -57,7 +59,7 @@ impl Renderer {
         let (layout, tlm) = self.prepare_tlm(&view)?;
         let (nodes, terrain) = self.prepare_terrain(&view, &selected, report);
         self.prepare_seeds(&view, &terrain, report)?;
-        Ok(FramePlan { layout, camera_grid_m: view.grid_m, tlm, nodes })
+        Ok(FramePlan { layout, camera_grid_m: view.grid_m, tlm, nodes, terrain })
     }
 
     /// Terrain LOD: the nodes whose triangles keep their target size on screen.

@@ -5,8 +5,9 @@
 use std::time::Duration;
 
 use crate::camera::Camera;
+use crate::classes::ClassTable;
 use crate::gpu::GpuError;
-use crate::gpu::gpu_types::{SeedCounters, SeedRecord, TlmCell};
+use crate::gpu::gpu_types::{SeedCounters, SeedRecord, TerrainUniforms, TlmCell};
 use crate::gpu::readback::read_texture;
 use crate::passes::compact::frame::Compacted;
 use crate::passes::seed_select::frame::{SeedCellRef, SeedOutput};
@@ -17,6 +18,14 @@ use crate::streaming::wants::pinned_tiles;
 use crate::streaming::{CacheStats, TileCache};
 
 use super::{FrameReport, RenderError, Renderer};
+
+/// A settled frame's targets, to draw more over (`Renderer::last_canvas`).
+pub(crate) struct Canvas<'a> {
+    pub terrain: &'a TerrainUniforms,
+    pub colour: &'a wgpu::Texture,
+    pub colour_view: &'a wgpu::TextureView,
+    pub depth_view: &'a wgpu::TextureView,
+}
 
 /// Frames `Renderer::render_resolved` renders at most before it calls a view stuck: far more than
 /// any view needs (every frame uploads a tile or waits for the loaders to read one), so only a hang
@@ -119,6 +128,25 @@ impl Renderer {
     /// The seeded world of this renderer: species tables and patterns (`None` without land cover).
     pub fn seed_world(&self) -> Option<(&SeedTables, &SeedPatterns)> {
         self.seeds.as_ref().map(|s| (&s.tables, &s.patterns))
+    }
+
+    /// The class table the species come from (`None` without land cover).
+    pub fn class_table(&self) -> Option<&ClassTable> {
+        self.seeds.as_ref().map(|s| &s.table)
+    }
+
+    /// What the ground truth draws its seeds into, over the last frame: the terrain's uniforms
+    /// (matrix, sun, haze), and the colour and depth targets with their views (`None` before a
+    /// first frame).
+    pub(crate) fn last_canvas(&self) -> Option<Canvas<'_>> {
+        let last = self.last.as_ref()?;
+        let t = &self.targets;
+        Some(Canvas {
+            terrain: &last.terrain,
+            colour: &t.colour,
+            colour_view: &t.colour_view,
+            depth_view: &t.depth_view,
+        })
     }
 
     /// The last frame's seeds as pass 3 wrote them, with its counters, waiting for the GPU

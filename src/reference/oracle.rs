@@ -106,7 +106,7 @@ pub struct OracleSeed {
 }
 
 /// Seeds judged, and where each went: every candidate lands in exactly one other field.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct OracleCounts {
     /// Every seed of every ring-0 cell within reach: `seeds_per_pattern` per cell.
     pub candidates: u64,
@@ -136,8 +136,33 @@ impl OracleCounts {
     }
 }
 
+/// Which culls judge a seed: the GPU's selection (`Culls::SELECTION`) or the ground truth's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Culls {
+    /// One reach for every seed, metres, its draw LOD always 0; `None`: `draw_seeds.reach_m`,
+    /// scaled by the seed's size, as pass 3 reaches.
+    pub reach_m: Option<f64>,
+    /// Whether a seed whose eye→summit segment passes below the terrain is culled. The ground
+    /// truth keeps it: whether any part of it shows is for its image to say.
+    pub occlusion: bool,
+}
+
+impl Culls {
+    /// Pass 3's culls, exact: reach by size, frustum (bounding sphere), occlusion (summit).
+    pub const SELECTION: Self = Self { reach_m: None, occlusion: true };
+}
+
 /// The visible seeds of the view, sorted by (address, rank), and the counts of every fate.
 pub fn visible_seeds(inputs: &OracleInputs) -> Result<(Vec<OracleSeed>, OracleCounts), OracleError> {
+    judge_seeds(inputs, Culls::SELECTION)
+}
+
+/// The seeds of the view that survive `culls` (the frustum cull always applies: a bounding sphere
+/// outside the view has no pixel in it), sorted by (address, rank), and the counts of every fate.
+pub fn judge_seeds(
+    inputs: &OracleInputs,
+    culls: Culls,
+) -> Result<(Vec<OracleSeed>, OracleCounts), OracleError> {
     let &OracleInputs { dataset, settings, patterns, camera, viewport_px, .. } = inputs;
     camera.validate()?;
     let clip = camera.clip_from_view(viewport_px[0], viewport_px[1])? * camera.view_from_world();
@@ -157,7 +182,8 @@ pub fn visible_seeds(inputs: &OracleInputs) -> Result<(Vec<OracleSeed>, OracleCo
     let extent_m = dataset.height.pyramid.size.map(|n| f64::from(n.max(1) - 1) * spacing_m);
     let eye = camera.position_m - DVec3::new(manifest.origin_m[0], manifest.origin_m[1], 0.0);
     let cell_m = settings.tlm.cell_m;
-    let reach_m = settings.draw_seeds.reach_m.iter().fold(0.0f64, |a, &b| a.max(b));
+    let reach_m =
+        culls.reach_m.unwrap_or_else(|| settings.draw_seeds.reach_m.iter().fold(0.0f64, |a, &b| a.max(b)));
 
     // Ring-0 cells overlapping the height rectangle whose square comes within reach.
     let range = |c: f64, a: usize| {
@@ -187,7 +213,8 @@ pub fn visible_seeds(inputs: &OracleInputs) -> Result<(Vec<OracleSeed>, OracleCo
     let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= extent_m[0] && p.y <= extent_m[1];
     // An eye below the ground sees nothing (every seed reaching the occlusion test is hidden).
     let eye_underground = inside(eye.truncate()) && eye.z < dem.ground(eye.truncate()).0;
-    let view = View { inputs, dem, landcover, planes: frustum_planes(clip), eye, eye_underground, extent_m };
+    let planes = frustum_planes(clip);
+    let view = View { inputs, culls, dem, landcover, planes, eye, eye_underground, extent_m };
     let judged: Vec<(Vec<OracleSeed>, OracleCounts)> =
         cells.par_iter().map(|&address| view.cell(address)).collect::<Result<_, _>>()?;
     let mut counts = OracleCounts::default();
@@ -244,6 +271,7 @@ enum Fate {
 
 struct View<'a> {
     inputs: &'a OracleInputs<'a>,
+    culls: Culls,
     dem: DemWindow,
     landcover: LandcoverTiles,
     planes: [DVec4; 5],
@@ -313,15 +341,20 @@ impl View<'_> {
         let rel = DVec3::new(p.x, p.y, ground_m) - self.eye;
         let distance_m = rel.length();
         let scale = (height_m / seeds.reference_height_m).min(1.0);
-        let Some(lod) = settings.draw_seeds.reach_m.iter().position(|&r| distance_m < r * scale) else {
+        let lod = match self.culls.reach_m {
+            Some(reach_m) => (distance_m < reach_m).then_some(0),
+            None => settings.draw_seeds.reach_m.iter().position(|&r| distance_m < r * scale),
+        };
+        let Some(lod) = lod else {
             return Ok(Fate::Distance);
         };
         if !self.in_frustum(species, rel, height_m) {
             return Ok(Fate::Frustum);
         }
         let summit = DVec3::new(p.x, p.y, ground_m - seeds.sink_fraction * height_m + height_m);
-        if self.eye_underground
-            || self.dem.min_clearance_m(self.eye, summit, 1.0 - SEGMENT_END_SKIP, true) < 0.0
+        if self.culls.occlusion
+            && (self.eye_underground
+                || self.dem.min_clearance_m(self.eye, summit, 1.0 - SEGMENT_END_SKIP, true) < 0.0)
         {
             return Ok(Fate::Occlusion);
         }

@@ -2,11 +2,14 @@
 //! one texture array), the pipeline and binding table, the frame's constants and the recorded
 //! indirect draws.
 
+use std::ops::Range;
+
 use bytemuck::Zeroable;
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedVertex};
+use crate::gpu::layout::SEED_LODS;
 use crate::gpu::resources::{buffer, buffer_init, pipeline_layout};
 use crate::gpu::shaders::{SEED_RECORD, WgslSource};
 use crate::gpu::struct_layout::GpuLayout;
@@ -43,6 +46,10 @@ pub const BINDINGS: BindingTable<8> = BindingTable {
         Binding::sampler(7, "repeat_sampler", Stage::FRAGMENT, wgpu::SamplerBindingType::Filtering),
     ],
 };
+
+/// The ground truth's seed-id target (`fs_truth`): per sample, the record index + 1 of the seed
+/// drawn there, 0 where none is.
+pub const SEED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
 /// What the draw reads from the earlier passes: pass 3's records and compaction's order.
 pub struct DrawSeedsInputs<'a> {
@@ -140,7 +147,8 @@ impl DrawSeedsPass {
                 ..Default::default()
             })
         };
-        let (pipeline, layout) = pipeline(device);
+        let layout = BINDINGS.layout(device);
+        let pipeline = pipeline(device, &layout, "fs_main", &[Some(COLOUR_FORMAT.into())]);
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
         Ok(Self {
             pipeline,
@@ -197,6 +205,41 @@ impl DrawSeedsPass {
         )
     }
 
+    /// The ground truth's pipeline over this pass's geometry and bindings: `fs_truth` writes each
+    /// fragment's colour and its seed's id (`SEED_ID_FORMAT`).
+    pub fn truth_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let targets = [Some(COLOUR_FORMAT.into()), Some(SEED_ID_FORMAT.into())];
+        pipeline(device, &self.layout, "fs_truth", &targets)
+    }
+
+    /// Species `species`'s full mesh (its LOD 0 geometry), or `None` when its model has none
+    /// (LOD 0 is then its first billboard cloud) or no impostor.
+    pub fn mesh_of(&self, species: u32) -> Option<SeedDrawArgs> {
+        let template = *self.templates.get((species * SEED_LODS) as usize)?;
+        let cloud = self.templates.get((species * SEED_LODS + 1) as usize)?;
+        (template.index_count > 0 && template.first_index != cloud.first_index).then_some(template)
+    }
+
+    /// Records the ground truth's draws into `pass` (its pipeline from `truth_pipeline`, the bind
+    /// group over records whose `order` is the identity): per entry, `mesh` once for each record
+    /// in the range.
+    pub fn encode_meshes(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        pipeline: &wgpu::RenderPipeline,
+        bind_group: &wgpu::BindGroup,
+        draws: &[(SeedDrawArgs, Range<u32>)],
+    ) {
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        for (mesh, instances) in draws {
+            let indices = mesh.first_index..mesh.first_index + mesh.index_count;
+            pass.draw_indexed(indices, mesh.base_vertex, instances.clone());
+        }
+    }
+
     /// Writes the frame's constants.
     pub fn prepare(&self, queue: &wgpu::Queue, uniforms: &DrawSeedsUniforms) {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
@@ -246,12 +289,16 @@ impl DrawSeedsPass {
     }
 }
 
-fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
-    let layout = BINDINGS.layout(device);
+fn pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    fragment: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
     let module = SHADER.module(device);
-    let pipeline_layout = pipeline_layout(device, "draw_seeds", &[&layout]);
+    let pipeline_layout = pipeline_layout(device, "draw_seeds", &[layout]);
     let attributes = SeedVertex::layout().vertex_attributes();
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("draw_seeds"),
         layout: Some(&pipeline_layout),
         vertex: wgpu::VertexState {
@@ -266,9 +313,9 @@ fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayo
         },
         fragment: Some(wgpu::FragmentState {
             module: &module,
-            entry_point: Some("fs_main"),
+            entry_point: Some(fragment),
             compilation_options: Default::default(),
-            targets: &[Some(COLOUR_FORMAT.into())],
+            targets,
         }),
         // A billboard is seen from both sides, and so are leaves (the glTF's double-sided ones).
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
@@ -282,6 +329,5 @@ fn pipeline(device: &wgpu::Device) -> (wgpu::RenderPipeline, wgpu::BindGroupLayo
         multisample: Default::default(),
         multiview_mask: None,
         cache: None,
-    });
-    (pipeline, layout)
+    })
 }
