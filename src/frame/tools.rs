@@ -23,8 +23,7 @@ use super::{FrameReport, RenderError, Renderer};
 pub(crate) struct Canvas<'a> {
     pub terrain: &'a TerrainUniforms,
     pub colour: &'a wgpu::Texture,
-    pub colour_view: &'a wgpu::TextureView,
-    pub depth_view: &'a wgpu::TextureView,
+    pub depth: &'a wgpu::Texture,
 }
 
 /// Frames `Renderer::render_resolved` renders at most before it calls a view stuck: far more than
@@ -135,18 +134,11 @@ impl Renderer {
         self.seeds.as_ref().map(|s| &s.table)
     }
 
-    /// What the ground truth draws its seeds into, over the last frame: the terrain's uniforms
-    /// (matrix, sun, haze), and the colour and depth targets with their views (`None` before a
-    /// first frame).
+    /// What the ground truth draws its seeds over: the last frame's terrain uniforms (matrix,
+    /// sun, haze) and its colour and depth targets (`None` before a first frame).
     pub(crate) fn last_canvas(&self) -> Option<Canvas<'_>> {
         let last = self.last.as_ref()?;
-        let t = &self.targets;
-        Some(Canvas {
-            terrain: &last.terrain,
-            colour: &t.colour,
-            colour_view: &t.colour_view,
-            depth_view: &t.depth_view,
-        })
+        Some(Canvas { terrain: &last.terrain, colour: &self.targets.colour, depth: &self.targets.depth })
     }
 
     /// The last frame's seeds as pass 3 wrote them, with its counters, waiting for the GPU

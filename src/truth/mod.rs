@@ -203,17 +203,30 @@ pub fn draw_truth(
     supersample: u32,
 ) -> Result<Truth, TruthError> {
     let canvas = renderer.last_canvas().ok_or(TruthError::NoFrame)?;
-    let size = canvas.colour.size();
-    let ids_texture = renderer.gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("truth seed ids"),
-        size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: SEED_ID_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let device = &renderer.gpu.device;
+    // The seeds are drawn over copies: the renderer's own targets keep its frame.
+    let scratch = |label, like: &wgpu::Texture, format| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: like.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    };
+    let colour = scratch("truth colour", canvas.colour, canvas.colour.format());
+    let depth = scratch("truth depth", canvas.depth, canvas.depth.format());
+    let ids_texture = scratch("truth seed ids", canvas.colour, SEED_ID_FORMAT);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    for (from, to) in [(canvas.colour, &colour), (canvas.depth, &depth)] {
+        encoder.copy_texture_to_texture(from.as_image_copy(), to.as_image_copy(), from.size());
+    }
+    renderer.gpu.queue.submit([encoder.finish()]);
     let scene = match (renderer.class_table(), renderer.seed_world()) {
         (Some(table), Some((tables, _))) if !seeds.is_empty() => {
             Some((table, TruthScene::new(&renderer.dataset, &renderer.settings, tables, camera, seeds)?))
@@ -248,6 +261,8 @@ pub fn draw_truth(
         let pipeline = draw.truth_pipeline(&gpu.device);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let ids_view = ids_texture.create_view(&Default::default());
+        let colour_view = colour.create_view(&Default::default());
+        let depth_view = depth.create_view(&Default::default());
         {
             let keep = wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store };
             let clear = wgpu::Operations {
@@ -259,9 +274,9 @@ pub fn draw_truth(
             };
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("truth seeds"),
-                color_attachments: &[attachment(canvas.colour_view, keep), attachment(&ids_view, clear)],
+                color_attachments: &[attachment(&colour_view, keep), attachment(&ids_view, clear)],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: canvas.depth_view,
+                    view: &depth_view,
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Load,
                         store: wgpu::StoreOp::Store,
@@ -277,39 +292,40 @@ pub fn draw_truth(
         gpu.queue.submit([encoder.finish()]);
         gpu.check()?;
     }
+    let read = |texture, aspect| read_texture(&renderer.gpu, texture, aspect, 4);
     let seed_ids: Vec<u32> = match scene {
-        Some(_) => bytemuck::pod_collect_to_vec(&read_texture(
-            &renderer.gpu,
-            &ids_texture,
-            wgpu::TextureAspect::All,
-            4,
-        )?),
-        None => vec![0; (size.width * size.height) as usize],
+        Some(_) => bytemuck::pod_collect_to_vec(&read(&ids_texture, wgpu::TextureAspect::All)?),
+        None => vec![0; (colour.width() * colour.height()) as usize],
     };
     let seeds = scene.map(|(_, s)| s.seeds).unwrap_or_default();
     let samples = samples_per_seed(&seed_ids, seeds.len());
-    let colour = box_filter(&renderer.read_colour()?, supersample);
+    let (w, h) = (colour.width(), colour.height());
+    let samples_image = image::RgbaImage::from_raw(w, h, read(&colour, wgpu::TextureAspect::All)?)
+        .ok_or_else(|| GpuError::Validation("truth colour: readback size mismatch".into()))?;
+    let colour = box_filter(&samples_image, supersample);
+    let depth = bytemuck::pod_collect_to_vec(&read(&depth, wgpu::TextureAspect::DepthOnly)?);
     Ok(Truth {
         size_px: [colour.width(), colour.height()],
         supersample,
         colour,
         seed_ids,
-        depth: renderer.read_depth()?,
+        depth,
         seeds,
         samples,
         counts: OracleCounts::default(),
     })
 }
 
+/// An sRGB-encoded byte in linear light (IEC 61966-2-1).
+fn srgb_to_linear(byte: u8) -> f64 {
+    let c = f64::from(byte) / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
 /// `image` (sRGB) reduced by `factor` along each axis, each pixel the mean of its samples in
 /// linear light.
 pub fn box_filter(image: &image::RgbaImage, factor: u32) -> image::RgbaImage {
-    let to_linear: Vec<f64> = (0..=255u8)
-        .map(|b| {
-            let c = f64::from(b) / 255.0;
-            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-        })
-        .collect();
+    let to_linear: Vec<f64> = (0..=255u8).map(srgb_to_linear).collect();
     let to_srgb = |l: f64| {
         let c = if l <= 0.0031308 { l * 12.92 } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 };
         (c.clamp(0.0, 1.0) * 255.0).round() as u8

@@ -116,10 +116,7 @@ impl<'a> ImageryTexels<'a> {
         let local = [0, 1].map(|a| t[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
         let at = 4 * (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize;
         let rgba = bytes.get(at..at + 4).unwrap_or(&[0; 4]);
-        let linear = |byte: u8| {
-            let c = f64::from(byte) / 255.0;
-            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-        };
+        let linear = super::srgb_to_linear;
         Ok([linear(rgba[0]), linear(rgba[1]), linear(rgba[2]), f64::from(rgba[3]) / 255.0])
     }
 
