@@ -12,12 +12,10 @@
 mod raster;
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 use glam::{DVec2, DVec3};
-use terramp::bake::{BakeOptions, bake_missing};
 use terramp::camera::Camera;
-use terramp::classes::{ClassTable, SpeciesKind};
+use terramp::classes::SpeciesKind;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::impostor::{AlphaMode, Impostor};
@@ -25,7 +23,7 @@ use terramp::reference::oracle::{OracleSeed, segment_clears_dem};
 use terramp::seeds::{pcg, seed_hash};
 use terramp::truth::{Truth, TruthOptions, draw_truth, files, render_truth, truth_settings};
 use terramp_testkit::data::target_tmp_dir;
-use terramp_testkit::{camera, gpu, shared_data, small_settings, synth_dataset};
+use terramp_testkit::{camera, gpu, small_settings, synth_dataset};
 
 use raster::{Corner, Pinhole, Raster};
 
@@ -40,21 +38,8 @@ const RIDGE_IMAGE_PX: [u32; 2] = [96, 54];
 /// The tree hidden behind the ridge, metres.
 const TREE_M: f64 = 15.0;
 
-/// The nc table's models (the synthetic land cover is nc's), baked once per test process; `None`
-/// when the shared data is skipped.
 fn impostors() -> Option<&'static Path> {
-    static DIR: OnceLock<Option<PathBuf>> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let models = shared_data()?.join("models");
-        let table = ClassTable::load("nc").unwrap();
-        let names: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
-        let out = target_tmp_dir().join("truth-impostors");
-        let options = BakeOptions { texels: 256, ..Default::default() };
-        let missing = bake_missing(&models, &names, &out, &options, false).unwrap();
-        assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
-        Some(out)
-    })
-    .as_deref()
+    terramp_testkit::nc_impostors()
 }
 
 /// A truth renderer over a synthetic dataset (size, seed), settled at `camera`'s pose `[fx, fy, above, yaw,

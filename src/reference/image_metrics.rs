@@ -117,6 +117,26 @@ fn filter_valid(values: &[f64], width: usize, height: usize, kernel: &[f64; SSIM
 
 /// The mean structural similarity of two images' luma (1 for identical images, less otherwise).
 pub fn ssim(a: &image::RgbaImage, b: &image::RgbaImage) -> Result<f64, ImageMetricError> {
+    let map = ssim_map(a, b)?;
+    Ok(map.values.iter().sum::<f64>() / map.values.len() as f64)
+}
+
+/// The SSIM of every window position: `values[y * width + x]` is the window whose centre is
+/// pixel (x + `offset_px`, y + `offset_px`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SsimMap {
+    /// Window positions along x and y.
+    pub width: usize,
+    /// Window positions along y.
+    pub height: usize,
+    /// The first window's centre, pixels from the image's edges.
+    pub offset_px: usize,
+    /// The SSIM of each position, row by row.
+    pub values: Vec<f64>,
+}
+
+/// The SSIM map of two images' luma over the valid window positions (no padding).
+pub fn ssim_map(a: &image::RgbaImage, b: &image::RgbaImage) -> Result<SsimMap, ImageMetricError> {
     same_size(a, b)?;
     let (width, height) = (a.width() as usize, a.height() as usize);
     if width < SSIM_WINDOW_PX || height < SSIM_WINDOW_PX {
@@ -128,16 +148,29 @@ pub fn ssim(a: &image::RgbaImage, b: &image::RgbaImage) -> Result<f64, ImageMetr
     let products = |p: &[f64], q: &[f64]| p.iter().zip(q).map(|(p, q)| p * q).collect::<Vec<f64>>();
     let (mu_x, mu_y) = (filter(&x), filter(&y));
     let (xx, yy, xy) = (filter(&products(&x, &x)), filter(&products(&y, &y)), filter(&products(&x, &y)));
-    let n = mu_x.len();
-    let sum: f64 = (0..n)
+    let values = (0..mu_x.len())
         .map(|i| {
             let (mx, my) = (mu_x[i], mu_y[i]);
             let (vx, vy, cxy) = (xx[i] - mx * mx, yy[i] - my * my, xy[i] - mx * my);
             ((2.0 * mx * my + SSIM_C1) * (2.0 * cxy + SSIM_C2))
                 / ((mx * mx + my * my + SSIM_C1) * (vx + vy + SSIM_C2))
         })
-        .sum();
-    Ok(sum / n as f64)
+        .collect();
+    Ok(SsimMap {
+        width: width + 1 - SSIM_WINDOW_PX,
+        height: height + 1 - SSIM_WINDOW_PX,
+        offset_px: SSIM_WINDOW_PX / 2,
+        values,
+    })
+}
+
+/// Each pixel's squared error, the mean over R, G and B (what `mse` averages).
+pub fn squared_errors(a: &image::RgbaImage, b: &image::RgbaImage) -> Result<Vec<f64>, ImageMetricError> {
+    same_size(a, b)?;
+    Ok(a.pixels()
+        .zip(b.pixels())
+        .map(|(p, q)| (0..3).map(|c| (f64::from(p[c]) - f64::from(q[c])).powi(2)).sum::<f64>() / 3.0)
+        .collect())
 }
 
 #[cfg(test)]

@@ -1,20 +1,19 @@
-//! How it works: one point of a sweep, and the reference it is judged against. Each gets a fresh
-//! renderer (own device, cold caches), so points do not inherit each other's resident tiles.
-//! - The reference: the accurate preset with caches as large as the layers and every tile pinned
-//!   (`pin_everything`); at each sample pose its frame is rendered until resolved and read back.
-//!   When seeds are drawn (`draw_seeds.impostors` set), a second such renderer without impostors gives
-//!   the ground alone.
-//! - A point: the timed flight through `profile::Session` (one step per frame), its summary; then
-//!   at each sample pose the settled view's seeds go to the oracle and its frame is read back; with
-//!   seeds drawn, a second renderer of the same settings without impostors settles the same poses
-//!   for the ground alone.
+//! How it works: one point of a sweep, judged against the ground truths (`truths`). Each point
+//! gets a fresh renderer (own device, cold caches), so points do not inherit each other's resident
+//! tiles: the timed flight through `profile::Session` (one step per frame) and its summary; then at
+//! each sample pose the settled view's seeds go to the exact summit oracle (height error, and
+//! agreement with pass 3's rule) and to the any-part oracle of its world's truth, and its frame is
+//! judged against the reference world's truth, whole and per distance band
+//! (`truth::compare`). With seeds drawn, a second renderer of the same settings without impostors
+//! settles the same poses for the ground alone, judged against the truth's ground.
 
 use std::path::Path;
 
 use glam::DVec3;
 use image::RgbaImage;
 
-use super::report::{PassTime, SampleFigures, SeedFigures, TradePoint};
+use super::report::{AnyPartFigures, PassTime, SampleFigures, SeedFigures, TradePoint};
+use super::truths::Truths;
 use super::{Point, Progress, SweepError};
 use crate::camera::Camera;
 use crate::config::Settings;
@@ -24,8 +23,10 @@ use crate::gpu::Gpu;
 use crate::path::CameraPath;
 use crate::profile::{Meta, Session, Summary, timing_of};
 use crate::reference::accuracy::{HeightError, SeedAgreement};
-use crate::reference::image_metrics::{capped_psnr_db, mse, psnr_of_mse, ssim};
+use crate::reference::image_metrics::{capped_psnr_db, mse, psnr_of_mse};
 use crate::reference::oracle::{OracleInputs, visible_seeds};
+use crate::truth::compare::{bands, frame_error, pool};
+use crate::truth::visibility::{Visibility, judge};
 
 pub(super) struct Flight<'a> {
     pub dataset_dir: &'a Path,
@@ -34,18 +35,6 @@ pub(super) struct Flight<'a> {
     pub poses: &'a [(f64, Camera)],
     pub warmup: u32,
     pub frames: u32,
-}
-
-/// The reference images of one pose: the frame, and the ground alone (`None`: the frame is it).
-pub(super) struct Images {
-    frame: RgbaImage,
-    ground: Option<RgbaImage>,
-}
-
-impl Images {
-    fn ground(&self) -> &RgbaImage {
-        self.ground.as_ref().unwrap_or(&self.frame)
-    }
 }
 
 /// A measured point, with how it was timed.
@@ -86,44 +75,12 @@ impl Flight<'_> {
         Ok(images)
     }
 
-    /// The all-resident renders of every pose, with `settings` (the accurate preset's).
-    pub fn references(
-        &self,
-        settings: &Settings,
-        progress: &mut dyn FnMut(Progress),
-    ) -> Result<Vec<Images>, SweepError> {
-        let pinned = |settings: Settings| -> Result<Renderer, SweepError> {
-            let mut settings = settings;
-            let dataset = Dataset::open(self.dataset_dir)?;
-            let tiles = |layer: Option<&crate::dataset::LayerPack>| {
-                layer.map_or(16, |l| l.pyramid.tile_count().min(u64::from(u32::MAX)) as u32).max(16)
-            };
-            let c = &mut settings.cache;
-            c.height_slots = c.height_slots.max(tiles(Some(&dataset.height)));
-            c.imagery_slots = c.imagery_slots.max(tiles(dataset.imagery.as_ref()));
-            c.landcover_slots = c.landcover_slots.max(tiles(dataset.landcover.as_ref()));
-            let mut renderer = Renderer::new(Gpu::new(settings.gpu.adapter)?, dataset, settings)?;
-            renderer.pin_everything()?;
-            Ok(renderer)
-        };
-        let none = |_: &Renderer, _: &Camera| Ok(());
-        let frames = self.settle(&mut pinned(settings.clone())?, "reference", progress, none)?;
-        let grounds = match settings.draw_seeds.impostors.is_empty() {
-            true => vec![None; frames.len()],
-            false => {
-                let mut r = pinned(without_impostors(settings))?;
-                self.settle(&mut r, "reference ground", progress, none)?.into_iter().map(Some).collect()
-            }
-        };
-        Ok(frames.into_iter().zip(grounds).map(|(frame, ground)| Images { frame, ground }).collect())
-    }
-
     /// Times `point` along the path, then measures it at every pose against `references`.
     pub fn measure(
         &self,
         point: &Point,
         settings: Settings,
-        references: &[Images],
+        truths: &mut Truths,
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Measured, SweepError> {
         let label = point.label();
@@ -163,6 +120,7 @@ impl Flight<'_> {
 
         let mut seeds: Option<(SeedAgreement, HeightError)> = None;
         let mut per_pose: Vec<(SeedAgreement, HeightError)> = Vec::new();
+        let mut selected: Vec<Vec<([i64; 2], u32)>> = Vec::new();
         let frames = self.settle(&mut renderer, &label, progress, |r, camera| {
             let figures = seed_figures(r, camera)?;
             if let Some((agreement, height)) = figures {
@@ -171,9 +129,24 @@ impl Flight<'_> {
                 h.add(&height);
                 per_pose.push((agreement, height));
             }
+            let kept = r.read_seeds()?.map(|(records, _)| records).unwrap_or_default();
+            selected.push(kept.iter().map(|s| (s.address.map(i64::from), s.rank)).collect());
             Ok(())
         })?;
         drop(renderer);
+        // The any-part oracle, where the truth drew seeds (impostors given).
+        let draws_truth_seeds = truths.options().reach_m > 0.0;
+        let any_part: Vec<Visibility> = match draws_truth_seeds {
+            false => Vec::new(),
+            true => {
+                let world = truths.of_world(self, &settings, progress)?;
+                world
+                    .iter()
+                    .zip(&selected)
+                    .map(|(t, kept)| judge(&t.seeds, &t.samples, kept.iter().copied()))
+                    .collect()
+            }
+        };
         let grounds = match draws_seeds {
             false => None,
             true => {
@@ -183,22 +156,32 @@ impl Flight<'_> {
         };
 
         let mut samples = Vec::with_capacity(frames.len());
-        let (mut frame_mse, mut ground_mse, mut ssim_sum) = (0.0, 0.0, 0.0);
-        for (i, (frame, reference)) in frames.iter().zip(references).enumerate() {
+        let mut errors = Vec::with_capacity(frames.len());
+        let mut ground_mse = 0.0;
+        let (near_m, bands) = (settings.render.near_m, bands(&settings));
+        for (i, (frame, truth)) in frames.iter().zip(truths.images()).enumerate() {
             let ground = grounds.as_ref().map_or(frame, |g| &g[i]);
-            let (f_mse, g_mse) = (mse(frame, &reference.frame)?, mse(ground, reference.ground())?);
-            let s = ssim(frame, &reference.frame)?;
-            (frame_mse, ground_mse, ssim_sum) = (frame_mse + f_mse, ground_mse + g_mse, ssim_sum + s);
-            let seeds = per_pose.get(i).map(|(a, h)| SeedFigures::of(a, h));
+            let g_mse = mse(ground, &truth.ground)?;
+            ground_mse += g_mse;
+            let error = frame_error(truth, near_m, frame, &bands)?;
             samples.push(SampleFigures {
                 t: self.poses[i].0,
                 ground_psnr_db: capped_psnr_db(psnr_of_mse(g_mse)),
-                frame_psnr_db: capped_psnr_db(psnr_of_mse(f_mse)),
-                frame_ssim: s,
-                seeds,
+                frame_psnr_db: error.frame.psnr_db,
+                frame_ssim: error.frame.ssim,
+                frame_flip: error.frame.flip,
+                seeds: per_pose.get(i).map(|(a, h)| SeedFigures::of(a, h)),
+                any_part: any_part.get(i).map(AnyPartFigures::of),
             });
+            errors.push(error);
         }
         let n = samples.len().max(1) as f64;
+        let error = pool(&errors).ok_or_else(|| SweepError::Options("no sample pose".into()))?;
+        let any_part = (!any_part.is_empty()).then(|| {
+            let mut total = Visibility::default();
+            any_part.iter().for_each(|v| total.add(v));
+            AnyPartFigures::of(&total)
+        });
         let passes = summary
             .passes
             .iter()
@@ -216,9 +199,12 @@ impl Flight<'_> {
             seeds_selected: summary.seeds.selected_median,
             passes,
             seeds: seeds.map(|(a, h)| SeedFigures::of(&a, &h)),
+            any_part,
             ground_psnr_db: capped_psnr_db(psnr_of_mse(ground_mse / n)),
-            frame_psnr_db: capped_psnr_db(psnr_of_mse(frame_mse / n)),
-            frame_ssim: ssim_sum / n,
+            frame_psnr_db: error.frame.psnr_db,
+            frame_ssim: error.frame.ssim,
+            frame_flip: error.frame.flip,
+            error,
             samples,
         };
         Ok(Measured { adapter, timing_note, point })

@@ -4,24 +4,28 @@
 //! in a fresh renderer, timed by the profiling session (`profile::Session`): warm-up frames, then
 //! the timed frames, reduced by `profile::Summary` to per-pass GPU medians and the frame's median
 //! wall time. Then, at a few sample poses spread along the same path, it settles the view
-//! (`render_resolved`: everything the view asked for is resident) and measures it (`measure`):
-//! - its seeds against the exact oracle (`reference::oracle`): recall, precision, and the distance
-//!   of each kept seed's ground height from the f64 bilinear DEM (`reference::accuracy`);
-//! - its ground (the frame without seeds) against the ground of an all-resident reference render:
-//!   the accurate preset with every tile of every layer pinned, from the same pose (PSNR);
-//! - its frame against that reference's frame, seeds drawn when `draw_seeds.impostors` is set (PSNR and
-//!   SSIM, `reference::image_metrics`).
+//! (`render_resolved`: everything the view asked for is resident) and measures it (`measure`)
+//! against two references, neither of them the thing measured:
+//! - the **ground truth** (`truth`, through `truths`): the point's kept seeds against the any-part
+//!   oracle of its own seeded world (recall, precision, pixel-weighted recall); its frame against
+//!   the reference world's truth image (the accurate preset's seeds, all grown, as meshes,
+//!   supersampled) by PSNR, SSIM and FLIP, whole and per distance band (`truth::compare`); its
+//!   ground (the frame without seeds) against the truth's ground (PSNR);
+//! - the **exact summit oracle** (`reference::oracle`): the distance of each kept seed's ground
+//!   height from the f64 DEM (`reference::accuracy`), and recall and precision against pass 3's
+//!   own rule, done exactly.
 //!
-//! Seed counts add up over the sample poses (recall is over all their seeds); PSNR pools the
-//! samples' squared errors (as one image); SSIM is their mean. `report` writes `trade.csv`,
-//! `trade.json` (schema `terramp-trade/1`), `trade.md` and the terminal table; `plot` draws
-//! `trade.png`.
-//! Progress goes to a callback, one step per frame rendered and per pose settled.
+//! Seed counts add up over the sample poses (recall is over all their seeds); image errors pool
+//! the poses' pixels (as one image). `report` writes `trade.csv`, `trade.json` (schema
+//! `terramp-trade/2`), `tables` `trade.md` and the terminal table; `plot` draws `trade.png`.
+//! Progress goes to a callback, one step per frame rendered, pose settled and truth rendered.
 
 pub mod knobs;
 mod measure;
 pub mod plot;
 pub mod report;
+pub mod tables;
+mod truths;
 
 use std::path::{Path, PathBuf};
 
@@ -32,6 +36,7 @@ use crate::config::{Settings, SettingsError};
 use crate::dataset::{Dataset, DatasetError};
 use crate::path::CameraPath;
 use crate::profile::ProfileError;
+use crate::truth::TruthOptions;
 pub use knobs::{Knob, Point, points};
 pub use report::{SCHEMA, Trade, TradePoint};
 
@@ -56,6 +61,9 @@ pub enum SweepError {
     /// A height tile could not be read for the default path or the seeds' height error.
     #[error(transparent)]
     Pack(#[from] crate::dataset::PackError),
+    /// A ground truth could not be rendered.
+    #[error(transparent)]
+    Truth(#[from] crate::truth::TruthError),
     /// The exact oracle could not list the visible seeds of a sample pose.
     #[error(transparent)]
     Oracle(#[from] crate::reference::oracle::OracleError),
@@ -109,6 +117,9 @@ pub struct SweepOptions {
     pub width: Option<u32>,
     /// Override of `render.height` for every point and the reference, pixels.
     pub height: Option<u32>,
+    /// How the ground truths are rendered (supersampling, reach; impostors: the reference
+    /// settings' `draw_seeds.impostors` when empty; without any, the truths grow no seeds).
+    pub truth: TruthOptions,
 }
 
 /// A sweep's progress, for a progress bar.
@@ -122,7 +133,7 @@ pub enum Progress<'a> {
 
 /// File `write_outputs` puts the table in, as CSV, one row per point.
 pub const CSV_FILE: &str = "trade.csv";
-/// File `write_outputs` puts the whole `Trade` in, as JSON (schema `terramp-trade/1`).
+/// File `write_outputs` puts the whole `Trade` in, as JSON (schema `terramp-trade/2`).
 pub const JSON_FILE: &str = "trade.json";
 /// File `write_outputs` draws the speed/accuracy plot in.
 pub const PLOT_FILE: &str = "trade.png";
@@ -172,9 +183,20 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         let grounds = if s.draw_seeds.impostors.is_empty() { 0 } else { 1 };
         u64::from(options.warmup + options.frames) + u64::from(options.samples) * (1 + grounds)
     };
-    let reference_steps =
-        u64::from(options.samples) * if reference_settings.draw_seeds.impostors.is_empty() { 1 } else { 2 };
-    progress(Progress::Total(reference_steps + settings.iter().map(per_point).sum::<u64>()));
+    let mut truth = options.truth.clone();
+    if truth.impostors.as_os_str().is_empty() {
+        truth.impostors = PathBuf::from(&reference_settings.draw_seeds.impostors);
+    }
+    if truth.impostors.as_os_str().is_empty() {
+        // No mesh to draw seeds with: the truths are the ground alone.
+        truth.reach_m = 0.0;
+    }
+    let worlds = match truth.reach_m > 0.0 {
+        true => truths::world_count(&reference_settings, &settings),
+        false => 1,
+    };
+    let truth_steps = u64::from(options.samples) * worlds as u64;
+    progress(Progress::Total(truth_steps + settings.iter().map(per_point).sum::<u64>()));
 
     let flight = measure::Flight {
         dataset_dir: &options.dataset,
@@ -183,10 +205,10 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         warmup: options.warmup,
         frames: options.frames,
     };
-    let references = flight.references(&reference_settings, progress)?;
+    let mut truths = truths::Truths::new(&flight, &reference_settings, truth.clone(), progress)?;
     let mut measured = Vec::with_capacity(points.len());
     for (point, settings) in points.iter().zip(settings) {
-        measured.push(flight.measure(point, settings, &references, progress)?);
+        measured.push(flight.measure(point, settings, &mut truths, progress)?);
     }
     let first = measured.first();
     Ok(Trade {
@@ -199,7 +221,13 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         warmup: options.warmup,
         frames: options.frames,
         sample_t: poses.iter().map(|(t, _)| *t).collect(),
-        reference: "accurate preset, every tile of every layer resident (pinned), same pose".into(),
+        reference: format!(
+            "ground truth: the accurate preset's world, every seed within {:.0} m as its full mesh{}, \
+             every tile at its finest level, {}² samples per pixel; selections against their own world's truth",
+            truth.reach_m,
+            if truth.reach_m > 0.0 { "" } else { " (none: no impostors)" },
+            truth.supersample
+        ),
         settings: options.settings.as_ref().map(|f| f.display().to_string()),
         points: measured.into_iter().map(|m| m.point).collect(),
     })
@@ -215,7 +243,7 @@ pub fn write_outputs(trade: &Trade, dir: &Path) -> Result<(), SweepError> {
     let json = dir.join(JSON_FILE);
     std::fs::write(&json, report::json(trade)).map_err(io(format!("writing {}", json.display())))?;
     let markdown = dir.join(MARKDOWN_FILE);
-    std::fs::write(&markdown, report::markdown(trade))
+    std::fs::write(&markdown, tables::markdown(trade))
         .map_err(io(format!("writing {}", markdown.display())))?;
     plot::write(trade, &dir.join(PLOT_FILE))
 }

@@ -1,37 +1,44 @@
 //! How it works: a sweep's figures (`Trade`) and their three renderings: the JSON (this struct,
-//! serialised), the CSV (one row per point), the terminal table and Markdown tables for docs. PSNRs are capped at
+//! serialised) and the CSV (one row per point); the terminal table and Markdown tables for docs are `tables`'. PSNRs are capped at
 //! `image_metrics::PSNR_CAP_DB` (identical images), so every figure is a finite number; figures a
 //! point lacks (seeds on a dataset without land cover, GPU times where none arrived) are `null` in
 //! the JSON and empty in the CSV.
 //!
 //! The JSON:
 //! ```text
-//! { "schema": "terramp-trade/1", "adapter": str, "timing": str, "dataset": str, "path": str,
+//! { "schema": "terramp-trade/2", "adapter": str, "timing": str, "dataset": str, "path": str,
 //!   "resolution": [w, h], "warmup": int, "frames": int, "sample_t": [float], "reference": str,
 //!   "settings": str | null,
 //!   "points": [ { "label": str, "preset": str, "knobs": { key: value },
 //!                 "frame_ms": float, "gpu_ms", "cpu_ms", "fps", "seeds_selected": float | null,
 //!                 "passes": [ { "label": str, "source": str, "median_ms": float } ],
-//!                 "seeds": seeds | null,
-//!                 "ground_psnr_db", "frame_psnr_db", "frame_ssim": float,
-//!                 "samples": [ { "t", "ground_psnr_db", "frame_psnr_db", "frame_ssim": float,
-//!                                "seeds": seeds | null } ] } ] }
+//!                 "seeds": seeds | null, "any_part": any_part | null,
+//!                 "ground_psnr_db", "frame_psnr_db", "frame_ssim", "frame_flip": float,
+//!                 "error": { "frame": region, "bands": [region] },
+//!                 "samples": [ { "t", "ground_psnr_db", "frame_psnr_db", "frame_ssim",
+//!                                "frame_flip": float, "seeds": seeds | null,
+//!                                "any_part": any_part | null } ] } ] }
 //! ```
 //! where seeds is `{ "visible", "kept", "common": int, "recall_pct", "precision_pct",
-//! "height_error_max_m", "height_error_mean_m": float }`. The CSV has the same figures under the
+//! "height_error_max_m", "height_error_mean_m": float }` (the exact summit oracle), any_part is
+//! `{ "visible", "selected", "selected_visible": int, "recall_pct", "precision_pct",
+//! "pixel_weighted_recall_pct": float }` (the truth's any-part oracle) and region is `{ "band":
+//! { "name", "from_m", "to_m" }, "pixels", "mse", "psnr_db", "ssim", "flip" }` (`truth::compare`;
+//! an infinite `to_m` and a figure of an empty band are `null`). The CSV has the same figures under the
 //! same names (pass medians as `<label>_ms`, seed figures without their `seeds.` prefix, knobs as
 //! `key=value;key=value`).
 
 use std::collections::BTreeMap;
-use std::fmt::Write;
 
 use serde::Serialize;
 
 use crate::gpu::TimeSource;
 use crate::reference::accuracy::{HeightError, SeedAgreement};
+use crate::truth::compare::FrameError;
+use crate::truth::visibility::Visibility;
 
 /// The version of the JSON layout.
-pub const SCHEMA: &str = "terramp-trade/1";
+pub const SCHEMA: &str = "terramp-trade/2";
 
 /// A sweep's figures: every point's speed and accuracy over the same path and sample poses.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -83,16 +90,23 @@ pub struct TradePoint {
     pub seeds_selected: Option<f64>,
     /// Median time of each pass over the timed frames, GPU passes first.
     pub passes: Vec<PassTime>,
-    /// Over all sample poses; `None` without land cover.
+    /// Against the exact summit oracle (pass 3's rule, exactly), over all sample poses; `None`
+    /// without land cover.
     pub seeds: Option<SeedFigures>,
-    /// The ground (the frame without seeds) against the reference's, over all sample poses: PSNR
-    /// of the pooled squared error, dB (capped at `image_metrics::PSNR_CAP_DB`).
+    /// Against the any-part oracle of the point's world's truth, over all sample poses; `None`
+    /// without land cover or impostors.
+    pub any_part: Option<AnyPartFigures>,
+    /// The ground (the frame without seeds) against the truth's ground, over all sample poses:
+    /// PSNR of the pooled squared error, dB (capped at `image_metrics::PSNR_CAP_DB`).
     pub ground_psnr_db: f64,
-    /// The frame against the reference's frame, over all sample poses: PSNR of the pooled
-    /// squared error, dB (capped at `image_metrics::PSNR_CAP_DB`).
+    /// The frame against the truth, over all sample poses: PSNR of the pooled squared error, dB.
     pub frame_psnr_db: f64,
-    /// The frame against the reference's frame: mean SSIM over the sample poses (1 = identical).
+    /// The frame against the truth: SSIM over all sample poses' windows (1 = identical).
     pub frame_ssim: f64,
+    /// The frame against the truth: mean FLIP over all sample poses' pixels (0 = identical).
+    pub frame_flip: f64,
+    /// The frame's errors, whole and per distance band, pooled over the sample poses.
+    pub error: FrameError,
     /// The same figures at each sample pose, in path order.
     pub samples: Vec<SampleFigures>,
 }
@@ -142,6 +156,37 @@ impl SeedFigures {
     }
 }
 
+/// How the seeds pass 3 kept compare with the truth's visible ones (any sample shows them).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AnyPartFigures {
+    /// Seeds with at least one sample in the truth.
+    pub visible: u64,
+    /// Seeds pass 3 kept.
+    pub selected: u64,
+    /// Kept seeds that are visible.
+    pub selected_visible: u64,
+    /// Visible seeds kept, %.
+    pub recall_pct: f64,
+    /// Kept seeds that are visible, %.
+    pub precision_pct: f64,
+    /// The truth's seed samples whose seed pass 3 kept, %.
+    pub pixel_weighted_recall_pct: f64,
+}
+
+impl AnyPartFigures {
+    /// The figures of `v`, as percentages.
+    pub fn of(v: &Visibility) -> Self {
+        Self {
+            visible: v.visible,
+            selected: v.selected,
+            selected_visible: v.selected_visible,
+            recall_pct: 100.0 * v.recall(),
+            precision_pct: 100.0 * v.precision(),
+            pixel_weighted_recall_pct: 100.0 * v.pixel_weighted_recall(),
+        }
+    }
+}
+
 /// A point's accuracy at one sample pose.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SampleFigures {
@@ -153,8 +198,12 @@ pub struct SampleFigures {
     pub frame_psnr_db: f64,
     /// The frame against the reference's frame, SSIM (1 = identical).
     pub frame_ssim: f64,
-    /// The seeds against the oracle at this pose; `None` without land cover.
+    /// The frame against the truth, mean FLIP (0 = identical).
+    pub frame_flip: f64,
+    /// The seeds against the summit oracle at this pose; `None` without land cover.
     pub seeds: Option<SeedFigures>,
+    /// The seeds against the any-part oracle at this pose; `None` without land cover or impostors.
+    pub any_part: Option<AnyPartFigures>,
 }
 
 /// The pretty-printed JSON.
@@ -175,7 +224,7 @@ pub fn pass_labels(trade: &Trade) -> Vec<String> {
 }
 
 /// The fixed CSV columns before the passes' `<label>_ms`.
-pub const CSV_COLUMNS: [&str; 18] = [
+pub const CSV_COLUMNS: [&str; 23] = [
     "label",
     "preset",
     "knobs",
@@ -191,9 +240,14 @@ pub const CSV_COLUMNS: [&str; 18] = [
     "precision_pct",
     "height_error_max_m",
     "height_error_mean_m",
+    "any_part_visible",
+    "any_part_recall_pct",
+    "any_part_precision_pct",
+    "pixel_weighted_recall_pct",
     "ground_psnr_db",
     "frame_psnr_db",
     "frame_ssim",
+    "frame_flip",
 ];
 
 fn csv_field(text: &str) -> String {
@@ -215,7 +269,7 @@ pub fn csv(trade: &Trade) -> String {
     header.extend(labels.iter().map(|l| format!("{l}_ms")));
     let mut out = header.join(",") + "\n";
     for p in &trade.points {
-        let s = p.seeds.as_ref();
+        let (s, a) = (p.seeds.as_ref(), p.any_part.as_ref());
         let knobs = p.knobs.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(";");
         let mut row = vec![csv_field(&p.label), csv_field(&p.preset), csv_field(&knobs)];
         row.extend([Some(p.frame_ms), p.gpu_ms, p.cpu_ms, p.fps, p.seeds_selected].map(number));
@@ -229,9 +283,14 @@ pub fn csv(trade: &Trade) -> String {
                 s.map(|s| s.precision_pct),
                 s.map(|s| s.height_error_max_m),
                 s.map(|s| s.height_error_mean_m),
+                a.map(|a| a.visible as f64),
+                a.map(|a| a.recall_pct),
+                a.map(|a| a.precision_pct),
+                a.map(|a| a.pixel_weighted_recall_pct),
                 Some(p.ground_psnr_db),
                 Some(p.frame_psnr_db),
                 Some(p.frame_ssim),
+                Some(p.frame_flip),
             ]
             .map(number),
         );
@@ -241,130 +300,6 @@ pub fn csv(trade: &Trade) -> String {
         out += &(row.join(",") + "\n");
     }
     out
-}
-
-/// The figures as two Markdown tables (the trade, then each pass's median per point), for docs.
-pub fn markdown(trade: &Trade) -> String {
-    let mut out = String::new();
-    // Writing into a String cannot fail.
-    let _ = write_markdown(&mut out, trade);
-    out
-}
-
-fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
-    let opt = |v: Option<f64>, digits: usize| v.map_or("–".to_owned(), |v| format!("{v:.digits$}"));
-    writeln!(
-        out,
-        "| point | frame ms | GPU ms | visible (oracle) | recall | precision | seed height error max / mean | ground PSNR | frame PSNR | frame SSIM |"
-    )?;
-    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|")?;
-    for p in &t.points {
-        let s = p.seeds.as_ref();
-        let pct = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{v:.2} %"));
-        let height = s.map_or("–".to_owned(), |s| {
-            format!("{:.2} / {:.3} mm", 1000.0 * s.height_error_max_m, 1000.0 * s.height_error_mean_m)
-        });
-        writeln!(
-            out,
-            "| {} | {:.1} | {} | {} | {} | {} | {height} | {:.1} dB | {:.1} dB | {:.4} |",
-            p.label,
-            p.frame_ms,
-            opt(p.gpu_ms, 1),
-            s.map_or("–".to_owned(), |s| s.visible.to_string()),
-            pct(s.map(|s| s.recall_pct)),
-            pct(s.map(|s| s.precision_pct)),
-            p.ground_psnr_db,
-            p.frame_psnr_db,
-            p.frame_ssim
-        )?;
-    }
-    let labels = pass_labels(t);
-    writeln!(out, "\nMedian time per pass, ms:\n")?;
-    writeln!(out, "| point | {} |", labels.join(" | "))?;
-    writeln!(out, "|---|{}", "---|".repeat(labels.len()))?;
-    for p in &t.points {
-        let cells: Vec<String> = labels
-            .iter()
-            .map(|l| opt(p.passes.iter().find(|q| &q.label == l).map(|q| q.median_ms), 2))
-            .collect();
-        writeln!(out, "| {} | {} |", p.label, cells.join(" | "))?;
-    }
-    Ok(())
-}
-
-/// The terminal table: the trade, then each pass's median per point.
-pub fn table(trade: &Trade) -> String {
-    let mut out = String::new();
-    // Writing into a String cannot fail.
-    let _ = write_table(&mut out, trade);
-    out
-}
-
-fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
-    writeln!(
-        out,
-        "terramp sweep: {} · path {} · {}×{} · {} timed frames after {} warm-up · {} sample poses",
-        t.dataset,
-        t.path,
-        t.resolution[0],
-        t.resolution[1],
-        t.frames,
-        t.warmup,
-        t.sample_t.len()
-    )?;
-    writeln!(out, "adapter: {} · GPU passes timed with {}", t.adapter, t.timing)?;
-    writeln!(out, "reference: {}\n", t.reference)?;
-    let w = t.points.iter().map(|p| p.label.len()).max().unwrap_or(0).max(8);
-    let opt = |v: Option<f64>, digits: usize| v.map_or("-".to_owned(), |v| format!("{v:.digits$}"));
-    writeln!(
-        out,
-        "{:<w$} {:>9} {:>8} {:>9} {:>10} {:>14} {:>11} {:>10} {:>7}",
-        "point",
-        "frame ms",
-        "GPU ms",
-        "recall %",
-        "precision %",
-        "height max/mean",
-        "ground PSNR",
-        "frame PSNR",
-        "SSIM"
-    )?;
-    for p in &t.points {
-        let s = p.seeds.as_ref();
-        let height = s.map_or("-".to_owned(), |s| {
-            format!("{:.2}/{:.2} mm", 1000.0 * s.height_error_max_m, 1000.0 * s.height_error_mean_m)
-        });
-        writeln!(
-            out,
-            "{:<w$} {:>9.1} {:>8} {:>9} {:>11} {:>15} {:>8.1} dB {:>7.1} dB {:>7.4}",
-            p.label,
-            p.frame_ms,
-            opt(p.gpu_ms, 1),
-            opt(s.map(|s| s.recall_pct), 2),
-            opt(s.map(|s| s.precision_pct), 2),
-            height,
-            p.ground_psnr_db,
-            p.frame_psnr_db,
-            p.frame_ssim
-        )?;
-    }
-    let labels = pass_labels(t);
-    writeln!(out, "\nmedian ms per pass")?;
-    let cw = labels.iter().map(String::len).max().unwrap_or(0).max(7);
-    write!(out, "{:<w$}", "point")?;
-    for l in &labels {
-        write!(out, " {l:>cw$}")?;
-    }
-    writeln!(out)?;
-    for p in &t.points {
-        write!(out, "{:<w$}", p.label)?;
-        for l in &labels {
-            let ms = p.passes.iter().find(|q| &q.label == l).map(|q| q.median_ms);
-            write!(out, " {:>cw$}", opt(ms, 2))?;
-        }
-        writeln!(out)?;
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -402,9 +337,19 @@ pub(crate) mod tests {
                 height_error_max_m: 2e-4,
                 height_error_mean_m: 5e-5,
             }),
+            any_part: Some(AnyPartFigures {
+                visible: 1200,
+                selected: 990,
+                selected_visible: 985,
+                recall_pct: 82.08,
+                precision_pct: 99.49,
+                pixel_weighted_recall_pct: 97.5,
+            }),
             ground_psnr_db: 38.5,
             frame_psnr_db: 30.25,
             frame_ssim: ssim,
+            frame_flip: 0.125,
+            error: crate::truth::compare::tests::error(30.25, ssim, 0.125),
             samples: Vec::new(),
         };
         let mut knobbed = point("balanced seeds.frustum_epsilon=0,1", 80.0, 99.5, 0.93);
@@ -433,7 +378,7 @@ pub(crate) mod tests {
         assert_eq!(lines.len(), 4);
         assert!(
             lines[0].starts_with("label,preset,knobs,frame_ms")
-                && lines[0].ends_with("frame_ssim,terrain_ms,ground_ms,streaming_ms"),
+                && lines[0].ends_with("frame_ssim,frame_flip,terrain_ms,ground_ms,streaming_ms"),
             "{}",
             lines[0]
         );
@@ -445,20 +390,5 @@ pub(crate) mod tests {
             lines[2]
         );
         assert!(lines[1].ends_with(",12,20,"), "fast has no streaming pass: {}", lines[1]);
-    }
-
-    #[test]
-    fn table_lists_every_point_and_pass() {
-        let table = table(&trade());
-        for text in ["fast", "accurate", "97.00", "0.9300", "38.5 dB", "0.20/0.05 mm", "streaming"] {
-            assert!(table.contains(text), "no {text:?} in\n{table}");
-        }
-        let md = markdown(&trade());
-        assert_eq!(md.lines().filter(|l| l.starts_with("| fast")).count(), 2, "{md}");
-        assert!(md.contains("| 97.00 % |") && md.contains("| streaming |"), "{md}");
-        let json: serde_json::Value = serde_json::from_str(&json(&trade())).unwrap();
-        assert_eq!(json["schema"], SCHEMA);
-        assert_eq!(json["points"][0]["passes"][0]["source"], "gpu_timestamps");
-        assert_eq!(json["points"][1]["knobs"]["seeds.frustum_epsilon"], "0,1");
     }
 }

@@ -22,6 +22,8 @@
 //! different patterns grow different (equally dense) forests: their images are compared with one
 //! truth, their selections with the truth of their own world.
 
+#[cfg(feature = "flip")]
+pub mod compare;
 pub mod files;
 pub mod scene;
 pub mod visibility;
@@ -121,6 +123,8 @@ pub struct Truth {
     pub supersample: u32,
     /// The image, box-filtered from the samples (sRGB).
     pub colour: image::RgbaImage,
+    /// The same without the seeds: the ground alone.
+    pub ground: image::RgbaImage,
     /// Per sample (`size_px × supersample` along each axis, top row first): 0 for terrain or
     /// sky, else the index + 1 of the seed in `seeds`.
     pub seed_ids: Vec<u32>,
@@ -303,11 +307,13 @@ pub fn draw_truth(
     let samples_image = image::RgbaImage::from_raw(w, h, read(&colour, wgpu::TextureAspect::All)?)
         .ok_or_else(|| GpuError::Validation("truth colour: readback size mismatch".into()))?;
     let colour = box_filter(&samples_image, supersample);
+    let ground = box_filter(&renderer.read_colour()?, supersample);
     let depth = bytemuck::pod_collect_to_vec(&read(&depth, wgpu::TextureAspect::DepthOnly)?);
     Ok(Truth {
         size_px: [colour.width(), colour.height()],
         supersample,
         colour,
+        ground,
         seed_ids,
         depth,
         seeds,

@@ -2,7 +2,8 @@
 //! `terramp-data-tools`): where the shared real data lives (`data`), synthetic datasets built
 //! once per test process (`datasets`), a GPU and renderers (`setup`), cameras (`camera`), the
 //! frame audit against rays through the f64 DEM (`audit`), the Tile Load Map's GPU-vs-twin
-//! harness (`tlm`) and golden-image comparison (`images`, over the library's metrics).
+//! harness (`tlm`), golden-image comparison (`images`, over the library's metrics) and the
+//! shared models baked into impostors (`impostors`).
 //!
 //! Tests fail by panicking, so this crate unwraps freely.
 #![allow(clippy::unwrap_used, reason = "test support: a failure is a panic that names it")]
@@ -12,10 +13,12 @@ pub mod camera;
 pub mod data;
 pub mod datasets;
 pub mod images;
+pub mod impostors;
 pub mod setup;
 pub mod tlm;
 
 pub use data::{TempDir, shared_data};
 pub use datasets::{synth_dataset, synth_dataset_with};
 pub use images::{Golden, psnr};
+pub use impostors::nc_impostors;
 pub use setup::{gpu, renderer, small_settings};

@@ -39,6 +39,16 @@ pub struct SweepArgs {
     width: Option<u32>,
     #[arg(long)]
     height: Option<u32>,
+    /// The ground truths' samples per pixel along each axis.
+    #[arg(long, default_value_t = 4)]
+    truth_supersample: u32,
+    /// The ground truths grow seeds out to this distance, metres.
+    #[arg(long, default_value_t = terramp::truth::DEFAULT_REACH_M)]
+    truth_reach_m: f64,
+    /// Impostors the truths draw their meshes from (default: the settings' `draw_seeds.impostors`;
+    /// without any, the truths are the ground alone and selections are not judged against them).
+    #[arg(long)]
+    truth_impostors: Option<PathBuf>,
 }
 
 impl SweepArgs {
@@ -55,6 +65,11 @@ impl SweepArgs {
             samples: self.samples,
             width: self.width,
             height: self.height,
+            truth: terramp::truth::TruthOptions {
+                supersample: self.truth_supersample,
+                reach_m: self.truth_reach_m,
+                impostors: self.truth_impostors.unwrap_or_default(),
+            },
         };
         let bar = indicatif::ProgressBar::new(0);
         bar.set_style(
@@ -71,7 +86,7 @@ impl SweepArgs {
         bar.finish_and_clear();
         let trade = trade?;
         terramp::sweep::write_outputs(&trade, &out)?;
-        print!("{}", terramp::sweep::report::table(&trade));
+        print!("{}", terramp::sweep::tables::table(&trade));
         let files = [CSV_FILE, JSON_FILE, PLOT_FILE, MARKDOWN_FILE];
         println!("\nwrote {}", files.map(|f| out.join(f).display().to_string()).join(", "));
         Ok(())

@@ -1,0 +1,93 @@
+//! How it works: the ground truths a sweep judges its points against, one per sample pose and
+//! seeded world (`truth::render_truth`, each in a fresh renderer). Images are judged against one
+//! truth: the reference settings' world (the accurate preset's), so a preset that grows a
+//! different forest (other patterns) shows that difference too. Selections are judged by seed
+//! identity, so against the truth of the point's own world (its cell size, patterns, germ, seeds
+//! per pattern, class table and placement): worlds are keyed by those settings, and their truths
+//! rendered once and shared by every point of that world. Without impostors the truths grow no
+//! seeds (there is no mesh to draw them with): images are judged, selections are not.
+
+use super::measure::Flight;
+use super::{Progress, SweepError};
+use crate::config::Settings;
+use crate::dataset::Dataset;
+use crate::gpu::Gpu;
+use crate::truth::{Truth, TruthOptions, render_truth};
+
+/// What makes two settings grow the same seeds, in the same places.
+fn world_key(s: &Settings) -> String {
+    let (t, seeds) = (&s.tlm, &s.seeds);
+    format!(
+        "{}|{}|{}|{}|{}|{}|{}|{}",
+        t.cell_m,
+        t.patterns,
+        t.seed,
+        seeds.seeds_per_pattern,
+        seeds.class_table,
+        seeds.sink_fraction,
+        seeds.ground_colour_radius_m,
+        s.render.width
+    )
+}
+
+/// The worlds the truths of `reference` and `points` grow: how many truths per pose a sweep renders.
+pub(super) fn world_count(reference: &Settings, points: &[Settings]) -> usize {
+    let mut keys: Vec<String> = std::iter::once(reference).chain(points).map(world_key).collect();
+    keys.sort();
+    keys.dedup();
+    keys.len()
+}
+
+/// The truths rendered so far, by world.
+pub(super) struct Truths {
+    options: TruthOptions,
+    by_world: Vec<(String, Vec<Truth>)>,
+    reference: String,
+}
+
+impl Truths {
+    /// The truths of `reference`'s world at every pose of `flight`, rendered now.
+    pub fn new(
+        flight: &Flight,
+        reference: &Settings,
+        options: TruthOptions,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Self, SweepError> {
+        let mut truths = Self { options, by_world: Vec::new(), reference: world_key(reference) };
+        truths.of_world(flight, reference, progress)?;
+        Ok(truths)
+    }
+
+    /// What the truths grow and draw with.
+    pub fn options(&self) -> &TruthOptions {
+        &self.options
+    }
+
+    /// The reference world's truths, one per pose: what every point's images are judged against.
+    pub fn images(&self) -> &[Truth] {
+        self.by_world.iter().find(|(k, _)| *k == self.reference).map_or(&[], |(_, t)| t)
+    }
+
+    /// The truths of `settings`' world, one per pose (rendered on first use).
+    pub fn of_world(
+        &mut self,
+        flight: &Flight,
+        settings: &Settings,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<&[Truth], SweepError> {
+        let key = world_key(settings);
+        if let Some(i) = self.by_world.iter().position(|(k, _)| *k == key) {
+            return Ok(&self.by_world[i].1);
+        }
+        let mut truths = Vec::with_capacity(flight.poses.len());
+        for (i, (t, camera)) in flight.poses.iter().enumerate() {
+            let n = flight.poses.len();
+            progress(Progress::Step(&format!("truth: pose {} of {n} (t = {t:.2})", i + 1)));
+            let dataset = Dataset::open(flight.dataset_dir)?;
+            let gpu = Gpu::new(settings.gpu.adapter)?;
+            truths.push(render_truth(gpu, dataset, settings, camera, &self.options)?);
+        }
+        self.by_world.push((key, truths));
+        Ok(self.by_world.last().map_or(&[][..], |(_, t)| &t[..]))
+    }
+}

@@ -1,0 +1,29 @@
+//! The shared models of the nc class table (which the synthetic land cover uses too), baked into
+//! impostors once per test run into the target's scratch folder, for tests that draw seeds.
+//! Baking skips models already baked in the current format, and writes each model's folder
+//! atomically, so test binaries may share the folder.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use terramp::bake::{BakeOptions, bake_missing};
+use terramp::classes::ClassTable;
+
+use crate::data::{shared_data, target_tmp_dir};
+
+/// The baked folder, or `None` when the shared data is skipped (`TERRAMP_SKIP_SHARED=1`).
+pub fn nc_impostors() -> Option<&'static Path> {
+    static DIR: OnceLock<Option<PathBuf>> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let models = shared_data()?.join("models");
+        let table = ClassTable::load("nc").unwrap();
+        let names: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
+        let out = target_tmp_dir().join("nc-impostors");
+        // Small atlases: enough for test views, quick to bake.
+        let options = BakeOptions { texels: 256, ..Default::default() };
+        let missing = bake_missing(&models, &names, &out, &options, false).unwrap();
+        assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
+        Some(out)
+    })
+    .as_deref()
+}
