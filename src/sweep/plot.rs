@@ -1,9 +1,10 @@
 //! How it works: `trade.png`, the trade as a picture: frame time (median wall time, ms) up, error
-//! across, one labelled point per preset or knob value. Two panels share the time axis: the
-//! frame's image error against the all-resident accurate reference (1 − SSIM, which folds mesh,
-//! imagery and seeds into one number), and the seed set's error against the exact oracle
-//! (100 − F1 %, F1 the harmonic mean of recall and precision, so both lost and extra seeds count).
-//! The second panel is left out when no point has seeds. Drawn by plotters into a pixel buffer and
+//! across, one labelled point per preset or knob value, presets ringed. Two panels share the time
+//! axis: the frame's error against the ground truth (mean FLIP, which folds terrain, imagery and
+//! seeds into what a viewer sees), and the seeds it misses (100 − pixel-weighted recall against
+//! the truth's any-part oracle, %: the share of the truth's tree pixels whose tree is not drawn).
+//! The second panel is left out when no point was judged against seeds. In each, the Pareto front
+//! (`front`: the points no other beats on both time and error) is drawn as a staircase. Drawn by plotters into a pixel buffer and
 //! saved as PNG with `image`; text uses the embedded DejaVu Sans Mono (assets/fonts), so the plot
 //! needs no system font.
 
@@ -18,26 +19,44 @@ use super::report::Trade;
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
 const SIZE_PX: (u32, u32) = (1400, 640);
 
-/// The seed-set error of a point, %: 100 − F1 of recall and precision.
-pub fn seed_error_pct(recall_pct: f64, precision_pct: f64) -> f64 {
-    let (r, p) = (recall_pct / 100.0, precision_pct / 100.0);
-    if r + p <= 0.0 { 100.0 } else { 100.0 * (1.0 - 2.0 * r * p / (r + p)) }
+/// One panel's points: (label, error, frame ms, a preset).
+type Series = Vec<(String, f64, f64, bool)>;
+
+/// Which of `points` (error, time) are on the Pareto front: no other point is at least as good on
+/// both and better on one. A NaN is on no front and beats nothing.
+pub fn front(points: &[(f64, f64)]) -> Vec<bool> {
+    let finite = |&(e, t): &(f64, f64)| e.is_finite() && t.is_finite();
+    points
+        .iter()
+        .map(|p| {
+            finite(p)
+                && !points.iter().any(|q| finite(q) && q.0 <= p.0 && q.1 <= p.1 && (q.0 < p.0 || q.1 < p.1))
+        })
+        .collect()
 }
 
-/// One panel's points: (label, error, frame ms).
-type Series = Vec<(String, f64, f64)>;
+/// How far `p` (error, time) is from the front of `points`: its time over the least time of any
+/// point with no more error (1 on the front; 1.5: a point as accurate is 1.5× faster).
+pub fn front_slack(points: &[(f64, f64)], p: (f64, f64)) -> f64 {
+    let best = points.iter().filter(|q| q.0 <= p.0 && q.1.is_finite()).map(|q| q.1).fold(p.1, f64::min);
+    p.1 / best
+}
 
 /// Draws the plot into `path`.
 pub fn write(trade: &Trade, path: &Path) -> Result<(), SweepError> {
     let fail = |message: String| SweepError::Plot { path: path.display().to_string(), message };
     register_font("sans-serif", FontStyle::Normal, FONT).map_err(|_| fail("the embedded font".into()))?;
-    let image_error: Series =
-        trade.points.iter().map(|p| (p.label.clone(), (1.0 - p.frame_ssim).max(0.0), p.frame_ms)).collect();
+    let image_error: Series = trade
+        .points
+        .iter()
+        .map(|p| (p.label.clone(), p.frame_flip, p.frame_ms, p.knobs.is_empty()))
+        .collect();
     let seed_error: Series = trade
         .points
         .iter()
         .filter_map(|p| {
-            Some((p.label.clone(), seed_error_pct(p.seeds?.recall_pct, p.seeds?.precision_pct), p.frame_ms))
+            let missed = 100.0 - p.any_part?.pixel_weighted_recall_pct;
+            Some((p.label.clone(), missed, p.frame_ms, p.knobs.is_empty()))
         })
         .collect();
     let (w, h) = SIZE_PX;
@@ -57,12 +76,13 @@ pub fn write(trade: &Trade, path: &Path) -> Result<(), SweepError> {
             trade.sample_t.len()
         );
         let root = root.titled(&title, ("sans-serif", 22)).map_err(|e| fail(e.to_string()))?;
+        let flip = "frame error vs ground truth: mean FLIP";
         let panels: Vec<(&str, &Series)> = if seed_error.is_empty() {
-            vec![("frame error vs accurate, all resident: 1 - SSIM", &image_error)]
+            vec![(flip, &image_error)]
         } else {
             vec![
-                ("frame error vs accurate, all resident: 1 - SSIM", &image_error),
-                ("seed-set error vs exact oracle: 100 - F1 (%)", &seed_error),
+                (flip, &image_error),
+                ("tree pixels missed vs ground truth: 100 - pixel-weighted recall (%)", &seed_error),
             ]
         };
         let areas = root.split_evenly((1, panels.len()));
@@ -80,7 +100,7 @@ fn panel(
     x_desc: &str,
     series: &Series,
 ) -> Result<(), String> {
-    let max_x = series.iter().map(|s| s.1).fold(0.0f64, f64::max);
+    let max_x = series.iter().map(|s| s.1).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
     let max_y = series.iter().map(|s| s.2).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
     // Room for the labels to the right of the points; never an empty range.
     let x_end = if max_x > 0.0 { max_x * 1.35 } else { 1e-3 };
@@ -107,11 +127,30 @@ fn panel(
         RGBColor(255, 127, 14),
         RGBColor(140, 86, 75),
     ];
-    for (i, (label, x, y)) in series.iter().enumerate() {
+    // The front as a staircase: from each front point across to the next more accurate one's
+    // error, then down... to its time.
+    let points: Vec<(f64, f64)> = series.iter().map(|s| (s.1, s.2)).collect();
+    let on_front = front(&points);
+    let mut steps: Vec<(f64, f64)> =
+        points.iter().zip(&on_front).filter(|(_, f)| **f).map(|(p, _)| *p).collect();
+    steps.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let stairs: Vec<(f64, f64)> = steps
+        .windows(2)
+        .flat_map(|w| [w[0], (w[1].0, w[0].1), w[1]])
+        .chain(steps.first().copied().filter(|_| steps.len() == 1))
+        .collect();
+    let grey = RGBColor(120, 120, 120);
+    chart.draw_series(LineSeries::new(stairs, grey.stroke_width(2))).map_err(|e| e.to_string())?;
+    for (i, (label, x, y, preset)) in series.iter().enumerate() {
+        if !(x.is_finite() && y.is_finite()) {
+            continue;
+        }
         let colour = colours[i % colours.len()];
-        // The label beside its point, not over it.
+        // The label beside its point, not over it; a preset ringed.
+        let ring = if *preset { 10 } else { 0 };
         let marker = EmptyElement::at((*x, *y))
-            + Circle::new((0, 0), 6, colour.filled())
+            + Circle::new((0, 0), 5, colour.filled())
+            + Circle::new((0, 0), ring, colour.stroke_width(2))
             + Text::new(label.clone(), (10, -18), ("sans-serif", 14).into_font().color(&colour));
         chart.draw_series(std::iter::once(marker)).map_err(|e| e.to_string())?;
     }
@@ -123,10 +162,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn seed_error_is_100_minus_f1() {
-        assert_eq!(seed_error_pct(100.0, 100.0), 0.0);
-        assert!((seed_error_pct(90.0, 60.0) - 28.0).abs() < 1e-9); // F1 = 2·0.54/1.5 = 0.72
-        assert_eq!(seed_error_pct(0.0, 0.0), 100.0);
+    fn the_front_keeps_the_points_nothing_beats_and_slack_measures_the_rest() {
+        // (error, time): b beats d on both; c is the most accurate; a the fastest.
+        let points = [(0.30, 10.0), (0.10, 20.0), (0.05, 40.0), (0.12, 30.0), (f64::NAN, 1.0)];
+        assert_eq!(front(&points), [true, true, true, false, false]);
+        assert_eq!(front_slack(&points, points[3]), 1.5);
+        assert_eq!(front_slack(&points, points[1]), 1.0);
     }
 
     #[test]

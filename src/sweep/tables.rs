@@ -4,6 +4,7 @@
 
 use std::fmt::Write;
 
+use super::plot::front_slack;
 use super::report::{Trade, pass_labels};
 
 /// The figures as three Markdown tables (the trade, the error per band, each pass's median per
@@ -18,13 +19,26 @@ pub fn markdown(trade: &Trade) -> String {
 fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
     let opt = |v: Option<f64>, digits: usize| v.map_or("–".to_owned(), |v| format!("{v:.digits$}"));
     let pct = |v: Option<f64>| v.map_or("–".to_owned(), |v| format!("{v:.2} %"));
+    // Each point's distance from the two fronts of the plot (FLIP; tree pixels missed).
+    let flip: Vec<(f64, f64)> = t.points.iter().map(|p| (p.frame_flip, p.frame_ms)).collect();
+    let missed: Vec<(f64, f64)> = t
+        .points
+        .iter()
+        .map(|p| (p.any_part.map_or(f64::NAN, |a| 100.0 - a.pixel_weighted_recall_pct), p.frame_ms))
+        .collect();
     writeln!(
         out,
         "| point | frame ms | GPU ms | visible (truth) | recall | precision | pixel-weighted recall | \
-         recall / precision (summit oracle) | seed height error max / mean | ground PSNR | frame PSNR | SSIM | FLIP |"
+         recall / precision (summit oracle) | seed height error max / mean | ground PSNR | frame PSNR | SSIM | FLIP | \
+         off the fronts (FLIP; pixels missed) |"
     )?;
-    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|")?;
-    for p in &t.points {
+    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")?;
+    for (i, p) in t.points.iter().enumerate() {
+        let slack = |points: &[(f64, f64)]| {
+            let s = front_slack(points, points[i]);
+            if s.is_finite() { format!("{s:.2}×") } else { "–".into() }
+        };
+        let fronts = format!("{}; {}", slack(&flip), slack(&missed));
         let (s, a) = (p.seeds.as_ref(), p.any_part.as_ref());
         let height = s.map_or("–".to_owned(), |s| {
             format!("{:.2} / {:.3} mm", 1000.0 * s.height_error_max_m, 1000.0 * s.height_error_mean_m)
@@ -33,7 +47,7 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
             s.map_or("–".to_owned(), |s| format!("{:.2} / {:.2} %", s.recall_pct, s.precision_pct));
         writeln!(
             out,
-            "| {} | {:.1} | {} | {} | {} | {} | {} | {summit} | {height} | {:.1} dB | {:.1} dB | {:.4} | {:.4} |",
+            "| {} | {:.1} | {} | {} | {} | {} | {} | {summit} | {height} | {:.1} dB | {:.1} dB | {:.4} | {:.4} | {fronts} |",
             p.label,
             p.frame_ms,
             opt(p.gpu_ms, 1),
