@@ -18,6 +18,7 @@ pub mod manifest;
 pub mod pack;
 pub mod pyramid;
 pub mod staging;
+pub mod surface;
 
 use std::path::{Path, PathBuf};
 
