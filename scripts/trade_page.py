@@ -37,7 +37,7 @@ here at {first['resolution'][0]} × {first['resolution'][1]} with every frame sh
   tile it asks for resident):
   - *recall* and *precision* of pass 3's seed set against the exact oracle (f64, full-resolution
     DEM, exact frustum and occlusion), counted over all poses' seeds;
-  - *seed height error*: |ground height of each kept seed − f64 bilinear DEM|;
+  - *seed height error*: |ground height of each kept seed − f64 drawn ground (the finest mesh's triangles)|;
   - *ground PSNR*: the frame without seeds against the all-resident reference (accurate preset,
     every tile of every layer pinned, same pose, also without seeds);
   - *frame PSNR* and *SSIM* (Gaussian 11 × 11, σ = 1.5, on luma, standard constants): the frame

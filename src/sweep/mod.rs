@@ -6,7 +6,7 @@
 //! wall time. Then, at a few sample poses spread along the same path, it settles the view
 //! (`render_resolved`: everything the view asked for is resident) and measures it (`measure`):
 //! - its seeds against the exact oracle (`reference::oracle`): recall, precision, and the distance
-//!   of each kept seed's ground height from the f64 bilinear DEM (`reference::accuracy`);
+//!   of each kept seed's ground height from the f64 drawn ground (`reference::accuracy`);
 //! - its ground (the frame without seeds) against the ground of an all-resident reference render:
 //!   the accurate preset with every tile of every layer pinned, from the same pose (PSNR);
 //! - its frame against that reference's frame, seeds drawn when `draw_seeds.impostors` is set (PSNR and
