@@ -145,6 +145,8 @@ struct Standing {
     /// Largest height of a seed's ground (before sinking) above the mesh, and below it (signed).
     ground_above_m: f64,
     ground_below_m: f64,
+    /// Seeds whose ground (before sinking) stands more than `LIMIT_M` above the mesh.
+    floating: usize,
     /// Largest height of a seed's sunk anchor above the mesh (negative: every anchor is below it).
     anchor_above_m: f64,
     /// Largest height of the bilinear patch above the mesh at the same seeds.
@@ -208,6 +210,7 @@ fn stand(what: &str, dir: &Path) -> Standing {
             s.anchor_above_m = s.anchor_above_m.max(p.z - ground_mesh_m);
             s.bilinear_above_m = s.bilinear_above_m.max(mesh.bilinear_m(p.x, p.y) - ground_mesh_m);
             view_above = view_above.max(ground_m - ground_mesh_m);
+            s.floating += usize::from(ground_m - ground_mesh_m > LIMIT_M);
         }
         println!("{what} {pose:?}: {} seeds, ground up to {view_above:.4} m above the mesh", records.len());
         s.seeds += records.len();
