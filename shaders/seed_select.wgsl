@@ -1,11 +1,12 @@
 // Pass 3, seed selection (Amara et al. 2007, § 4.4): one invocation per seed of each active
 // ring-0 cell's pattern (workgroups along x cover a pattern, one row of workgroups per cell).
-// A seed is placed on the finest resident height level (bilinear, identical whatever the mesh
-// LOD), given a class by the LCC quadtree (any resident level: the coding makes them agree), a
-// species by its rank, checked against its species' altitude and slope rules, sized by its hash,
-// cut at the radial LOD distance for its size, culled by frustum (bounding sphere, NDC tolerance)
-// and by occlusion (its summit against the terrain's depth, with a tolerance growing with
-// distance), and written out with its ground colour from the imagery around it.
+// A seed is placed on the finest resident height level (on the ground that level's mesh draws,
+// `shared/terrain_surface.wgsl`: identical whatever the mesh LOD), given a class by the LCC
+// quadtree (any resident level: the coding makes them agree), a species by its rank, checked
+// against its species' altitude and slope rules, sized by its hash, cut at the radial LOD distance
+// for its size, culled by frustum (bounding sphere, NDC tolerance) and by occlusion (its summit
+// against the terrain's depth, with a tolerance growing with distance), and written out with its
+// ground colour from the imagery around it.
 //
 // Exactness: the CPU twin (`reference/seed_select.rs`) must take the same decisions, so the
 // shader avoids division and transcendental functions, and every product goes through `mul`,
@@ -153,7 +154,8 @@ struct Ground {
     found: bool,
 }
 
-// Bilinear height at `p` (level-0 samples) from the finest resident level.
+// The drawn ground at `p` (level-0 samples) from the finest resident level: its cell split as that
+// level's mesh splits it.
 fn ground_at(p: GridPos) -> Ground {
     let s0 = vec2<u32>(p.texel);
     var level = 0u;
@@ -183,13 +185,9 @@ fn ground_at(p: GridPos) -> Ground {
     let mask = (1u << level) - 1u;
     let scale = ldexp(1.0, -i32(level));
     let f = vec2<f32>(mul(f32(s0.x & mask) + p.frac.x, scale), mul(f32(s0.y & mask) + p.frac.y, scale));
-    let south = h00 + mul(h10 - h00, f.x);
-    let north = h01 + mul(h11 - h01, f.x);
-    let height_m = south + mul(north - south, f.y);
-    let dx = (h10 - h00) + mul((h11 - h01) - (h10 - h00), f.y);
-    let dy = (h01 - h00) + mul((h11 - h10) - (h01 - h00), f.x);
+    let drawn = drawn_ground(s, vec4<f32>(h00, h10, h01, h11), f);
     let per_m = mul(scale, u.inv_spacing_m);
-    return Ground(height_m, vec2<f32>(mul(dx, per_m), mul(dy, per_m)), level, true);
+    return Ground(drawn.height_m, vec2<f32>(mul(drawn.slope.x, per_m), mul(drawn.slope.y, per_m)), level, true);
 }
 
 // Palette index of level-1 land-cover texel `q`, read from `wanted` or, while that streams in,
@@ -271,7 +269,7 @@ fn pixel_of(x: f32, w: f32, n: u32, step: f32) -> u32 {
     return i;
 }
 
-// Whether the DEM (finest resident heights, bilinear) rises above the segment from the eye to
+// Whether the drawn ground (finest resident heights) rises above the segment from the eye to
 // camera-relative `summit_rel` anywhere: samples at least every half height spacing (a power of two
 // of them, at most `refine_max_steps`), positions by products only, so the twin agrees exactly.
 fn dem_blocks(summit_rel: vec3<f32>) -> bool {

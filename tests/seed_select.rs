@@ -1,7 +1,7 @@
 //! Pass 3 on a synthetic dataset: the GPU equals its CPU twin (read in block-table order, in the
-//! same order too), runs and paths agree, seeds sit on the DEM, a too-small output is flagged
-//! without corrupting what it keeps, and compaction's draw order is the same in every run and
-//! equals its twin's.
+//! same order too), runs and paths agree, seeds sit on the drawn ground, a too-small output is
+//! flagged without corrupting what it keeps, and compaction's draw order is the same in every run
+//! and equals its twin's.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
@@ -130,7 +130,7 @@ fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
 }
 
 #[test]
-fn seeds_sit_on_the_bilinear_dem() {
+fn seeds_sit_on_the_drawn_ground() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     let mut r = terramp_testkit::renderer(&dataset, terramp_testkit::small_settings(320, 180));
     let camera = cameras(&r)[0];
@@ -152,7 +152,7 @@ fn seeds_sit_on_the_bilinear_dem() {
         );
     }
     println!("{} seeds, largest base error {:.2} mm", records.len(), worst_m * 1000.0);
-    assert!(worst_m <= 0.01, "a seed's base is {worst_m} m off the DEM");
+    assert!(worst_m <= 0.01, "a seed's base is {worst_m} m off the drawn ground");
 }
 
 #[test]

@@ -1,9 +1,9 @@
 //! Seed selection (pass 3) on real data: `nc/` (DEM, Landsat, land use) and `zion/` (DEM and
 //! NLCD) are built into a temporary folder. The GPU pass equals its CPU twin from several
-//! cameras, with every seed on the f64 bilinear DEM; against the exact oracle, the `accurate`
-//! preset keeps at least 99 % of the visible seeds with at least 95 % precision; and on `nc/` the
-//! species follow the map: no trees on water or developed land, and each class's seed count
-//! matches its table density over the ground it covers.
+//! cameras, with every seed on the f64 drawn ground (the finest mesh's triangles); against the
+//! exact oracle, the `accurate` preset keeps at least 99 % of the visible seeds with at least 95 %
+//! precision; and on `nc/` the species follow the map: no trees on water or developed land, and
+//! each class's seed count matches its table density over the ground it covers.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
@@ -39,7 +39,7 @@ fn renderer(dataset: Dataset, mut settings: Settings, width: u32, height: u32) -
     Renderer::new(gpu, dataset, settings).unwrap()
 }
 
-/// Largest distance between a seed's base and the f64 bilinear DEM under it, metres.
+/// Largest distance between a seed's base and the f64 drawn ground under it, metres.
 fn worst_base_error_m(r: &Renderer, camera: &Camera, seeds: &[SeedRecord]) -> f64 {
     let origin = r.dataset.manifest.origin_m;
     let c = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);

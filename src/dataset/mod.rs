@@ -18,6 +18,7 @@ pub mod manifest;
 pub mod pack;
 pub mod pyramid;
 pub mod staging;
+pub mod surface;
 
 use std::path::{Path, PathBuf};
 
@@ -244,7 +245,8 @@ impl Dataset {
         Ok(self.height.tile_range(id)?.unwrap_or(fallback))
     }
 
-    /// Height at grid-space position (`x_m`, `y_m`) from `level`, bilinear between samples and
+    /// Height of the drawn ground at grid-space position (`x_m`, `y_m`) from `level`: the
+    /// triangle of the cell under it as the terrain mesh splits it (`surface::drawn_height`),
     /// clamped to the dataset. Reads at most four tiles; for camera placement and tests, not the
     /// per-frame path.
     pub fn height_at(&self, x_m: f64, y_m: f64, level: u32) -> Result<f64, PackError> {
@@ -252,16 +254,16 @@ impl Dataset {
         let level = level.min(pyramid.levels - 1);
         let spacing = self.manifest.height.spacing_m * f64::from(1u32 << level);
         let size = pyramid.size_at(level);
-        let max = [f64::from(size[0] - 1), f64::from(size[1] - 1)];
-        let (gx, gy) = ((x_m / spacing).clamp(0.0, max[0]), (y_m / spacing).clamp(0.0, max[1]));
-        let (ix, iy) = (gx.floor() as u32, gy.floor() as u32);
-        let (fx, fy) = (gx - f64::from(ix), gy - f64::from(iy));
+        // The cell (its south-west sample) and the position in it; the last samples close the last cells.
+        let axis = |v_m: f64, n: u32| {
+            let g = (v_m / spacing).clamp(0.0, f64::from(n - 1));
+            let i = (g.floor() as u32).min(n.saturating_sub(2));
+            (i, g - f64::from(i))
+        };
+        let ((ix, fx), (iy, fy)) = (axis(x_m, size[0]), axis(y_m, size[1]));
         let sample = |x: u32, y: u32| self.height_sample(level, x.min(size[0] - 1), y.min(size[1] - 1));
-        let (h00, h10) = (sample(ix, iy)?, sample(ix + 1, iy)?);
-        let (h01, h11) = (sample(ix, iy + 1)?, sample(ix + 1, iy + 1)?);
-        let south = h00 + (h10 - h00) * fx;
-        let north = h01 + (h11 - h01) * fx;
-        Ok(south + (north - south) * fy)
+        let corners = [sample(ix, iy)?, sample(ix + 1, iy)?, sample(ix, iy + 1)?, sample(ix + 1, iy + 1)?];
+        Ok(surface::drawn_height([ix, iy], corners, [fx, fy]).0)
     }
 
     /// The land cover's LCC coding, if the dataset has land cover.

@@ -11,6 +11,8 @@ use super::layout::{self, PackedWord};
 
 /// The terrain mesh both terrain passes draw.
 pub const TERRAIN_MESH: &str = include_str!("../../shaders/shared/terrain_mesh.wgsl");
+/// The ground that mesh draws, at any point: what seeds stand on (Rust: `dataset::surface`).
+pub const TERRAIN_SURFACE: &str = include_str!("../../shaders/shared/terrain_surface.wgsl");
 /// The hashes that pick seed patterns and vary seeds.
 pub const HASH: &str = include_str!("../../shaders/shared/hash.wgsl");
 /// One selected seed, shared by the pass that writes it and the pass that draws it.

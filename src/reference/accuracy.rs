@@ -5,7 +5,8 @@
 //!   that are really visible). Agreements of several views add up, so a flight's recall is over all
 //!   its seeds, not a mean of ratios.
 //! - `HeightError`: how far each kept seed's ground height (`SeedRecord::ground_m`, before sinking)
-//!   is from the f64 bilinear DEM under it (level 0, `Dataset::height_at`), in metres.
+//!   is from the f64 drawn ground under it (level 0, `Dataset::height_at`: the finest mesh's
+//!   triangles, `dataset::surface`), in metres.
 
 use std::collections::HashSet;
 
@@ -81,7 +82,8 @@ impl SeedAgreement {
     }
 }
 
-/// The distance between kept seeds' ground heights and the f64 bilinear DEM, metres.
+/// The distance between kept seeds' ground heights and the f64 drawn ground (the finest mesh's
+/// triangles), metres.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct HeightError {
     /// Largest error of any seed, metres; NaN when a seed's error is not finite (`non_finite`).

@@ -4,18 +4,18 @@
 //! GPU pass's order of culls (class, rule, distance, frustum, occlusion), but exactly. The seeded
 //! world (patterns, hashes, rank thinning, sizes) is the shared definition in `crate::seeds`.
 //!
-//! The ground is the bilinear surface of the level-0 height samples (sample (i, j) at grid
-//! (i·spacing, j·spacing)); a seed's slope is that patch's gradient (the patch of the cell whose
-//! floor holds the point). Its class is the level-1 land-cover texel under it, the land-cover grid
-//! starting half a spacing south-west of grid space's origin. Its bounding sphere (centred half-way
-//! up its sunk trunk) must reach the inner side of each of the five planes of the view (left,
-//! right, bottom, top, near). Occlusion is exact: the eye→summit segment (bar its last 1e-6) must
-//! never pass strictly below the bilinear surface. The walk visits the DEM cells the segment's
-//! horizontal projection crosses, in order (2D DDA, each crossing's parameter computed directly,
-//! so no error accumulates); in a cell the surface along the segment is a quadratic in the
-//! parameter and the segment's height linear, so their difference is checked at the interval's
-//! ends and at the quadratic's vertex. Outside the dataset there is no terrain; an eye below the
-//! surface sees nothing.
+//! The ground is the surface the finest terrain mesh draws over the level-0 height samples (sample
+//! (i, j) at grid (i·spacing, j·spacing)), each cell split into two triangles as the mesh splits
+//! it (`dataset::surface`); a seed's slope is that triangle's gradient. Its class is the level-1
+//! land-cover texel under it, the land-cover grid starting half a spacing south-west of grid
+//! space's origin. Its bounding sphere (centred half-way up its sunk trunk) must reach the inner
+//! side of each of the five planes of the view (left, right, bottom, top, near). Occlusion is
+//! exact: the eye→summit segment (bar its last 1e-6) must never pass strictly below that ground.
+//! The walk visits the DEM cells the segment's horizontal projection crosses, in order (2D DDA,
+//! each crossing's parameter computed directly, so no error accumulates); in a cell the ground
+//! along the segment is linear on each side of the cell's diagonal and the segment's height
+//! linear, so their difference is checked at the stretch's ends and where it crosses the
+//! diagonal. Outside the dataset there is no terrain; an eye below the surface sees nothing.
 //!
 //! Speed: the level-0 heights around the camera are copied once into a dense window and the
 //! land-cover tiles under it decoded once; cells are judged in parallel (rayon). The result is
@@ -97,7 +97,7 @@ pub struct OracleSeed {
     pub species: u32,
     /// Where it stands, grid space, metres.
     pub position_grid_m: [f64; 2],
-    /// The bilinear ground height under the seed (its anchor sinks below it).
+    /// The drawn ground's height under the seed (its anchor sinks below it).
     pub ground_m: f64,
     /// Its height (its size), metres.
     pub height_m: f64,
@@ -228,7 +228,7 @@ pub fn judge_seeds(
 }
 
 /// Whether the segment eye→target (grid space, metres) clears the full-resolution DEM: it never
-/// passes strictly below the bilinear surface where the dataset has terrain. The last
+/// passes strictly below its drawn ground (`dataset::surface`) where the dataset has terrain. The last
 /// `SEGMENT_END_SKIP` of the segment, at the target's end, is ignored.
 pub fn segment_clears_dem(
     dataset: &Dataset,

@@ -10,6 +10,7 @@
 use std::collections::HashMap;
 
 use crate::classes::MAX_SPECIES_PER_CLASS;
+use crate::dataset::surface::drawn_height;
 use crate::dataset::{Dataset, PackError, TileId};
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{
@@ -247,17 +248,13 @@ fn ground_at(u: &SeedUniforms, heights: &TwinCache<f32>, p: &GridPos) -> Option<
         s[1] - tile[1] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
     ];
     let load = |dx: u32, dy: u32| heights.load(slot, local[0] + dx, local[1] + dy);
-    let (h00, h10, h01, h11) = (load(0, 0), load(1, 0), load(0, 1), load(1, 1));
+    let corners = [load(0, 0), load(1, 0), load(0, 1), load(1, 1)];
     let mask = (1u32 << level) - 1;
     let scale = 1.0 / (1u32 << level) as f32;
     let f = [((s0[0] & mask) as f32 + p.frac[0]) * scale, ((s0[1] & mask) as f32 + p.frac[1]) * scale];
-    let south = h00 + (h10 - h00) * f[0];
-    let north = h01 + (h11 - h01) * f[0];
-    let height_m = south + (north - south) * f[1];
-    let dx = (h10 - h00) + ((h11 - h01) - (h10 - h00)) * f[1];
-    let dy = (h01 - h00) + ((h11 - h10) - (h01 - h00)) * f[0];
+    let (height_m, slope) = drawn_height(s, corners, f);
     let per_m = scale * u.inv_spacing_m;
-    Some(Ground { height_m, gradient: [dx * per_m, dy * per_m], level })
+    Some(Ground { height_m, gradient: [slope[0] * per_m, slope[1] * per_m], level })
 }
 
 fn class_at(u: &SeedUniforms, landcover: &TwinCache<u32>, q: [u32; 2], wanted: u32) -> Option<(u32, u32)> {

@@ -12,7 +12,7 @@
 //!   supersampled) by PSNR, SSIM and FLIP, whole and per distance band (`truth::compare`); its
 //!   ground (the frame without seeds) against the truth's ground (PSNR);
 //! - the **exact summit oracle** (`reference::oracle`): the distance of each kept seed's ground
-//!   height from the f64 DEM (`reference::accuracy`), and recall and precision against pass 3's
+//!   height from the f64 drawn ground (`reference::accuracy`), and recall and precision against pass 3's
 //!   own rule, done exactly.
 //!
 //! Seed counts add up over the sample poses (recall is over all their seeds); image errors pool

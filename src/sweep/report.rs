@@ -135,9 +135,9 @@ pub struct SeedFigures {
     pub recall_pct: f64,
     /// Kept seeds that are visible, % (100 when nothing is kept).
     pub precision_pct: f64,
-    /// Largest distance of a kept seed's ground height from the f64 bilinear DEM, metres.
+    /// Largest distance of a kept seed's ground height from the f64 drawn ground, metres.
     pub height_error_max_m: f64,
-    /// Mean distance of the kept seeds' ground heights from the f64 bilinear DEM, metres.
+    /// Mean distance of the kept seeds' ground heights from the f64 drawn ground, metres.
     pub height_error_mean_m: f64,
 }
 

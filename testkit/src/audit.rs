@@ -4,14 +4,14 @@
 //! judged against rays cast through the full-resolution DEM in f64.
 //!
 //! The ray oracle is deliberately tolerant where it cannot be sure and strict where it can: a ray
-//! that enters the dataset at least `height_m` above the bilinear DEM and later dips `height_m`
+//! that enters the dataset at least `height_m` above the finest mesh and later dips `height_m`
 //! below it (inside the dataset shrunk by `margin_m`) must show ground; a ray that stays `height_m`
 //! above it wherever it passes over the dataset must show sky; anything else (silhouettes within
 //! the LOD error, rays under the dataset's edge where skirts hang, rays that meet the ground before
 //! the near plane) is not judged. Where the frame
 //! shows ground, the point its depth puts on the pixel's ray must lie within `height_m` of the DEM.
-//! The ground rays meet is the finest terrain mesh (the DEM's cells split into triangles as the
-//! mesh splits them); the ground seeds stand on is the bilinear DEM, as pass 3 defines it.
+//! The ground rays meet and seeds stand on is the finest terrain mesh (the DEM's cells split into
+//! triangles as the mesh splits them), derived here on its own.
 
 use glam::{DMat4, DVec3, DVec4};
 use terramp::camera::Camera;
@@ -67,12 +67,15 @@ impl Dem {
         x_m >= margin_m && y_m >= margin_m && x_m <= span[0] - margin_m && y_m <= span[1] - margin_m
     }
 
+    /// Sample (`i`, `j`), metres (clamped to the dataset).
+    pub fn sample_m(&self, i: u32, j: u32) -> f64 {
+        self.heights_m[(j.min(self.size[1] - 1) * self.size[0] + i.min(self.size[0] - 1)) as usize]
+    }
+
     /// The cell holding grid position (x, y) (clamped to the samples), the position in it, and its
     /// corners' heights (sw, se, nw, ne).
-    fn cell(&self, x_m: f64, y_m: f64) -> ([u32; 2], [f64; 2], [f64; 4]) {
-        let sample = |i: u32, j: u32| {
-            self.heights_m[(j.min(self.size[1] - 1) * self.size[0] + i.min(self.size[0] - 1)) as usize]
-        };
+    pub fn cell(&self, x_m: f64, y_m: f64) -> ([u32; 2], [f64; 2], [f64; 4]) {
+        let sample = |i: u32, j: u32| self.sample_m(i, j);
         let axis = |v: f64, n: u32| {
             let g = (v / self.spacing_m).clamp(0.0, f64::from(n.saturating_sub(1)));
             let i = (g.floor() as u32).min(n.saturating_sub(2));
@@ -82,21 +85,10 @@ impl Dem {
         ([i, j], [u, v], [sample(i, j), sample(i + 1, j), sample(i, j + 1), sample(i + 1, j + 1)])
     }
 
-    /// Bilinear height at grid position (x, y), clamped to the samples: the ground seeds stand on.
-    pub fn height_m(&self, x_m: f64, y_m: f64) -> f64 {
-        let (_, [u, v], [h00, h10, h01, h11]) = self.cell(x_m, y_m);
-        let (south, north) = (h00 + (h10 - h00) * u, h01 + (h11 - h01) * u);
-        south + (north - south) * v
-    }
-
-    /// The higher of the two surfaces at (x, y): where a camera is above the ground.
-    pub fn ground_m(&self, x_m: f64, y_m: f64) -> f64 {
-        self.height_m(x_m, y_m).max(self.mesh_height_m(x_m, y_m))
-    }
-
     /// Height of the finest terrain mesh at (x, y): two triangles per cell, the diagonal
     /// alternating like a checkerboard (`terramp::passes::terrain::frame::grid_indices`),
-    /// south-west to north-east on even cells.
+    /// south-west to north-east on even cells. The ground seeds stand on, and where a camera is
+    /// above the ground.
     pub fn mesh_height_m(&self, x_m: f64, y_m: f64) -> f64 {
         let ([i, j], [u, v], [h00, h10, h01, h11]) = self.cell(x_m, y_m);
         match ((i + j) % 2 == 0, u >= v, u + v <= 1.0) {
@@ -270,12 +262,12 @@ pub struct Audit {
     pub counters_bad: bool,
     pub seeds_not_finite: usize,
     /// Seeds whose base is not sunk exactly `sink_fraction` of their height below their ground
-    /// height (a gap under a seed, or one buried), or whose ground is off the level-0 DEM.
+    /// height (a gap under a seed, or one buried), or whose ground is off the finest mesh.
     pub seeds_off_ground: usize,
     pub seeds_outside: usize,
     pub worst_seed_ground_error_m: f64,
     /// The largest height of a seed's base above the finest mesh under it: the gap one would see
-    /// under a seed standing on the bilinear DEM where the mesh's triangle runs lower.
+    /// under a seed standing above the mesh's triangle.
     pub worst_seed_gap_m: f64,
 }
 
@@ -376,7 +368,8 @@ fn audit_tlm(r: &Renderer, a: &mut Audit) {
 }
 
 /// Pass 3's records: finite, over the dataset, their base sunk into the ground they stand on by
-/// exactly their sink, that ground on the DEM (level-0 seeds, to 1 cm); and its counters adding up.
+/// exactly their sink, that ground on the finest mesh (level-0 seeds, to 1 cm); and its counters
+/// adding up.
 fn audit_seeds(r: &Renderer, rays: &Rays, dem: &Dem, a: &mut Audit) {
     let Some((records, counters)) = r.read_seeds().unwrap() else { return };
     let s = &r.settings.seeds;
@@ -402,7 +395,7 @@ fn audit_seeds(r: &Renderer, rays: &Rays, dem: &Dem, a: &mut Audit) {
         let mut off = gap_m.abs() > slack_m;
         a.worst_seed_gap_m = a.worst_seed_gap_m.max(p.z - dem.mesh_height_m(p.x, p.y));
         if SpeciesLod::unpack(record.species_lod).height_level == 0 {
-            let error_m = (f64::from(ground_m) - dem.height_m(p.x, p.y)).abs();
+            let error_m = (f64::from(ground_m) - dem.mesh_height_m(p.x, p.y)).abs();
             a.worst_seed_ground_error_m = a.worst_seed_ground_error_m.max(error_m);
             off |= error_m > 0.01;
         }
@@ -423,7 +416,7 @@ pub fn camera_over(
     camera_at(r, dem, [fx * span[0], fy * span[1]], above_m, yaw_deg, pitch_deg)
 }
 
-/// A camera `above_m` over the ground (both surfaces) at grid position `grid_m`, in CRS metres.
+/// A camera `above_m` over the ground (the finest mesh) at grid position `grid_m`, in CRS metres.
 pub fn camera_at(
     r: &Renderer,
     dem: &Dem,
@@ -433,7 +426,7 @@ pub fn camera_at(
     pitch_deg: f64,
 ) -> Camera {
     let o = r.dataset.manifest.origin_m;
-    let ground = dem.ground_m(grid_m[0], grid_m[1]);
+    let ground = dem.mesh_height_m(grid_m[0], grid_m[1]);
     Camera {
         position_m: DVec3::new(o[0] + grid_m[0], o[1] + grid_m[1], ground + above_m),
         yaw_deg,

@@ -23,7 +23,7 @@ fn cameras_outside_every_corner_and_edge_look_in() {
         let edge = [centre[0] + 0.5 * span[0] * f64::from(dx), centre[1] + 0.5 * span[1] * f64::from(dy)];
         let out = DVec3::new(f64::from(dx), f64::from(dy), 0.0).normalize();
         let yaw_in = (-out.x).atan2(-out.y).to_degrees();
-        let edge_m = dem.ground_m(edge[0], edge[1]);
+        let edge_m = dem.mesh_height_m(edge[0], edge[1]);
         // Low: 2 m above the edge's height, 50 m out, level; high: 400 m out, 300 m above the
         // highest ground, looking down at the dataset.
         for (away_m, z_m, pitch) in [(50.0, edge_m + 2.0, 0.0), (400.0, dem.max_m + 300.0, -25.0)] {

@@ -292,7 +292,7 @@ fn cameras_2_m_and_100_km_and_500_km_up_see_ground_and_sky_where_they_must() {
 /// A camera `distance_m` from grid point `target` (on the ground), 60° above it, looking at it.
 fn high_oblique(r: &terramp::frame::Renderer, dem: &Dem, target: [f64; 2], distance_m: f64) -> Camera {
     let (down, yaw) = (60f64.to_radians(), 0.0f64);
-    let ground = dem.ground_m(target[0], target[1]);
+    let ground = dem.mesh_height_m(target[0], target[1]);
     let back = distance_m * down.cos();
     let o = r.dataset.manifest.origin_m;
     Camera {

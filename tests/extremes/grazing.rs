@@ -15,8 +15,7 @@ fn longest_lake_run(dem: &Dem, water_m: f64) -> ([u32; 2], u32) {
     for j in 0..dem.size[1] {
         let mut run = 0;
         for i in 0..dem.size[0] {
-            let (x, y) = (f64::from(i) * dem.spacing_m, f64::from(j) * dem.spacing_m);
-            run = if dem.height_m(x, y) == water_m { run + 1 } else { 0 };
+            run = if dem.sample_m(i, j) == water_m { run + 1 } else { 0 };
             if run > best.1 {
                 best = ([i + 1 - run, j], run);
             }
@@ -54,8 +53,7 @@ fn grazing_and_horizontal_views_keep_every_buffer_finite_and_the_ground_whole() 
         a.assert_sound(what);
         assert!(a.expect_ground > 50 && a.expect_sky > 50, "{what}: {a:?}");
         assert!(a.tlm_visible > 0, "{what}: the TLM sees nothing ({a:?})");
-        // The seed's base is sunk `sink_fraction` of its height into the bilinear ground; the mesh's
-        // triangles may run lower than that surface, but never by more than the sink.
+        // The seed's base is sunk `sink_fraction` of its height into the drawn ground: never above it.
         assert!(
             a.worst_seed_gap_m <= 0.0,
             "{what}: a seed's base is {} m above the mesh",

@@ -7,6 +7,7 @@ use std::ops::Range;
 use glam::DVec3;
 
 use crate::config::Settings;
+use crate::dataset::surface::diagonal_rises;
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
 use crate::gpu::layout::MAX_LEVELS;
@@ -145,8 +146,9 @@ pub fn height_tiles(lods: &Lods, selected: &[Selected]) -> Vec<TileId> {
 /// Triangles of a `cells`² grid ringed by skirts: `(cells + 3)²` vertices, the outer ring being
 /// the skirts' lower edge. Grouped quadrant by quadrant (south-west, south-east, north-west,
 /// north-east; skirts go with the quadrant they border), with each quadrant's index range. The
-/// grid is counter-clockwise seen from above with alternating diagonals (no directional bias);
-/// skirts are walls seen from either side, so they carry both windings.
+/// grid is counter-clockwise seen from above, each cell cut along the diagonal
+/// `dataset::surface::diagonal_rises` names (the ground seeds stand on is this mesh's); skirts are
+/// walls seen from either side, so they carry both windings.
 pub fn grid_indices(cells: u32) -> (Vec<u32>, [Range<u32>; 4]) {
     let row = cells + 3;
     let half = cells / 2;
@@ -157,7 +159,10 @@ pub fn grid_indices(cells: u32) -> (Vec<u32>, [Range<u32>; 4]) {
         for ci in 0..cells + 2 {
             let (sw, se, nw, ne) =
                 (cj * row + ci, cj * row + ci + 1, (cj + 1) * row + ci, (cj + 1) * row + ci + 1);
-            let t = if (ci + cj) % 2 == 0 { [sw, se, ne, sw, ne, nw] } else { [sw, se, nw, se, ne, nw] };
+            // Node cell (ci − 1, cj − 1) (the ring's wrap to u32::MAX keeps the parity). Nodes
+            // start at multiples of `cells`, a power of two: a node's cell has its dataset cell's parity.
+            let rises = diagonal_rises([ci.wrapping_sub(1), cj.wrapping_sub(1)]);
+            let t = if rises { [sw, se, ne, sw, ne, nw] } else { [sw, se, nw, se, ne, nw] };
             let quadrant = &mut quadrants[side(cj) * 2 + side(ci)];
             quadrant.extend_from_slice(&t);
             let inner = (1..=cells).contains(&ci) && (1..=cells).contains(&cj);

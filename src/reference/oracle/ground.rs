@@ -1,7 +1,7 @@
 //! How it works: what the oracle reads from the dataset, read once per view. `DemWindow` copies
 //! the level-0 height samples of a rectangle out of their tiles into one dense array and answers
-//! the bilinear surface, its gradient and the exact least clearance of a segment over it (the DDA
-//! walk described in `reference::oracle`). `LandcoverTiles` decodes the level-1 land-cover tiles
+//! the drawn ground (`dataset::surface`), its gradient and the exact least clearance of a segment
+//! over it (the DDA walk described in `reference::oracle`). `LandcoverTiles` decodes the level-1 land-cover tiles
 //! under the same rectangle and answers palette indices.
 
 use std::collections::HashMap;
@@ -10,6 +10,7 @@ use std::collections::hash_map::Entry;
 use glam::{DVec2, DVec3};
 
 use crate::dataset::lcc::{LCC_SOURCE_LEVEL, LccCoding};
+use crate::dataset::surface::{diagonal_rises, drawn_height};
 use crate::dataset::{Dataset, PackError, TileId};
 
 /// Level-0 height samples [first, first + held) per axis, copied out of their tiles.
@@ -23,7 +24,7 @@ pub(super) struct DemWindow {
 }
 
 impl DemWindow {
-    /// The samples every bilinear cell touching the rectangle [min_m, max_m] needs.
+    /// The samples every cell touching the rectangle [min_m, max_m] needs.
     pub(super) fn load(dataset: &Dataset, min_m: [f64; 2], max_m: [f64; 2]) -> Result<Self, PackError> {
         let pyramid = &dataset.height.pyramid;
         let spacing_m = dataset.manifest.height.spacing_m;
@@ -57,7 +58,7 @@ impl DemWindow {
         f64::from(self.heights_m[(y * self.held[0] + x) as usize])
     }
 
-    /// The bilinear cell holding coordinate `v_m` along `axis` (its floor, clamped to the
+    /// The cell holding coordinate `v_m` along `axis` (its floor, clamped to the
     /// window's cells) and the coordinate in it, in cells.
     fn cell(&self, v_m: f64, axis: usize) -> (u32, f64) {
         let g = v_m / self.spacing_m;
@@ -68,19 +69,16 @@ impl DemWindow {
         (i, g - f64::from(i))
     }
 
-    /// The cell's bilinear coefficients: h = a + b·u + c·v + d·u·v.
-    fn patch(&self, i: u32, j: u32) -> [f64; 4] {
-        let (h00, h10, h01, h11) =
-            (self.sample(i, j), self.sample(i + 1, j), self.sample(i, j + 1), self.sample(i + 1, j + 1));
-        [h00, h10 - h00, h01 - h00, h11 - h10 - h01 + h00]
+    /// The heights of cell (`i`, `j`)'s corners: south-west, south-east, north-west, north-east.
+    fn corners(&self, i: u32, j: u32) -> [f64; 4] {
+        [self.sample(i, j), self.sample(i + 1, j), self.sample(i, j + 1), self.sample(i + 1, j + 1)]
     }
 
-    /// Bilinear height at `p` and its gradient (height per metre east, north).
+    /// The drawn ground at `p` and its gradient (height per metre east, north).
     pub(super) fn ground(&self, p: DVec2) -> (f64, DVec2) {
         let ((i, u), (j, v)) = (self.cell(p.x, 0), self.cell(p.y, 1));
-        let [a, b, c, d] = self.patch(i, j);
-        let gradient = DVec2::new(b + d * v, c + d * u) / self.spacing_m;
-        (a + b * u + c * v + d * u * v, gradient)
+        let (height_m, slope) = drawn_height([i, j], self.corners(i, j), [u, v]);
+        (height_m, DVec2::from(slope) / self.spacing_m)
     }
 
     /// The least of z(t) − surface(x(t), y(t)) over t ∈ [0, t_end] where the segment from `eye`
@@ -132,22 +130,21 @@ impl DemWindow {
             // The cell of this stretch (between two crossings: one cell), from its middle.
             let mid = at(0.5 * (ta + tb));
             let ((i, _), (j, _)) = (self.cell(mid.x, 0), self.cell(mid.y, 1));
-            let [a, b, c, e] = self.patch(i, j);
+            let corners = self.corners(i, j);
             let pa = at(ta);
             let (ua, va) = (pa.x / s - f64::from(i), pa.y / s - f64::from(j));
-            // Along the stretch, τ = t − ta: surface = h0 + h1·τ + h2·τ², segment = pa.z + d.z·τ.
-            let h0 = a + b * ua + c * va + e * ua * va;
-            let h1 = b * du + c * dv + e * (ua * dv + va * du);
-            let h2 = e * du * dv;
-            let (f0, f1, f2) = (pa.z - h0, d.z - h1, -h2);
-            let f = |tau: f64| f0 + (f1 + f2 * tau) * tau;
+            // Along the stretch, τ = t − ta, the segment is at pa.z + d.z·τ and over (ua + du·τ,
+            // va + dv·τ) of the cell, whose drawn ground is planar on each side of the diagonal:
+            // the clearance is piecewise linear, least at an end or where the diagonal is crossed.
+            let clearance =
+                |tau: f64| pa.z + d.z * tau - drawn_height([i, j], corners, [ua + du * tau, va + dv * tau]).0;
             let length = tb - ta;
-            let mut low = f0.min(f(length));
-            if f2 > 0.0 {
-                let vertex = -f1 / (2.0 * f2);
-                if vertex > 0.0 && vertex < length {
-                    low = low.min(f(vertex));
-                }
+            // Where u = v (rising) or u + v = 1 (falling); NaN or ∞ along the diagonal or parallel to it.
+            let diagonal =
+                if diagonal_rises([i, j]) { (va - ua) / (du - dv) } else { (1.0 - ua - va) / (du + dv) };
+            let mut low = clearance(0.0).min(clearance(length));
+            if diagonal > 0.0 && diagonal < length {
+                low = low.min(clearance(diagonal));
             }
             least = least.min(low);
             if (stop && least < 0.0) || tb >= t1 {

@@ -69,22 +69,37 @@ fn random(state: &mut u32) -> f64 {
 }
 
 #[test]
-fn the_window_reads_every_sample_and_the_bilinear_surface() {
+fn the_window_reads_every_sample_and_the_drawn_ground() {
     let height = |i: u32, j: u32| (pcg(i * 131 + j) % 1000) as f32 * 0.1;
     let ds = dem("window", 29, 7.5, height);
     let dem = DemWindow::load(&ds, [0.0, 0.0], [210.0, 210.0]).unwrap();
     let mut state = 9;
+    let mut checked = 0;
     for _ in 0..500 {
         let p = DVec2::new(random(&mut state) * 210.0, random(&mut state) * 210.0);
         let (ground_m, gradient) = dem.ground(p);
-        assert!((ground_m - ds.height_at(p.x, p.y, 0).unwrap()).abs() < 1e-9, "{p}");
+        let at = |x: f64, y: f64| ds.height_at(x, y, 0).unwrap();
+        assert!((ground_m - at(p.x, p.y)).abs() < 1e-9, "{p}");
+        // Where the surface has no kink (a cell edge or diagonal), the gradient is its derivative.
         let e = 1e-6;
-        let slope_x =
-            (ds.height_at(p.x + e, p.y, 0).unwrap() - ds.height_at(p.x - e, p.y, 0).unwrap()) / (2.0 * e);
-        // Away from cell edges (where the gradient jumps) it is the surface's derivative.
-        if ((p.x / 7.5).fract() - 0.5).abs() < 0.49 {
-            assert!((gradient.x - slope_x).abs() < 1e-5, "{p}: {gradient} against {slope_x}");
+        let (east, west) = ((at(p.x + e, p.y) - ground_m) / e, (ground_m - at(p.x - e, p.y)) / e);
+        let (north, south) = ((at(p.x, p.y + e) - ground_m) / e, (ground_m - at(p.x, p.y - e)) / e);
+        if (east - west).abs() < 1e-4 && (north - south).abs() < 1e-4 {
+            assert!((gradient.x - east).abs() < 1e-4 && (gradient.y - north).abs() < 1e-4, "{p}: {gradient}");
+            checked += 1;
         }
+    }
+    assert!(checked > 400, "{checked} gradients checked");
+    // Each cell is two planes through three of its samples: at a cell's centre, the mean of the two
+    // samples its diagonal joins (whichever it is, not the mean of all four, as a bilinear patch).
+    let centre =
+        |i: u32, j: u32| ds.height_at((f64::from(i) + 0.5) * 7.5, (f64::from(j) + 0.5) * 7.5, 0).unwrap();
+    let h = |i: u32, j: u32| f64::from(height(i, j));
+    for (i, j) in [(3, 4), (4, 4), (10, 17), (11, 17)] {
+        let rising = 0.5 * (h(i, j) + h(i + 1, j + 1));
+        let falling = 0.5 * (h(i + 1, j) + h(i, j + 1));
+        let c = centre(i, j);
+        assert!((c - rising).abs() < 1e-9 || (c - falling).abs() < 1e-9, "cell ({i}, {j}): {c}");
     }
 }
 
@@ -119,32 +134,55 @@ fn a_ridge_between_samples_is_caught() {
     // Across the ridge between two of its samples.
     assert!(!clears(&ds, [55.0, 100.0, h - 5.0], [55.0, 220.0, h - 5.0]));
     assert!(clears(&ds, [55.0, 100.0, h + 0.5], [55.0, 220.0, h + 0.5]));
-    // Past the ridge's end, along the anti-diagonal of cell (20, 16): every sample and every cell
-    // edge the segment passes is at 0, but inside that cell the surface bulges to h/4.
+    // Past the ridge's end, across cell (20, 16) from its south-east corner to its north-west one:
+    // every sample and every cell edge the segment passes is at 0, but the cell's rising diagonal
+    // joins the ridge's last sample to the ground, and the segment crosses it half-way up, at h/2.
+    assert!(crate::dataset::surface::diagonal_rises([20, 16]));
     let along = |z: f64| clears(&ds, [22.0 * s, 15.0 * s, z], [19.0 * s, 18.0 * s, z]);
-    assert!(!along(h / 8.0));
-    assert!(!along(h / 4.0 - 0.01));
-    assert!(along(h / 4.0 + 0.01));
+    assert!(!along(h / 4.0));
+    assert!(!along(h / 2.0 - 0.01));
+    assert!(along(h / 2.0 + 0.01));
 }
 
-/// The least height above the bilinear surface of `ridge` along the segment, sampled every 1e-4.
+/// The least height above the drawn ground of `ridge` along the segment, sampled every 1e-4: each
+/// cell is the two triangles of the terrain mesh's index buffer, here the plane through a
+/// triangle's three samples (barycentric), the one holding the point.
 fn brute_min_clearance(eye: DVec3, target: DVec3, s: f64) -> f64 {
     let size = 32u32;
     let extent = f64::from(size - 1) * s;
+    let (indices, _) = crate::passes::terrain::frame::grid_indices(8);
+    // Vertex k of the node grid (with its skirt ring) is (k % 11, k / 11); inner cell (a, b) of a
+    // node is drawn by the two triangles whose vertices all lie in (1..=9)², least at (a + 1, b + 1).
+    let inner: Vec<[[f64; 2]; 3]> = indices
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]].map(|k| [f64::from(k % 11) - 1.0, f64::from(k / 11) - 1.0]))
+        .filter(|t| t.iter().all(|p| p.iter().all(|&c| (0.0..=8.0).contains(&c))))
+        .collect();
     let surface = |x: f64, y: f64| {
         if !(0.0..=extent).contains(&x) || !(0.0..=extent).contains(&y) {
             return None;
         }
         let (gx, gy) = (x / s, y / s);
         let (i, j) = ((gx.floor() as u32).min(size - 2), (gy.floor() as u32).min(size - 2));
-        let (u, v) = (gx - f64::from(i), gy - f64::from(j));
-        let h = |a, b| f64::from(ridge(a, b));
-        Some(
-            h(i, j) * (1.0 - u) * (1.0 - v)
-                + h(i + 1, j) * u * (1.0 - v)
-                + h(i, j + 1) * (1.0 - u) * v
-                + h(i + 1, j + 1) * u * v,
-        )
+        let node = [f64::from(i - i % 8), f64::from(j - j % 8)];
+        let local = [f64::from(i % 8), f64::from(j % 8)];
+        let mut best = (f64::NEG_INFINITY, 0.0);
+        for t in inner
+            .iter()
+            .filter(|t| t.iter().fold([9.0f64; 2], |m, p| [m[0].min(p[0]), m[1].min(p[1])]) == local)
+        {
+            let [a, b, c] = t.map(|p| [p[0] + node[0], p[1] + node[1]]);
+            let det = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1]);
+            let wa = ((b[1] - c[1]) * (gx - c[0]) + (c[0] - b[0]) * (gy - c[1])) / det;
+            let wb = ((c[1] - a[1]) * (gx - c[0]) + (a[0] - c[0]) * (gy - c[1])) / det;
+            let w = [wa, wb, 1.0 - wa - wb];
+            let h = [a, b, c].map(|p| f64::from(ridge(p[0] as u32, p[1] as u32)));
+            let least = w.iter().copied().fold(f64::INFINITY, f64::min);
+            if least > best.0 {
+                best = (least, w[0] * h[0] + w[1] * h[1] + w[2] * h[2]);
+            }
+        }
+        Some(best.1)
     };
     let t_end = 1.0 - SEGMENT_END_SKIP;
     (0..10_000).map(|k| f64::from(k) * 1e-4).chain([t_end]).fold(f64::INFINITY, |least, t| {
