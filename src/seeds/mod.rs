@@ -13,6 +13,7 @@
 //! they disagree only on visibility, never on what exists.
 
 pub mod patterns;
+pub mod spacing;
 
 use thiserror::Error;
 
