@@ -4,7 +4,7 @@
 //! across a border must be at least 0.9 × that of the seeds whose neighbour lies in their own
 //! cell (`seeds::spacing`). Prints the figures of `docs/seeds.md` ("Seed spacing across cell
 //! borders"), the radial distribution functions, and with `TERRAMP_SPACING_PNG=DIR` draws the
-//! seeds around one border corner of each dataset.
+//! balanced preset's seeds around the busiest cell corner of each dataset's first view.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 mod support;
@@ -53,32 +53,61 @@ fn selected_seeds(r: &mut Renderer, pose: [f64; 5]) -> (Vec<[f64; 2]>, Vec<[i64;
     (xy, cells)
 }
 
-/// Draws the seeds within `half_m` of `corner_m` (a cell corner), one colour per cell, cell
-/// borders in grey, into `path`.
-fn draw_corner(path: &Path, xy: &[[f64; 2]], cells: &[[i64; 2]], corner_m: [f64; 2], half_m: f64) {
-    let size = 720u32;
-    let mut img = image::RgbImage::from_pixel(size, size, image::Rgb([255, 255, 255]));
-    let px = |v: f64, a: usize| ((v - corner_m[a] + half_m) / (2.0 * half_m) * f64::from(size)) as i64;
-    for k in 0..size {
-        for (x, y) in [(size / 2, k), (k, size / 2)] {
-            img.put_pixel(x, y, image::Rgb([170, 170, 170]));
+/// Draws the seeds within `half_m` of the cell corner that has the most, one colour per cell,
+/// borders in grey, and a black segment from each seed to its nearest neighbour where that is
+/// closer than `close_m`, into `path`.
+fn draw_corner(path: &Path, xy: &[[f64; 2]], cells: &[[i64; 2]], cell_m: f64, half_m: f64, close_m: f64) {
+    let mut per_corner = std::collections::HashMap::<[i64; 2], usize>::new();
+    for p in xy {
+        let corner = p.map(|v| (v / cell_m).round() as i64);
+        if (0..2).all(|a| (p[a] - corner[a] as f64 * cell_m).abs() < half_m) {
+            *per_corner.entry(corner).or_default() += 1;
         }
     }
-    let palette = [[200, 40, 40], [30, 110, 200], [30, 150, 60], [150, 60, 170]];
-    for (p, c) in xy.iter().zip(cells) {
-        let (x, y) = (px(p[0], 0), i64::from(size) - 1 - px(p[1], 1));
-        let colour = palette[((c[0] & 1) + 2 * (c[1] & 1)) as usize];
-        for dy in -3i64..=3 {
-            for dx in -3i64..=3 {
-                let (qx, qy) = (x + dx, y + dy);
-                if dx * dx + dy * dy <= 9
-                    && (0..i64::from(size)).contains(&qx)
-                    && (0..i64::from(size)).contains(&qy)
-                {
+    let Some((&corner, _)) = per_corner.iter().max_by_key(|&(c, n)| (*n, std::cmp::Reverse(*c))) else {
+        return;
+    };
+    let corner_m = corner.map(|v| v as f64 * cell_m);
+    let near: Vec<usize> = (0..xy.len())
+        .filter(|&i| (0..2).all(|a| (xy[i][a] - corner_m[a]).abs() < half_m + close_m))
+        .collect();
+    let size = 720i64;
+    let mut img = image::RgbImage::from_pixel(size as u32, size as u32, image::Rgb([255, 255, 255]));
+    let to_px = |p: [f64; 2]| {
+        let f = |v: f64, a: usize| (v - corner_m[a] + half_m) / (2.0 * half_m) * size as f64;
+        [f(p[0], 0), size as f64 - f(p[1], 1)]
+    };
+    let dot = |img: &mut image::RgbImage, [x, y]: [f64; 2], r: i64, colour: [u8; 3]| {
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let (qx, qy) = (x as i64 + dx, y as i64 + dy);
+                if dx * dx + dy * dy <= r * r && (0..size).contains(&qx) && (0..size).contains(&qy) {
                     img.put_pixel(qx as u32, qy as u32, image::Rgb(colour));
                 }
             }
         }
+    };
+    for k in 0..size {
+        dot(&mut img, [(size / 2) as f64, k as f64], 0, [170, 170, 170]);
+        dot(&mut img, [k as f64, (size / 2) as f64], 0, [170, 170, 170]);
+    }
+    for &i in &near {
+        let d = |j: usize| (xy[j][0] - xy[i][0]).hypot(xy[j][1] - xy[i][1]);
+        let Some(j) = near.iter().copied().filter(|&j| j != i).min_by(|&a, &b| d(a).total_cmp(&d(b))) else {
+            continue;
+        };
+        if d(j) < close_m {
+            let (a, b) = (to_px(xy[i]), to_px(xy[j]));
+            for t in 0..=64 {
+                let t = f64::from(t) / 64.0;
+                dot(&mut img, [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t], 1, [0, 0, 0]);
+            }
+        }
+    }
+    let palette = [[200, 40, 40], [30, 110, 200], [30, 150, 60], [150, 60, 170]];
+    for &i in &near {
+        let c = cells[i];
+        dot(&mut img, to_px(xy[i]), 4, palette[((c[0] & 1) + 2 * (c[1] & 1)) as usize]);
     }
     img.save(path).unwrap();
 }
@@ -112,19 +141,9 @@ fn measure(name: &str, dataset: &Path, views: &[(&str, [f64; 5])]) -> Vec<(&'sta
                 && preset == "balanced"
                 && view == views[0].0
             {
-                // The cell corner nearest the median seed, and 24 m around it.
-                let mut sorted: Vec<[f64; 2]> = xy.clone();
-                sorted.sort_by(|a, b| a[0].total_cmp(&b[0]));
-                let median = sorted[sorted.len() / 2];
-                let cell_m = r.settings.tlm.cell_m;
-                let corner = median.map(|v| (v / cell_m).round() * cell_m);
-                draw_corner(
-                    &Path::new(&dir).join(format!("seeds_border_{name}.png")),
-                    &xy,
-                    &cells,
-                    corner,
-                    24.0,
-                );
+                // The busiest cell corner, 40 m around it; pairs closer than the inside 1st percentile.
+                let png = Path::new(&dir).join(format!("seeds_border_{name}.png"));
+                draw_corner(&png, &xy, &cells, r.settings.tlm.cell_m, 40.0, quantile(&s.inside, 0.01));
             }
             pooled.merge(&s);
         }

@@ -8,7 +8,7 @@
 //! figures agree.
 //!
 //! The radial distribution function compares all pairs with pairs across a border. Distances are
-//! in units of each centre's local spacing (1 / √λ, λ from its 8 nearest neighbours, so dense
+//! in units of each centre's local spacing (1 / √λ, λ from its 40 nearest neighbours, so dense
 //! forest and sparse shrubland compare), and a pair across a border counts 1 / φ(d), φ being
 //! the chance that a segment of length d, placed and turned at random, crosses a square grid of
 //! side L (Buffon on a grid: (4dL − d²) / (πL²)). Under a seamless process both curves agree;
@@ -20,8 +20,9 @@ use std::collections::HashMap;
 pub const RDF_BINS: usize = 30;
 /// Width of one bin, in local spacings.
 pub const RDF_BIN: f64 = 0.1;
-/// Neighbours that estimate a centre's local density.
-const DENSITY_NEIGHBOURS: usize = 8;
+/// Neighbours that estimate a centre's local density: the farthest of them sits at
+/// √(k / π) ≈ 3.6 spacings, beyond the curves (whatever bin it fell in would show a spike).
+const DENSITY_NEIGHBOURS: usize = 40;
 
 /// Nearest-neighbour distances and the radial distribution function of a seed set, split by
 /// whether they cross a cell border.
