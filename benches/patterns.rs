@@ -1,6 +1,7 @@
-//! Time to generate the seed patterns pass 3 uploads (Bridson candidates, then farthest-point
-//! ranking): 16 patterns of 2048 seeds (the default) and of 4096 (the accurate preset). Run with
-//! `cargo bench --bench patterns`.
+//! Time to generate the seed patterns pass 3 uploads (the corner-tile set: corner patches, edge
+//! strips, interiors, each Bridson candidates then a progressive ranking): 16 patterns (2 corner
+//! colours, every preset) of 1536, 2048 and 4096 seeds (fast, balanced, accurate), and 81
+//! (3 colours) of 2048. Run with `cargo bench --bench patterns`.
 #![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -9,9 +10,9 @@ use terramp::seeds::patterns::SeedPatterns;
 fn patterns(c: &mut Criterion) {
     let mut group = c.benchmark_group("seed_patterns");
     group.sample_size(10);
-    for seeds_per_pattern in [2048, 4096] {
-        group.bench_function(format!("16x{seeds_per_pattern}"), |b| {
-            b.iter(|| SeedPatterns::generate(16, seeds_per_pattern, 1))
+    for (colours, seeds_per_pattern) in [(2, 1536), (2, 2048), (2, 4096), (3, 2048)] {
+        group.bench_function(format!("{}x{seeds_per_pattern}", colours * colours * colours * colours), |b| {
+            b.iter(|| SeedPatterns::generate(colours, seeds_per_pattern, 1))
         });
     }
     group.finish();

@@ -79,7 +79,7 @@ fn main() {
     // Pass 3 checks only the ranks some class can grow (the densest class's share of a pattern).
     let ranks = r.seed_world().expect("land cover").0.active_ranks();
     println!("{ranks} of {SEEDS_PER_PATTERN} ranks per cell can grow a seed");
-    let (seed, patterns) = (r.settings.tlm.seed, r.settings.tlm.patterns);
+    let (seed, colours) = (r.settings.tlm.seed, r.settings.tlm.corner_colours());
     println!(
         "{:>10} {:>7} {:>10} {:>12} {:>14} {:>12} {:>14} {:>8}",
         "checked", "cells", "selected", "gpu ms", "gpu seeds/s", "twin ms", "twin seeds/s", "gpu÷twin"
@@ -97,7 +97,7 @@ fn main() {
                     r.settings.tlm.radial_bands_m.iter().filter(|&&t| distance_m >= t).count() as u32;
                 SeedCellRef {
                     address,
-                    pattern: cell_pattern([address[0] as i32, address[1] as i32], seed, patterns),
+                    pattern: cell_pattern([address[0] as i32, address[1] as i32], seed, colours),
                     radial_lod: radial_lod.min(2),
                 }
             })

@@ -30,7 +30,7 @@ struct TlmUniforms {
     height_lod_count: u32,
     rings: u32,
     cells: u32,
-    patterns: u32,
+    corner_colours: u32,
     seed: u32,
     no_fuse: u32,
     occlusion_tolerance_per_m: f32,
@@ -211,7 +211,7 @@ fn tlm_cell(ring: u32, cx: u32, cy: u32) -> TlmCell {
     cell.visibility = TLM_FIRST_PATTERN;
     if ring == 0u {
         let g = u.rings_info[0].origin_cell + vec2<i32>(i32(cx), i32(cy));
-        cell.visibility = tlm_visibility(pattern_hash(bitcast<u32>(g.x), bitcast<u32>(g.y), u.seed) % u.patterns);
+        cell.visibility = tlm_visibility(cell_pattern(bitcast<vec2<u32>>(g), u.seed, u.corner_colours));
     }
     cell.imagery_lod = 0u;
     if u.imagery_levels > 0u {

@@ -14,7 +14,9 @@ use terramp::passes::depth_pyramid::gpu::DepthPyramid;
 use terramp::passes::tile_load_map::frame::height_tile_ranges;
 use terramp::passes::tile_load_map::layout::TlmLayout;
 use terramp::reference::depth_pyramid::depth_pyramid;
-use terramp::reference::tile_load_map::{pattern_hash, tile_load_map};
+use terramp::reference::tile_load_map::tile_load_map;
+use terramp::seeds::cell_pattern;
+use terramp::seeds::patterns::corner_colours_of;
 use terramp_testkit::camera::{at_grid as camera_at, over};
 use terramp_testkit::tlm::{
     assert_gpu_equals_twin, assert_levels_match_f64, assert_no_false_culls, cell_height_range, run, run_with,
@@ -241,6 +243,7 @@ fn tlm_settings_are_checked_and_named() {
         ("[tlm]\ncells = 63\n", "tlm.cells"),
         ("[tlm]\nmax_rings = 17\n", "tlm.max_rings"),
         ("[tlm]\npatterns = 256\n", "tlm.patterns"),
+        ("[tlm]\npatterns = 20\n", "C⁴ for C corner colours: 1, 16 or 81"),
         ("[tlm]\nradial_bands_m = [700.0, 300.0, 3000.0]\n", "tlm.radial_bands_m"),
         ("[tlm]\ncell_m = 0\n", "tlm.cell_m"),
     ] {
@@ -248,25 +251,38 @@ fn tlm_settings_are_checked_and_named() {
         assert!(error.contains(key), "{error}");
     }
     assert_eq!(with("[tlm]\ncells = 32\n").unwrap().tlm.cells, 32);
+    for (patterns, colours) in [(1, 1), (16, 2), (81, 3)] {
+        assert_eq!(with(&format!("[tlm]\npatterns = {patterns}\n")).unwrap().tlm.corner_colours(), colours);
+    }
 }
 
 #[test]
-fn pattern_hash_is_deterministic_and_spread_over_every_pattern() {
-    let patterns = 16;
-    let mut counts = vec![0u32; patterns as usize];
-    for y in -64i32..64 {
-        for x in -64i32..64 {
-            let p = pattern_hash(x as u32, y as u32, 1) % patterns;
-            assert_eq!(p, pattern_hash(x as u32, y as u32, 1) % patterns);
-            counts[p as usize] += 1;
+fn cell_patterns_are_deterministic_spread_over_every_pattern_and_agree_with_their_neighbours() {
+    for colours in [2u32, 3] {
+        let patterns = colours.pow(4);
+        let mut counts = vec![0u32; patterns as usize];
+        for y in -64i32..64 {
+            for x in -64i32..64 {
+                let p = cell_pattern([x, y], 1, colours);
+                assert_eq!(p, cell_pattern([x, y], 1, colours));
+                counts[p as usize] += 1;
+                // The shared corners of the east and north neighbours have the same colours.
+                let [_, c10, c01, c11] = corner_colours_of(p, colours);
+                let [e00, _, e01, _] = corner_colours_of(cell_pattern([x + 1, y], 1, colours), colours);
+                let [n00, n10, ..] = corner_colours_of(cell_pattern([x, y + 1], 1, colours), colours);
+                assert_eq!((c10, c11, c01, c11), (e00, e01, n00, n10), "cell {x}, {y}");
+            }
         }
+        let mean = 128.0 * 128.0 / f64::from(patterns);
+        assert!(counts.iter().all(|&c| (f64::from(c) - mean).abs() < 0.25 * mean), "{counts:?}");
+        // Another germ, another assignment.
+        let moved = (0..256)
+            .filter(|&x| cell_pattern([x, 7], 1, colours) != cell_pattern([x, 7], 2, colours))
+            .count();
+        assert!(moved > 200);
     }
-    let mean = 128.0 * 128.0 / f64::from(patterns);
-    assert!(counts.iter().all(|&c| (f64::from(c) - mean).abs() < 0.2 * mean), "{counts:?}");
-    // Another germ, another assignment.
-    let moved =
-        (0..256u32).filter(|&x| pattern_hash(x, 7, 1) % patterns != pattern_hash(x, 7, 2) % patterns).count();
-    assert!(moved > 200);
+    // Addresses wrap like the shader's u32 arithmetic.
+    assert!(cell_pattern([i32::MAX, i32::MIN], 1, 3) < 81);
 }
 
 #[test]

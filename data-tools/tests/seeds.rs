@@ -218,13 +218,13 @@ fn nc_species_follow_the_land_cover() {
     r.render_resolved(&camera).unwrap();
     let cell_m = r.settings.tlm.cell_m;
     let first = [0.5 * w, 0.5 * h].map(|v| (v / cell_m).floor() as i64 - 8);
-    let (seed, patterns) = (r.settings.tlm.seed, r.settings.tlm.patterns);
+    let (seed, colours) = (r.settings.tlm.seed, r.settings.tlm.corner_colours());
     let cells: Vec<SeedCellRef> = (0..256)
         .map(|k| {
             let address = [first[0] + k % 16, first[1] + k / 16];
             SeedCellRef {
                 address,
-                pattern: cell_pattern([address[0] as i32, address[1] as i32], seed, patterns),
+                pattern: cell_pattern([address[0] as i32, address[1] as i32], seed, colours),
                 radial_lod: 1,
             }
         })

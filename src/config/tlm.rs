@@ -26,13 +26,23 @@ pub struct TlmSettings {
     /// The distance bands of ring-0 cells, metres: a cell whose nearest point lies in band k
     /// reads land-cover level k for its seeds; beyond the last, its seeds are not checked.
     pub radial_bands_m: [f64; TLM_RADIAL_BANDS as usize],
-    /// Seed patterns P (1 to 255); each ring-0 cell shows one, picked by a hash of its position.
+    /// Seed patterns P = C⁴ for C corner colours: 1, 16 or 81. Each lattice corner of the ring-0
+    /// grid gets one of C colours by a hash of its position, and a cell shows the pattern of its
+    /// four corners' colours (`seeds::patterns`), so neighbours agree across their border.
     pub patterns: u32,
     /// The germ of that hash: another value, another (equally deterministic) forest.
     pub seed: u32,
 }
 
+/// The pattern counts `tlm.patterns` accepts: C⁴ for C = 1, 2, 3 corner colours.
+pub const PATTERN_COUNTS: [u32; 3] = [1, 16, 81];
+
 impl TlmSettings {
+    /// Corner colours C of `patterns` = C⁴ (checked by `validate`; 1 for any other value).
+    pub fn corner_colours(&self) -> u32 {
+        PATTERN_COUNTS.iter().position(|&p| p == self.patterns).map_or(1, |c| c as u32 + 1)
+    }
+
     /// The occlusion tolerance of a cell's box.
     pub fn occlusion(&self) -> OcclusionTolerance {
         OcclusionTolerance { m: self.occlusion_tolerance_m, per_km: self.occlusion_tolerance_per_km }
@@ -77,7 +87,12 @@ impl TlmSettings {
                 format!("{r:?}"),
                 "three increasing positive distances, metres",
             ),
-            ((1..=255).contains(&self.patterns), "tlm.patterns", self.patterns.to_string(), "1 to 255"),
+            (
+                PATTERN_COUNTS.contains(&self.patterns),
+                "tlm.patterns",
+                self.patterns.to_string(),
+                "C⁴ for C corner colours: 1, 16 or 81 (a cell's pattern is its four corners' colours)",
+            ),
         ];
         match checks.into_iter().find(|(ok, ..)| !ok) {
             Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),

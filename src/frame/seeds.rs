@@ -226,7 +226,8 @@ fn seeded_world(
         seeds.seeds_per_pattern,
         seeds.density_scale,
     )?;
-    let patterns = SeedPatterns::generate(settings.tlm.patterns, seeds.seeds_per_pattern, settings.tlm.seed);
+    let patterns =
+        SeedPatterns::generate(settings.tlm.corner_colours(), seeds.seeds_per_pattern, settings.tlm.seed);
     Ok((table, tables, patterns))
 }
 

@@ -47,7 +47,7 @@ pub enum OracleError {
     /// A height or land-cover tile of the dataset's pack could not be read.
     #[error("oracle: {0}")]
     Pack(#[from] PackError),
-    /// The seed patterns given are fewer than `tlm.patterns`, or their positions do not fill
+    /// The seed patterns given are not the `tlm.patterns` asked for, or their positions do not fill
     /// `count × seeds_per_pattern`.
     #[error(
         "oracle: the patterns hold {count} patterns of {seeds_per_pattern} seeds in {positions} positions; \
@@ -167,7 +167,8 @@ pub fn judge_seeds(
     camera.validate()?;
     let clip = camera.clip_from_view(viewport_px[0], viewport_px[1])? * camera.view_from_world();
     let spp = patterns.seeds_per_pattern;
-    if patterns.count < settings.tlm.patterns.max(1)
+    if patterns.count != settings.tlm.patterns
+        || patterns.corner_colours != settings.tlm.corner_colours()
         || patterns.positions_unit.len() != patterns.count as usize * spp as usize
     {
         return Err(OracleError::Patterns {
@@ -288,7 +289,7 @@ impl View<'_> {
         };
         let tlm = &self.inputs.settings.tlm;
         let spp = self.inputs.patterns.seeds_per_pattern;
-        let pattern = cell_pattern(i32_address, tlm.seed, tlm.patterns);
+        let pattern = cell_pattern(i32_address, tlm.seed, tlm.corner_colours());
         let positions = &self.inputs.patterns.positions_unit[(pattern * spp) as usize..][..spp as usize];
         let mut counts = OracleCounts { candidates: u64::from(spp), ..Default::default() };
         let mut seeds = Vec::new();

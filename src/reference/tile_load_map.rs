@@ -12,7 +12,7 @@ use crate::gpu::layout::{
     TLM_SPAN_INSIDE, TileSpan, tlm_visibility,
 };
 use crate::passes::depth_pyramid::frame::HizMips;
-pub use crate::seeds::{pattern_hash, pcg};
+pub use crate::seeds::{cell_pattern, pattern_hash, pcg};
 
 fn length_sq(v: [f32; 3]) -> f32 {
     v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
@@ -144,7 +144,7 @@ fn tlm_cell(
     if ring == 0 {
         let origin = u.rings_info[0].origin_cell;
         let g = [origin[0].wrapping_add(cx as i32), origin[1].wrapping_add(cy as i32)];
-        cell.visibility = tlm_visibility(pattern_hash(g[0] as u32, g[1] as u32, u.seed) % u.patterns);
+        cell.visibility = tlm_visibility(cell_pattern(g, u.seed, u.corner_colours));
     }
     if u.imagery_levels > 0 {
         cell.imagery_lod =

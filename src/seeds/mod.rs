@@ -1,6 +1,7 @@
 //! How it works: the seeded world, defined once (paper § 4.4). The ground is tiled by the TLM's
-//! ring-0 cells; each cell shows one of P generic blue-noise patterns (`patterns`), picked by a
-//! hash of its global address, so a place always shows the same seeds and neighbours differ. A
+//! ring-0 cells; each cell shows one of P generic blue-noise patterns (`patterns`), picked by the
+//! hashed colours of its four lattice corners, so a place always shows the same seeds, neighbours
+//! differ, and any two neighbours' seeds agree across their border. A
 //! seed is identified by (cell address, rank in the pattern); everything random about it (its
 //! size, orientation, colour, where its ground colour is sampled) derives from one hash of that
 //! identity and the world's seed number.
@@ -13,6 +14,7 @@
 //! they disagree only on visibility, never on what exists.
 
 pub mod patterns;
+pub mod spacing;
 
 use thiserror::Error;
 
@@ -82,9 +84,19 @@ pub fn pattern_hash(x: u32, y: u32, seed: u32) -> u32 {
     pcg(x ^ pcg(y ^ pcg(seed)))
 }
 
-/// The pattern ring-0 cell `address` shows, of `patterns`.
-pub fn cell_pattern(address: [i32; 2], seed: u32, patterns: u32) -> u32 {
-    pattern_hash(address[0] as u32, address[1] as u32, seed) % patterns.max(1)
+/// The colour, of `colours`, of lattice corner (`x`, `y`) of the ring-0 cell grid (the corner at
+/// the south-west of cell (x, y)): the shader's `corner_colour`.
+pub fn corner_colour(x: u32, y: u32, seed: u32, colours: u32) -> u32 {
+    pattern_hash(x, y, seed) % colours.max(1)
+}
+
+/// The pattern ring-0 cell `address` shows: the one of its four corners' colours,
+/// c₀₀ + C (c₁₀ + C (c₀₁ + C c₁₁)) of the C⁴ (`patterns::SeedPatterns`). The shader's
+/// `cell_pattern`.
+pub fn cell_pattern(address: [i32; 2], seed: u32, colours: u32) -> u32 {
+    let (x, y, c) = (address[0] as u32, address[1] as u32, colours.max(1));
+    let k = |dx: u32, dy: u32| corner_colour(x.wrapping_add(dx), y.wrapping_add(dy), seed, c);
+    k(0, 0) + c * (k(1, 0) + c * (k(0, 1) + c * k(1, 1)))
 }
 
 /// The hash of seed `rank` of cell `address`: the shader's `seed_hash`.

@@ -16,7 +16,8 @@ use terramp::passes::terrain::select::Lods;
 use terramp::passes::tile_load_map::frame::{TlmFrame, TlmImagery, TlmInputs};
 use terramp::passes::tile_load_map::gpu::TileLoadMapPass;
 use terramp::passes::tile_load_map::layout::TlmLayout;
-use terramp::reference::tile_load_map::{pattern_hash, tile_load_map};
+use terramp::reference::tile_load_map::tile_load_map;
+use terramp::seeds::cell_pattern;
 
 /// One view's Tile Load Map, from the GPU and from the twin, with what both were computed from.
 pub struct Run {
@@ -224,7 +225,7 @@ pub fn assert_levels_match_f64(r: &Renderer, run: &Run, camera: &Camera, what: &
         assert_eq!(cell.imagery_lod, imagery_lod, "{what}: imagery LOD of {:?}", (ring, cx, cy));
         if ring == 0 {
             let g = run.layout.global_address(ring, cx, cy);
-            let pattern = pattern_hash(g.x as i32 as u32, g.y as i32 as u32, s.tlm.seed) % s.tlm.patterns;
+            let pattern = cell_pattern([g.x as i32, g.y as i32], s.tlm.seed, s.tlm.corner_colours());
             assert_eq!(cell.visibility, tlm_visibility(pattern), "{what}: pattern of {g:?}");
         } else {
             assert_eq!(cell.visibility, TLM_FIRST_PATTERN);

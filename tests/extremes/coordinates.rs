@@ -42,7 +42,7 @@ fn worst_placement_error_m(r: &Renderer, seeds: &[SeedRecord], camera_grid_m: DV
     seeds
         .iter()
         .map(|s| {
-            let pattern = cell_pattern(s.address, tlm.seed, tlm.patterns);
+            let pattern = cell_pattern(s.address, tlm.seed, tlm.corner_colours());
             let unit = patterns.positions_unit[(pattern * spp + s.rank) as usize];
             let exact = [0, 1].map(|a| (f64::from(s.address[a]) + f64::from(unit[a])) * tlm.cell_m);
             let gpu = [0, 1].map(|a| camera_grid_m[a] + f64::from(s.position_rel_m[a]));

@@ -85,8 +85,9 @@ gpu_struct! {
         pub rings: u32,
         /// Cells per ring side.
         pub cells: u32,
-        /// Seed patterns P (visibility of a ring-0 cell is 1 + hash % P).
-        pub patterns: u32,
+        /// Corner colours C of the seed patterns (`tlm.patterns` = C⁴): a ring-0 cell's
+        /// visibility is 1 + its pattern, the one of its four corners' hashed colours.
+        pub corner_colours: u32,
         /// The world's seed number (`tlm.seed`): the germ of every ring-0 cell's pattern hash.
         pub seed: u32,
         /// Always 0: OR-ed into every product so no compiler fuses it into an FMA (see the shader).

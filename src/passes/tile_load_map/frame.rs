@@ -122,7 +122,7 @@ impl TlmFrame {
             height_lod_count: lods.range_m.len() as u32,
             rings: layout.rings,
             cells: layout.cells,
-            patterns: s.patterns.max(1),
+            corner_colours: s.corner_colours(),
             seed: s.seed,
             no_fuse: 0,
             occlusion_tolerance_per_m: s.occlusion().per_m() as f32,

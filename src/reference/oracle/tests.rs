@@ -250,7 +250,7 @@ fn run(dataset: &Dataset, pose: [f64; 5], viewport_px: [u32; 2]) -> (Vec<OracleS
     let table = ClassTable::load(&landcover.scheme).unwrap();
     let spp = settings.seeds.seeds_per_pattern;
     let tables = SeedTables::new(&table, &landcover.coding, settings.tlm.cell_m, spp, 1.0).unwrap();
-    let patterns = SeedPatterns::generate(settings.tlm.patterns, spp, settings.tlm.seed);
+    let patterns = SeedPatterns::generate(settings.tlm.corner_colours(), spp, settings.tlm.seed);
     let [x, y, above_m, yaw_deg, pitch_deg] = pose;
     let origin = dataset.manifest.origin_m;
     let z = dataset.height_at(x, y, 0).unwrap() + above_m;
