@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The speed trade (issue 6): `terramp sweep` over nc/, zion/ and the synthetic default dataset, every
-# preset, and docs/TRADE.md written from what it measured. One command:
+# The speed trade (issues 6 and 12): `terramp sweep` over nc/, zion/ and the synthetic default
+# dataset, every preset judged against the ground truth (`terramp truth`: every seed as its mesh,
+# finest tiles, 4 × 4 supersampled), and docs/TRADE.md written from what it measured. One command:
 #
 #   scripts/trade.sh            # needs ../shared/data (nc/, zion/ and models/)
 #
@@ -8,15 +9,15 @@
 #    reused while `terramp info` reads it): nc/ (DEM, Landsat bands 3,2,1, land use) and zion/ (DEM,
 #    NLCD) as data-tools/tests/support builds them, and the synthetic default (`synth --size 1024`).
 # 2. Bakes the 11 shared models into impostors (reused when present) and writes a settings layer
-#    that points `draw_seeds.impostors` at them, so that every frame, the references' included, shows
-#    its trees.
+#    that points `draw_seeds.impostors` at them, so that every frame shows its trees and the ground
+#    truths draw their meshes.
 # 3. Sweeps each dataset along its default path (nc/ and zion/: the generated orbit; synthetic:
 #    config/paths/default.toml) into docs/trade/<name>/ (trade.csv, trade.json, trade.png,
 #    trade.md), then writes docs/TRADE.md (`scripts/trade_page.py`): how it was measured, each
 #    dataset's tables and plot, and the issue's acceptance checks computed from the JSON.
 #
 # Environment: FRAMES (60 timed frames per point), WARMUP (10), SAMPLES (3 poses), PRESETS
-# (fast,balanced,accurate), WIDTH × HEIGHT (1280 × 720), DATA_DIR, SWEEP ("synthetic nc zion": the
+# (fast,balanced,accurate), WIDTH × HEIGHT (1280 × 720), TRUTH_SUPERSAMPLE (4), TRUTH_REACH_M (4000), DATA_DIR, SWEEP ("synthetic nc zion": the
 # datasets to sweep again; the page is always written from all three folders' trade.json, so
 # SWEEP=nc re-measures nc/ alone and SWEEP= only rewrites the page).
 set -euo pipefail
@@ -77,6 +78,7 @@ for name in ${SWEEP-synthetic nc zion}; do
     echo "## sweep $name" >&2
     "$terramp" sweep --dataset "$data/$name" --out "docs/trade/$name" --presets "$presets" \
         --frames "$frames" --warmup "$warmup" --samples "$samples" --width "$width" --height "$height" \
+        --truth-supersample "${TRUTH_SUPERSAMPLE:-4}" --truth-reach-m "${TRUTH_REACH_M:-4000}" \
         --settings "$trees" 2>/dev/null
 done
 
