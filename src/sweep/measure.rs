@@ -20,6 +20,7 @@ use crate::config::Settings;
 use crate::dataset::Dataset;
 use crate::frame::Renderer;
 use crate::gpu::Gpu;
+use crate::gpu::gpu_types::SeedRecord;
 use crate::path::CameraPath;
 use crate::profile::{Meta, Session, Summary, timing_of};
 use crate::reference::accuracy::{HeightError, SeedAgreement};
@@ -122,15 +123,14 @@ impl Flight<'_> {
         let mut per_pose: Vec<(SeedAgreement, HeightError)> = Vec::new();
         let mut selected: Vec<Vec<([i64; 2], u32)>> = Vec::new();
         let frames = self.settle(&mut renderer, &label, progress, |r, camera| {
-            let figures = seed_figures(r, camera)?;
-            if let Some((agreement, height)) = figures {
+            let kept = r.read_seeds()?.map(|(records, _)| records);
+            if let Some((agreement, height)) = seed_figures(r, camera, kept.as_deref())? {
                 let (a, h) = seeds.get_or_insert_default();
                 a.add(&agreement);
                 h.add(&height);
                 per_pose.push((agreement, height));
             }
-            let kept = r.read_seeds()?.map(|(records, _)| records).unwrap_or_default();
-            selected.push(kept.iter().map(|s| (s.address.map(i64::from), s.rank)).collect());
+            selected.push(kept.iter().flatten().map(|s| (s.address.map(i64::from), s.rank)).collect());
             Ok(())
         })?;
         drop(renderer);
@@ -211,9 +211,13 @@ impl Flight<'_> {
     }
 }
 
-/// The settled view's seeds against the oracle (`None` without land cover).
-fn seed_figures(r: &Renderer, camera: &Camera) -> Result<Option<(SeedAgreement, HeightError)>, SweepError> {
-    let (Some((tables, patterns)), Some((kept, _))) = (r.seed_world(), r.read_seeds()?) else {
+/// The settled view's kept seeds against the summit oracle (`None` without land cover).
+fn seed_figures(
+    r: &Renderer,
+    camera: &Camera,
+    kept: Option<&[SeedRecord]>,
+) -> Result<Option<(SeedAgreement, HeightError)>, SweepError> {
+    let (Some((tables, patterns)), Some(kept)) = (r.seed_world(), kept) else {
         return Ok(None);
     };
     let inputs = OracleInputs {
@@ -227,5 +231,5 @@ fn seed_figures(r: &Renderer, camera: &Camera) -> Result<Option<(SeedAgreement, 
     let (visible, _) = visible_seeds(&inputs)?;
     let origin = r.dataset.manifest.origin_m;
     let camera_grid_m = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
-    Ok(Some((SeedAgreement::of(&kept, &visible), HeightError::of(&r.dataset, camera_grid_m, &kept)?)))
+    Ok(Some((SeedAgreement::of(kept, &visible), HeightError::of(&r.dataset, camera_grid_m, kept)?)))
 }

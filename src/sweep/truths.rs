@@ -14,11 +14,11 @@ use crate::dataset::Dataset;
 use crate::gpu::Gpu;
 use crate::truth::{Truth, TruthOptions, render_truth};
 
-/// What makes two settings grow the same seeds, in the same places.
+/// What makes two settings grow the same seeds, in the same places, seen through the same viewport.
 fn world_key(s: &Settings) -> String {
     let (t, seeds) = (&s.tlm, &s.seeds);
     format!(
-        "{}|{}|{}|{}|{}|{}|{}|{}",
+        "{}|{}|{}|{}|{}|{}|{}|{}x{}|{}",
         t.cell_m,
         t.patterns,
         t.seed,
@@ -26,7 +26,9 @@ fn world_key(s: &Settings) -> String {
         seeds.class_table,
         seeds.sink_fraction,
         seeds.ground_colour_radius_m,
-        s.render.width
+        s.render.width,
+        s.render.height,
+        s.render.fov_deg
     )
 }
 
