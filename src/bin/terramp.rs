@@ -52,27 +52,47 @@ impl SettingsArgs {
     }
 }
 
+/// One view of a dataset: which, from where, through what viewport, with what settings.
+#[derive(Args)]
+struct ViewArgs {
+    #[arg(long)]
+    dataset: PathBuf,
+    /// X,Y,Z,YAW,PITCH: position in the dataset CRS (metres; Z above the datum), compass
+    /// heading and pitch above the horizon (degrees). E.g. `--camera 636000,214000,900,0,-20`.
+    #[arg(long, allow_hyphen_values = true)]
+    camera: String,
+    /// Vertical field of view, degrees.
+    #[arg(long)]
+    fov: Option<f64>,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    #[command(flatten)]
+    settings: SettingsArgs,
+}
+
+impl ViewArgs {
+    /// The settings with the view's overrides, and the camera.
+    fn load(&self) -> Result<(Settings, Camera)> {
+        let mut settings = self.settings.load()?;
+        let r = &mut settings.render;
+        r.fov_deg = self.fov.unwrap_or(r.fov_deg);
+        r.width = self.width.unwrap_or(r.width);
+        r.height = self.height.unwrap_or(r.height);
+        let camera = Camera::parse_pose(&self.camera, r.fov_deg, r.near_m)?;
+        Ok((settings, camera))
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Render one frame of a dataset to a PNG.
     Render {
-        #[arg(long)]
-        dataset: PathBuf,
-        /// X,Y,Z,YAW,PITCH: position in the dataset CRS (metres; Z above the datum), compass
-        /// heading and pitch above the horizon (degrees). E.g. `--camera 636000,214000,900,0,-20`.
-        #[arg(long, allow_hyphen_values = true)]
-        camera: String,
-        /// Vertical field of view, degrees.
-        #[arg(long)]
-        fov: Option<f64>,
-        #[arg(long)]
-        width: Option<u32>,
-        #[arg(long)]
-        height: Option<u32>,
+        #[command(flatten)]
+        view: ViewArgs,
         #[arg(long)]
         out: PathBuf,
-        #[command(flatten)]
-        settings: SettingsArgs,
     },
     /// The main job on the embedded default: synthesize the default dataset and bake the
     /// species' impostors if missing, then fly over it with seeds drawn, write the frames and
@@ -173,13 +193,9 @@ enum Command {
 
 fn main() -> Result<()> {
     match Cli::parse().command {
-        Command::Render { dataset, camera, fov, width, height, out, settings } => {
-            let mut settings = settings.load()?;
-            settings.render.fov_deg = fov.unwrap_or(settings.render.fov_deg);
-            settings.render.width = width.unwrap_or(settings.render.width);
-            settings.render.height = height.unwrap_or(settings.render.height);
-            let camera = Camera::parse_pose(&camera, settings.render.fov_deg, settings.render.near_m)?;
-            render_one(&dataset, settings, &camera, &out)
+        Command::Render { view, out } => {
+            let (settings, camera) = view.load()?;
+            render_one(&view.dataset, settings, &camera, &out)
         }
         Command::Demo { dataset, out, frames, warmup, impostors, models, settings } => {
             demo::run(&demo::DemoArgs {

@@ -5,27 +5,16 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use terramp::camera::Camera;
 use terramp::dataset::Dataset;
 use terramp::gpu::Gpu;
 use terramp::truth::{DEFAULT_REACH_M, TruthOptions, files, render_truth};
 
-use super::SettingsArgs;
+use super::ViewArgs;
 
 #[derive(Args)]
 pub struct TruthArgs {
-    #[arg(long)]
-    dataset: PathBuf,
-    /// X,Y,Z,YAW,PITCH as for `render`.
-    #[arg(long, allow_hyphen_values = true)]
-    camera: String,
-    /// Vertical field of view, degrees.
-    #[arg(long)]
-    fov: Option<f64>,
-    #[arg(long)]
-    width: Option<u32>,
-    #[arg(long)]
-    height: Option<u32>,
+    #[command(flatten)]
+    view: ViewArgs,
     /// Samples per pixel along each axis (box-filtered).
     #[arg(long, default_value_t = 4)]
     supersample: u32,
@@ -38,18 +27,12 @@ pub struct TruthArgs {
     /// Folder written: truth.png, seed_ids.u32, depth.f32, seeds.csv, truth.json.
     #[arg(long)]
     out: PathBuf,
-    #[command(flatten)]
-    settings: SettingsArgs,
 }
 
 impl TruthArgs {
     pub fn run(self) -> Result<()> {
-        let mut settings = self.settings.load()?;
-        settings.render.fov_deg = self.fov.unwrap_or(settings.render.fov_deg);
-        settings.render.width = self.width.unwrap_or(settings.render.width);
-        settings.render.height = self.height.unwrap_or(settings.render.height);
-        let camera = Camera::parse_pose(&self.camera, settings.render.fov_deg, settings.render.near_m)?;
-        let dataset = Dataset::open(&self.dataset)?;
+        let (settings, camera) = self.view.load()?;
+        let dataset = Dataset::open(&self.view.dataset)?;
         let gpu = Gpu::new(settings.gpu.adapter)?;
         eprintln!("terramp: adapter {}", gpu.describe());
         let options = TruthOptions {
