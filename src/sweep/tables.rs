@@ -71,10 +71,17 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
         for r in &p.error.bands {
             let to = if r.band.to_m.is_finite() { format!("{:.0}", r.band.to_m) } else { "∞".into() };
             let share = 100.0 * r.pixels as f64 / p.error.frame.pixels.max(1) as f64;
+            // A band with no pixel (or too thin for an SSIM window) has no figure.
+            let figure = |v: f64, text: String| if v.is_finite() { text } else { "–".into() };
             writeln!(
                 out,
-                "| {} | {} | {:.0}–{to} | {share:.1} % | {:.1} dB | {:.4} | {:.4} |",
-                p.label, r.band.name, r.band.from_m, r.psnr_db, r.ssim, r.flip
+                "| {} | {} | {:.0}–{to} | {share:.1} % | {} | {} | {} |",
+                p.label,
+                r.band.name,
+                r.band.from_m,
+                figure(r.psnr_db, format!("{:.1} dB", r.psnr_db)),
+                figure(r.ssim, format!("{:.4}", r.ssim)),
+                figure(r.flip, format!("{:.4}", r.flip))
             )?;
         }
     }
