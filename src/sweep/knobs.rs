@@ -131,9 +131,50 @@ pub fn points(presets: &[String], knobs: &[Knob]) -> Vec<Point> {
     points
 }
 
+/// Each preset as it is, then each preset with one knob set to one of its values, knob by knob:
+/// one series per knob through every preset, the others left at the preset's (what a front over
+/// many knobs needs: their product would be thousands of points).
+pub fn series(presets: &[String], knobs: &[Knob]) -> Vec<Point> {
+    let alone = presets.iter().map(|preset| Point { preset: preset.clone(), knobs: Vec::new() });
+    let varied = knobs.iter().flat_map(|knob| {
+        knob.values.iter().flat_map(move |v| {
+            presets.iter().map(move |preset| Point {
+                preset: preset.clone(),
+                knobs: vec![(knob.key.clone(), v.clone())],
+            })
+        })
+    });
+    alone.chain(varied).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn series_vary_one_knob_at_a_time() {
+        let presets = ["fast".to_owned(), "accurate".to_owned()];
+        let knobs: Vec<Knob> =
+            ["seeds.density_scale=0.25,0.5,1", "tlm.cells=16"].iter().map(|k| k.parse().unwrap()).collect();
+        let labels: Vec<String> = series(&presets, &knobs).iter().map(Point::label).collect();
+        assert_eq!(
+            labels,
+            [
+                "fast",
+                "accurate",
+                "fast seeds.density_scale=0.25",
+                "accurate seeds.density_scale=0.25",
+                "fast seeds.density_scale=0.5",
+                "accurate seeds.density_scale=0.5",
+                "fast seeds.density_scale=1",
+                "accurate seeds.density_scale=1",
+                "fast tlm.cells=16",
+                "accurate tlm.cells=16"
+            ]
+        );
+        // The product instead crosses them: 2 presets × 3 × 1.
+        assert_eq!(points(&presets, &knobs).len(), 6);
+    }
 
     #[test]
     fn knobs_parse_with_arrays_and_strings() {

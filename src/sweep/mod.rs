@@ -103,8 +103,11 @@ pub struct SweepOptions {
     pub path: Option<PathBuf>,
     /// Presets to measure (`fast`, `balanced`, `accurate`), each crossed with every knob value.
     pub presets: Vec<String>,
-    /// Settings keys to vary, one `--knob` each; the points are their cartesian product.
+    /// Settings keys to vary, one `--knob` each; the points are their cartesian product, or with
+    /// `series` one knob at a time (`knobs::series`).
     pub knobs: Vec<Knob>,
+    /// Vary one knob at a time from each preset instead of crossing them all.
+    pub series: bool,
     /// A settings file laid over every point's preset and over the reference (before the knobs).
     pub settings: Option<PathBuf>,
     /// Timed frames per point, spread evenly along the path, after `warmup` frames at its start.
@@ -159,7 +162,10 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         s.render.height = options.height.unwrap_or(s.render.height);
         s
     };
-    let points = points(&options.presets, &options.knobs);
+    let points = match options.series {
+        true => knobs::series(&options.presets, &options.knobs),
+        false => points(&options.presets, &options.knobs),
+    };
     let settings: Vec<Settings> =
         points.iter().map(|p| p.settings(user.as_ref()).map(resize)).collect::<Result<_, _>>()?;
     let reference_point = Point { preset: "accurate".into(), knobs: Vec::new() };

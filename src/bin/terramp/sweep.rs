@@ -22,6 +22,9 @@ pub struct SweepArgs {
     /// the product), e.g. `--knob seeds.occlusion_tolerance_m=0.5,1,2`.
     #[arg(long)]
     knob: Vec<Knob>,
+    /// Vary one knob at a time from each preset (a series per knob) instead of their product.
+    #[arg(long)]
+    series: bool,
     /// Timed frames per point, spread evenly along the path.
     #[arg(long, default_value_t = 60)]
     frames: u32,
@@ -59,6 +62,7 @@ impl SweepArgs {
             path: self.path,
             presets: self.presets,
             knobs: self.knob,
+            series: self.series,
             settings: self.settings,
             frames: self.frames,
             warmup: self.warmup,
