@@ -335,6 +335,7 @@ fn a_truth_grown_from_the_land_cover_is_written_whole() {
     let settings = small_settings(IMAGE_PX[0], IMAGE_PX[1]);
     let r = terramp_testkit::renderer(&dir, settings.clone());
     let camera = camera::over_fraction(&r, [0.4, 0.4], 20.0, 30.0, -15.0);
+    let eye = eye_grid(&r, &camera);
     drop(r);
     let options = TruthOptions { supersample: 2, reach_m: 300.0, impostors: impostors.to_owned() };
     let truth = render_truth(gpu(), dataset, &settings, &camera, &options).unwrap();
@@ -345,7 +346,6 @@ fn a_truth_grown_from_the_land_cover_is_written_whole() {
         truth.counts.candidates
     );
     assert!(visible > 10 && visible < truth.seeds.len());
-    let eye = eye_grid(&terramp_testkit::renderer(&dir, settings.clone()), &camera);
     for s in &truth.seeds {
         let p = DVec3::new(s.position_grid_m[0], s.position_grid_m[1], s.ground_m);
         assert!((p - eye).length() < options.reach_m, "a seed beyond the reach: {s:?}");
