@@ -48,6 +48,9 @@ pub enum PathError {
     },
 }
 
+/// Spline samples per key when `CameraPath::walk` measures the arc length.
+const WALK_SAMPLES_PER_KEY: f64 = 4096.0;
+
 /// One pose the flight passes through (`[[key]]` in the file).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -112,6 +115,35 @@ impl CameraPath {
             near_m,
         }
     }
+
+    /// Up to `count` cameras along the path from parameter `t0`, each `step_m` metres of flight
+    /// beyond the one before (arc length, measured on a fine sampling of the spline), with their
+    /// parameters: a flight at a steady speed, as consecutive frames see it. Fewer when the path
+    /// ends first; one when it does not move (a single key, or `step_m` not positive).
+    pub fn walk(&self, t0: f64, step_m: f64, count: usize, fov_deg: f64, near_m: f64) -> Vec<(f64, Camera)> {
+        let t0 = t0.clamp(0.0, 1.0);
+        let mut out = vec![(t0, self.camera_at(t0, fov_deg, near_m))];
+        if count <= 1 || step_m.is_nan() || step_m <= 0.0 {
+            out.truncate(count.max(1));
+            return out;
+        }
+        // Fine enough that a chord is the arc to well under a millimetre on any sensible path.
+        let dt = 1.0 / (self.keys.len() as f64 * WALK_SAMPLES_PER_KEY);
+        let (mut t, mut travelled_m, mut next_m) = (t0, 0.0, step_m);
+        let mut at = out[0].1.position_m;
+        while out.len() < count && t < 1.0 {
+            let t1 = (t + dt).min(1.0);
+            let p1 = self.camera_at(t1, fov_deg, near_m).position_m;
+            let chord_m = (p1 - at).length();
+            while out.len() < count && travelled_m + chord_m >= next_m && chord_m > 0.0 {
+                let t_step = t + (t1 - t) * (next_m - travelled_m) / chord_m;
+                out.push((t_step, self.camera_at(t_step, fov_deg, near_m)));
+                next_m += step_m;
+            }
+            (t, at, travelled_m) = (t1, p1, travelled_m + chord_m);
+        }
+        out
+    }
 }
 
 fn catmull_rom(p0: DVec3, p1: DVec3, p2: DVec3, p3: DVec3, t: f64) -> DVec3 {
@@ -147,10 +179,31 @@ mod tests {
     }
 
     #[test]
+    fn a_walk_steps_evenly_along_the_arc_and_stops_at_the_end() {
+        let path = CameraPath::parse(TWO_KEYS, "test").unwrap();
+        let walk = path.walk(0.25, 2.5, 16, 60.0, 0.1);
+        assert_eq!(walk.len(), 16);
+        for pair in walk.windows(2) {
+            let step_m = (pair[1].1.position_m - pair[0].1.position_m).length();
+            assert!((step_m - 2.5).abs() < 1e-3, "{step_m}");
+            assert!(pair[1].0 > pair[0].0);
+        }
+        // To the end of the path and no further: the last step stops within a step of it.
+        let end = path.camera_at(1.0, 60.0, 0.1).position_m;
+        let to_end = path.walk(0.99, 5.0, 100, 60.0, 0.1);
+        let last = to_end.last().unwrap();
+        assert!(to_end.len() > 1 && to_end.len() < 100 && last.0 <= 1.0, "{}", to_end.len());
+        assert!((end - last.1.position_m).length() < 5.0);
+        assert_eq!(path.walk(0.5, 0.0, 5, 60.0, 0.1).len(), 1);
+        assert!(path.walk(0.5, 1.0, 0, 60.0, 0.1).len() == 1);
+    }
+
+    #[test]
     fn a_single_key_is_a_still_camera() {
         let one = "[[key]]\nat = [5.0, 6.0, 7.0]\nyaw_deg = 0.0\npitch_deg = 0.0\n";
         let path = CameraPath::parse(one, "one").unwrap();
         assert_eq!(path.camera_at(0.7, 60.0, 0.1).position_m, DVec3::new(5.0, 6.0, 7.0));
+        assert_eq!(path.walk(0.2, 1.0, 8, 60.0, 0.1).len(), 1);
     }
 
     #[test]

@@ -23,6 +23,7 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
         .args(["sweep", "--presets", "fast,accurate", "--frames", "4", "--warmup", "2", "--samples", "2"])
         .args(["--width", "160", "--height", "90", "--knob", "seeds.frustum_epsilon=0,0.05"])
         .args(["--truth-supersample", "2", "--truth-reach-m", "1500"])
+        .args(["--popping-frames", "4", "--popping-step-m", "3"])
         .arg("--settings")
         .arg(&layer)
         .arg("--dataset")
@@ -42,7 +43,8 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
     assert!(plot.width() > 600 && plot.height() > 300);
     let _ = std::fs::remove_dir_all(&out);
 
-    assert_eq!(json["schema"], "terramp-trade/2");
+    assert_eq!(json["schema"], "terramp-trade/3");
+    assert_eq!(json["popping_flight"]["frames"], 4);
     assert_eq!(json["resolution"], serde_json::json!([160, 90]));
     let points = json["points"].as_array().unwrap();
     let labels: Vec<&str> = points.iter().map(|p| p["label"].as_str().unwrap()).collect();
@@ -71,6 +73,9 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
         let (seeds, any_part) = (&point["seeds"], &point["any_part"]);
         for (name, value) in [
             ("frame_flip", &point["frame_flip"]),
+            ("popping", &point["popping"]["popping"]),
+            ("block_change_largest", &point["popping"]["largest"]),
+            ("truth_block_change_largest", &point["popping"]["truth_largest"]),
             ("any_part_visible", &any_part["visible"]),
             ("any_part_recall_pct", &any_part["recall_pct"]),
             ("pixel_weighted_recall_pct", &any_part["pixel_weighted_recall_pct"]),
@@ -120,6 +125,16 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
             assert!(db > 20.0 && db <= PSNR_CAP_DB, "{}: {key} {db}", row[0]);
         }
         assert_eq!(point["samples"].as_array().unwrap().len(), 2);
+        // Popping: three pairs of frames; block changes are levels of 255, the truth moves too.
+        let popping = &point["popping"];
+        assert_eq!(popping["pairs"], 3, "{popping}");
+        let (largest, truth_largest) =
+            (popping["largest"].as_f64().unwrap(), popping["truth_largest"].as_f64().unwrap());
+        assert!(
+            largest > 0.0 && largest <= 255.0 && truth_largest > 0.0 && truth_largest <= 255.0,
+            "{popping}"
+        );
+        assert!(popping["popping"].as_f64().unwrap() <= largest, "{popping}");
         let flip = point["frame_flip"].as_f64().unwrap();
         assert!(flip > 0.0 && flip < 0.5, "{}: FLIP {flip}", row[0]);
         // The bands: meshes first, beyond last; their pixels are the frame's bar the sky.

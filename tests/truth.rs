@@ -21,7 +21,7 @@ use terramp::frame::Renderer;
 use terramp::impostor::{AlphaMode, Impostor};
 use terramp::reference::oracle::{OracleSeed, segment_clears_dem};
 use terramp::seeds::{pcg, seed_hash};
-use terramp::truth::{Truth, TruthOptions, draw_truth, files, render_truth, truth_settings};
+use terramp::truth::{Truth, TruthOptions, TruthRenderer, draw_truth, files, render_truth, truth_settings};
 use terramp_testkit::data::target_tmp_dir;
 use terramp_testkit::{camera, gpu, small_settings, synth_dataset};
 
@@ -365,6 +365,19 @@ fn a_truth_grown_from_the_land_cover_is_written_whole() {
         serde_json::from_str(&std::fs::read_to_string(out.join(files::META_FILE)).unwrap()).unwrap();
     assert_eq!(meta["seeds_visible"], visible);
     assert_eq!(meta["samples_width"], IMAGE_PX[0] * 2);
+    // One truth renderer over several views (a flight, a sweep's poses) gives each view's truth as
+    // a fresh one does: nothing of the view before carries over.
+    let mut other = camera;
+    other.position_m += DVec3::new(30.0, -20.0, 5.0);
+    other.yaw_deg += 15.0;
+    let mut flight = TruthRenderer::new(gpu(), Dataset::open(&dir).unwrap(), &settings, &options).unwrap();
+    let first = flight.render(&other).unwrap();
+    let again = flight.render(&camera).unwrap();
+    assert_ne!(first.colour, truth.colour, "the second view is a different view");
+    assert!(
+        again.colour == truth.colour && again.seed_ids == truth.seed_ids && again.depth == truth.depth,
+        "a reused truth renderer differs from a fresh one"
+    );
     // Bad options are errors, not pictures.
     let zero = TruthOptions { supersample: 0, ..options.clone() };
     let dataset = Dataset::open(&dir).unwrap();

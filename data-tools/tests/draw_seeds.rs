@@ -25,6 +25,7 @@ use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::{FrameReport, Renderer};
 use terramp::gpu::{AdapterChoice, Gpu};
+use terramp::reference::frame_change::largest_block_change;
 use terramp::reference::seed_select::SeedComparison;
 
 use support::{build_nc, tests_dir};
@@ -353,7 +354,8 @@ fn trees_stand_on_forest_not_on_water(
 }
 
 /// Largest changes between consecutive frames: of one pixel's luma, and of a 4 × 4 block's mean
-/// luma (the dither's period: a cross-fade flips single pixels, a pop changes whole blocks).
+/// luma (`frame_change`: the dither's period, so a cross-fade flips single pixels, a pop changes
+/// whole blocks).
 fn frame_change(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, f64) {
     let luma =
         |p: &image::Rgba<u8>| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
@@ -361,14 +363,7 @@ fn frame_change(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, f64) {
     let delta = |x: u32, y: u32| luma(b.get_pixel(x, y)) - luma(a.get_pixel(x, y));
     let pixel =
         (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| delta(x, y).abs()).fold(0.0, f64::max);
-    let mut block = 0.0f64;
-    for by in 0..h / 4 {
-        for bx in 0..w / 4 {
-            let sum: f64 = (0..16).map(|k| delta(4 * bx + k % 4, 4 * by + k / 4)).sum();
-            block = block.max((sum / 16.0).abs());
-        }
-    }
-    (pixel, block)
+    (pixel, largest_block_change(a, b).unwrap())
 }
 
 /// A slow change of distance, with everything else still: the camera stays, and every seed's LOD

@@ -2,13 +2,15 @@
 //! shader-shaped (same structure, same f32 arithmetic in the same order), so tests can demand
 //! GPU == CPU exactly for integer outputs. The exact oracle used to measure accuracy (f64, full
 //! resolution) is separate from these twins: a twin reproduces the GPU, the oracle judges it.
-//! `accuracy` (seeds against the oracle) and `image_metrics` (PSNR, SSIM of frames against
-//! all-resident references) are what the speed trade (`sweep`) reports; `worst` takes error
-//! maxima that never drop a NaN.
+//! `accuracy` (seeds against the oracle), `image_metrics` (PSNR, SSIM of frames against the
+//! ground truth) and `frame_change` (popping: 4 × 4 block changes between consecutive frames,
+//! against the truth's along the same flight) are what the speed trade (`sweep`) reports; `worst`
+//! takes error maxima that never drop a NaN.
 
 pub mod accuracy;
 pub mod compact;
 pub mod depth_pyramid;
+pub mod frame_change;
 pub mod image_metrics;
 pub mod oracle;
 pub mod seed_select;

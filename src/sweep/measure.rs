@@ -4,8 +4,11 @@
 //! each sample pose the settled view's seeds go to the exact summit oracle (height error, and
 //! agreement with pass 3's rule) and to the any-part oracle of its world's truth, and its frame is
 //! judged against the reference world's truth, whole and per distance band
-//! (`truth::compare`). With seeds drawn, a second renderer of the same settings without impostors
-//! settles the same poses for the ground alone, judged against the truth's ground.
+//! (`truth::compare`). Then, from the popping flight's first pose settled, it flies the popping
+//! flight frame by frame as a user would (streaming and readbacks a frame or two behind), and its
+//! frames' changes are judged against the truth's along the same flight (`frame_change::Popping`).
+//! With seeds drawn, a second renderer of the same settings without impostors settles the same
+//! poses for the ground alone, judged against the truth's ground.
 
 use std::path::Path;
 
@@ -24,6 +27,7 @@ use crate::gpu::gpu_types::SeedRecord;
 use crate::path::CameraPath;
 use crate::profile::{Meta, Session, Summary, timing_of};
 use crate::reference::accuracy::{HeightError, SeedAgreement};
+use crate::reference::frame_change::Popping;
 use crate::reference::image_metrics::{capped_psnr_db, mse, psnr_of_mse};
 use crate::reference::oracle::{OracleInputs, visible_seeds};
 use crate::truth::compare::{bands, frame_error, pool};
@@ -34,6 +38,8 @@ pub(super) struct Flight<'a> {
     pub path: &'a CameraPath,
     /// Sample poses: path parameter and camera.
     pub poses: &'a [(f64, Camera)],
+    /// The popping flight: consecutive frames at a steady speed (empty: not measured).
+    pub popping: &'a [Camera],
     pub warmup: u32,
     pub frames: u32,
 }
@@ -74,6 +80,30 @@ impl Flight<'_> {
             images.push(renderer.read_colour()?);
         }
         Ok(images)
+    }
+
+    /// The frames of the popping flight in `renderer`: the first pose settled, then one frame per
+    /// pose, each read back.
+    fn fly_popping(
+        &self,
+        renderer: &mut Renderer,
+        what: &str,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Vec<RgbaImage>, SweepError> {
+        let mut frames = Vec::with_capacity(self.popping.len());
+        for (i, camera) in self.popping.iter().enumerate() {
+            progress(Progress::Step(&format!(
+                "{what}: popping flight, frame {} of {}",
+                i + 1,
+                self.popping.len()
+            )));
+            match i {
+                0 => _ = renderer.render_resolved(camera)?,
+                _ => _ = renderer.render(camera)?,
+            }
+            frames.push(renderer.read_colour()?);
+        }
+        Ok(frames)
     }
 
     /// Times `point` along the path, then measures it at every pose against `references`.
@@ -133,7 +163,12 @@ impl Flight<'_> {
             selected.push(kept.iter().flatten().map(|s| (s.address.map(i64::from), s.rank)).collect());
             Ok(())
         })?;
+        let flown = self.fly_popping(&mut renderer, &label, progress)?;
         drop(renderer);
+        let popping = match flown.is_empty() {
+            true => None,
+            false => Some(Popping::of(&flown, truths.flight_images())?),
+        };
         // The any-part oracle, where the truth drew seeds (impostors given).
         let draws_truth_seeds = truths.options().reach_m > 0.0;
         let any_part: Vec<Visibility> = match draws_truth_seeds {
@@ -204,6 +239,7 @@ impl Flight<'_> {
             frame_psnr_db: error.frame.psnr_db,
             frame_ssim: error.frame.ssim,
             frame_flip: error.frame.flip,
+            popping,
             error,
             samples,
         };

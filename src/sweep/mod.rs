@@ -15,9 +15,14 @@
 //!   height from the f64 drawn ground (`reference::accuracy`), and recall and precision against pass 3's
 //!   own rule, done exactly.
 //!
+//! Popping is measured along a short flight of consecutive frames at a steady speed
+//! (`popping_frames` frames `popping_step_m` apart, from the middle sample pose on): the largest
+//! 4 × 4 block change between frames, against the reference world's truth along the same flight
+//! (`reference::frame_change`).
+//!
 //! Seed counts add up over the sample poses (recall is over all their seeds); image errors pool
 //! the poses' pixels (as one image). `report` writes `trade.csv`, `trade.json` (schema
-//! `terramp-trade/2`), `tables` `trade.md` and the terminal table; `plot` draws `trade.png`.
+//! `terramp-trade/3`), `tables` `trade.md` and the terminal table; `plot` draws `trade.png`.
 //! Progress goes to a callback, one step per frame rendered, pose settled and truth rendered.
 
 pub mod knobs;
@@ -38,7 +43,7 @@ use crate::path::CameraPath;
 use crate::profile::ProfileError;
 use crate::truth::TruthOptions;
 pub use knobs::{Knob, Point, points};
-pub use report::{SCHEMA, Trade, TradePoint};
+pub use report::{PoppingFlight, SCHEMA, Trade, TradePoint};
 
 /// Why a sweep, or writing its outputs, failed.
 #[derive(Debug, Error)]
@@ -120,6 +125,11 @@ pub struct SweepOptions {
     pub width: Option<u32>,
     /// Override of `render.height` for every point and the reference, pixels.
     pub height: Option<u32>,
+    /// Frames of the popping flight (0: popping is not measured).
+    pub popping_frames: u32,
+    /// Metres the camera moves between the popping flight's frames (0.25 m: 15 m/s at 60 frames
+    /// per second; slow, so that motion alone changes few blocks much and artefacts stand out).
+    pub popping_step_m: f64,
     /// How the ground truths are rendered (supersampling, reach; impostors: the reference
     /// settings' `draw_seeds.impostors` when empty; without any, the truths grow no seeds).
     pub truth: TruthOptions,
@@ -136,7 +146,7 @@ pub enum Progress<'a> {
 
 /// File `write_outputs` puts the table in, as CSV, one row per point.
 pub const CSV_FILE: &str = "trade.csv";
-/// File `write_outputs` puts the whole `Trade` in, as JSON (schema `terramp-trade/2`).
+/// File `write_outputs` puts the whole `Trade` in, as JSON (schema `terramp-trade/3`).
 pub const JSON_FILE: &str = "trade.json";
 /// File `write_outputs` draws the speed/accuracy plot in.
 pub const PLOT_FILE: &str = "trade.png";
@@ -184,10 +194,29 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         })
         .collect();
     drop(dataset);
+    // The popping flight starts at the middle sample pose (settled there, then flown).
+    let (popping_t, popping_start) = poses[poses.len() / 2];
+    let popping: Vec<Camera> = match options.popping_frames {
+        0 => Vec::new(),
+        n => {
+            let walk = path.walk(popping_t, options.popping_step_m, n as usize, r.fov_deg, r.near_m);
+            if walk.len() < 2 {
+                let at = popping_start.position_m;
+                return Err(SweepError::Options(format!(
+                    "the popping flight from t = {popping_t:.2} ({:.0}, {:.0}) does not move: the path \
+                     ends there, or --popping-step-m is not positive",
+                    at.x, at.y
+                )));
+            }
+            walk.into_iter().map(|(_, camera)| camera).collect()
+        }
+    };
 
     let per_point = |s: &Settings| {
         let grounds = if s.draw_seeds.impostors.is_empty() { 0 } else { 1 };
-        u64::from(options.warmup + options.frames) + u64::from(options.samples) * (1 + grounds)
+        u64::from(options.warmup + options.frames)
+            + u64::from(options.samples) * (1 + grounds)
+            + popping.len() as u64
     };
     let mut truth = options.truth.clone();
     if truth.impostors.as_os_str().is_empty() {
@@ -201,13 +230,14 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         true => truths::world_count(&reference_settings, &settings),
         false => 1,
     };
-    let truth_steps = u64::from(options.samples) * worlds as u64;
+    let truth_steps = u64::from(options.samples) * worlds as u64 + popping.len() as u64;
     progress(Progress::Total(truth_steps + settings.iter().map(per_point).sum::<u64>()));
 
     let flight = measure::Flight {
         dataset_dir: &options.dataset,
         path: &path,
         poses: &poses,
+        popping: &popping,
         warmup: options.warmup,
         frames: options.frames,
     };
@@ -227,6 +257,11 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         warmup: options.warmup,
         frames: options.frames,
         sample_t: poses.iter().map(|(t, _)| *t).collect(),
+        popping_flight: (!popping.is_empty()).then_some(PoppingFlight {
+            frames: popping.len() as u32,
+            step_m: options.popping_step_m,
+            from_t: popping_t,
+        }),
         reference: format!(
             "ground truth: the accurate preset's world, every seed within {:.0} m as its full mesh{}, \
              every tile at its finest level, {}² samples per pixel; selections against their own world's truth",

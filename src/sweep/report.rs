@@ -6,14 +6,16 @@
 //!
 //! The JSON:
 //! ```text
-//! { "schema": "terramp-trade/2", "adapter": str, "timing": str, "dataset": str, "path": str,
-//!   "resolution": [w, h], "warmup": int, "frames": int, "sample_t": [float], "reference": str,
-//!   "settings": str | null,
+//! { "schema": "terramp-trade/3", "adapter": str, "timing": str, "dataset": str, "path": str,
+//!   "resolution": [w, h], "warmup": int, "frames": int, "sample_t": [float],
+//!   "popping_flight": { "frames": int, "step_m": float, "from_t": float } | null,
+//!   "reference": str, "settings": str | null,
 //!   "points": [ { "label": str, "preset": str, "knobs": { key: value },
 //!                 "frame_ms": float, "gpu_ms", "cpu_ms", "fps", "seeds_selected": float | null,
 //!                 "passes": [ { "label": str, "source": str, "median_ms": float } ],
 //!                 "seeds": seeds | null, "any_part": any_part | null,
 //!                 "ground_psnr_db", "frame_psnr_db", "frame_ssim", "frame_flip": float,
+//!                 "popping": { "pairs": int, "largest", "truth_largest", "popping": float } | null,
 //!                 "error": { "frame": region, "bands": [region] },
 //!                 "samples": [ { "t", "ground_psnr_db", "frame_psnr_db", "frame_ssim",
 //!                                "frame_flip": float, "seeds": seeds | null,
@@ -24,9 +26,10 @@
 //! `{ "visible", "selected", "selected_visible": int, "recall_pct", "precision_pct",
 //! "pixel_weighted_recall_pct": float }` (the truth's any-part oracle) and region is `{ "band":
 //! { "name", "from_m", "to_m" }, "pixels", "mse", "psnr_db", "ssim", "flip" }` (`truth::compare`;
-//! an infinite `to_m` and a figure of an empty band are `null`). The CSV has the same figures under the
-//! same names (pass medians as `<label>_ms`, seed figures without their `seeds.` prefix, knobs as
-//! `key=value;key=value`).
+//! an infinite `to_m` and a figure of an empty band are `null`); popping is in levels of 255
+//! (`reference::frame_change`). The CSV has the same figures under the same names (pass medians
+//! as `<label>_ms`, seed figures without their `seeds.` prefix, popping's as `popping`,
+//! `block_change_largest` and `truth_block_change_largest`, knobs as `key=value;key=value`).
 
 use std::collections::BTreeMap;
 
@@ -34,11 +37,12 @@ use serde::Serialize;
 
 use crate::gpu::TimeSource;
 use crate::reference::accuracy::{HeightError, SeedAgreement};
+use crate::reference::frame_change::Popping;
 use crate::truth::compare::FrameError;
 use crate::truth::visibility::Visibility;
 
 /// The version of the JSON layout.
-pub const SCHEMA: &str = "terramp-trade/2";
+pub const SCHEMA: &str = "terramp-trade/3";
 
 /// A sweep's figures: every point's speed and accuracy over the same path and sample poses.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -61,12 +65,25 @@ pub struct Trade {
     pub frames: u32,
     /// Path parameters of the sample poses.
     pub sample_t: Vec<f64>,
+    /// The flight popping is measured along (`None`: not measured).
+    pub popping_flight: Option<PoppingFlight>,
     /// What the images are compared with.
     pub reference: String,
     /// The settings file laid over every preset, if any.
     pub settings: Option<String>,
     /// One per preset × knob values, in the order of `knobs::points`.
     pub points: Vec<TradePoint>,
+}
+
+/// The short flight of consecutive frames popping is measured along.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PoppingFlight {
+    /// Frames flown.
+    pub frames: u32,
+    /// Metres between consecutive frames.
+    pub step_m: f64,
+    /// The path parameter it starts at (the middle sample pose).
+    pub from_t: f64,
 }
 
 /// One point of the sweep: its timings over the flight and its accuracy at the sample poses.
@@ -105,6 +122,9 @@ pub struct TradePoint {
     pub frame_ssim: f64,
     /// The frame against the truth: mean FLIP over all sample poses' pixels (0 = identical).
     pub frame_flip: f64,
+    /// Along the popping flight, the largest 4 × 4 block change between frames against the
+    /// truth's; `None` when not measured.
+    pub popping: Option<Popping>,
     /// The frame's errors, whole and per distance band, pooled over the sample poses.
     pub error: FrameError,
     /// The same figures at each sample pose, in path order.
@@ -224,7 +244,7 @@ pub fn pass_labels(trade: &Trade) -> Vec<String> {
 }
 
 /// The fixed CSV columns before the passes' `<label>_ms`.
-pub const CSV_COLUMNS: [&str; 23] = [
+pub const CSV_COLUMNS: [&str; 26] = [
     "label",
     "preset",
     "knobs",
@@ -248,6 +268,9 @@ pub const CSV_COLUMNS: [&str; 23] = [
     "frame_psnr_db",
     "frame_ssim",
     "frame_flip",
+    "popping",
+    "block_change_largest",
+    "truth_block_change_largest",
 ];
 
 fn csv_field(text: &str) -> String {
@@ -291,6 +314,9 @@ pub fn csv(trade: &Trade) -> String {
                 Some(p.frame_psnr_db),
                 Some(p.frame_ssim),
                 Some(p.frame_flip),
+                p.popping.map(|q| q.popping),
+                p.popping.map(|q| q.largest),
+                p.popping.map(|q| q.truth_largest),
             ]
             .map(number),
         );
@@ -349,6 +375,7 @@ pub(crate) mod tests {
             frame_psnr_db: 30.25,
             frame_ssim: ssim,
             frame_flip: 0.125,
+            popping: Some(Popping { pairs: 7, largest: 14.5, truth_largest: 9.25, popping: 6.0 }),
             error: crate::truth::compare::tests::error(30.25, ssim, 0.125),
             samples: Vec::new(),
         };
@@ -365,6 +392,7 @@ pub(crate) mod tests {
             warmup: 2,
             frames: 4,
             sample_t: vec![0.25, 0.75],
+            popping_flight: Some(PoppingFlight { frames: 8, step_m: 2.0, from_t: 0.75 }),
             reference: "accurate".into(),
             settings: None,
             points: vec![point("fast", 40.0, 97.0, 0.9), knobbed, point("accurate", 120.0, 100.0, 1.0)],
@@ -378,7 +406,9 @@ pub(crate) mod tests {
         assert_eq!(lines.len(), 4);
         assert!(
             lines[0].starts_with("label,preset,knobs,frame_ms")
-                && lines[0].ends_with("frame_ssim,frame_flip,terrain_ms,ground_ms,streaming_ms"),
+                && lines[0].ends_with(
+                    "frame_flip,popping,block_change_largest,truth_block_change_largest,terrain_ms,ground_ms,streaming_ms"
+                ),
             "{}",
             lines[0]
         );

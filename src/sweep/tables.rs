@@ -1,6 +1,7 @@
 //! How it works: a sweep's figures as tables: the terminal's (`table`) and Markdown for docs
 //! (`markdown`): the trade (time; the seeds against the summit oracle and the truth's any-part
-//! oracle; the frame against the truth), the error per distance band, and each pass's median.
+//! oracle; the frame against the truth; popping along a flight against the truth's), the error per
+//! distance band, and each pass's median.
 
 use std::fmt::Write;
 
@@ -30,9 +31,9 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
         out,
         "| point | frame ms | GPU ms | visible (truth) | recall | precision | pixel-weighted recall | \
          recall / precision (summit oracle) | seed height error max / mean | ground PSNR | frame PSNR | SSIM | FLIP | \
-         off the fronts (FLIP; pixels missed) |"
+         popping (truth's) | off the fronts (FLIP; pixels missed) |"
     )?;
-    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")?;
+    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")?;
     for (i, p) in t.points.iter().enumerate() {
         let slack = |points: &[(f64, f64)]| {
             let s = front_slack(points, points[i]);
@@ -45,9 +46,10 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
         });
         let summit =
             s.map_or("–".to_owned(), |s| format!("{:.2} / {:.2} %", s.recall_pct, s.precision_pct));
+        let popping = popping_text(p);
         writeln!(
             out,
-            "| {} | {:.1} | {} | {} | {} | {} | {} | {summit} | {height} | {:.1} dB | {:.1} dB | {:.4} | {:.4} | {fronts} |",
+            "| {} | {:.1} | {} | {} | {} | {} | {} | {summit} | {height} | {:.1} dB | {:.1} dB | {:.4} | {:.4} | {popping} | {fronts} |",
             p.label,
             p.frame_ms,
             opt(p.gpu_ms, 1),
@@ -99,6 +101,11 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
     Ok(())
 }
 
+/// Popping and, in brackets, the truth's largest block change along the same flight.
+fn popping_text(p: &super::TradePoint) -> String {
+    p.popping.map_or("–".to_owned(), |q| format!("{:+.1} ({:.1})", q.popping, q.truth_largest))
+}
+
 /// The terminal table: the trade, then each pass's median per point.
 pub fn table(trade: &Trade) -> String {
     let mut out = String::new();
@@ -125,7 +132,7 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
     let opt = |v: Option<f64>, digits: usize| v.map_or("-".to_owned(), |v| format!("{v:.digits$}"));
     writeln!(
         out,
-        "{:<w$} {:>9} {:>8} {:>9} {:>11} {:>8} {:>15} {:>11} {:>10} {:>7} {:>7}",
+        "{:<w$} {:>9} {:>8} {:>9} {:>11} {:>8} {:>15} {:>11} {:>10} {:>7} {:>7} {:>14}",
         "point",
         "frame ms",
         "GPU ms",
@@ -136,7 +143,8 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
         "ground PSNR",
         "frame PSNR",
         "SSIM",
-        "FLIP"
+        "FLIP",
+        "popping (truth)"
     )?;
     for p in &t.points {
         let (s, a) = (p.seeds.as_ref(), p.any_part.as_ref());
@@ -145,7 +153,7 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
         });
         writeln!(
             out,
-            "{:<w$} {:>9.1} {:>8} {:>9} {:>11} {:>8} {:>15} {:>8.1} dB {:>7.1} dB {:>7.4} {:>7.4}",
+            "{:<w$} {:>9.1} {:>8} {:>9} {:>11} {:>8} {:>15} {:>8.1} dB {:>7.1} dB {:>7.4} {:>7.4} {:>14}",
             p.label,
             p.frame_ms,
             opt(p.gpu_ms, 1),
@@ -156,7 +164,8 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
             p.ground_psnr_db,
             p.frame_psnr_db,
             p.frame_ssim,
-            p.frame_flip
+            p.frame_flip,
+            popping_text(p)
         )?;
     }
     let labels = pass_labels(t);
@@ -186,16 +195,28 @@ mod tests {
     #[test]
     fn table_lists_every_point_and_pass() {
         let table = table(&trade());
-        for text in
-            ["fast", "accurate", "82.08", "97.50", "0.9300", "0.1250", "38.5 dB", "0.20/0.05 mm", "streaming"]
-        {
+        for text in [
+            "fast",
+            "accurate",
+            "82.08",
+            "97.50",
+            "0.9300",
+            "0.1250",
+            "38.5 dB",
+            "0.20/0.05 mm",
+            "streaming",
+            "+6.0 (9.2)",
+        ] {
             assert!(table.contains(text), "no {text:?} in\n{table}");
         }
         let md = markdown(&trade());
         // The trade, two bands, the passes.
         assert_eq!(md.lines().filter(|l| l.starts_with("| fast")).count(), 4, "{md}");
         assert!(
-            md.contains("| 82.08 % |") && md.contains("97.00 / 99.00 %") && md.contains("| streaming |"),
+            md.contains("| 82.08 % |")
+                && md.contains("97.00 / 99.00 %")
+                && md.contains("| streaming |")
+                && md.contains("| +6.0 (9.2) |"),
             "{md}"
         );
         assert!(md.contains("| fast | meshes | 0–100 | 50.0 % |"), "{md}");

@@ -1,10 +1,11 @@
 //! How it works: the ground truths a sweep judges its points against, one per sample pose and
-//! seeded world (`truth::render_truth`, each in a fresh renderer). Images are judged against one
+//! seeded world (one `truth::TruthRenderer` per world renders all its poses). Images are judged against one
 //! truth: the reference settings' world (the accurate preset's), so a preset that grows a
 //! different forest (other patterns) shows that difference too. Selections are judged by seed
 //! identity, so against the truth of the point's own world (its cell size, patterns, germ, seeds
 //! per pattern, class table and placement): worlds are keyed by those settings, and their truths
-//! rendered once and shared by every point of that world. Without impostors the truths grow no
+//! rendered once and shared by every point of that world. Popping is judged against the reference
+//! world's truth along the popping flight (its images only). Without impostors the truths grow no
 //! seeds (there is no mesh to draw them with): images are judged, selections are not.
 
 use super::measure::Flight;
@@ -12,7 +13,7 @@ use super::{Progress, SweepError};
 use crate::config::Settings;
 use crate::dataset::Dataset;
 use crate::gpu::Gpu;
-use crate::truth::{Truth, TruthOptions, render_truth};
+use crate::truth::{Truth, TruthOptions, TruthRenderer};
 
 /// What makes two settings grow the same seeds, in the same places, seen through the same viewport.
 fn world_key(s: &Settings) -> String {
@@ -45,19 +46,42 @@ pub(super) struct Truths {
     options: TruthOptions,
     by_world: Vec<(String, Vec<Truth>)>,
     reference: String,
+    /// The reference world's truth images along the popping flight (empty without one).
+    flight: Vec<image::RgbaImage>,
 }
 
 impl Truths {
-    /// The truths of `reference`'s world at every pose of `flight`, rendered now.
+    /// The truths of `reference`'s world at every pose of `flight` and along its popping flight,
+    /// rendered now.
     pub fn new(
         flight: &Flight,
         reference: &Settings,
         options: TruthOptions,
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Self, SweepError> {
-        let mut truths = Self { options, by_world: Vec::new(), reference: world_key(reference) };
+        let mut truths =
+            Self { options, by_world: Vec::new(), reference: world_key(reference), flight: Vec::new() };
         truths.of_world(flight, reference, progress)?;
+        if !flight.popping.is_empty() {
+            let mut renderer = truths.renderer(flight, reference)?;
+            for (i, camera) in flight.popping.iter().enumerate() {
+                let n = flight.popping.len();
+                progress(Progress::Step(&format!("truth: popping flight, frame {} of {n}", i + 1)));
+                truths.flight.push(renderer.render(camera)?.colour);
+            }
+        }
         Ok(truths)
+    }
+
+    fn renderer(&self, flight: &Flight, settings: &Settings) -> Result<TruthRenderer, SweepError> {
+        let dataset = Dataset::open(flight.dataset_dir)?;
+        let gpu = Gpu::new(settings.gpu.adapter)?;
+        Ok(TruthRenderer::new(gpu, dataset, settings, &self.options)?)
+    }
+
+    /// The reference world's truth images along the popping flight, in flight order.
+    pub fn flight_images(&self) -> &[image::RgbaImage] {
+        &self.flight
     }
 
     /// What the truths grow and draw with.
@@ -82,12 +106,11 @@ impl Truths {
             return Ok(&self.by_world[i].1);
         }
         let mut truths = Vec::with_capacity(flight.poses.len());
+        let mut renderer = self.renderer(flight, settings)?;
         for (i, (t, camera)) in flight.poses.iter().enumerate() {
             let n = flight.poses.len();
             progress(Progress::Step(&format!("truth: pose {} of {n} (t = {t:.2})", i + 1)));
-            let dataset = Dataset::open(flight.dataset_dir)?;
-            let gpu = Gpu::new(settings.gpu.adapter)?;
-            truths.push(render_truth(gpu, dataset, settings, camera, &self.options)?);
+            truths.push(renderer.render(camera)?);
         }
         self.by_world.push((key, truths));
         Ok(self.by_world.last().map_or(&[][..], |(_, t)| &t[..]))

@@ -166,35 +166,96 @@ pub fn render_truth(
     camera: &Camera,
     options: &TruthOptions,
 ) -> Result<Truth, TruthError> {
-    if options.supersample == 0 {
-        return Err(TruthError::Supersample);
-    }
-    let impostors = match options.impostors.as_os_str().is_empty() {
-        true => PathBuf::from(&settings.draw_seeds.impostors),
-        false => options.impostors.clone(),
-    };
-    let truth = truth_settings(settings, &dataset, options.supersample);
-    let mut renderer = Renderer::new(gpu, dataset, truth)?;
-    renderer.pin_everything()?;
-    renderer.render_resolved(camera)?;
-    let (seeds, counts) = match renderer.seed_world() {
-        Some((tables, patterns)) => {
-            let s = &renderer.settings;
-            let inputs = OracleInputs {
-                dataset: &renderer.dataset,
-                settings: s,
-                tables,
-                patterns,
-                camera,
-                viewport_px: [s.render.width, s.render.height],
-            };
-            judge_seeds(&inputs, Culls { reach_m: Some(options.reach_m), occlusion: false })?
+    TruthRenderer::new(gpu, dataset, settings, options)?.render(camera)
+}
+
+/// The ground truth of one seeded world from any number of views (a flight, a sweep's poses):
+/// every tile loaded and pinned once, the seeds' meshes uploaded on first use and kept.
+pub struct TruthRenderer {
+    renderer: Renderer,
+    meshes: MeshDrawer,
+    options: TruthOptions,
+}
+
+impl TruthRenderer {
+    /// A renderer with `truth_settings` over `dataset`, every tile pinned; the seeds' meshes come
+    /// from `options.impostors`, else `settings`' `draw_seeds.impostors`.
+    pub fn new(
+        gpu: Gpu,
+        dataset: Dataset,
+        settings: &Settings,
+        options: &TruthOptions,
+    ) -> Result<Self, TruthError> {
+        if options.supersample == 0 {
+            return Err(TruthError::Supersample);
         }
-        None => (Vec::new(), OracleCounts::default()),
-    };
-    let mut truth = draw_truth(&renderer, camera, seeds, &impostors, options.supersample)?;
-    truth.counts = counts;
-    Ok(truth)
+        let impostors = match options.impostors.as_os_str().is_empty() {
+            true => PathBuf::from(&settings.draw_seeds.impostors),
+            false => options.impostors.clone(),
+        };
+        let truth = truth_settings(settings, &dataset, options.supersample);
+        let mut renderer = Renderer::new(gpu, dataset, truth)?;
+        renderer.pin_everything()?;
+        Ok(Self { renderer, meshes: MeshDrawer::new(impostors), options: options.clone() })
+    }
+
+    /// The truth of the view from `camera`.
+    pub fn render(&mut self, camera: &Camera) -> Result<Truth, TruthError> {
+        let renderer = &mut self.renderer;
+        renderer.render_resolved(camera)?;
+        let (seeds, counts) = match renderer.seed_world() {
+            Some((tables, patterns)) => {
+                let s = &renderer.settings;
+                let inputs = OracleInputs {
+                    dataset: &renderer.dataset,
+                    settings: s,
+                    tables,
+                    patterns,
+                    camera,
+                    viewport_px: [s.render.width, s.render.height],
+                };
+                judge_seeds(&inputs, Culls { reach_m: Some(self.options.reach_m), occlusion: false })?
+            }
+            None => (Vec::new(), OracleCounts::default()),
+        };
+        let mut truth = draw_seeds(renderer, camera, seeds, &mut self.meshes, self.options.supersample)?;
+        truth.counts = counts;
+        Ok(truth)
+    }
+}
+
+/// Pass 4 set up to draw the seeds' full meshes with the truth's pipeline, built on first use.
+struct MeshDrawer {
+    dir: PathBuf,
+    built: Option<(DrawSeedsPass, wgpu::RenderPipeline)>,
+}
+
+impl MeshDrawer {
+    fn new(dir: PathBuf) -> Self {
+        Self { dir, built: None }
+    }
+
+    /// The pass over the models of `species` (loaded from `dir` now, the first time) and its
+    /// truth pipeline.
+    fn get(
+        &mut self,
+        gpu: &Gpu,
+        species: &[crate::classes::Species],
+    ) -> Result<&(DrawSeedsPass, wgpu::RenderPipeline), TruthError> {
+        let built = match self.built.take() {
+            Some(built) => built,
+            None => {
+                if self.dir.as_os_str().is_empty() {
+                    return Err(TruthError::NoImpostors);
+                }
+                let impostors = load_impostors(&self.dir, species)?;
+                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors)?;
+                let pipeline = draw.truth_pipeline(&gpu.device);
+                (draw, pipeline)
+            }
+        };
+        Ok(self.built.insert(built))
+    }
 }
 
 /// Draws `seeds` (each its full mesh) over the settled frame of `renderer` (made with
@@ -204,6 +265,16 @@ pub fn draw_truth(
     camera: &Camera,
     seeds: Vec<OracleSeed>,
     impostor_dir: &Path,
+    supersample: u32,
+) -> Result<Truth, TruthError> {
+    draw_seeds(renderer, camera, seeds, &mut MeshDrawer::new(impostor_dir.to_owned()), supersample)
+}
+
+fn draw_seeds(
+    renderer: &Renderer,
+    camera: &Camera,
+    seeds: Vec<OracleSeed>,
+    meshes: &mut MeshDrawer,
     supersample: u32,
 ) -> Result<Truth, TruthError> {
     let canvas = renderer.last_canvas().ok_or(TruthError::NoFrame)?;
@@ -238,12 +309,9 @@ pub fn draw_truth(
         _ => None,
     };
     if let Some((table, scene)) = &scene {
-        if impostor_dir.as_os_str().is_empty() {
-            return Err(TruthError::NoImpostors);
-        }
-        let impostors = load_impostors(impostor_dir, &table.species)?;
         let (gpu, settings) = (&renderer.gpu, &renderer.settings);
-        let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors)?;
+        let dir = meshes.dir.clone();
+        let (draw, pipeline) = meshes.get(gpu, &table.species)?;
         let mut uniforms = draw_uniforms(settings, canvas.terrain);
         uniforms.draw_reach_m = [NO_FADE_REACH_M; 4];
         draw.prepare(&gpu.queue, &uniforms);
@@ -252,7 +320,7 @@ pub fn draw_truth(
             let Some(mesh) = draw.mesh_of(*species) else {
                 let s = &table.species[*species as usize];
                 let (species, model) = (s.name.clone(), s.model.clone());
-                return Err(TruthError::NoMesh { species, model, dir: impostor_dir.to_owned() });
+                return Err(TruthError::NoMesh { species, model, dir });
             };
             draws.push((mesh, range.clone()));
         }
@@ -262,7 +330,6 @@ pub fn draw_truth(
         let identity: Vec<u32> = (0..scene.records.len() as u32).collect();
         let order = buffer_init(&gpu.device, "truth order", bytemuck::cast_slice(&identity), storage);
         let bind_group = draw.bind_group(&gpu.device, &DrawSeedsInputs { records: &records, order: &order });
-        let pipeline = draw.truth_pipeline(&gpu.device);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let ids_view = ids_texture.create_view(&Default::default());
         let colour_view = colour.create_view(&Default::default());
@@ -291,7 +358,7 @@ pub fn draw_truth(
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            draw.encode_meshes(&mut pass, &pipeline, &bind_group, &draws);
+            draw.encode_meshes(&mut pass, pipeline, &bind_group, &draws);
         }
         gpu.queue.submit([encoder.finish()]);
         gpu.check()?;

@@ -42,6 +42,14 @@ pub struct SweepArgs {
     width: Option<u32>,
     #[arg(long)]
     height: Option<u32>,
+    /// Frames of the flight popping is measured along (consecutive frames from the middle sample
+    /// pose on, against the truth's); 0 does not measure popping.
+    #[arg(long, default_value_t = 12)]
+    popping_frames: u32,
+    /// Metres the camera moves between the popping flight's frames (0.25 m: 15 m/s at 60 fps).
+    /// Slow, so that motion alone changes few blocks much and the artefacts stand out.
+    #[arg(long, default_value_t = 0.25)]
+    popping_step_m: f64,
     /// The ground truths' samples per pixel along each axis.
     #[arg(long, default_value_t = 4)]
     truth_supersample: u32,
@@ -69,6 +77,8 @@ impl SweepArgs {
             samples: self.samples,
             width: self.width,
             height: self.height,
+            popping_frames: self.popping_frames,
+            popping_step_m: self.popping_step_m,
             truth: terramp::truth::TruthOptions {
                 supersample: self.truth_supersample,
                 reach_m: self.truth_reach_m,
