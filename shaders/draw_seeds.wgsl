@@ -128,8 +128,15 @@ fn bayer4(pixel: vec2<u32>, shift: u32) -> f32 {
     return (f32(m[(p.y & 3u) * 4u + (p.x & 3u)]) + 0.5) / 16.0;
 }
 
-// The fragment's lit, hazed colour, or discarded (alpha test, dither).
-fn shade(in: VertexOut) -> vec4<f32> {
+// A fragment of a seed, before the alpha test: its lit, hazed colour, its alpha and how fast that
+// alpha changes across the pixel.
+struct Surface {
+    colour: vec4<f32>,
+    alpha: f32,
+    alpha_per_px: f32,
+}
+
+fn surface(in: VertexOut) -> Surface {
     let material = materials[in.material];
     // Derivatives in uniform control flow; the samplers differ only in wrapping (the mesh's
     // textures repeat, the atlases must not bleed across their edge).
@@ -145,10 +152,6 @@ fn shade(in: VertexOut) -> vec4<f32> {
         }
     }
     texel *= material.base_colour;
-    let t = bayer4(vec2<u32>(in.clip.xy), u32(in.keep.z));
-    if texel.a < material.alpha_cutoff || t < in.keep.x || t >= in.keep.y {
-        discard;
-    }
     let albedo = mix(texel.rgb, in.ground.rgb, in.ground.w) * in.tint;
     // Seen from the side facing the eye (billboards, leaves); foliage lets light wrap around.
     var normal = normalize(in.normal);
@@ -159,12 +162,66 @@ fn shade(in: VertexOut) -> vec4<f32> {
     let sky = 0.3;
     let lit = albedo * (sun + sky);
     let haze = 1.0 - exp2(-length(in.rel_m) / u.haze.w);
-    return vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0);
+    return Surface(vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0), texel.a, fwidth(texel.a));
+}
+
+// Whether the cross-fade gives this pixel to the other of the seed's two draws.
+fn faded_out(in: VertexOut) -> bool {
+    let t = bayer4(vec2<u32>(in.clip.xy), u32(in.keep.z));
+    return t < in.keep.x || t >= in.keep.y;
+}
+
+// The fragment's lit, hazed colour, or discarded (alpha test, dither).
+fn shade(in: VertexOut) -> vec4<f32> {
+    let s = surface(in);
+    if s.alpha < materials[in.material].alpha_cutoff || faded_out(in) {
+        discard;
+    }
+    return s.colour;
 }
 
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     return shade(in);
+}
+
+struct CoverageOut {
+    @location(0) colour: vec4<f32>,
+    @builtin(sample_mask) mask: u32,
+}
+
+// The standard 4× sample positions, in an order whose first k spread over the pixel (top,
+// bottom, left, right: the first two are diagonal), turned per pixel and seed.
+const COVERAGE_ORDER = array<u32, 4>(0u, 3u, 2u, 1u);
+
+// Multisampled drawing (`draw_seeds.samples` = SEED_SAMPLES): the alpha test's edge, anti-aliased.
+// The alpha is sharpened to cross the cutoff over one pixel (alpha − cutoff over its change per
+// pixel, centred), so a texture magnified up close keeps crisp leaf edges while a minified one
+// blends. That coverage of the triangle's part of the pixel becomes a share of the samples the
+// triangle covers (dithered, so the mean share is exact), and those samples are written with their
+// own depth: trees behind show through the gaps, and the resolve averages the samples.
+@fragment
+fn fs_coverage(in: VertexOut, @builtin(sample_mask) covered: u32) -> CoverageOut {
+    let s = surface(in);
+    let cutoff = materials[in.material].alpha_cutoff;
+    let coverage = clamp((s.alpha - cutoff) / max(s.alpha_per_px, 1e-4) + 0.5, 0.0, 1.0);
+    // A dither of its own, not the cross-fade's (the two would be correlated).
+    let pixel = vec2<u32>(in.clip.xy);
+    let wanted = u32(coverage * f32(countOneBits(covered)) + bayer4(pixel, u32(in.keep.z) + 7u));
+    if wanted == 0u || faded_out(in) {
+        discard;
+    }
+    let turn = (pixel.x + 2u * pixel.y + in.record) % SEED_SAMPLES;
+    var mask = 0u;
+    var taken = 0u;
+    for (var k = 0u; k < SEED_SAMPLES; k++) {
+        let bit = 1u << COVERAGE_ORDER[(k + turn) % SEED_SAMPLES];
+        if taken < wanted && (covered & bit) != 0u {
+            mask |= bit;
+            taken++;
+        }
+    }
+    return CoverageOut(s.colour, mask);
 }
 
 struct TruthOut {
@@ -177,4 +234,27 @@ struct TruthOut {
 @fragment
 fn fs_truth(in: VertexOut) -> TruthOut {
     return TruthOut(shade(in), in.record + 1u);
+}
+
+// Multisampled drawing starts from the frame as the ground passes left it: each pixel's colour
+// (a copy of the frame's) and the terrain's depth written to all of its samples, by one triangle
+// over the whole view.
+@group(0) @binding(8) var frame_colour: texture_2d<f32>;
+@group(0) @binding(9) var frame_depth: texture_depth_2d;
+
+@vertex
+fn vs_fill(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<f32> {
+    let corner = vec2<f32>(f32((vertex << 1u) & 2u), f32(vertex & 2u));
+    return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+
+struct FillOut {
+    @location(0) colour: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+@fragment
+fn fs_fill(@builtin(position) position: vec4<f32>) -> FillOut {
+    let texel = vec2<i32>(position.xy);
+    return FillOut(textureLoad(frame_colour, texel, 0), textureLoad(frame_depth, texel, 0));
 }

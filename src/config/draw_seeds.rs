@@ -5,7 +5,7 @@
 use serde::Deserialize;
 
 use super::{SettingsError, TlmSettings};
-use crate::gpu::layout::SEED_LODS;
+use crate::gpu::layout::{SEED_LODS, SEED_SAMPLES};
 
 /// Drawing the seeds, see `config/default.toml` `[draw_seeds]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -18,6 +18,10 @@ pub struct DrawSeedsSettings {
     /// The outer part of each LOD's reach over which a seed cross-fades into the next LOD (the
     /// last LOD: fades out), as a fraction of the reach; 0 switches at once (pops).
     pub fade_fraction: f64,
+    /// Samples per pixel the seeds are drawn with: 1 alpha-tests every fragment at the pixel's
+    /// centre; `SEED_SAMPLES` (4) draws them multisampled, each fragment covering as many of its
+    /// pixel's samples as its (sharpened) alpha says, and resolves into the frame.
+    pub samples: u32,
     /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
     /// selected but not drawn. Species whose model is not there are not drawn.
     pub impostors: String,
@@ -27,7 +31,7 @@ impl DrawSeedsSettings {
     pub(super) fn validate(&self, tlm: &TlmSettings) -> Result<(), SettingsError> {
         let r = self.reach_m;
         let last_band = tlm.radial_bands_m[tlm.radial_bands_m.len() - 1];
-        let checks: [(bool, &'static str, String, &'static str); 3] = [
+        let checks: [(bool, &'static str, String, &'static str); 4] = [
             (
                 r[0] >= 0.0
                     && r[1] > 0.0
@@ -48,6 +52,12 @@ impl DrawSeedsSettings {
                 "draw_seeds.fade_fraction",
                 self.fade_fraction.to_string(),
                 "0 to 0.5 of each LOD's reach",
+            ),
+            (
+                self.samples == 1 || self.samples == SEED_SAMPLES,
+                "draw_seeds.samples",
+                self.samples.to_string(),
+                "1 (alpha test) or 4 (multisampled, coverage from alpha)",
             ),
         ];
         match checks.into_iter().find(|(ok, ..)| !ok) {

@@ -243,7 +243,7 @@ impl Renderer {
         let tlm_bindings = tlm.bind_group(device, &height_tile_ranges(&dataset), &depth_pyramid);
         let tlm_readback = ReadbackRing::new(device, "tile load map", tlm.capacity_bytes(), DEFAULT_SLOTS);
         let terrain_bindings = terrain.bind_group(device, &caches.heights, &caches.imagery, ground.sampler());
-        let seeds = seeds::SeedStage::new(&gpu, &dataset, &settings, &caches, &targets.depth_view)?;
+        let seeds = seeds::SeedStage::new(&gpu, &dataset, &settings, &caches, &targets)?;
         let h = &dataset.manifest.height;
         let bounds = NodeBounds::new([h.min_m, h.max_m]);
         let profiler = Profiler::new(&gpu, settings.gpu.timestamps);

@@ -27,7 +27,7 @@ use crate::passes::seed_select::gpu::{SeedSelectPass, SeedSources};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
 
-use super::{Caches, RenderError};
+use super::{Caches, RenderError, Targets};
 
 /// Pass 3's counters for one frame, as the frame log records them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
@@ -78,7 +78,7 @@ impl SeedStage {
         dataset: &Dataset,
         settings: &Settings,
         caches: &Caches,
-        depth: &wgpu::TextureView,
+        targets: &Targets,
     ) -> Result<Option<Self>, RenderError> {
         let (Some(landcover), Some(landcover_cache)) = (&dataset.manifest.landcover, &caches.landcover)
         else {
@@ -88,7 +88,7 @@ impl SeedStage {
             heights: &caches.heights,
             landcover: landcover_cache,
             imagery: &caches.imagery,
-            depth,
+            depth: &targets.depth_view,
         };
         let device = &gpu.device;
         check_capacity(device, settings.seeds.capacity)?;
@@ -102,7 +102,7 @@ impl SeedStage {
             ReadbackRing::new(device, "seed counters", size_of::<SeedCounters>() as u64, DEFAULT_SLOTS);
         let draw = match settings.draw_seeds.impostors.as_str() {
             "" => None,
-            dir => Some(draw_pass(gpu, Path::new(dir), &table, &pass, &mut compact)?),
+            dir => Some(draw_pass(gpu, settings, Path::new(dir), &table, &pass, &mut compact, targets)?),
         };
         Ok(Some(Self {
             table,
@@ -235,13 +235,18 @@ fn seeded_world(
 /// compaction's order; compaction takes its draw templates.
 fn draw_pass(
     gpu: &Gpu,
+    settings: &Settings,
     dir: &Path,
     table: &ClassTable,
     pass: &SeedSelectPass,
     compact: &mut CompactPass,
+    targets: &Targets,
 ) -> Result<(DrawSeedsPass, wgpu::BindGroup), RenderError> {
     let impostors = load_impostors(dir, &table.species)?;
-    let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors)?;
+    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors)?;
+    if settings.draw_seeds.samples > 1 {
+        draw = draw.multisampled(&gpu.device, &targets.colour, &targets.depth);
+    }
     compact.set_templates(&gpu.queue, draw.templates());
     let bind_group =
         draw.bind_group(&gpu.device, &DrawSeedsInputs { records: pass.records(), order: compact.order() });

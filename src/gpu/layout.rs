@@ -238,6 +238,11 @@ wgsl_constants! { seed_constants:
     pub const SEED_LODS: u32 = 4;
     /// Draw groups: one per (species, LOD), `species × SEED_LODS + lod` (`seed_group`).
     pub const SEED_GROUPS: u32 = MAX_SPECIES * SEED_LODS;
+    /// Samples per pixel of pass 4's multisampled drawing (`draw_seeds.samples` = this, or 1 for
+    /// the single-sampled alpha test): 4 is what every adapter supports for the colour and depth
+    /// formats, and its standard sample positions are what `fs_coverage` spreads a pixel's
+    /// coverage over.
+    pub const SEED_SAMPLES: u32 = 4;
     /// Indirect draws compaction writes: each group's own, then (at `SEED_GROUPS + group`) the
     /// same instances with the next LOD's geometry, which the seeds in the outer band of their LOD
     /// cross-fade into.

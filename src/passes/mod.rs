@@ -79,7 +79,12 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     },
     PipelineBindings {
         shader: &draw_seeds::gpu::SHADER,
-        entry_points: &["vs_main", "fs_main"],
+        entry_points: &["vs_main", "fs_main", "fs_coverage", "fs_truth"],
         bindings: &draw_seeds::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &draw_seeds::gpu::SHADER,
+        entry_points: &["vs_fill", "fs_fill"],
+        bindings: &draw_seeds::multisample::FILL_BINDINGS.bindings,
     },
 ];

@@ -18,6 +18,7 @@ use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
 use super::DrawSeedsError;
 use super::assets;
+use super::multisample::{self, Multisample};
 
 /// Pass 4's shader.
 pub const SHADER: WgslSource = WgslSource {
@@ -75,6 +76,8 @@ pub struct DrawSeedsPass {
     templates: Vec<SeedDrawArgs>,
     species_drawn: usize,
     species_missing: usize,
+    /// With `draw_seeds.samples` > 1: the multisampled targets and `fs_coverage`'s pipeline.
+    multisample: Option<(Multisample, wgpu::RenderPipeline)>,
 }
 
 impl DrawSeedsPass {
@@ -148,7 +151,8 @@ impl DrawSeedsPass {
             })
         };
         let layout = BINDINGS.layout(device);
-        let pipeline = pipeline(device, &layout, "fs_main", &[Some(COLOUR_FORMAT.into())]);
+        let pipeline =
+            pipeline(device, &layout, "fs_main", &[Some(COLOUR_FORMAT.into())], Default::default());
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
         Ok(Self {
             pipeline,
@@ -173,7 +177,22 @@ impl DrawSeedsPass {
             templates: built.templates,
             species_drawn,
             species_missing: impostors.len() - species_drawn,
+            multisample: None,
         })
+    }
+
+    /// The same pass drawing multisampled (`draw_seeds.samples` = `SEED_SAMPLES`) over the frame's
+    /// `colour` and the terrain's `depth`, resolving into `colour` (`multisample`).
+    pub fn multisampled(
+        mut self,
+        device: &wgpu::Device,
+        colour: &wgpu::Texture,
+        depth: &wgpu::Texture,
+    ) -> Self {
+        let targets = [Some(COLOUR_FORMAT.into())];
+        let coverage = pipeline(device, &self.layout, "fs_coverage", &targets, multisample::state());
+        self.multisample = Some((Multisample::new(device, colour, depth), coverage));
+        self
     }
 
     /// The draws' index ranges, for `CompactPass::set_templates` (`SEED_DRAWS` of them).
@@ -209,7 +228,7 @@ impl DrawSeedsPass {
     /// fragment's colour and its seed's id (`SEED_ID_FORMAT`).
     pub fn truth_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         let targets = [Some(COLOUR_FORMAT.into()), Some(SEED_ID_FORMAT.into())];
-        pipeline(device, &self.layout, "fs_truth", &targets)
+        pipeline(device, &self.layout, "fs_truth", &targets, Default::default())
     }
 
     /// Species `species`'s full mesh (its LOD 0 geometry), or `None` when its model has none
@@ -246,7 +265,7 @@ impl DrawSeedsPass {
     }
 
     /// Records each group's draw and cross-fade draw from `draw_args` (compaction's) into the
-    /// targets.
+    /// targets (multisampled when `multisampled` made it so, resolved into `colour`).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -256,6 +275,10 @@ impl DrawSeedsPass {
         depth: &wgpu::TextureView,
     ) {
         if self.species_drawn == 0 {
+            return;
+        }
+        if let Some((targets, pipeline)) = &self.multisample {
+            targets.encode(encoder, |pass| self.record(pass, pipeline, bind_group, draw_args));
             return;
         }
         let keep = wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store };
@@ -276,7 +299,18 @@ impl DrawSeedsPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        self.record(&mut pass, &self.pipeline, bind_group, draw_args);
+    }
+
+    /// Every group's indirect draws with `pipeline`.
+    fn record(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        pipeline: &wgpu::RenderPipeline,
+        bind_group: &wgpu::BindGroup,
+        draw_args: &wgpu::Buffer,
+    ) {
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
@@ -294,6 +328,7 @@ fn pipeline(
     layout: &wgpu::BindGroupLayout,
     fragment: &str,
     targets: &[Option<wgpu::ColorTargetState>],
+    multisample: wgpu::MultisampleState,
 ) -> wgpu::RenderPipeline {
     let module = SHADER.module(device);
     let pipeline_layout = pipeline_layout(device, "draw_seeds", &[layout]);
@@ -326,7 +361,7 @@ fn pipeline(
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: Default::default(),
+        multisample,
         multiview_mask: None,
         cache: None,
     })

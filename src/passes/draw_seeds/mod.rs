@@ -14,7 +14,9 @@
 //! of its LOD's reach cross-fades: its own geometry keeps the pixels whose (per-seed shifted)
 //! Bayer threshold is below the fade, the next LOD's geometry the others, so each pixel shows
 //! exactly one of the two and nothing pops; outside the band the cross-fade draw collapses its
-//! vertices. The last LOD fades out to nothing at the visibility radius.
+//! vertices. The last LOD fades out to nothing at the visibility radius. With `draw_seeds.samples`
+//! at 4 the groups are drawn multisampled instead, each fragment covering as many of its pixel's
+//! samples as its alpha says, and resolved into the frame (`multisample`).
 //!
 //! `frame` (the frame's constants, the impostors loaded from a folder) and `assets` (their layout
 //! for one upload) are the CPU half; `gpu` the pipeline, binding table, uploads and draws.
@@ -22,6 +24,7 @@
 pub mod assets;
 pub mod frame;
 pub mod gpu;
+pub mod multisample;
 
 use std::path::PathBuf;
 
