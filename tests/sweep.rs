@@ -79,6 +79,9 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
             ("any_part_visible", &any_part["visible"]),
             ("any_part_recall_pct", &any_part["recall_pct"]),
             ("pixel_weighted_recall_pct", &any_part["pixel_weighted_recall_pct"]),
+            ("missed_reach_pct", &any_part["missed_pct"]["reach"]),
+            ("missed_density_pct", &any_part["missed_pct"]["density"]),
+            ("missed_selection_pct", &any_part["missed_pct"]["selection"]),
             ("frame_ms", &point["frame_ms"]),
             ("gpu_ms", &point["gpu_ms"]),
             ("ground_psnr_db", &point["ground_psnr_db"]),
@@ -125,6 +128,13 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
             assert!(db > 20.0 && db <= PSNR_CAP_DB, "{}: {key} {db}", row[0]);
         }
         assert_eq!(point["samples"].as_array().unwrap().len(), 2);
+        // The samples missed, by why, add up to all the samples missed.
+        let missed: f64 = ["reach", "density", "frustum", "summit_hidden", "selection"]
+            .iter()
+            .map(|k| any_part["missed_pct"][k].as_f64().unwrap())
+            .sum();
+        let pw = any_part["pixel_weighted_recall_pct"].as_f64().unwrap();
+        assert!((missed - (100.0 - pw)).abs() < 1e-9, "{}: {missed} missed, {pw} recalled", row[0]);
         // Popping: three pairs of frames; block changes are levels of 255, the truth moves too.
         let popping = &point["popping"];
         assert_eq!(popping["pairs"], 3, "{popping}");
@@ -160,6 +170,10 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
     );
     assert!(recall(fast) < 70.0 && recall(accurate) > 90.0, "{fast}\n{accurate}");
     assert!(pixel_recall(accurate) > pixel_recall(fast), "{fast}\n{accurate}");
+    // `fast` grows half the density: much of what it misses is not grown; `accurate` grows all.
+    let not_grown = |p: &Value| p["any_part"]["missed_pct"]["density"].as_f64().unwrap();
+    println!("not grown: fast {:.2} %, accurate {:.2} %", not_grown(fast), not_grown(accurate));
+    assert!(not_grown(fast) > 10.0 && not_grown(accurate) == 0.0, "{fast}\n{accurate}");
 }
 
 /// One CSV line's fields (quoted fields may hold commas and doubled quotes).

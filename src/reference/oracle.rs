@@ -163,28 +163,12 @@ pub fn judge_seeds(
     inputs: &OracleInputs,
     culls: Culls,
 ) -> Result<(Vec<OracleSeed>, OracleCounts), OracleError> {
-    let &OracleInputs { dataset, settings, patterns, camera, viewport_px, .. } = inputs;
-    camera.validate()?;
-    let clip = camera.clip_from_view(viewport_px[0], viewport_px[1])? * camera.view_from_world();
-    let spp = patterns.seeds_per_pattern;
-    if patterns.count != settings.tlm.patterns
-        || patterns.corner_colours != settings.tlm.corner_colours()
-        || patterns.positions_unit.len() != patterns.count as usize * spp as usize
-    {
-        return Err(OracleError::Patterns {
-            count: patterns.count,
-            seeds_per_pattern: spp,
-            positions: patterns.positions_unit.len(),
-            wanted: settings.tlm.patterns,
-        });
-    }
-    let manifest = &dataset.manifest;
-    let spacing_m = manifest.height.spacing_m;
-    let extent_m = dataset.height.pyramid.size.map(|n| f64::from(n.max(1) - 1) * spacing_m);
-    let eye = camera.position_m - DVec3::new(manifest.origin_m[0], manifest.origin_m[1], 0.0);
-    let cell_m = settings.tlm.cell_m;
-    let reach_m =
-        culls.reach_m.unwrap_or_else(|| settings.draw_seeds.reach_m.iter().fold(0.0f64, |a, &b| a.max(b)));
+    let frame = ViewFrame::new(inputs)?;
+    let (eye, extent_m) = (frame.eye, frame.extent_m);
+    let cell_m = inputs.settings.tlm.cell_m;
+    let reach_m = culls
+        .reach_m
+        .unwrap_or_else(|| inputs.settings.draw_seeds.reach_m.iter().fold(0.0f64, |a, &b| a.max(b)));
 
     // Ring-0 cells overlapping the height rectangle whose square comes within reach.
     let range = |c: f64, a: usize| {
@@ -209,13 +193,7 @@ pub fn judge_seeds(
     let region_min = [x0 as f64 * cell_m, y0 as f64 * cell_m];
     let region_max =
         [((x1 + 1) as f64 * cell_m).min(extent_m[0]), ((y1 + 1) as f64 * cell_m).min(extent_m[1])];
-    let dem = DemWindow::load(dataset, region_min, region_max)?;
-    let landcover = LandcoverTiles::load(dataset, region_min, region_max)?;
-    let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= extent_m[0] && p.y <= extent_m[1];
-    // An eye below the ground sees nothing (every seed reaching the occlusion test is hidden).
-    let eye_underground = inside(eye.truncate()) && eye.z < dem.ground(eye.truncate()).0;
-    let planes = frustum_planes(clip);
-    let view = View { inputs, culls, dem, landcover, planes, eye, eye_underground, extent_m };
+    let view = frame.view(inputs, culls, region_min, region_max)?;
     let judged: Vec<(Vec<OracleSeed>, OracleCounts)> =
         cells.par_iter().map(|&address| view.cell(address)).collect::<Result<_, _>>()?;
     let mut counts = OracleCounts::default();
@@ -226,6 +204,78 @@ pub fn judge_seeds(
     }
     seeds.sort_by_key(|s| (s.address, s.rank));
     Ok((seeds, counts))
+}
+
+/// How each of `seeds` (named by address and rank; judged before in a view of the same dataset,
+/// with any culls) fares under `culls` in the view of `inputs`: what the oracle would have done
+/// with it, seed by seed, in order.
+pub fn fates_of(inputs: &OracleInputs, culls: Culls, seeds: &[OracleSeed]) -> Result<Vec<Fate>, OracleError> {
+    let frame = ViewFrame::new(inputs)?;
+    let (mut lo, mut hi) = (frame.eye.truncate(), frame.eye.truncate());
+    for s in seeds {
+        lo = lo.min(DVec2::from(s.position_grid_m));
+        hi = hi.max(DVec2::from(s.position_grid_m));
+    }
+    let view = frame.view(inputs, culls, lo.to_array(), hi.to_array())?;
+    seeds
+        .par_iter()
+        .map(|s| match s.address.map(i32::try_from) {
+            [Ok(x), Ok(y)] => view.seed(s.address, [x, y], s.rank, DVec2::from(s.position_grid_m)),
+            _ => Err(OracleError::Address(s.address[0], s.address[1])),
+        })
+        .collect()
+}
+
+/// What every judge of one view shares: the camera checked and where it stands, the projection's
+/// planes, the patterns checked against the settings.
+struct ViewFrame {
+    planes: [DVec4; 5],
+    /// The eye, grid space, metres.
+    eye: DVec3,
+    extent_m: [f64; 2],
+}
+
+impl ViewFrame {
+    fn new(inputs: &OracleInputs) -> Result<Self, OracleError> {
+        let &OracleInputs { dataset, settings, patterns, camera, viewport_px, .. } = inputs;
+        camera.validate()?;
+        let clip = camera.clip_from_view(viewport_px[0], viewport_px[1])? * camera.view_from_world();
+        let spp = patterns.seeds_per_pattern;
+        if patterns.count != settings.tlm.patterns
+            || patterns.corner_colours != settings.tlm.corner_colours()
+            || patterns.positions_unit.len() != patterns.count as usize * spp as usize
+        {
+            return Err(OracleError::Patterns {
+                count: patterns.count,
+                seeds_per_pattern: spp,
+                positions: patterns.positions_unit.len(),
+                wanted: settings.tlm.patterns,
+            });
+        }
+        let manifest = &dataset.manifest;
+        let spacing_m = manifest.height.spacing_m;
+        let extent_m = dataset.height.pyramid.size.map(|n| f64::from(n.max(1) - 1) * spacing_m);
+        let eye = camera.position_m - DVec3::new(manifest.origin_m[0], manifest.origin_m[1], 0.0);
+        Ok(Self { planes: frustum_planes(clip), eye, extent_m })
+    }
+
+    /// The view over the ground of the rectangle [`region_min`, `region_max`] (grid metres).
+    fn view<'a>(
+        self,
+        inputs: &'a OracleInputs<'a>,
+        culls: Culls,
+        region_min: [f64; 2],
+        region_max: [f64; 2],
+    ) -> Result<View<'a>, OracleError> {
+        let Self { planes, eye, extent_m } = self;
+        let dataset = inputs.dataset;
+        let dem = DemWindow::load(dataset, region_min, region_max)?;
+        let landcover = LandcoverTiles::load(dataset, region_min, region_max)?;
+        let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= extent_m[0] && p.y <= extent_m[1];
+        // An eye below the ground sees nothing (every seed reaching the occlusion test is hidden).
+        let eye_underground = inside(eye.truncate()) && eye.z < dem.ground(eye.truncate()).0;
+        Ok(View { inputs, culls, dem, landcover, planes, eye, eye_underground, extent_m })
+    }
 }
 
 /// Whether the segment eye→target (grid space, metres) clears the full-resolution DEM: it never
@@ -260,13 +310,20 @@ fn frustum_planes(clip_from_world: DMat4) -> [DVec4; 5] {
     [w + x, w - x, w + y, w - y, w - z].map(|p| p / p.truncate().length().max(1e-300))
 }
 
-/// A seed's fate.
-enum Fate {
+/// A seed's fate: the first cull it fails, in pass 3's order, or none.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Fate {
+    /// Outside the dataset, no class there, or a class whose density leaves its rank out.
     Class,
+    /// Its species' altitude or slope rule.
     Rule,
+    /// Beyond its reach.
     Distance,
+    /// Its bounding sphere lies outside the view.
     Frustum,
+    /// Its eye→summit segment passes below the terrain (with the occlusion cull).
     Occlusion,
+    /// Survives every cull.
     Visible(OracleSeed),
 }
 

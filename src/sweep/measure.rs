@@ -31,7 +31,7 @@ use crate::reference::frame_change::Popping;
 use crate::reference::image_metrics::{capped_psnr_db, mse, psnr_of_mse};
 use crate::reference::oracle::{OracleInputs, visible_seeds};
 use crate::truth::compare::{bands, frame_error, pool};
-use crate::truth::visibility::{Visibility, judge};
+use crate::truth::visibility::{Missed, Visibility, judge, missed};
 
 pub(super) struct Flight<'a> {
     pub dataset_dir: &'a Path,
@@ -149,9 +149,16 @@ impl Flight<'_> {
             Summary::new(&recording, meta)
         };
 
+        // The any-part oracle, where the truth drew seeds (impostors given): the truths of the
+        // point's own world, rendered before its poses are settled (a separate renderer).
+        let draws_truth_seeds = truths.options().reach_m > 0.0;
+        if draws_truth_seeds {
+            truths.ensure(self, &settings, progress)?;
+        }
+        let world = truths.of_world(&settings);
         let mut seeds: Option<(SeedAgreement, HeightError)> = None;
         let mut per_pose: Vec<(SeedAgreement, HeightError)> = Vec::new();
-        let mut selected: Vec<Vec<([i64; 2], u32)>> = Vec::new();
+        let mut any_part: Vec<(Visibility, Missed)> = Vec::new();
         let frames = self.settle(&mut renderer, &label, progress, |r, camera| {
             let kept = r.read_seeds()?.map(|(records, _)| records);
             if let Some((agreement, height)) = seed_figures(r, camera, kept.as_deref())? {
@@ -160,7 +167,13 @@ impl Flight<'_> {
                 h.add(&height);
                 per_pose.push((agreement, height));
             }
-            selected.push(kept.iter().flatten().map(|s| (s.address.map(i64::from), s.rank)).collect());
+            let selected: Vec<([i64; 2], u32)> =
+                kept.iter().flatten().map(|s| (s.address.map(i64::from), s.rank)).collect();
+            if let (Some(truth), Some(inputs)) = (world.get(any_part.len()), oracle_inputs(r, camera)) {
+                let visibility = judge(&truth.seeds, &truth.samples, selected.iter().copied());
+                let missed = missed(&inputs, &truth.seeds, &truth.samples, selected.iter().copied())?;
+                any_part.push((visibility, missed));
+            }
             Ok(())
         })?;
         let flown = self.fly_popping(&mut renderer, &label, progress)?;
@@ -168,19 +181,6 @@ impl Flight<'_> {
         let popping = match flown.is_empty() {
             true => None,
             false => Some(Popping::of(&flown, truths.flight_images())?),
-        };
-        // The any-part oracle, where the truth drew seeds (impostors given).
-        let draws_truth_seeds = truths.options().reach_m > 0.0;
-        let any_part: Vec<Visibility> = match draws_truth_seeds {
-            false => Vec::new(),
-            true => {
-                let world = truths.of_world(self, &settings, progress)?;
-                world
-                    .iter()
-                    .zip(&selected)
-                    .map(|(t, kept)| judge(&t.seeds, &t.samples, kept.iter().copied()))
-                    .collect()
-            }
         };
         let grounds = match draws_seeds {
             false => None,
@@ -206,16 +206,19 @@ impl Flight<'_> {
                 frame_ssim: error.frame.ssim,
                 frame_flip: error.frame.flip,
                 seeds: per_pose.get(i).map(|(a, h)| SeedFigures::of(a, h)),
-                any_part: any_part.get(i).map(AnyPartFigures::of),
+                any_part: any_part.get(i).map(|(v, m)| AnyPartFigures::of(v, m)),
             });
             errors.push(error);
         }
         let n = samples.len().max(1) as f64;
         let error = pool(&errors).ok_or_else(|| SweepError::Options("no sample pose".into()))?;
         let any_part = (!any_part.is_empty()).then(|| {
-            let mut total = Visibility::default();
-            any_part.iter().for_each(|v| total.add(v));
-            AnyPartFigures::of(&total)
+            let (mut visibility, mut missed) = (Visibility::default(), Missed::default());
+            for (v, m) in &any_part {
+                visibility.add(v);
+                missed.add(m);
+            }
+            AnyPartFigures::of(&visibility, &missed)
         });
         let passes = summary
             .passes
@@ -247,22 +250,27 @@ impl Flight<'_> {
     }
 }
 
-/// The settled view's kept seeds against the summit oracle (`None` without land cover).
-fn seed_figures(
-    r: &Renderer,
-    camera: &Camera,
-    kept: Option<&[SeedRecord]>,
-) -> Result<Option<(SeedAgreement, HeightError)>, SweepError> {
-    let (Some((tables, patterns)), Some(kept)) = (r.seed_world(), kept) else {
-        return Ok(None);
-    };
-    let inputs = OracleInputs {
+/// What the exact oracle reads to judge `r`'s view from `camera` (`None` without land cover).
+fn oracle_inputs<'a>(r: &'a Renderer, camera: &'a Camera) -> Option<OracleInputs<'a>> {
+    let (tables, patterns) = r.seed_world()?;
+    Some(OracleInputs {
         dataset: &r.dataset,
         settings: &r.settings,
         tables,
         patterns,
         camera,
         viewport_px: [r.settings.render.width, r.settings.render.height],
+    })
+}
+
+/// The settled view's kept seeds against the summit oracle (`None` without land cover).
+fn seed_figures(
+    r: &Renderer,
+    camera: &Camera,
+    kept: Option<&[SeedRecord]>,
+) -> Result<Option<(SeedAgreement, HeightError)>, SweepError> {
+    let (Some(inputs), Some(kept)) = (oracle_inputs(r, camera), kept) else {
+        return Ok(None);
     };
     let (visible, _) = visible_seeds(&inputs)?;
     let origin = r.dataset.manifest.origin_m;

@@ -24,11 +24,14 @@
 //! where seeds is `{ "visible", "kept", "common": int, "recall_pct", "precision_pct",
 //! "height_error_max_m", "height_error_mean_m": float }` (the exact summit oracle), any_part is
 //! `{ "visible", "selected", "selected_visible": int, "recall_pct", "precision_pct",
-//! "pixel_weighted_recall_pct": float }` (the truth's any-part oracle) and region is `{ "band":
+//! "pixel_weighted_recall_pct": float, "missed_pct": { "reach", "density", "frustum",
+//! "summit_hidden", "selection": float } }` (the truth's any-part oracle; why the missed samples
+//! are missed, `truth::visibility::Missed`) and region is `{ "band":
 //! { "name", "from_m", "to_m" }, "pixels", "mse", "psnr_db", "ssim", "flip" }` (`truth::compare`;
 //! an infinite `to_m` and a figure of an empty band are `null`); popping is in levels of 255
 //! (`reference::frame_change`). The CSV has the same figures under the same names (pass medians
-//! as `<label>_ms`, seed figures without their `seeds.` prefix, popping's as `popping`,
+//! as `<label>_ms`, seed figures without their `seeds.` prefix, the missed shares as
+//! `missed_<why>_pct`, popping's as `popping`,
 //! `block_change_largest` and `truth_block_change_largest`, knobs as `key=value;key=value`).
 
 use std::collections::BTreeMap;
@@ -39,7 +42,7 @@ use crate::gpu::TimeSource;
 use crate::reference::accuracy::{HeightError, SeedAgreement};
 use crate::reference::frame_change::Popping;
 use crate::truth::compare::FrameError;
-use crate::truth::visibility::Visibility;
+use crate::truth::visibility::{Missed, Visibility};
 
 /// The version of the JSON layout.
 pub const SCHEMA: &str = "terramp-trade/3";
@@ -191,11 +194,30 @@ pub struct AnyPartFigures {
     pub precision_pct: f64,
     /// The truth's seed samples whose seed pass 3 kept, %.
     pub pixel_weighted_recall_pct: f64,
+    /// The truth's seed samples missed, % of them all, by why (`truth::visibility::Missed`): the
+    /// five add up to 100 − `pixel_weighted_recall_pct`.
+    pub missed_pct: MissedPct,
+}
+
+/// `Missed` as percentages of the truth's seed samples.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MissedPct {
+    /// Beyond the point's reach for the seed's size.
+    pub reach: f64,
+    /// Not grown at the point's density (or class, or rules).
+    pub density: f64,
+    /// Bounding sphere outside the view by pass 3's test.
+    pub frustum: f64,
+    /// Summit hidden by the terrain, another part showing.
+    pub summit_hidden: f64,
+    /// Kept by the exact rule, lost to pass 3's approximations.
+    pub selection: f64,
 }
 
 impl AnyPartFigures {
-    /// The figures of `v`, as percentages.
-    pub fn of(v: &Visibility) -> Self {
+    /// The figures of `v` and `missed`, as percentages.
+    pub fn of(v: &Visibility, missed: &Missed) -> Self {
+        let pct = |n: u64| if v.seed_samples == 0 { 0.0 } else { 100.0 * n as f64 / v.seed_samples as f64 };
         Self {
             visible: v.visible,
             selected: v.selected,
@@ -203,6 +225,13 @@ impl AnyPartFigures {
             recall_pct: 100.0 * v.recall(),
             precision_pct: 100.0 * v.precision(),
             pixel_weighted_recall_pct: 100.0 * v.pixel_weighted_recall(),
+            missed_pct: MissedPct {
+                reach: pct(missed.reach),
+                density: pct(missed.density),
+                frustum: pct(missed.frustum),
+                summit_hidden: pct(missed.summit_hidden),
+                selection: pct(missed.selection),
+            },
         }
     }
 }
@@ -244,7 +273,7 @@ pub fn pass_labels(trade: &Trade) -> Vec<String> {
 }
 
 /// The fixed CSV columns before the passes' `<label>_ms`.
-pub const CSV_COLUMNS: [&str; 26] = [
+pub const CSV_COLUMNS: [&str; 31] = [
     "label",
     "preset",
     "knobs",
@@ -264,6 +293,11 @@ pub const CSV_COLUMNS: [&str; 26] = [
     "any_part_recall_pct",
     "any_part_precision_pct",
     "pixel_weighted_recall_pct",
+    "missed_reach_pct",
+    "missed_density_pct",
+    "missed_frustum_pct",
+    "missed_summit_hidden_pct",
+    "missed_selection_pct",
     "ground_psnr_db",
     "frame_psnr_db",
     "frame_ssim",
@@ -310,6 +344,11 @@ pub fn csv(trade: &Trade) -> String {
                 a.map(|a| a.recall_pct),
                 a.map(|a| a.precision_pct),
                 a.map(|a| a.pixel_weighted_recall_pct),
+                a.map(|a| a.missed_pct.reach),
+                a.map(|a| a.missed_pct.density),
+                a.map(|a| a.missed_pct.frustum),
+                a.map(|a| a.missed_pct.summit_hidden),
+                a.map(|a| a.missed_pct.selection),
                 Some(p.ground_psnr_db),
                 Some(p.frame_psnr_db),
                 Some(p.frame_ssim),
@@ -370,6 +409,13 @@ pub(crate) mod tests {
                 recall_pct: 82.08,
                 precision_pct: 99.49,
                 pixel_weighted_recall_pct: 97.5,
+                missed_pct: MissedPct {
+                    reach: 1.5,
+                    density: 0.5,
+                    frustum: 0.0,
+                    summit_hidden: 0.25,
+                    selection: 0.25,
+                },
             }),
             ground_psnr_db: 38.5,
             frame_psnr_db: 30.25,

@@ -1,7 +1,7 @@
 //! How it works: a sweep's figures as tables: the terminal's (`table`) and Markdown for docs
 //! (`markdown`): the trade (time; the seeds against the summit oracle and the truth's any-part
-//! oracle; the frame against the truth; popping along a flight against the truth's), the error per
-//! distance band, and each pass's median.
+//! oracle; the frame against the truth; popping along a flight against the truth's), the truth's
+//! tree pixels missed by why, the error per distance band, and each pass's median.
 
 use std::fmt::Write;
 
@@ -62,6 +62,33 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
             p.frame_ssim,
             p.frame_flip
         )?;
+    }
+    if t.points.iter().any(|p| p.any_part.is_some()) {
+        writeln!(
+            out,
+            "\nThe truth's tree pixels each point misses, by why (% of them all; the exact oracle's fate of each \
+             missed seed under the point's settings):\n"
+        )?;
+        writeln!(
+            out,
+            "| point | missed | beyond reach | not grown (density) | outside frustum | summit hidden | pass 3's approximations |"
+        )?;
+        writeln!(out, "|---|---|---|---|---|---|---|")?;
+        for p in &t.points {
+            let Some(a) = p.any_part else { continue };
+            let m = a.missed_pct;
+            writeln!(
+                out,
+                "| {} | {:.2} % | {:.2} % | {:.2} % | {:.2} % | {:.2} % | {:.2} % |",
+                p.label,
+                100.0 - a.pixel_weighted_recall_pct,
+                m.reach,
+                m.density,
+                m.frustum,
+                m.summit_hidden,
+                m.selection
+            )?;
+        }
     }
     writeln!(
         out,
@@ -211,12 +238,13 @@ mod tests {
         }
         let md = markdown(&trade());
         // The trade, two bands, the passes.
-        assert_eq!(md.lines().filter(|l| l.starts_with("| fast")).count(), 4, "{md}");
+        assert_eq!(md.lines().filter(|l| l.starts_with("| fast")).count(), 5, "{md}");
         assert!(
             md.contains("| 82.08 % |")
                 && md.contains("97.00 / 99.00 %")
                 && md.contains("| streaming |")
-                && md.contains("| +6.0 (9.2) |"),
+                && md.contains("| +6.0 (9.2) |")
+                && md.contains("| fast | 2.50 % | 1.50 % | 0.50 % | 0.00 % | 0.25 % | 0.25 % |"),
             "{md}"
         );
         assert!(md.contains("| fast | meshes | 0–100 | 50.0 % |"), "{md}");

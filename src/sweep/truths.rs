@@ -61,7 +61,7 @@ impl Truths {
     ) -> Result<Self, SweepError> {
         let mut truths =
             Self { options, by_world: Vec::new(), reference: world_key(reference), flight: Vec::new() };
-        truths.of_world(flight, reference, progress)?;
+        truths.ensure(flight, reference, progress)?;
         if !flight.popping.is_empty() {
             let mut renderer = truths.renderer(flight, reference)?;
             for (i, camera) in flight.popping.iter().enumerate() {
@@ -94,16 +94,16 @@ impl Truths {
         self.by_world.iter().find(|(k, _)| *k == self.reference).map_or(&[], |(_, t)| t)
     }
 
-    /// The truths of `settings`' world, one per pose (rendered on first use).
-    pub fn of_world(
+    /// Renders the truths of `settings`' world, one per pose, unless they are already here.
+    pub fn ensure(
         &mut self,
         flight: &Flight,
         settings: &Settings,
         progress: &mut dyn FnMut(Progress),
-    ) -> Result<&[Truth], SweepError> {
+    ) -> Result<(), SweepError> {
         let key = world_key(settings);
-        if let Some(i) = self.by_world.iter().position(|(k, _)| *k == key) {
-            return Ok(&self.by_world[i].1);
+        if self.by_world.iter().any(|(k, _)| *k == key) {
+            return Ok(());
         }
         let mut truths = Vec::with_capacity(flight.poses.len());
         let mut renderer = self.renderer(flight, settings)?;
@@ -113,6 +113,12 @@ impl Truths {
             truths.push(renderer.render(camera)?);
         }
         self.by_world.push((key, truths));
-        Ok(self.by_world.last().map_or(&[][..], |(_, t)| &t[..]))
+        Ok(())
+    }
+
+    /// The truths of `settings`' world, one per pose (empty before `ensure`).
+    pub fn of_world(&self, settings: &Settings) -> &[Truth] {
+        let key = world_key(settings);
+        self.by_world.iter().find(|(k, _)| *k == key).map_or(&[], |(_, t)| t)
     }
 }

@@ -5,13 +5,16 @@
 //! seeds, named by their identity: ring-0 cell address and rank) is judged by recall (visible
 //! seeds selected), precision (selected seeds visible) and pixel-weighted recall (the share of the
 //! truth's seed samples whose seed is selected): missing a tree that covers a hundred pixels costs
-//! a hundred times one that covers one.
+//! a hundred times one that covers one. `missed` says why the samples a selection misses are
+//! missed: the fate the exact oracle gives each missed seed under the selection's own settings
+//! (beyond its reach, thinned by its density, outside its frustum, its summit hidden), or, when
+//! the exact rule keeps it, the selection's own approximations.
 
 use std::collections::HashSet;
 
 use serde::Serialize;
 
-use crate::reference::oracle::OracleSeed;
+use crate::reference::oracle::{Culls, Fate, OracleError, OracleInputs, OracleSeed, fates_of};
 
 /// How a selection of seeds compares with the truth's visible ones.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -52,6 +55,64 @@ impl Visibility {
         self.seed_samples += other.seed_samples;
         self.seed_samples_selected += other.seed_samples_selected;
     }
+}
+
+/// The truth's seed samples a selection misses, by why: the fate of their seed under the
+/// selection's own rule done exactly (the summit oracle with the selection's settings).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Missed {
+    /// Beyond the selection's reach for the seed's size (`draw_seeds.reach_m`, scaled).
+    pub reach: u64,
+    /// Not grown by the selection: thinned by its density (`seeds.density_scale`), or its class
+    /// or rules.
+    pub density: u64,
+    /// Its bounding sphere outside the view (a crown poking in from beyond the frustum's test).
+    pub frustum: u64,
+    /// Its summit hidden by the terrain while another part of it shows.
+    pub summit_hidden: u64,
+    /// Kept by the exact rule, yet not selected: what the selection's approximations lose (the
+    /// Tile Load Map's cells, depth tolerances, overflow).
+    pub selection: u64,
+}
+
+impl Missed {
+    /// Sums two views' samples.
+    pub fn add(&mut self, other: &Self) {
+        self.reach += other.reach;
+        self.density += other.density;
+        self.frustum += other.frustum;
+        self.summit_hidden += other.summit_hidden;
+        self.selection += other.selection;
+    }
+}
+
+/// Why the truth's visible `seeds` (with `samples` each) that `selected` leaves out are missed,
+/// judged by the oracle in the selection's view (`inputs`: its settings, seeded world and camera).
+pub fn missed(
+    inputs: &OracleInputs,
+    seeds: &[OracleSeed],
+    samples: &[u64],
+    selected: impl IntoIterator<Item = ([i64; 2], u32)>,
+) -> Result<Missed, OracleError> {
+    let selected: HashSet<([i64; 2], u32)> = selected.into_iter().collect();
+    let (left_out, weights): (Vec<OracleSeed>, Vec<u64>) = seeds
+        .iter()
+        .zip(samples)
+        .filter(|&(s, &n)| n > 0 && !selected.contains(&(s.address, s.rank)))
+        .map(|(s, &n)| (*s, n))
+        .unzip();
+    let mut out = Missed::default();
+    for (fate, n) in fates_of(inputs, Culls::SELECTION, &left_out)?.into_iter().zip(weights) {
+        let bin = match fate {
+            Fate::Distance => &mut out.reach,
+            Fate::Class | Fate::Rule => &mut out.density,
+            Fate::Frustum => &mut out.frustum,
+            Fate::Occlusion => &mut out.summit_hidden,
+            Fate::Visible(_) => &mut out.selection,
+        };
+        *bin += n;
+    }
+    Ok(out)
 }
 
 fn ratio(part: u64, whole: u64) -> f64 {

@@ -242,9 +242,14 @@ fn synthetic(size: u32) -> Dataset {
     Dataset::open(&dir).unwrap()
 }
 
-/// Runs the oracle on `dataset` from grid point (x, y), `above_m` over the ground, looking along
-/// `yaw_deg` and `pitch_deg`.
-fn run(dataset: &Dataset, pose: [f64; 5], viewport_px: [u32; 2]) -> (Vec<OracleSeed>, OracleCounts) {
+/// Runs `judge` with the oracle's inputs on `dataset` from grid point (x, y), `above_m` over the
+/// ground, looking along `yaw_deg` and `pitch_deg`.
+fn with_inputs<R>(
+    dataset: &Dataset,
+    pose: [f64; 5],
+    viewport_px: [u32; 2],
+    judge: impl FnOnce(&OracleInputs) -> R,
+) -> R {
     let settings = Settings::default();
     let landcover = dataset.manifest.landcover.as_ref().unwrap();
     let table = ClassTable::load(&landcover.scheme).unwrap();
@@ -256,15 +261,44 @@ fn run(dataset: &Dataset, pose: [f64; 5], viewport_px: [u32; 2]) -> (Vec<OracleS
     let z = dataset.height_at(x, y, 0).unwrap() + above_m;
     let position_m = DVec3::new(origin[0] + x, origin[1] + y, z);
     let camera = Camera { position_m, yaw_deg, pitch_deg, fov_deg: 60.0, near_m: 0.1 };
-    let inputs = OracleInputs {
+    judge(&OracleInputs {
         dataset,
         settings: &settings,
         tables: &tables,
         patterns: &patterns,
         camera: &camera,
         viewport_px,
-    };
-    visible_seeds(&inputs).unwrap()
+    })
+}
+
+/// The visible seeds (pass 3's rule, exactly) of the view `with_inputs` describes.
+fn run(dataset: &Dataset, pose: [f64; 5], viewport_px: [u32; 2]) -> (Vec<OracleSeed>, OracleCounts) {
+    with_inputs(dataset, pose, viewport_px, |inputs| visible_seeds(inputs).unwrap())
+}
+
+#[test]
+fn fates_seed_by_seed_agree_with_the_judge() {
+    let ds = synthetic(160);
+    // Low over the ground, looking level: some seeds beyond reach, some behind the hills.
+    let pose = [200.0, 200.0, 3.0, 45.0, 0.0];
+    with_inputs(&ds, pose, [400, 250], |inputs| {
+        // Every seed in view out to beyond the draw reaches, occluded or not, judged again by pass
+        // 3's rule: the visible ones are exactly the judge's, the others beyond reach or hidden.
+        let wide = Culls { reach_m: Some(5000.0), occlusion: false };
+        let (all, _) = judge_seeds(inputs, wide).unwrap();
+        let (visible, counts) = visible_seeds(inputs).unwrap();
+        let fates = fates_of(inputs, Culls::SELECTION, &all).unwrap();
+        let kept: Vec<OracleSeed> =
+            fates.iter().filter_map(|f| if let Fate::Visible(s) = f { Some(*s) } else { None }).collect();
+        assert_eq!(kept, visible);
+        let count = |want: fn(&Fate) -> bool| fates.iter().filter(|f| want(f)).count() as u64;
+        assert_eq!(count(|f| matches!(f, Fate::Occlusion)), counts.occlusion);
+        assert!(count(|f| matches!(f, Fate::Distance)) > 0 && counts.occlusion > 0, "{counts:?}");
+        assert_eq!(count(|f| matches!(f, Fate::Class | Fate::Rule | Fate::Frustum)), 0);
+        // And under the judge's own culls, every seed it kept stays.
+        let again = fates_of(inputs, wide, &all).unwrap();
+        assert!(again.iter().zip(&all).all(|(f, s)| *f == Fate::Visible(*s)));
+    });
 }
 
 #[test]
