@@ -16,10 +16,16 @@
 #    trade.md), then writes docs/TRADE.md (`scripts/trade_page.py`): how it was measured, each
 #    dataset's tables and plot, and the issue's acceptance checks computed from the JSON.
 #
+# Besides the presets, every dataset's sweep varies each speed knob over three values, one at a
+# time from the `balanced` preset (`--series --series-from balanced`), so that trade.png shows a
+# front of some thirty points.
+#
 # Environment: FRAMES (60 timed frames per point), WARMUP (10), SAMPLES (3 poses), PRESETS
-# (fast,balanced,accurate), WIDTH × HEIGHT (1280 × 720), TRUTH_SUPERSAMPLE (4), TRUTH_REACH_M (4000), DATA_DIR, SWEEP ("synthetic nc zion": the
-# datasets to sweep again; the page is always written from all three folders' trade.json, so
-# SWEEP=nc re-measures nc/ alone and SWEEP= only rewrites the page).
+# (fast,balanced,accurate), SERIES_FROM (balanced), FRONT (1; 0 measures the presets alone),
+# POPPING_FRAMES (12), WIDTH × HEIGHT (1280 × 720), TRUTH_SUPERSAMPLE (4), TRUTH_REACH_M (4000),
+# DATA_DIR, SWEEP ("synthetic nc zion": the datasets to sweep again; the page is always written
+# from all three folders' trade.json, so SWEEP=nc re-measures nc/ alone and SWEEP= only rewrites
+# the page).
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -74,12 +80,31 @@ trees="$data/trees.toml"
 printf '# Written by scripts/trade.sh: draw the seeds with the baked impostors.\n[draw_seeds]\nimpostors = "%s"\n' \
     "$(cd "$impostors" && pwd)" >"$trees"
 
+# The front's knobs: three values each besides balanced's own (in brackets).
+knobs=(
+    "tlm.cells=32,48,96"                                                   # [64]
+    "tlm.radial_bands_m=[500,1000,3000],[1000,2000,3000],[1400,2200,3000]" # [700,1400,3000]
+    "seeds.occlusion_tolerance_m=1,2,20"                                   # [5]
+    "seeds.density_scale=0.25,0.5,0.75"                                    # [1]
+    "seeds.seeds_per_pattern=1024,3072,4096"                               # [2048]
+    "draw_seeds.reach_m=[0,700,1400,3000],[60,700,1400,3000],[300,700,1400,3000]" # mesh reach [120]
+    "draw_seeds.fade_fraction=0,0.05,0.25"                                 # [0.1]
+    "terrain.triangle_px=2,8,16"                                           # [4]
+    "cache.imagery_slots=32,48,192"                                        # [96]
+    "draw_seeds.samples=4"                                                 # [1]
+)
+front=()
+if [[ "${FRONT:-1}" != 0 ]]; then
+    front=(--series --series-from "${SERIES_FROM:-balanced}")
+    for k in "${knobs[@]}"; do front+=(--knob "$k"); done
+fi
+
 for name in ${SWEEP-synthetic nc zion}; do
     echo "## sweep $name" >&2
     "$terramp" sweep --dataset "$data/$name" --out "docs/trade/$name" --presets "$presets" \
         --frames "$frames" --warmup "$warmup" --samples "$samples" --width "$width" --height "$height" \
         --truth-supersample "${TRUTH_SUPERSAMPLE:-4}" --truth-reach-m "${TRUTH_REACH_M:-4000}" \
-        --settings "$trees" 2>/dev/null
+        --popping-frames "${POPPING_FRAMES:-12}" --settings "$trees" "${front[@]}" 2> >(grep -v XDG_RUNTIME_DIR >&2)
 done
 
 python3 scripts/trade_page.py "$frames" "$warmup" >docs/TRADE.md

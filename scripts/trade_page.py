@@ -63,11 +63,31 @@ standing elsewhere, not only blur. `fast` also grows half of every class's densi
 (`seeds.density_scale` 0.5) and reaches 2 km where the others reach 3 km: its recall against the
 truth (which grows every seed, full density, out to the truth's reach) shows what that costs.
 """)
+def presets_only(markdown):
+    """The sweep's trade.md with its later tables (missed pixels, bands, passes) cut to the presets'
+    rows: the knob points are in the first table and the plot, and whole in docs/trade/NAME/trade.md."""
+    out, first_table_done, in_table = [], False, False
+    for line in markdown.splitlines():
+        if line.startswith("|"):
+            in_table = True
+            label = line.split("|")[1].strip()
+            knob_row = first_table_done and " " in label and "=" in label
+            if not knob_row:
+                out.append(line)
+        else:
+            if in_table:
+                first_table_done = True
+            in_table = False
+            out.append(line)
+    return "\n".join(out)
+
+
 for name, title in names.items():
     t = trades[name]
     print(f"## {name}\n\n{title}; path: {t['path']}.\n")
-    print(open(f"docs/trade/{name}/trade.md").read())
     print(f"![{name} trade](trade/{name}/trade.png)\n")
+    print(presets_only(open(f"docs/trade/{name}/trade.md").read()))
+    print(f"\nEvery point's tables: [trade/{name}/trade.md](trade/{name}/trade.md).\n")
 print("## Acceptance (issue 12)\n")
 print("""Against the truth, `accurate` is not there yet, and the figures say why. At the synthetic pose of
 [truth.md](truth.md), the truth itself rendered at one sample per pixel is already 0.035 FLIP from

@@ -4,7 +4,10 @@
 //! values separated by commas, commas inside brackets excepted (`tlm.radial_bands_m=[500,1000,2000],
 //! [700,1400,3000]`). Each value becomes a one-key TOML layer over the preset (and over the user's
 //! settings file), so it goes through the same key and range checks as any settings file; a value
-//! that is not TOML (`fast`) is taken as a string.
+//! that is not TOML (`fast`) is taken as a string. Settings that only make sense together are one
+//! knob of several keys joined by `+`, each value their values joined by `+` in the same order
+//! (`tlm.radial_bands_m+draw_seeds.reach_m=[700,1400,4000]+[200,700,1400,4000]`): the layers
+//! are checked once all of them are laid.
 
 use std::str::FromStr;
 
@@ -27,29 +30,37 @@ impl FromStr for Knob {
             .split_once('=')
             .ok_or_else(|| format!("`{text}`: expected KEY=V1,V2,... (e.g. seeds.frustum_epsilon=0,0.01)"))?;
         let key = key.trim();
-        let parts: Vec<&str> = key.split('.').collect();
-        if parts.len() < 2
-            || parts.iter().any(|p| p.is_empty() || !p.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'))
-        {
-            return Err(format!("`{key}`: expected a settings key such as seeds.occlusion_tolerance_m"));
+        let keys: Vec<&str> = key.split('+').map(str::trim).collect();
+        for k in &keys {
+            let parts: Vec<&str> = k.split('.').collect();
+            if parts.len() < 2
+                || parts
+                    .iter()
+                    .any(|p| p.is_empty() || !p.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'))
+            {
+                return Err(format!("`{k}`: expected a settings key such as seeds.occlusion_tolerance_m"));
+            }
         }
-        let values = split_values(values);
+        let values = split_outside_brackets(values, ',');
         if values.is_empty() || values.iter().any(String::is_empty) {
             return Err(format!("`{text}`: every value must be non-empty"));
         }
-        Ok(Self { key: key.to_owned(), values })
+        if let Some(v) = values.iter().find(|v| split_outside_brackets(v, '+').len() != keys.len()) {
+            return Err(format!("`{v}`: {} keys need {} values joined by +", keys.len(), keys.len()));
+        }
+        Ok(Self { key: keys.join("+"), values })
     }
 }
 
-/// Splits at commas outside brackets, trimming each value.
-fn split_values(text: &str) -> Vec<String> {
+/// Splits at `separator` outside brackets, trimming each part.
+fn split_outside_brackets(text: &str, separator: char) -> Vec<String> {
     let mut values = Vec::new();
     let (mut depth, mut current) = (0i32, String::new());
     for c in text.chars() {
         match c {
             '[' => depth += 1,
             ']' => depth -= 1,
-            ',' if depth == 0 => {
+            c if c == separator && depth == 0 => {
                 values.push(current.trim().to_owned());
                 current.clear();
                 continue;
@@ -106,7 +117,10 @@ impl Point {
         let mut layers = vec![(format!("preset {}", self.preset), (*preset_text).to_owned())];
         layers.extend(user.cloned());
         for (key, value) in &self.knobs {
-            layers.push((format!("--knob {key}={value}"), layer_text(key, value)));
+            let origin = format!("--knob {key}={value}");
+            for (k, v) in key.split('+').zip(split_outside_brackets(value, '+')) {
+                layers.push((origin.clone(), layer_text(k, &v)));
+            }
         }
         Settings::from_layers(&layers)
     }
@@ -131,14 +145,15 @@ pub fn points(presets: &[String], knobs: &[Knob]) -> Vec<Point> {
     points
 }
 
-/// Each preset as it is, then each preset with one knob set to one of its values, knob by knob:
-/// one series per knob through every preset, the others left at the preset's (what a front over
-/// many knobs needs: their product would be thousands of points).
-pub fn series(presets: &[String], knobs: &[Knob]) -> Vec<Point> {
+/// Each preset as it is, then each preset of `from` (every one of `presets` when empty) with one
+/// knob set to one of its values, knob by knob: one series per knob, the others left at the
+/// preset's (what a front over many knobs needs: their product would be thousands of points).
+pub fn series(presets: &[String], from: &[String], knobs: &[Knob]) -> Vec<Point> {
     let alone = presets.iter().map(|preset| Point { preset: preset.clone(), knobs: Vec::new() });
+    let from = if from.is_empty() { presets } else { from };
     let varied = knobs.iter().flat_map(|knob| {
         knob.values.iter().flat_map(move |v| {
-            presets.iter().map(move |preset| Point {
+            from.iter().map(move |preset| Point {
                 preset: preset.clone(),
                 knobs: vec![(knob.key.clone(), v.clone())],
             })
@@ -156,7 +171,7 @@ mod tests {
         let presets = ["fast".to_owned(), "accurate".to_owned()];
         let knobs: Vec<Knob> =
             ["seeds.density_scale=0.25,0.5,1", "tlm.cells=16"].iter().map(|k| k.parse().unwrap()).collect();
-        let labels: Vec<String> = series(&presets, &knobs).iter().map(Point::label).collect();
+        let labels: Vec<String> = series(&presets, &[], &knobs).iter().map(Point::label).collect();
         assert_eq!(
             labels,
             [
@@ -174,6 +189,10 @@ mod tests {
         );
         // The product instead crosses them: 2 presets × 3 × 1.
         assert_eq!(points(&presets, &knobs).len(), 6);
+        // Series from one preset only, the others measured as they are.
+        let from = ["accurate".to_owned()];
+        let labels: Vec<String> = series(&presets, &from, &knobs[1..]).iter().map(Point::label).collect();
+        assert_eq!(labels, ["fast", "accurate", "accurate tlm.cells=16"]);
     }
 
     #[test]
@@ -188,6 +207,21 @@ mod tests {
         assert!("seeds".parse::<Knob>().is_err());
         assert!("frustum_epsilon=0".parse::<Knob>().is_err());
         assert!("seeds.frustum_epsilon=0,".parse::<Knob>().is_err());
+        // Keys that go together: as many values per point, joined by +.
+        let k: Knob =
+            "tlm.radial_bands_m+draw_seeds.reach_m=[700,1400,4000]+[200,700,1400,4000]".parse().unwrap();
+        assert_eq!((k.key.as_str(), k.values.len()), ("tlm.radial_bands_m+draw_seeds.reach_m", 1));
+        assert!("tlm.cells+seeds.density_scale=32".parse::<Knob>().is_err());
+        let s = Point { preset: "accurate".into(), knobs: vec![(k.key, k.values[0].clone())] }
+            .settings(None)
+            .unwrap();
+        assert_eq!((s.tlm.radial_bands_m[2], s.draw_seeds.reach_m[3]), (4000.0, 4000.0));
+        // Each alone would be refused (a reach beyond the last band); together they are checked once.
+        let alone = Point {
+            preset: "accurate".into(),
+            knobs: vec![("draw_seeds.reach_m".into(), "[200,700,1400,4000]".into())],
+        };
+        assert!(alone.settings(None).is_err());
     }
 
     #[test]

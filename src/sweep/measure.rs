@@ -2,9 +2,9 @@
 //! gets a fresh renderer (own device, cold caches), so points do not inherit each other's resident
 //! tiles: the timed flight through `profile::Session` (one step per frame) and its summary; then at
 //! each sample pose the settled view's seeds go to the exact summit oracle (height error, and
-//! agreement with pass 3's rule) and to the any-part oracle of its world's truth, and its frame is
-//! judged against the reference world's truth, whole and per distance band
-//! (`truth::compare`). Then, from the popping flight's first pose settled, it flies the popping
+//! agreement with pass 3's rule) and to the any-part oracle of its world's truth (rendered first,
+//! in a renderer of its own), and its frame is judged against that truth, whole and per distance
+//! band (`truth::compare`). Then, from the popping flight's first pose settled, it flies the popping
 //! flight frame by frame as a user would (streaming and readbacks a frame or two behind), and its
 //! frames' changes are judged against the truth's along the same flight (`frame_change::Popping`).
 //! With seeds drawn, a second renderer of the same settings without impostors settles the same
@@ -194,7 +194,9 @@ impl Flight<'_> {
         let mut errors = Vec::with_capacity(frames.len());
         let mut ground_mse = 0.0;
         let (near_m, bands) = (settings.render.near_m, bands(&settings));
-        for (i, (frame, truth)) in frames.iter().zip(truths.images()).enumerate() {
+        // Its own world's truths, or without seeds in the truths, the reference's (the ground).
+        let image_truths = if world.is_empty() { truths.images() } else { world };
+        for (i, (frame, truth)) in frames.iter().zip(image_truths).enumerate() {
             let ground = grounds.as_ref().map_or(frame, |g| &g[i]);
             let g_mse = mse(ground, &truth.ground)?;
             ground_mse += g_mse;

@@ -6,11 +6,11 @@
 //! wall time. Then, at a few sample poses spread along the same path, it settles the view
 //! (`render_resolved`: everything the view asked for is resident) and measures it (`measure`)
 //! against two references, neither of them the thing measured:
-//! - the **ground truth** (`truth`, through `truths`): the point's kept seeds against the any-part
-//!   oracle of its own seeded world (recall, precision, pixel-weighted recall); its frame against
-//!   the reference world's truth image (the accurate preset's seeds, all grown, as meshes,
-//!   supersampled) by PSNR, SSIM and FLIP, whole and per distance band (`truth::compare`); its
-//!   ground (the frame without seeds) against the truth's ground (PSNR);
+//! - the **ground truth** (`truth`, through `truths`) of the point's own seeded world (every seed
+//!   grown, as meshes, supersampled): its kept seeds against the any-part oracle (recall,
+//!   precision, pixel-weighted recall, and why the missed pixels are missed); its frame by PSNR,
+//!   SSIM and FLIP, whole and per distance band (`truth::compare`); its ground (the frame without
+//!   seeds) against the truth's ground (PSNR);
 //! - the **exact summit oracle** (`reference::oracle`): the distance of each kept seed's ground
 //!   height from the f64 drawn ground (`reference::accuracy`), and recall and precision against pass 3's
 //!   own rule, done exactly.
@@ -113,6 +113,8 @@ pub struct SweepOptions {
     pub knobs: Vec<Knob>,
     /// Vary one knob at a time from each preset instead of crossing them all.
     pub series: bool,
+    /// With `series`, the presets the knobs are varied from (empty: every one of `presets`).
+    pub series_from: Vec<String>,
     /// A settings file laid over every point's preset and over the reference (before the knobs).
     pub settings: Option<PathBuf>,
     /// Timed frames per point, spread evenly along the path, after `warmup` frames at its start.
@@ -173,7 +175,7 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         s
     };
     let points = match options.series {
-        true => knobs::series(&options.presets, &options.knobs),
+        true => knobs::series(&options.presets, &options.series_from, &options.knobs),
         false => points(&options.presets, &options.knobs),
     };
     let settings: Vec<Settings> =
@@ -263,8 +265,8 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
             from_t: popping_t,
         }),
         reference: format!(
-            "ground truth: the accurate preset's world, every seed within {:.0} m as its full mesh{}, \
-             every tile at its finest level, {}² samples per pixel; selections against their own world's truth",
+            "ground truth of each point's own world (its seed patterns), every seed within {:.0} m as its \
+             full mesh{}, every tile at its finest level, {}² samples per pixel",
             truth.reach_m,
             if truth.reach_m > 0.0 { "" } else { " (none: no impostors)" },
             truth.supersample

@@ -1,6 +1,7 @@
 //! How it works: `trade.png`, the trade as a picture: frame time (median wall time, ms) up, error
-//! across, one labelled point per preset or knob value, presets ringed. Two panels share the time
-//! axis: the frame's error against the ground truth (mean FLIP, which folds terrain, imagery and
+//! across, one point per preset or knob value. Presets are ringed and named; a knob's points share
+//! a colour (the legend names the knob) and are labelled with their value alone, so thirty points
+//! stay legible. Two panels share the time axis: the frame's error against the ground truth (mean FLIP, which folds terrain, imagery and
 //! seeds into what a viewer sees), and the seeds it misses (100 − pixel-weighted recall against
 //! the truth's any-part oracle, %: the share of the truth's tree pixels whose tree is not drawn).
 //! The second panel is left out when no point was judged against seeds. In each, the Pareto front
@@ -17,10 +18,32 @@ use super::SweepError;
 use super::report::Trade;
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
-const SIZE_PX: (u32, u32) = (1400, 640);
+const SIZE_PX: (u32, u32) = (1600, 760);
 
-/// One panel's points: (label, error, frame ms, a preset).
-type Series = Vec<(String, f64, f64, bool)>;
+/// One point of a panel.
+struct Dot {
+    /// The legend's group: "presets", or the knobs the point varies.
+    group: String,
+    /// Its label beside the point: the preset's name, or the knob values alone.
+    short: String,
+    error: f64,
+    frame_ms: f64,
+}
+
+/// One panel's points.
+type Series = Vec<Dot>;
+
+/// The point's dot: its legend group and short label.
+fn dot(p: &super::TradePoint, error: f64) -> Dot {
+    let (group, short) = match p.knobs.is_empty() {
+        true => ("presets".to_owned(), p.preset.clone()),
+        false => (
+            p.knobs.keys().cloned().collect::<Vec<_>>().join(" + "),
+            p.knobs.values().cloned().collect::<Vec<_>>().join(", "),
+        ),
+    };
+    Dot { group, short, error, frame_ms: p.frame_ms }
+}
 
 /// Which of `points` (error, time) are on the Pareto front: no other point is at least as good on
 /// both and better on one. A NaN is on no front and beats nothing.
@@ -46,18 +69,11 @@ pub fn front_slack(points: &[(f64, f64)], p: (f64, f64)) -> f64 {
 pub fn write(trade: &Trade, path: &Path) -> Result<(), SweepError> {
     let fail = |message: String| SweepError::Plot { path: path.display().to_string(), message };
     register_font("sans-serif", FontStyle::Normal, FONT).map_err(|_| fail("the embedded font".into()))?;
-    let image_error: Series = trade
-        .points
-        .iter()
-        .map(|p| (p.label.clone(), p.frame_flip, p.frame_ms, p.knobs.is_empty()))
-        .collect();
+    let image_error: Series = trade.points.iter().map(|p| dot(p, p.frame_flip)).collect();
     let seed_error: Series = trade
         .points
         .iter()
-        .filter_map(|p| {
-            let missed = 100.0 - p.any_part?.pixel_weighted_recall_pct;
-            Some((p.label.clone(), missed, p.frame_ms, p.knobs.is_empty()))
-        })
+        .filter_map(|p| Some(dot(p, 100.0 - p.any_part?.pixel_weighted_recall_pct)))
         .collect();
     let (w, h) = SIZE_PX;
     let mut pixels = vec![255u8; w as usize * h as usize * 3];
@@ -100,16 +116,19 @@ fn panel(
     x_desc: &str,
     series: &Series,
 ) -> Result<(), String> {
-    let max_x = series.iter().map(|s| s.1).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
-    let max_y = series.iter().map(|s| s.2).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
-    // Room for the labels to the right of the points; never an empty range.
-    let x_end = if max_x > 0.0 { max_x * 1.35 } else { 1e-3 };
-    let y_end = if max_y > 0.0 { max_y * 1.15 } else { 1.0 };
+    let finite: Vec<&Dot> = series.iter().filter(|d| d.error.is_finite() && d.frame_ms.is_finite()).collect();
+    let max_x = finite.iter().map(|d| d.error).fold(0.0f64, f64::max);
+    let (min_y, max_y) =
+        finite.iter().map(|d| d.frame_ms).fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
+    // Room for the labels to the right of the points; the times' own range, never an empty one.
+    let x_end = if max_x > 0.0 { max_x * 1.2 } else { 1e-3 };
+    let pad = ((max_y - min_y) * 0.08).max(max_y * 0.02).max(1e-3);
+    let (y_start, y_end) = if max_y > 0.0 { ((min_y - pad).max(0.0), max_y + pad) } else { (0.0, 1.0) };
     let mut chart = ChartBuilder::on(area)
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(64)
-        .build_cartesian_2d(0.0..x_end, 0.0..y_end)
+        .build_cartesian_2d(0.0..x_end, y_start..y_end)
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()
@@ -119,17 +138,9 @@ fn panel(
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| e.to_string())?;
-    let colours = [
-        RGBColor(31, 119, 180),
-        RGBColor(214, 39, 40),
-        RGBColor(44, 160, 44),
-        RGBColor(148, 103, 189),
-        RGBColor(255, 127, 14),
-        RGBColor(140, 86, 75),
-    ];
     // The front as a staircase: from each front point across to the next more accurate one's
     // error, then down... to its time.
-    let points: Vec<(f64, f64)> = series.iter().map(|s| (s.1, s.2)).collect();
+    let points: Vec<(f64, f64)> = series.iter().map(|d| (d.error, d.frame_ms)).collect();
     let on_front = front(&points);
     let mut steps: Vec<(f64, f64)> =
         points.iter().zip(&on_front).filter(|(_, f)| **f).map(|(p, _)| *p).collect();
@@ -141,21 +152,55 @@ fn panel(
         .collect();
     let grey = RGBColor(120, 120, 120);
     chart.draw_series(LineSeries::new(stairs, grey.stroke_width(2))).map_err(|e| e.to_string())?;
-    for (i, (label, x, y, preset)) in series.iter().enumerate() {
-        if !(x.is_finite() && y.is_finite()) {
-            continue;
+    let mut groups: Vec<&str> = Vec::new();
+    for d in &finite {
+        if !groups.contains(&d.group.as_str()) {
+            groups.push(&d.group);
         }
-        let colour = colours[i % colours.len()];
-        // The label beside its point, not over it; a preset ringed.
-        let ring = if *preset { 10 } else { 0 };
-        let marker = EmptyElement::at((*x, *y))
-            + Circle::new((0, 0), 5, colour.filled())
-            + Circle::new((0, 0), ring, colour.stroke_width(2))
-            + Text::new(label.clone(), (10, -18), ("sans-serif", 14).into_font().color(&colour));
-        chart.draw_series(std::iter::once(marker)).map_err(|e| e.to_string())?;
     }
+    for (g, group) in groups.iter().enumerate() {
+        let colour = COLOURS[g % COLOURS.len()];
+        let presets = *group == "presets";
+        let dots = finite.iter().filter(|d| d.group == *group).map(|d| {
+            // The label beside its point, not over it; a preset ringed and named larger.
+            let (ring, size) = if presets { (10, 16) } else { (0, 12) };
+            EmptyElement::at((d.error, d.frame_ms))
+                + Circle::new((0, 0), 5, colour.filled())
+                + Circle::new((0, 0), ring, colour.stroke_width(2))
+                + Text::new(d.short.clone(), (9, -14), ("sans-serif", size).into_font().color(&colour))
+        });
+        chart
+            .draw_series(dots)
+            .map_err(|e| e.to_string())?
+            .label(*group)
+            .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(grey)
+        .label_font(("sans-serif", 13))
+        .draw()
+        .map_err(|e| e.to_string())?;
     Ok(())
 }
+
+/// The groups' colours, in the order the groups first appear (presets first).
+const COLOURS: [RGBColor; 12] = [
+    RGBColor(20, 20, 20),
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+    RGBColor(188, 189, 34),
+    RGBColor(127, 127, 127),
+    RGBColor(0, 0, 128),
+];
 
 #[cfg(test)]
 mod tests {

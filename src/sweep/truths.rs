@@ -1,12 +1,14 @@
 //! How it works: the ground truths a sweep judges its points against, one per sample pose and
-//! seeded world (one `truth::TruthRenderer` per world renders all its poses). Images are judged against one
-//! truth: the reference settings' world (the accurate preset's), so a preset that grows a
-//! different forest (other patterns) shows that difference too. Selections are judged by seed
-//! identity, so against the truth of the point's own world (its cell size, patterns, germ, seeds
-//! per pattern, class table and placement): worlds are keyed by those settings, and their truths
-//! rendered once and shared by every point of that world. Popping is judged against the reference
-//! world's truth along the popping flight (its images only). Without impostors the truths grow no
-//! seeds (there is no mesh to draw them with): images are judged, selections are not.
+//! seeded world (one `truth::TruthRenderer` per world renders all its poses). A point is judged
+//! against the truth of its own world (its cell size, patterns, germ, seeds per pattern, class
+//! table and placement): its selection by seed identity, its frame pixel by pixel, so a point that
+//! grows another, equally dense forest (other patterns) is not charged for trees standing
+//! elsewhere, while one that grows fewer (`seeds.density_scale`) or stops sooner is. Worlds are
+//! keyed by those settings, and their truths rendered once and shared by every point of that
+//! world. Popping is judged against the reference world's truth along the popping flight (its
+//! images only: motion's changes, whatever the forest). Without impostors the truths grow no seeds
+//! (there is no mesh to draw them with): every point's frame is judged against the reference's
+//! truth (the ground alone), selections are not.
 
 use super::measure::Flight;
 use super::{Progress, SweepError};
@@ -89,7 +91,8 @@ impl Truths {
         &self.options
     }
 
-    /// The reference world's truths, one per pose: what every point's images are judged against.
+    /// The reference world's truths, one per pose: what images are judged against when the truths
+    /// grow no seeds.
     pub fn images(&self) -> &[Truth] {
         self.by_world.iter().find(|(k, _)| *k == self.reference).map_or(&[], |(_, t)| t)
     }

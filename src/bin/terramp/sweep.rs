@@ -25,6 +25,9 @@ pub struct SweepArgs {
     /// Vary one knob at a time from each preset (a series per knob) instead of their product.
     #[arg(long)]
     series: bool,
+    /// With --series, vary the knobs from these presets only (default: every preset measured).
+    #[arg(long, value_delimiter = ',')]
+    series_from: Vec<String>,
     /// Timed frames per point, spread evenly along the path.
     #[arg(long, default_value_t = 60)]
     frames: u32,
@@ -71,6 +74,7 @@ impl SweepArgs {
             presets: self.presets,
             knobs: self.knob,
             series: self.series,
+            series_from: self.series_from,
             settings: self.settings,
             frames: self.frames,
             warmup: self.warmup,
