@@ -175,6 +175,9 @@ pub struct Class {
     /// `MAX_SPECIES_PER_CLASS`); empty means no seeds.
     #[serde(default)]
     pub seeds: Vec<SeedRule>,
+    /// Dense enough to be drawn as a forest far away (texcells): a forest sample is baked for it.
+    #[serde(default)]
+    pub texcells: bool,
 }
 
 /// A manifest's class list compares equal to a table's classes when codes and names match.

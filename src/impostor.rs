@@ -44,7 +44,7 @@ use thiserror::Error;
 
 pub use manifest::{AlphaMode, BoundingSphere, Plane, Submesh};
 pub use mips::{MipChain, TexelRect, build_mip_chain, mip_size};
-pub use store::{is_current, load, models, save};
+pub use store::{is_current, load, models, replace_folder, save};
 
 /// The on-disk format's version: a reader refuses any other.
 pub const FORMAT_VERSION: u32 = 1;

@@ -27,4 +27,5 @@ pub mod streaming;
 pub mod sweep;
 #[cfg(feature = "synth")]
 pub mod synth;
+pub mod texcell;
 pub mod truth;

@@ -101,6 +101,7 @@ const LAYERS: &[&[&str]] = &[
     &["config", "dataset", "path", "impostor"],
     &["classes", "streaming"],
     &["seeds", "synth"],
+    &["texcell"],
     &["passes", "bake"],
     &["reference"],
     &["frame"],

@@ -35,15 +35,23 @@ enum Command {
         #[arg(long, default_value_t = terramp::synth::SynthParams::default().seed)]
         seed: u64,
     },
-    /// Bake impostors (billboard clouds at 3 LODs, atlases with mips, the mesh) from glTF models.
+    /// Bake impostors (billboard clouds at 3 LODs, atlases with mips, the mesh) from glTF models,
+    /// and with --classes the forest samples (texcells) of a class table's dense classes.
     Bake(BakeArgs),
 }
 
 #[derive(clap::Args)]
 struct BakeArgs {
     /// A glTF model (.glb) to bake; repeat for several. The impostor is named after the file.
-    #[arg(long = "model", required = true)]
+    #[arg(long = "model", required_unless_present = "classes")]
     models: Vec<PathBuf>,
+    /// A class table (nc, nlcd, or a TOML file): bake a forest sample (texcells) for each class it
+    /// marks `texcells = true`, from its species' models in --models, into OUT/texcells/CODE.
+    #[arg(long, requires = "models_dir")]
+    classes: Option<String>,
+    /// The folder of the glTF models the class table names (`<model>.glb`).
+    #[arg(long = "models")]
+    models_dir: Option<PathBuf>,
     /// The output folder: one sub-folder per model (replaced atomically).
     #[arg(long)]
     out: PathBuf,
@@ -57,14 +65,34 @@ struct BakeArgs {
 
 fn bake(args: BakeArgs) -> Result<()> {
     let started = Instant::now();
-    let options = terramp::bake::BakeOptions { planes: args.planes, texels: args.texels };
-    let reports = terramp::bake::bake_models(None, &args.models, &args.out, &options, true)?;
-    println!(
-        "baked {} models into {} in {:.1} s",
-        reports.len(),
-        args.out.display(),
-        started.elapsed().as_secs_f64()
-    );
+    if !args.models.is_empty() {
+        let options = terramp::bake::BakeOptions { planes: args.planes, texels: args.texels };
+        let reports = terramp::bake::bake_models(None, &args.models, &args.out, &options, true)?;
+        println!(
+            "baked {} models into {} in {:.1} s",
+            reports.len(),
+            args.out.display(),
+            started.elapsed().as_secs_f64()
+        );
+    }
+    if let (Some(classes), Some(models)) = (&args.classes, &args.models_dir) {
+        let table = terramp::classes::ClassTable::load(classes)?;
+        let options = terramp::bake::forest::ForestOptions::default();
+        let reports =
+            terramp::bake::forest::bake_forests(None, &table, models, &args.out, &options, &mut |r| {
+                println!(
+                    "forest sample of class {} ({}): {} trees in {:.1} s, {}",
+                    r.class_code,
+                    r.class_name,
+                    r.trees,
+                    r.seconds,
+                    r.dir.display()
+                )
+            })?;
+        if reports.is_empty() {
+            println!("class table {classes} marks no class `texcells = true`: no forest sample to bake");
+        }
+    }
     Ok(())
 }
 

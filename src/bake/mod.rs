@@ -13,6 +13,7 @@
 //! aligned to 2^(mips−1) texels never share a box with a neighbour at any level.
 
 mod fit;
+pub mod forest;
 mod model;
 mod pack;
 mod render;
@@ -102,6 +103,14 @@ pub enum BakeError {
         path: PathBuf,
         /// What is wrong with it.
         source: Box<ModelError>,
+    },
+    /// A class's forest sample (texcells) could not be baked.
+    #[error("forest sample of class {class:?}: {problem}")]
+    Forest {
+        /// The land-cover class's name.
+        class: String,
+        /// What went wrong.
+        problem: String,
     },
     /// No GPU could be opened to bake on (only tried when none is passed in).
     #[error("opening a GPU to bake on: {0}")]

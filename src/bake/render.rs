@@ -257,10 +257,116 @@ impl Baker {
             layout: &self.planes_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: matrix_buffer.as_entire_binding() }],
         });
+        self.render_into(gpu, [atlas, atlas], |pass| {
+            pass.set_bind_group(0, &planes_group, &[]);
+            pass.set_vertex_buffer(0, uploaded.vertices.slice(..));
+            pass.set_index_buffer(index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+            for (p, material, range) in draws {
+                let r = planes[p as usize].rect;
+                pass.set_viewport(r.x as f32, r.y as f32, r.width as f32, r.height as f32, 0.0, 1.0);
+                pass.set_scissor_rect(r.x, r.y, r.width, r.height);
+                pass.set_bind_group(1, &uploaded.materials[material as usize], &[]);
+                pass.draw_indexed(range, 0, p..p + 1);
+            }
+        })
+    }
+}
+
+/// One mesh drawn many times into one image: per instance, its clip space from model space and
+/// the rectangle it lands in (its whole mesh each time).
+pub struct Instances<'a> {
+    pub mesh: &'a Mesh,
+    pub uploaded: &'a UploadedMesh,
+    /// Sorted by rectangle, so that each rectangle's instances draw together.
+    pub instances: Vec<(Mat4, TexelRect)>,
+}
+
+impl Baker {
+    /// Renders every batch's instances into one `size` image, RGBA8 sRGB cleared to transparent,
+    /// depth-tested across batches (the nearest surface of any mesh wins).
+    pub fn render_instances(
+        &self,
+        gpu: &Gpu,
+        batches: &[Instances],
+        size: [u32; 2],
+    ) -> Result<Vec<u8>, RenderError> {
+        let device = &gpu.device;
+        let limit = device.limits().max_texture_dimension_2d;
+        if size[0].max(size[1]) > limit {
+            return Err(RenderError::TooLarge { atlas: size[0].max(size[1]), limit });
+        }
+        let matrices: Vec<[f32; 16]> =
+            batches.iter().flat_map(|b| b.instances.iter().map(|(m, _)| m.to_cols_array())).collect();
+        if matrices.is_empty() {
+            return Err(RenderError::NothingToDraw);
+        }
+        let matrix_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("bake instances"),
+            contents: bytemuck::cast_slice(&matrices),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let planes_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("bake instances"),
+            layout: &self.planes_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: matrix_buffer.as_entire_binding() }],
+        });
+        // Every batch's indices in one buffer; a mesh's are grouped by material already (its
+        // submeshes): one draw per material and rectangle.
+        let mut indices: Vec<u32> = Vec::new();
+        let mut ranges: Vec<Vec<(u32, Range<u32>)>> = Vec::new();
+        for b in batches {
+            let base = indices.len() as u32;
+            indices.extend_from_slice(&b.mesh.indices);
+            let submeshes = b.mesh.submeshes.iter().filter(|m| m.index_count > 0);
+            ranges.push(
+                submeshes
+                    .map(|m| (m.material, base + m.first_index..base + m.first_index + m.index_count))
+                    .collect(),
+            );
+        }
+        let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("bake indices"),
+            contents: bytemuck::cast_slice(&indices),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        self.render_into(gpu, size, |pass| {
+            pass.set_bind_group(0, &planes_group, &[]);
+            pass.set_index_buffer(index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+            let mut first = 0u32;
+            for (b, per_material) in batches.iter().zip(&ranges) {
+                pass.set_vertex_buffer(0, b.uploaded.vertices.slice(..));
+                let mut i = 0;
+                while i < b.instances.len() {
+                    let rect = b.instances[i].1;
+                    let run = b.instances[i..].iter().take_while(|(_, r)| *r == rect).count();
+                    let r = rect;
+                    pass.set_viewport(r.x as f32, r.y as f32, r.width as f32, r.height as f32, 0.0, 1.0);
+                    pass.set_scissor_rect(r.x, r.y, r.width, r.height);
+                    let instances = first + i as u32..first + (i + run) as u32;
+                    for (material, range) in per_material {
+                        pass.set_bind_group(1, &b.uploaded.materials[*material as usize], &[]);
+                        pass.draw_indexed(range.clone(), 0, instances.clone());
+                    }
+                    i += run;
+                }
+                first += b.instances.len() as u32;
+            }
+        })
+    }
+
+    /// One render pass over a `size` colour target (RGBA8 sRGB, cleared to transparent) and a depth
+    /// target, with the bake pipeline set; `record` draws; the colour is read back.
+    fn render_into(
+        &self,
+        gpu: &Gpu,
+        size: [u32; 2],
+        record: impl FnOnce(&mut wgpu::RenderPass),
+    ) -> Result<Vec<u8>, RenderError> {
+        let device = &gpu.device;
         let target = |format, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("bake atlas"),
-                size: wgpu::Extent3d { width: atlas, height: atlas, depth_or_array_layers: 1 },
+                label: Some("bake target"),
+                size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -277,7 +383,7 @@ impl Baker {
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("bake atlas"),
+                label: Some("bake"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: &colour_view,
                     depth_slice: None,
@@ -300,16 +406,7 @@ impl Baker {
                 multiview_mask: None,
             });
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &planes_group, &[]);
-            pass.set_vertex_buffer(0, uploaded.vertices.slice(..));
-            pass.set_index_buffer(index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-            for (p, material, range) in draws {
-                let r = planes[p as usize].rect;
-                pass.set_viewport(r.x as f32, r.y as f32, r.width as f32, r.height as f32, 0.0, 1.0);
-                pass.set_scissor_rect(r.x, r.y, r.width, r.height);
-                pass.set_bind_group(1, &uploaded.materials[material as usize], &[]);
-                pass.draw_indexed(range, 0, p..p + 1);
-            }
+            record(&mut pass);
         }
         gpu.queue.submit([encoder.finish()]);
         let texels = crate::gpu::readback::read_texture(gpu, &colour, wgpu::TextureAspect::All, 4)

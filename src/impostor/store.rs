@@ -20,28 +20,44 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ImpostorError + '_ {
 /// Writes `impostor` as `dir/<impostor.name>/`, replacing an earlier one; returns that folder.
 pub fn save(dir: &Path, impostor: &Impostor) -> Result<PathBuf, ImpostorError> {
     check(impostor)?;
-    let name = &impostor.name;
-    fs::create_dir_all(dir).map_err(io(dir))?;
-    let out = dir.join(name);
-    let staging = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    let out = dir.join(&impostor.name);
+    replace_folder(
+        &out,
+        |staging| write_all(staging, impostor),
+        |path, source| ImpostorError::Io { path: path.to_owned(), source },
+    )?;
+    Ok(out)
+}
+
+/// Makes `out` the folder `fill` writes, atomically: `fill` writes into a hidden folder beside it
+/// (`.NAME.partial-PID`, removed if `fill` fails), which is then renamed into place, the old
+/// `out` moved aside first and removed last, so `out` is always whole. `io` names a failing path.
+pub fn replace_folder<E>(
+    out: &Path,
+    fill: impl FnOnce(&Path) -> Result<(), E>,
+    io: impl Fn(&Path, std::io::Error) -> E,
+) -> Result<(), E> {
+    let parent = out.parent().unwrap_or(Path::new("."));
+    let name = out.file_name().map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
+    fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
+    let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
     if staging.exists() {
-        fs::remove_dir_all(&staging).map_err(io(&staging))?;
+        fs::remove_dir_all(&staging).map_err(|e| io(&staging, e))?;
     }
-    fs::create_dir_all(&staging).map_err(io(&staging))?;
-    let written = write_all(&staging, impostor);
-    if let Err(e) = written {
+    fs::create_dir_all(&staging).map_err(|e| io(&staging, e))?;
+    if let Err(e) = fill(&staging) {
         let _ = fs::remove_dir_all(&staging);
         return Err(e);
     }
-    let old = dir.join(format!(".{name}.old-{}", std::process::id()));
+    let old = parent.join(format!(".{name}.old-{}", std::process::id()));
     if out.exists() {
-        fs::rename(&out, &old).map_err(io(&out))?;
+        fs::rename(out, &old).map_err(|e| io(out, e))?;
     }
-    fs::rename(&staging, &out).map_err(io(&out))?;
+    fs::rename(&staging, out).map_err(|e| io(out, e))?;
     if old.exists() {
-        fs::remove_dir_all(&old).map_err(io(&old))?;
+        fs::remove_dir_all(&old).map_err(|e| io(&old, e))?;
     }
-    Ok(out)
+    Ok(())
 }
 
 fn write_all(folder: &Path, impostor: &Impostor) -> Result<(), ImpostorError> {

@@ -85,6 +85,6 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     PipelineBindings {
         shader: &draw_seeds::gpu::SHADER,
         entry_points: &["vs_fill", "fs_fill"],
-        bindings: &draw_seeds::multisample::FILL_BINDINGS.bindings,
+        bindings: &draw_seeds::gpu::multisample::FILL_BINDINGS.bindings,
     },
 ];

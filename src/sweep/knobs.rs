@@ -212,13 +212,13 @@ mod tests {
             "tlm.radial_bands_m+draw_seeds.reach_m=[700,1400,4000]+[200,700,1400,4000]".parse().unwrap();
         assert_eq!((k.key.as_str(), k.values.len()), ("tlm.radial_bands_m+draw_seeds.reach_m", 1));
         assert!("tlm.cells+seeds.density_scale=32".parse::<Knob>().is_err());
-        let s = Point { preset: "accurate".into(), knobs: vec![(k.key, k.values[0].clone())] }
+        let s = Point { preset: "balanced".into(), knobs: vec![(k.key, k.values[0].clone())] }
             .settings(None)
             .unwrap();
         assert_eq!((s.tlm.radial_bands_m[2], s.draw_seeds.reach_m[3]), (4000.0, 4000.0));
         // Each alone would be refused (a reach beyond the last band); together they are checked once.
         let alone = Point {
-            preset: "accurate".into(),
+            preset: "balanced".into(),
             knobs: vec![("draw_seeds.reach_m".into(), "[200,700,1400,4000]".into())],
         };
         assert!(alone.settings(None).is_err());

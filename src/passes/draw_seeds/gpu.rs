@@ -18,7 +18,9 @@ use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
 use super::DrawSeedsError;
 use super::assets;
-use super::multisample::{self, Multisample};
+use multisample::Multisample;
+
+pub mod multisample;
 
 /// Pass 4's shader.
 pub const SHADER: WgslSource = WgslSource {

@@ -16,7 +16,7 @@
 //! exactly one of the two and nothing pops; outside the band the cross-fade draw collapses its
 //! vertices. The last LOD fades out to nothing at the visibility radius. With `draw_seeds.samples`
 //! at 4 the groups are drawn multisampled instead, each fragment covering as many of its pixel's
-//! samples as its alpha says, and resolved into the frame (`multisample`).
+//! samples as its alpha says, and resolved into the frame (`gpu::multisample`).
 //!
 //! `frame` (the frame's constants, the impostors loaded from a folder) and `assets` (their layout
 //! for one upload) are the CPU half; `gpu` the pipeline, binding table, uploads and draws.
@@ -24,7 +24,6 @@
 pub mod assets;
 pub mod frame;
 pub mod gpu;
-pub mod multisample;
 
 use std::path::PathBuf;
 

@@ -16,7 +16,7 @@ use crate::gpu::layout::SEED_SAMPLES;
 use crate::gpu::resources::pipeline_layout;
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
-use super::gpu::SHADER;
+use super::SHADER;
 
 /// `vs_fill`/`fs_fill`'s bindings: the frame's colour (a copy) and the terrain's depth.
 pub const FILL_BINDINGS: BindingTable<2> = BindingTable {
