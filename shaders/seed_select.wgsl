@@ -190,30 +190,9 @@ fn ground_at(p: GridPos) -> Ground {
     return Ground(drawn.height_m, vec2<f32>(mul(drawn.slope.x, per_m), mul(drawn.slope.y, per_m)), level, true);
 }
 
-// Palette index of level-1 land-cover texel `q`, read from `wanted` or, while that streams in,
-// another resident level (they all decode to the same class); NO_CLASS when none is resident.
+// Palette index of level-1 land-cover texel `q` (`shared/landcover.wgsl`), and the level it came from.
 fn class_at(q: vec2<u32>, wanted: u32) -> vec2<u32> {
-    for (var n = 0u; n < LCC_LEVELS; n += 1u) {
-        let level = (wanted + n) % LCC_LEVELS;
-        var texel = q << vec2<u32>(1u);
-        if level == LCC_SOURCE_LEVEL {
-            texel = q;
-        } else if level == LCC_PACKED_LEVEL {
-            texel = q >> vec2<u32>(1u);
-        }
-        let info = u.lcc_levels[level];
-        let tile = min(texel / LCC_TILE_TEXELS, info.yz - 1u);
-        let slot = lcc_page_table[info.x + tile.y * info.y + tile.x];
-        if slot != PAGE_EMPTY {
-            let word = textureLoad(lcc_tiles, vec2<i32>(texel - tile * LCC_TILE_TEXELS), page_layer(slot), 0).x;
-            if level != LCC_PACKED_LEVEL {
-                return vec2<u32>(word, level);
-            }
-            let shift = u.lcc_sub_bits * ((q.x & 1u) + 2u * (q.y & 1u));
-            return vec2<u32>((word >> shift) & ((1u << u.lcc_sub_bits) - 1u), level);
-        }
-    }
-    return vec2<u32>(NO_CLASS, 0u);
+    return landcover_class(q, wanted, u.lcc_levels, u.lcc_sub_bits);
 }
 
 // Linear colour of level-0 imagery texel `t` from the finest resident level (alpha 0: none).

@@ -16,10 +16,12 @@ use crate::gpu::AdapterChoice;
 
 mod draw_seeds;
 mod seeds;
+mod texcells;
 mod tlm;
 
 pub use draw_seeds::DrawSeedsSettings;
 pub use seeds::{OcclusionTolerance, SeedSettings};
+pub use texcells::TexcellSettings;
 pub use tlm::TlmSettings;
 
 const DEFAULTS: &str = include_str!("../config/default.toml");
@@ -118,6 +120,8 @@ pub struct Settings {
     pub seeds: SeedSettings,
     /// `[draw_seeds]`: the draw LODs' reaches, their cross-fade and the impostors (pass 4).
     pub draw_seeds: DrawSeedsSettings,
+    /// `[texcells]`: the far forest, beyond the last seed band.
+    pub texcells: TexcellSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -319,6 +323,7 @@ impl Settings {
         self.tlm.validate()?;
         self.seeds.validate()?;
         self.draw_seeds.validate(&self.tlm)?;
+        self.texcells.validate(&self.draw_seeds)?;
         match checks.into_iter().find(|(ok, ..)| !ok) {
             Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
             None => Ok(()),

@@ -207,7 +207,8 @@ fn binding_mismatch(module: &Module, global: &naga::GlobalVariable, b: &Binding)
 /// Where a pipeline's binding table disagrees with its shader, if it does.
 fn table_mismatch(p: &PipelineBindings) -> Option<String> {
     let (module, info) = parse(p.shader);
-    let bound = |g: &naga::GlobalVariable| g.binding.as_ref().filter(|rb| rb.group == 0).map(|rb| rb.binding);
+    let bound =
+        |g: &naga::GlobalVariable| g.binding.as_ref().filter(|rb| rb.group == p.group).map(|rb| rb.binding);
     // Every table entry whose number the shader declares must describe that global.
     for b in p.bindings {
         let declared = module.global_variables.iter().find(|(_, g)| bound(g) == Some(b.binding));

@@ -28,7 +28,7 @@ use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::reference::frame_change::largest_block_change;
 use terramp::reference::seed_select::SeedComparison;
 
-use support::{build_nc, tests_dir};
+use support::{build_nc, ground_under_pixels, tests_dir};
 use terramp_testkit::{Golden, TempDir, shared_data};
 
 const FOREST: u8 = 5;
@@ -272,39 +272,9 @@ fn trees_stand_on_forest_not_on_water(
     trees: &image::RgbaImage,
 ) {
     let [w, h] = size;
-    let clip_from_world = camera.clip_from_view(w, h).unwrap() * camera.view_from_world();
-    let world_from_clip = clip_from_world.inverse();
-    let meta = dataset.manifest.landcover.clone().unwrap();
-    let texel_m = 2.0 * meta.layer.texel_m;
-    let origin = dataset.manifest.origin_m;
-    let half = 0.5 * dataset.manifest.height.spacing_m;
-    let mut codes = std::collections::HashMap::new();
-    // Ground class and distance under each pixel (None: sky or outside the map).
-    let ground: Vec<Option<(u8, f64)>> = (0..w * h)
-        .map(|i| {
-            let d = f64::from(bare_depth[i as usize]);
-            if d <= 0.0 {
-                return None;
-            }
-            let ndc = [
-                (f64::from(i % w) + 0.5) / f64::from(w) * 2.0 - 1.0,
-                1.0 - (f64::from(i / w) + 0.5) / f64::from(h) * 2.0,
-            ];
-            let p = world_from_clip * glam::DVec4::new(ndc[0], ndc[1], d, 1.0);
-            let rel = p.truncate() / p.w;
-            let grid = [camera.position_m.x + rel.x - origin[0], camera.position_m.y + rel.y - origin[1]];
-            // Cell layers tile the extent from half a height spacing south-west of the grid.
-            let q = [((grid[0] + half) / texel_m).floor(), ((grid[1] + half) / texel_m).floor()];
-            if q[0] < 0.0 || q[1] < 0.0 {
-                return None;
-            }
-            let q = [q[0] as u32, q[1] as u32];
-            let code = *codes.entry(q).or_insert_with(|| {
-                let index = dataset.landcover_index(1, q).ok()?;
-                meta.coding.code_of(index)
-            });
-            code.map(|c| (c, rel.length()))
-        })
+    let ground: Vec<Option<(u8, f64)>> = ground_under_pixels(dataset, camera, size, bare_depth)
+        .into_iter()
+        .map(|g| g.map(|g| (g.code, g.distance_m)))
         .collect();
     let table = terramp::classes::ClassTable::load("nc").unwrap();
     let tallest_m = table.species.iter().map(|s| f64::from(s.height_m[1])).fold(0.0, f64::max);

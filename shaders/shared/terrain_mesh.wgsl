@@ -72,6 +72,29 @@ fn height_at(node: TerrainNode, g: vec2<f32>) -> f32 {
     return mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);
 }
 
+// A vertex of the drawn surface: node grid position `g`, morphed as the camera recedes.
+struct SurfaceVertex {
+    // Camera-relative horizontal position and the ground's height under it, metres.
+    xy: vec2<f32>,
+    z: f32,
+    normal: vec3<f32>,
+}
+
+fn surface_vertex(node: TerrainNode, g: vec2<f32>) -> SurfaceVertex {
+    let h = height_at(node, g) - u.camera_grid_m.z;
+    let distance = length(vec3<f32>(node.origin_rel_m + g * node.cell_m, h));
+    let morph = clamp((distance - node.morph_start_m) / (node.morph_end_m - node.morph_start_m), 0.0, 1.0);
+    let g_morphed = min(g - fract(g * 0.5) * 2.0 * morph, node.cells_inside);
+    // Central differences one (level) sample apart; the tile border makes them valid at the edges.
+    let dx = height_at(node, g_morphed + vec2<f32>(1.0, 0.0)) - height_at(node, g_morphed - vec2<f32>(1.0, 0.0));
+    let dy = height_at(node, g_morphed + vec2<f32>(0.0, 1.0)) - height_at(node, g_morphed - vec2<f32>(0.0, 1.0));
+    return SurfaceVertex(
+        node.origin_rel_m + g_morphed * node.cell_m,
+        height_at(node, g_morphed) - u.camera_grid_m.z,
+        normalize(vec3<f32>(-dx, -dy, 2.0 * node.cell_m)),
+    );
+}
+
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
     let node = nodes[instance];
@@ -81,27 +104,17 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance
     let last = f32(u.node_cells + 2u);
     let skirt = ij.x == 0.0 || ij.y == 0.0 || ij.x == last || ij.y == last;
     let g = min(clamp(ij - 1.0, vec2<f32>(0.0), vec2<f32>(f32(u.node_cells))), node.cells_inside);
-
-    let h = height_at(node, g) - u.camera_grid_m.z;
-    let distance = length(vec3<f32>(node.origin_rel_m + g * node.cell_m, h));
-    let morph = clamp((distance - node.morph_start_m) / (node.morph_end_m - node.morph_start_m), 0.0, 1.0);
-    let g_morphed = min(g - fract(g * 0.5) * 2.0 * morph, node.cells_inside);
-
-    let xy = node.origin_rel_m + g_morphed * node.cell_m;
+    let surface = surface_vertex(node, g);
     // Skirts hang `skirt_m` below the edge, but never lower than a cell under the dataset's lowest
     // ground: still below both sides of any seam, and nothing dangles under the terrain for a view
     // past its edge to see.
-    let surface = height_at(node, g_morphed) - u.camera_grid_m.z;
     let floor = u.height_range_m.x - node.cell_m - u.camera_grid_m.z;
-    let z = select(surface, max(surface - node.skirt_m, floor), skirt);
-    // Central differences one (level) sample apart; the tile border makes them valid at the edges.
-    let dx = height_at(node, g_morphed + vec2<f32>(1.0, 0.0)) - height_at(node, g_morphed - vec2<f32>(1.0, 0.0));
-    let dy = height_at(node, g_morphed + vec2<f32>(0.0, 1.0)) - height_at(node, g_morphed - vec2<f32>(0.0, 1.0));
+    let z = select(surface.z, max(surface.z - node.skirt_m, floor), skirt);
 
     var out: VertexOut;
-    out.rel_m = vec3<f32>(xy, z);
+    out.rel_m = vec3<f32>(surface.xy, z);
     out.clip = u.clip_from_view_world * vec4<f32>(out.rel_m, 1.0);
-    out.grid_m = u.camera_grid_m.xy + xy;
-    out.normal = normalize(vec3<f32>(-dx, -dy, 2.0 * node.cell_m));
+    out.grid_m = u.camera_grid_m.xy + surface.xy;
+    out.normal = surface.normal;
     return out;
 }

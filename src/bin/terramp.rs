@@ -295,7 +295,15 @@ fn open_renderer(dataset_dir: &Path, settings: Settings) -> Result<Renderer> {
     let dataset = Dataset::open(dataset_dir)?;
     let gpu = Gpu::new(settings.gpu.adapter)?;
     eprintln!("terramp: adapter {}", gpu.describe());
-    Ok(Renderer::new(gpu, dataset, settings)?)
+    let renderer = Renderer::new(gpu, dataset, settings)?;
+    let unbaked = renderer.texcell_classes_unbaked();
+    if !unbaked.is_empty() {
+        eprintln!(
+            "terramp: dense classes {unbaked:?} have no forest sample in draw_seeds.impostors: no texcells there \
+             (terramp-data bake --classes SCHEME --models DIR --out IMPOSTORS)"
+        );
+    }
+    Ok(renderer)
 }
 
 fn render_one(dataset_dir: &Path, settings: Settings, camera: &Camera, out: &Path) -> Result<()> {

@@ -33,10 +33,12 @@ mod clearance;
 mod prepare;
 mod seeds;
 mod setup;
+mod texcells;
 mod tools;
 
 pub use clearance::GROUND_CLEARANCE_NEAR;
 pub use seeds::SeedReport;
+pub use texcells::TexcellReport;
 pub use tools::{RESOLVE_GUARD_FRAMES, Replay};
 
 /// Linear-RGB colour of the sky, also the haze the distance fades into.
@@ -78,6 +80,10 @@ pub enum RenderError {
     /// or its readback found a bad block.
     #[error(transparent)]
     Compact(#[from] crate::passes::compact::CompactError),
+    /// The texcell pass could not be set up: a forest sample unreadable, samples of different
+    /// shapes, or more than the texture array holds.
+    #[error(transparent)]
+    Texcells(#[from] crate::passes::texcells::TexcellsError),
     /// Pass 4 could not be set up: `draw_seeds.impostors` missing or unreadable, an impostor short
     /// of LODs, or an adapter without the features it needs.
     #[error(transparent)]
@@ -155,6 +161,8 @@ pub struct FrameReport {
     pub seed_species_undrawn: usize,
     /// Metres the camera was lifted by because it was under the ground (0 when it was not).
     pub camera_lifted_m: f64,
+    /// The far forest's patches and slices (all zero without texcells).
+    pub texcells: TexcellReport,
 }
 
 /// What a frame's Tile Load Map is read against when it comes back: the frame, its rings and
@@ -213,6 +221,10 @@ pub struct Renderer {
     tlm_readback: ReadbackRing<TlmTag>,
     /// Pass 3 and 4 and what they need; `None` without land cover.
     seeds: Option<seeds::SeedStage>,
+    /// The far forest; `None` without dense classes baked, or with `texcells.reach_m` 0.
+    texcells: Option<texcells::TexcellStage>,
+    /// Dense classes of the dataset without a forest sample.
+    texcells_unbaked: Vec<u8>,
     caches: Caches,
     loader: Loader,
     targets: Targets,
@@ -244,6 +256,17 @@ impl Renderer {
         let tlm_readback = ReadbackRing::new(device, "tile load map", tlm.capacity_bytes(), DEFAULT_SLOTS);
         let terrain_bindings = terrain.bind_group(device, &caches.heights, &caches.imagery, ground.sampler());
         let seeds = seeds::SeedStage::new(&gpu, &dataset, &settings, &caches, &targets)?;
+        let (texcells, texcells_unbaked) = match &seeds {
+            Some(stage) => texcells::TexcellStage::new(
+                &gpu,
+                &dataset,
+                &settings,
+                &stage.table,
+                &terrain,
+                caches.landcover.as_ref(),
+            )?,
+            None => (None, Vec::new()),
+        };
         let h = &dataset.manifest.height;
         let bounds = NodeBounds::new([h.min_m, h.max_m]);
         let profiler = Profiler::new(&gpu, settings.gpu.timestamps);
@@ -260,6 +283,8 @@ impl Renderer {
             tlm_bindings,
             tlm_readback,
             seeds,
+            texcells,
+            texcells_unbaked,
             caches,
             loader,
             targets,
@@ -274,6 +299,12 @@ impl Renderer {
     /// Pass timings of the latest frame whose timings have arrived (never blocks for them).
     pub fn last_timings(&self) -> &[PassTiming] {
         &self.last_timings
+    }
+
+    /// Dense land-cover classes (codes) the dataset holds whose forest sample is not in
+    /// `draw_seeds.impostors`: they show bare ground beyond the seeds instead of texcells.
+    pub fn texcell_classes_unbaked(&self) -> &[u8] {
+        &self.texcells_unbaked
     }
 
     /// The terrain's reversed-Z depth of the last frame (1 near, 0 at infinity), for later passes.
@@ -314,6 +345,10 @@ impl Renderer {
         p.pass(gpu, encoder, "ground", |e| {
             self.ground.encode(e, mesh, &t.colour_view, &t.depth_view, SKY_LINEAR)
         })?;
+        if let Some(stage) = &self.texcells {
+            // The far forest: slices of the dense classes' samples over the ground beyond the seeds.
+            p.pass(gpu, encoder, "texcells", |e| stage.encode(e, mesh, &t.colour_view, &t.depth_view))?;
+        }
         if let Some(stage) = &self.seeds {
             // 3. Seed selection: the seeds of the cells the latest TLM found near and visible.
             p.pass(gpu, encoder, "seed_select", |e| stage.encode(e))?;

@@ -17,6 +17,7 @@ use crate::passes::tile_load_map::layout::TlmLayout;
 use crate::streaming::wants::after_pinned;
 use crate::streaming::{CacheStats, TileCache, UploadBudget};
 
+use super::texcells::TexcellView;
 use super::{FrameReport, RenderError, Renderer, SKY_LINEAR};
 
 /// What `prepare` uploaded for a frame, which the passes are recorded over.
@@ -88,7 +89,13 @@ impl Renderer {
         let c = &mut self.caches;
         let wanted_heights = after_pinned(&c.pinned_heights, &selected_heights);
         let wanted_imagery = after_pinned(&c.pinned_imagery, &latest.ground);
-        let wanted_landcover = after_pinned(&c.pinned_landcover, &latest.classification);
+        let mut classification = latest.classification.clone();
+        if let Some(stage) = &self.texcells {
+            let far: Vec<_> =
+                stage.wanted_landcover.iter().filter(|id| !classification.contains(id)).copied().collect();
+            classification.extend(far);
+        }
+        let wanted_landcover = after_pinned(&c.pinned_landcover, &classification);
         let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
         let (loader, has_imagery) = (&self.loader, self.dataset.imagery.is_some());
         let (heights, imagery, landcover) = (&mut c.heights, &mut c.imagery, &mut c.landcover);
@@ -151,7 +158,17 @@ impl Renderer {
         report.nodes_dropped = dropped;
         let clip = view.clip_from_view_world.as_mat4();
         let uniforms = terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR);
-        (self.terrain.prepare(&self.gpu.queue, &uniforms, &batches), uniforms)
+        let nodes = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
+        if let Some(stage) = self.texcells.as_mut() {
+            let texcell_view = TexcellView {
+                camera_grid_m: view.grid_m,
+                metres_per_px_at_1m: view.camera.metres_per_pixel(1.0, self.settings.render.height),
+            };
+            report.texcells = self.profiler.cpu("texcell_place", || {
+                stage.prepare(&self.gpu, &self.settings, &self.dataset, &batches, &nodes, &texcell_view)
+            });
+        }
+        (nodes, uniforms)
     }
 
     /// Pass 3's cells (those the latest TLM found near and visible), and pass 4's constants (the

@@ -3,7 +3,7 @@
 //! storage buffer of a Rust type, a texture, a storage texture, a sampler). The same table builds
 //! the bind group layout (`layout`) and, from resources given in table order, the bind group
 //! (`bind_group`), so the numbers are written once on the Rust side. `tests/shaders.rs` checks
-//! every table against the `@group(0) @binding(n)` globals of its shader with naga: name, kind,
+//! every table against the `@group(g) @binding(n)` globals of its shader with naga: name, kind,
 //! texture type, buffer size (or element stride), access and the stages that read it.
 
 use wgpu::{ShaderStages, TextureSampleType, TextureViewDimension};
@@ -196,10 +196,12 @@ impl<const N: usize> BindingTable<N> {
 /// `tests/shaders.rs` checks against the WGSL.
 #[derive(Debug, Clone, Copy)]
 pub struct PipelineBindings {
-    /// The shader whose `@group(0)` globals the table binds.
+    /// The shader whose `@group(group)` globals the table binds.
     pub shader: &'static super::shaders::WgslSource,
     /// The entry points of `shader` the pipeline runs: every global they use must be in the table.
     pub entry_points: &'static [&'static str],
+    /// The bind group the table is (`@group(n)`).
+    pub group: u32,
     /// The table's bindings (`BindingTable::bindings`).
     pub bindings: &'static [Binding],
 }

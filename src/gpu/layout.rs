@@ -331,6 +331,35 @@ wgsl_constants! { draw_constants:
 const _: () = assert!(SEED_GROUPS <= COMPACT_CHUNK, "a lane per group sums or scans a column");
 const _: () = assert!(COMPACT_CHUNK * SEED_GROUPS * 4 <= 16384, "the chunk's table fits workgroup memory");
 
+// --- Texcells ---
+wgsl_constants! { texcell_constants:
+    /// Most forest samples (dense classes with a baked sample) a renderer draws: the class
+    /// table's sample indices and the texture array's layers are sized for them.
+    pub const TEXCELL_MAX_SAMPLES: u32 = 4;
+    /// Ground cells along each side of a forest sample (`texcell::tiling`): the 2 × 2 torus that
+    /// holds each of the eight tiles once.
+    pub const TEXCELL_REFERENCE_CELLS: u32 = 2;
+    /// Most slices of a forest sample's finest level (2^N): the texture array holds this many
+    /// layers per sample.
+    pub const TEXCELL_MAX_SLICES: u32 = 64;
+    /// Points per workgroup of the shader's probe of its tiling (`passes::texcells::gpu::probe`).
+    pub const TEXCELL_PROBE_WORKGROUP: u32 = 64;
+}
+
+packed_word! {
+    /// `TexcellRecord::slice`: which part of its terrain node a texcell instance covers and which
+    /// of its slices it draws.
+    pub struct TexcellSlice as texcell_slice {
+        /// The node's quadrant (bit 0: east half, bit 1: north half), as the terrain's grid.
+        quadrant: 2,
+        /// The slice, 0 the lowest, of the `2^(N − level)` the patch draws.
+        index: 8,
+        /// The slice pyramid's level: the patch draws `S_level` (`2^(N − level)` slices, each
+        /// aggregating `2^level` of the finest) and samples mips at or above `level`.
+        level: 4,
+    }
+}
+
 /// The WGSL twins of the functions of this module, emitted into the prelude after the constants
 /// (kept here, beside their Rust twins, so the two change together).
 pub const WGSL_FUNCTIONS: &str = r"
@@ -352,12 +381,20 @@ fn seed_group(species: u32, lod: u32) -> u32 {
 
 /// Every constant the prelude declares: name, WGSL type, literal.
 pub fn wgsl_constants() -> Vec<(&'static str, &'static str, String)> {
-    [dataset_constants(), tlm_constants(), hiz_constants(), seed_constants(), draw_constants()].concat()
+    [
+        dataset_constants(),
+        tlm_constants(),
+        hiz_constants(),
+        seed_constants(),
+        draw_constants(),
+        texcell_constants(),
+    ]
+    .concat()
 }
 
 /// Every packed word the prelude declares.
 pub const PACKED_WORDS: &[PackedWord] =
-    &[LevelRange::WORD, TileSpan::WORD, SpeciesLod::WORD, SeedJitter::WORD];
+    &[LevelRange::WORD, TileSpan::WORD, SpeciesLod::WORD, SeedJitter::WORD, TexcellSlice::WORD];
 
 #[cfg(test)]
 mod tests {

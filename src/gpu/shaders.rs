@@ -11,12 +11,18 @@ use super::layout::{self, PackedWord};
 
 /// The terrain mesh both terrain passes draw.
 pub const TERRAIN_MESH: &str = include_str!("../../shaders/shared/terrain_mesh.wgsl");
+/// The ground's colour: the imagery cache's bindings and lookup, the relief tint.
+pub const IMAGERY: &str = include_str!("../../shaders/shared/imagery.wgsl");
 /// The ground that mesh draws, at any point: what seeds stand on (Rust: `dataset::surface`).
 pub const TERRAIN_SURFACE: &str = include_str!("../../shaders/shared/terrain_surface.wgsl");
 /// The hashes that pick seed patterns and vary seeds.
 pub const HASH: &str = include_str!("../../shaders/shared/hash.wgsl");
 /// One selected seed, shared by the pass that writes it and the pass that draws it.
 pub const SEED_RECORD: &str = include_str!("../../shaders/shared/seed_record.wgsl");
+/// Reading a land-cover class through the cache's page table (pass 3 and texcells).
+pub const LANDCOVER: &str = include_str!("../../shaders/shared/landcover.wgsl");
+/// The ordered dither of the cross-fades between representations (seeds' LODs, texcells).
+pub const DITHER: &str = include_str!("../../shaders/shared/dither.wgsl");
 /// How pass 3 hands its survivors to compaction: the block table's entries and lane ballots.
 pub const BLOCKS: &str = include_str!("../../shaders/shared/blocks.wgsl");
 

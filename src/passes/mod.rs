@@ -8,7 +8,8 @@
 //!
 //! 0. `terrain` (+ `depth_pyramid`): the ground's depth, and its Hi-Z pyramid;
 //! 1. `tile_load_map`: which tiles and seed patterns the view needs, read back a frame late;
-//! 2. `ground`: imagery on the terrain, from the finest resident level;
+//! 2. `ground`: imagery on the terrain, from the finest resident level, and `texcells`: the far
+//!    forest over it, where the land cover is dense;
 //! 3. `seed_select`: the seeds of the visible near cells, culled and classified;
 //! 4. `compact` and `draw_seeds`: the survivors grouped into indirect draws, and drawn.
 
@@ -18,6 +19,7 @@ pub mod draw_seeds;
 pub mod ground;
 pub mod seed_select;
 pub mod terrain;
+pub mod texcells;
 pub mod tile_load_map;
 
 use crate::gpu::bindings::PipelineBindings;
@@ -34,6 +36,7 @@ pub const SHADERS: &[&WgslSource] = &[
     &depth_pyramid::gpu::SHADER,
     &tile_load_map::gpu::SHADER,
     &ground::gpu::SHADER,
+    &texcells::gpu::SHADER,
     &seed_select::gpu::SHADER,
     &compact::gpu::SHADER,
     &draw_seeds::gpu::SHADER,
@@ -45,46 +48,79 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     PipelineBindings {
         shader: &terrain::gpu::SHADER,
         entry_points: &["vs_main"],
+        group: 0,
         bindings: &terrain::gpu::BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &depth_pyramid::gpu::SHADER,
         entry_points: &["reduce_depth"],
+        group: 0,
         bindings: &depth_pyramid::gpu::FROM_DEPTH.bindings,
     },
     PipelineBindings {
         shader: &depth_pyramid::gpu::SHADER,
         entry_points: &["reduce_mip"],
+        group: 0,
         bindings: &depth_pyramid::gpu::FROM_MIP.bindings,
     },
     PipelineBindings {
         shader: &tile_load_map::gpu::SHADER,
         entry_points: &["main"],
+        group: 0,
         bindings: &tile_load_map::gpu::BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &ground::gpu::SHADER,
         entry_points: &["vs_main", "fs_main"],
+        group: 0,
         bindings: &terrain::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &texcells::gpu::SHADER,
+        entry_points: &["vs_texcell", "fs_texcell"],
+        group: 0,
+        bindings: &terrain::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &texcells::gpu::SHADER,
+        entry_points: &["vs_texcell", "fs_texcell"],
+        group: 1,
+        bindings: &texcells::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &texcells::gpu::SHADER,
+        entry_points: &["probe_forest_uv"],
+        group: 1,
+        bindings: &texcells::gpu::probe::PROBE_UNIFORMS.bindings,
+    },
+    PipelineBindings {
+        shader: &texcells::gpu::SHADER,
+        entry_points: &["probe_forest_uv"],
+        group: 2,
+        bindings: &texcells::gpu::probe::PROBE_BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &seed_select::gpu::SHADER,
         entry_points: &["main"],
+        group: 0,
         bindings: &seed_select::gpu::BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &compact::gpu::SHADER,
         entry_points: &["reduce", "scan", "finish", "scatter"],
+        group: 0,
         bindings: &compact::gpu::BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &draw_seeds::gpu::SHADER,
         entry_points: &["vs_main", "fs_main", "fs_coverage", "fs_truth"],
+        group: 0,
         bindings: &draw_seeds::gpu::BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &draw_seeds::gpu::SHADER,
         entry_points: &["vs_fill", "fs_fill"],
+        group: 0,
         bindings: &draw_seeds::gpu::multisample::FILL_BINDINGS.bindings,
     },
 ];

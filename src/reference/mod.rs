@@ -14,5 +14,6 @@ pub mod frame_change;
 pub mod image_metrics;
 pub mod oracle;
 pub mod seed_select;
+pub mod texcells;
 pub mod tile_load_map;
 pub mod worst;

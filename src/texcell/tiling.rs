@@ -40,7 +40,7 @@ pub const fn triplet(h: u32, v: u32, d: u32) -> Triplet {
 }
 
 /// Cells along each side of the forest sample.
-pub const REFERENCE_CELLS: u32 = 2;
+pub const REFERENCE_CELLS: u32 = crate::gpu::layout::TEXCELL_REFERENCE_CELLS;
 
 /// The forest sample's edge colours, each indexed by cell (x + `REFERENCE_CELLS` · y), the sample
 /// wrapping around: `horizontal` the cell's bottom edge (its top is the bottom of the cell above),
@@ -120,6 +120,20 @@ pub fn ground_sample_cell(cell: [i32; 2], half: Half, seed: u32) -> [u32; 2] {
     sample_cell(half, ground_triplet(cell, half, seed)).unwrap_or([0, 0])
 }
 
+/// Every (half, triplet)'s sample cell in one word, as the texcell shader looks them up: 2 bits
+/// (x + 2y) at bit 2 · (8 · half + triplet), half 0 lower, 1 upper; triplets a half never has
+/// read cell (0, 0).
+pub fn sample_cells_word() -> u32 {
+    let mut word = 0;
+    for (h, half) in [Half::Lower, Half::Upper].into_iter().enumerate() {
+        for t in 0..8 {
+            let [x, y] = sample_cell(half, t).unwrap_or([0, 0]);
+            word |= (x + REFERENCE_CELLS * y) << (2 * (8 * h as u32 + t));
+        }
+    }
+    word
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,6 +158,19 @@ mod tests {
         for t in 0..8 {
             assert_eq!(sample_cell(Half::Lower, t).is_some(), parity(t) == 0);
             assert_eq!(sample_cell(Half::Upper, t).is_some(), parity(t) == 1);
+        }
+    }
+
+    #[test]
+    fn the_shader_word_names_each_tile_cell() {
+        let word = sample_cells_word();
+        for (h, half) in [Half::Lower, Half::Upper].into_iter().enumerate() {
+            for t in 0..8 {
+                let entry = (word >> (2 * (8 * h as u32 + t))) & 3;
+                if let Some([x, y]) = sample_cell(half, t) {
+                    assert_eq!(entry, x + 2 * y, "{half:?} {t}");
+                }
+            }
         }
     }
 

@@ -147,6 +147,8 @@ pub fn truth_settings(settings: &Settings, dataset: &Dataset, supersample: u32) 
     s.terrain.triangle_px = FINEST_TRIANGLE_PX;
     s.seeds.density_scale = 1.0;
     s.draw_seeds.impostors.clear();
+    // Every tree is its mesh out to the truth's reach: no forest stands in for them.
+    s.texcells.reach_m = 0.0;
     let tiles = |count: u64| u32::try_from(count).unwrap_or(u32::MAX);
     s.cache.height_slots = tiles(dataset.height.pyramid.tile_count());
     if let Some(layer) = &dataset.imagery {

@@ -148,3 +148,60 @@ pub fn number_before(text: &str, label: &str) -> u64 {
 pub fn tests_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests")
 }
+
+/// The ground under one pixel: its land-cover code, the level-1 land-cover texel it lies in, and
+/// its distance from the camera.
+#[derive(Debug, Clone, Copy)]
+pub struct PixelGround {
+    pub code: u8,
+    pub texel: [u32; 2],
+    pub distance_m: f64,
+}
+
+/// The land-cover code of level-1 texel `q` (`None` off the map or where the source had none).
+pub fn code_at(dataset: &Dataset, q: [u32; 2]) -> Option<u8> {
+    let meta = dataset.manifest.landcover.as_ref()?;
+    let index = dataset.landcover_index(1, q).ok()?;
+    meta.coding.code_of(index)
+}
+
+/// The ground under each pixel of a `size` frame seen from `camera`, read back from its
+/// reversed-Z `depth` (`None`: sky, or off the map).
+pub fn ground_under_pixels(
+    dataset: &Dataset,
+    camera: &terramp::camera::Camera,
+    size: [u32; 2],
+    depth: &[f32],
+) -> Vec<Option<PixelGround>> {
+    let [w, h] = size;
+    let clip_from_world = camera.clip_from_view(w, h).unwrap() * camera.view_from_world();
+    let world_from_clip = clip_from_world.inverse();
+    let meta = dataset.manifest.landcover.clone().unwrap();
+    let texel_m = 2.0 * meta.layer.texel_m;
+    let origin = dataset.manifest.origin_m;
+    let half = 0.5 * dataset.manifest.height.spacing_m;
+    let mut codes = std::collections::HashMap::new();
+    (0..w * h)
+        .map(|i| {
+            let d = f64::from(depth[i as usize]);
+            if d <= 0.0 {
+                return None;
+            }
+            let ndc = [
+                (f64::from(i % w) + 0.5) / f64::from(w) * 2.0 - 1.0,
+                1.0 - (f64::from(i / w) + 0.5) / f64::from(h) * 2.0,
+            ];
+            let p = world_from_clip * glam::DVec4::new(ndc[0], ndc[1], d, 1.0);
+            let rel = p.truncate() / p.w;
+            let grid = [camera.position_m.x + rel.x - origin[0], camera.position_m.y + rel.y - origin[1]];
+            // Cell layers tile the extent from half a height spacing south-west of the grid.
+            let q = [((grid[0] + half) / texel_m).floor(), ((grid[1] + half) / texel_m).floor()];
+            if q[0] < 0.0 || q[1] < 0.0 {
+                return None;
+            }
+            let texel = [q[0] as u32, q[1] as u32];
+            let code = *codes.entry(texel).or_insert_with(|| code_at(dataset, texel));
+            code.map(|code| PixelGround { code, texel, distance_m: rel.length() })
+        })
+        .collect()
+}

@@ -8,12 +8,14 @@ mod compact;
 mod draw_seeds;
 mod seed_select;
 mod terrain;
+mod texcells;
 mod tile_load_map;
 
 pub use compact::{CompactParams, SeedBlock, SeedDrawArgs};
 pub use draw_seeds::{DrawSeedsUniforms, SeedMaterial, SeedVertex};
 pub use seed_select::{SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms};
 pub use terrain::{TerrainNode, TerrainUniforms};
+pub use texcells::{TexcellRecord, TexcellUniforms};
 pub use tile_load_map::{TlmCell, TlmRing, TlmSpan, TlmUniforms};
 
 use super::struct_layout::{GpuLayout, StructLayout};
@@ -38,6 +40,8 @@ pub fn layouts() -> Vec<StructLayout> {
         CompactParams::layout(),
         DrawSeedsUniforms::layout(),
         SeedMaterial::layout(),
+        TexcellUniforms::layout(),
+        TexcellRecord::layout(),
     ]
 }
 

@@ -10,8 +10,8 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedVertex};
 use crate::gpu::layout::SEED_LODS;
-use crate::gpu::resources::{buffer, buffer_init, pipeline_layout};
-use crate::gpu::shaders::{SEED_RECORD, WgslSource};
+use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
+use crate::gpu::shaders::{DITHER, SEED_RECORD, WgslSource};
 use crate::gpu::struct_layout::GpuLayout;
 use crate::impostor::{Impostor, mip_size};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
@@ -25,7 +25,7 @@ pub mod multisample;
 /// Pass 4's shader.
 pub const SHADER: WgslSource = WgslSource {
     name: "draw_seeds",
-    parts: &[SEED_RECORD, include_str!("../../../shaders/draw_seeds.wgsl")],
+    parts: &[SEED_RECORD, DITHER, include_str!("../../../shaders/draw_seeds.wgsl")],
 };
 
 /// Pass 4's bindings: the frame's constants, pass 3's records through compaction's order, and the
@@ -111,21 +111,7 @@ impl DrawSeedsPass {
         for (layer, mips) in built.layers.iter().enumerate() {
             for (mip, texels) in mips.iter().enumerate() {
                 let [w, h] = mip_size([built.size; 2], mip as u32);
-                queue.write_texture(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &texture,
-                        mip_level: mip as u32,
-                        origin: wgpu::Origin3d { x: 0, y: 0, z: layer as u32 },
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    texels,
-                    wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(4 * w),
-                        rows_per_image: Some(h),
-                    },
-                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                );
+                write_rgba8_layer(queue, &texture, layer as u32, mip as u32, [w, h], texels);
             }
         }
         let texture_view = texture.create_view(&wgpu::TextureViewDescriptor {
@@ -283,24 +269,7 @@ impl DrawSeedsPass {
             targets.encode(encoder, |pass| self.record(pass, pipeline, bind_group, draw_args));
             return;
         }
-        let keep = wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("draw_seeds"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: colour,
-                depth_slice: None,
-                resolve_target: None,
-                ops: keep,
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None);
         self.record(&mut pass, &self.pipeline, bind_group, draw_args);
     }
 

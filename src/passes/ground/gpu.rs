@@ -1,15 +1,17 @@
 //! The ground pass's GPU half: the pipeline over the terrain's bind group, and the recorded draw.
 
 use crate::config::Settings;
-use crate::gpu::resources::pipeline_layout;
-use crate::gpu::shaders::{TERRAIN_MESH, WgslSource};
+use crate::gpu::resources::{frame_pass, pipeline_layout};
+use crate::gpu::shaders::{IMAGERY, TERRAIN_MESH, WgslSource};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
 /// The ground pass's shader: the terrain mesh again, shaded (its bindings are the terrain's,
 /// `terrain::gpu::BINDINGS`).
-pub const SHADER: WgslSource =
-    WgslSource { name: "ground", parts: &[TERRAIN_MESH, include_str!("../../../shaders/ground.wgsl")] };
+pub const SHADER: WgslSource = WgslSource {
+    name: "ground",
+    parts: &[TERRAIN_MESH, IMAGERY, include_str!("../../../shaders/ground.wgsl")],
+};
 
 /// Pass 2 on the GPU: its pipeline (depth-equal, no depth write) and imagery sampler built once in
 /// `new`; `encode` records each frame's clear to the sky and the shaded redraw of the terrain's nodes.
@@ -76,26 +78,7 @@ impl GroundPass {
         sky_linear: [f64; 3],
     ) {
         let [r, g, b] = sky_linear;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("ground"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: colour,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame_pass(encoder, "ground", colour, depth, Some(wgpu::Color { r, g, b, a: 1.0 }));
         pass.set_pipeline(&self.pipeline);
         mesh.draw(&mut pass);
     }

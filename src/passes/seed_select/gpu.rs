@@ -12,7 +12,7 @@ use crate::gpu::gpu_types::{
 };
 use crate::gpu::readback::read_values;
 use crate::gpu::resources::{buffer, buffer_init, compute_pipeline, pipeline_layout};
-use crate::gpu::shaders::{BLOCKS, HASH, SEED_RECORD, TERRAIN_SURFACE, WgslSource};
+use crate::gpu::shaders::{BLOCKS, HASH, LANDCOVER, SEED_RECORD, TERRAIN_SURFACE, WgslSource};
 use crate::gpu::{Gpu, GpuError};
 use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::{MAX_SEED_CELLS, SeedTables, block_capacity, workgroups_per_cell};
@@ -23,7 +23,14 @@ use super::frame::{SeedFrame, SeedInputs, SeedOutput};
 /// Pass 3's shader.
 pub const SHADER: WgslSource = WgslSource {
     name: "seed_select",
-    parts: &[HASH, BLOCKS, SEED_RECORD, TERRAIN_SURFACE, include_str!("../../../shaders/seed_select.wgsl")],
+    parts: &[
+        HASH,
+        BLOCKS,
+        SEED_RECORD,
+        TERRAIN_SURFACE,
+        LANDCOVER,
+        include_str!("../../../shaders/seed_select.wgsl"),
+    ],
 };
 
 /// Pass 3's bindings: the frame's constants and cells (a storage buffer, not a uniform one: see

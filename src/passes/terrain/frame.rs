@@ -21,6 +21,29 @@ pub struct NodeBatches {
     /// Each quadrant's instances (south-west, south-east, north-west, north-east: the grid's index
     /// ranges' order); a node drawing several quadrants appears in each.
     pub by_quadrant: [Vec<TerrainNode>; 4],
+    /// The box each of those instances draws (its quadrant of the node), in the same order.
+    pub boxes: [Vec<QuadrantBox>; 4],
+}
+
+/// The grid-space box of one node quadrant's ground, metres: what the texcells over it stand in.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadrantBox {
+    /// South-west-bottom corner.
+    pub min_m: DVec3,
+    /// North-east-top corner.
+    pub max_m: DVec3,
+}
+
+impl QuadrantBox {
+    /// The distance from `point_m` to the box's nearest point (0 inside).
+    pub fn distance_m(&self, point_m: DVec3) -> f64 {
+        (self.min_m - point_m).max(point_m - self.max_m).max(DVec3::ZERO).length()
+    }
+
+    /// The distance from `point_m` to the box's farthest corner.
+    pub fn farthest_m(&self, point_m: DVec3) -> f64 {
+        (point_m - self.min_m).abs().max((self.max_m - point_m).abs()).length()
+    }
 }
 
 impl NodeBatches {
@@ -126,10 +149,28 @@ pub fn node_batches(
             // Deep enough to close any seam against a neighbour reading another level.
             skirt_m: (f64::from(high_m - low_m) + cell_m) as f32,
         };
-        for (q, quadrant) in batches.by_quadrant.iter_mut().enumerate() {
-            if s.quadrants & (1 << q) != 0 {
-                quadrant.push(node);
+        let origin = [f64::from(s.node.x) * size, f64::from(s.node.y) * size];
+        let half_cells = f64::from(lods.cells / 2);
+        for q in 0..4 {
+            if s.quadrants & (1 << q) == 0 {
+                continue;
             }
+            batches.by_quadrant[q].push(node);
+            // The quadrant's cells, cut to the node's cells inside the dataset.
+            let first = [(q & 1) as f64 * half_cells, (q >> 1) as f64 * half_cells];
+            let last = [0, 1].map(|a| (first[a] + half_cells).min(f64::from(inside[a])).max(first[a]));
+            batches.boxes[q].push(QuadrantBox {
+                min_m: DVec3::new(
+                    origin[0] + first[0] * cell_m,
+                    origin[1] + first[1] * cell_m,
+                    f64::from(low_m),
+                ),
+                max_m: DVec3::new(
+                    origin[0] + last[0] * cell_m,
+                    origin[1] + last[1] * cell_m,
+                    f64::from(high_m),
+                ),
+            });
         }
     }
     (batches, dropped)

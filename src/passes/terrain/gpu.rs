@@ -83,6 +83,16 @@ pub struct PreparedNodes {
     ranges: [Range<u32>; 4],
 }
 
+impl PreparedNodes {
+    /// The node buffer index of quadrant `q`'s `i`-th instance (`NodeBatches::by_quadrant[q][i]`),
+    /// or `None` when it did not fit.
+    pub fn instance(&self, q: usize, i: usize) -> Option<u32> {
+        let range = self.ranges.get(q)?;
+        let index = range.start.checked_add(u32::try_from(i).ok()?)?;
+        (index < range.end).then_some(index)
+    }
+}
+
 impl TerrainPass {
     /// Builds the depth-only pipeline, the uniform and node buffers (`MAX_NODES`) and the index
     /// buffer of the `terrain.node_cells`² grid, once for a renderer's life.

@@ -1,0 +1,201 @@
+// The texcell pass: the far forest as slices of a baked forest sample (Decaudin & Neyret 2004)
+// over the terrain mesh (`shared/terrain_mesh.wgsl`, group 0 the terrain's bindings).
+//
+// Each instance is one slice of one patch (a quadrant of a terrain node the frame draws): the
+// quadrant's grid, morphed exactly as the ground, lifted by the slice's height in the slab. A
+// fragment finds its forest sample from the land cover under it (a bilinear blend of the four
+// nearest level-1 classes' "dense" flags, so forest edges follow the classification smoothly),
+// its tile from the aperiodic tiling of the ground (a cell's lower or upper triangle, the edge
+// colours hashed from the lattice's vertices: Rust `texcell::tiling`), and reads that tile's texel
+// of its slice in the slice pyramid level the patch draws, at that level's mip or coarser. The
+// texel is premultiplied coverage; its opacity is corrected for the oblique path between slices
+// (A' = 1 − (1 − A)^k, k = 1 / cos of the view to the ground's normal, clamped), its colour lit
+// like the seeds' and blended towards the imagery under it, hazed like the ground, and it fades in
+// (dithered) where the last billboard clouds fade out, and out before the reach.
+
+struct TexcellUniforms {
+    lcc_levels: array<vec4<u32>, 4>,
+    lcc_size: vec2<u32>,
+    lcc_sub_bits: u32,
+    lcc_level: u32,
+    lcc_frame: vec4<f32>,
+    fade_m: vec4<f32>,
+    slab_height_m: f32,
+    inv_cell_m: f32,
+    seed: u32,
+    tile_cells: u32,
+    texels: f32,
+    finest_slices: u32,
+    opacity_max_factor: f32,
+    ground_blend: f32,
+}
+
+struct TexcellRecord {
+    node: u32,
+    slice: u32,
+}
+
+@group(1) @binding(0) var<uniform> tu: TexcellUniforms;
+@group(1) @binding(1) var<storage, read> texcell_records: array<TexcellRecord>;
+@group(1) @binding(2) var forest_slices: texture_2d_array<f32>;
+@group(1) @binding(3) var forest_sampler: sampler;
+@group(1) @binding(4) var<storage, read> sample_of_class: array<u32>;
+@group(1) @binding(5) var<storage, read> lcc_page_table: array<u32>;
+@group(1) @binding(6) var lcc_tiles: texture_2d_array<u32>;
+
+struct TexcellOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) rel_m: vec3<f32>,
+    @location(1) grid_m: vec2<f32>,
+    @location(2) normal: vec3<f32>,
+    // The slice (its index among the finest slices: the texture layer within a sample) and the
+    // slice pyramid level: the coarsest mip it may read.
+    @location(3) @interpolate(flat) slice: vec2<u32>,
+}
+
+@vertex
+fn vs_texcell(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> TexcellOut {
+    let record = texcell_records[instance];
+    let s = unpack_texcell_slice(record.slice);
+    let node = nodes[record.node];
+    // The quadrant's grid: vertex (i, j) of (cells / 2 + 1)², offset to the quadrant.
+    let half = u.node_cells / 2u;
+    let row = half + 1u;
+    let quadrant = vec2<f32>(f32(s.quadrant & 1u), f32(s.quadrant >> 1u)) * f32(half);
+    let g = min(quadrant + vec2<f32>(f32(vertex % row), f32(vertex / row)), node.cells_inside);
+    let surface = surface_vertex(node, g);
+    let slices = tu.finest_slices >> s.level;
+    let lift = (f32(s.index) + 0.5) / f32(slices) * tu.slab_height_m;
+
+    var out: TexcellOut;
+    out.rel_m = vec3<f32>(surface.xy, surface.z + lift);
+    out.clip = u.clip_from_view_world * vec4<f32>(out.rel_m, 1.0);
+    out.grid_m = u.camera_grid_m.xy + surface.xy;
+    out.normal = surface.normal;
+    out.slice = vec2<u32>(s.index << s.level, s.level);
+    return out;
+}
+
+// --- The aperiodic tiling (Rust: `texcell::tiling`) ---
+
+fn lattice_colour(i: i32, j: i32) -> u32 {
+    return pcg(pcg(pcg(bitcast<u32>(i) ^ 0x7e3ca1f5u) ^ (bitcast<u32>(j) * 0x9e3779b9u)) ^ tu.seed) >> 31u;
+}
+
+fn horizontal_edge(i: i32, j: i32) -> u32 {
+    return lattice_colour(i, j) ^ lattice_colour(i + 1, j) ^ (bitcast<u32>(j) & 1u);
+}
+
+fn vertical_edge(i: i32, j: i32) -> u32 {
+    return lattice_colour(i, j) ^ lattice_colour(i, j + 1);
+}
+
+// Where grid position `grid_m` reads the forest sample, in sample units (the sample wraps at 1):
+// the sample's triangle of the same half and edge colours as the ground's triangle there.
+fn forest_uv(grid_m: vec2<f32>) -> vec2<f32> {
+    let p = grid_m * tu.inv_cell_m;
+    let cell = floor(p);
+    let f = p - cell;
+    let c = vec2<i32>(cell);
+    let bottom = horizontal_edge(c.x, c.y);
+    let right = vertical_edge(c.x + 1, c.y);
+    let diagonal = bottom ^ right;
+    var entry = 0u;
+    if f.x > f.y {
+        entry = bottom | (right << 1u) | (diagonal << 2u);
+    } else {
+        entry = 8u + (horizontal_edge(c.x, c.y + 1) | (vertical_edge(c.x, c.y) << 1u) | (diagonal << 2u));
+    }
+    let sample_cell = (tu.tile_cells >> (2u * entry)) & 3u;
+    return (vec2<f32>(f32(sample_cell & 1u), f32(sample_cell >> 1u)) + f) * (1.0 / f32(TEXCELL_REFERENCE_CELLS));
+}
+
+// --- The forest under a fragment ---
+
+struct Forest {
+    // Index of the forest sample (the class's), and how much of the point is that forest (0 to 1).
+    sample: u32,
+    coverage: f32,
+}
+
+// The dense classes around `grid_m`: the four nearest level-1 texels, weighted bilinearly; the
+// sample of the heaviest.
+fn forest_at(grid_m: vec2<f32>) -> Forest {
+    let t = (grid_m - tu.lcc_frame.xy) * tu.lcc_frame.z - 0.5;
+    let base = floor(t);
+    let f = t - base;
+    var best = Forest(0u, 0.0);
+    var best_weight = 0.0;
+    var coverage = 0.0;
+    for (var k = 0u; k < 4u; k += 1u) {
+        let offset = vec2<f32>(f32(k & 1u), f32(k >> 1u));
+        let q = vec2<u32>(clamp(base + offset, vec2<f32>(0.0), vec2<f32>(tu.lcc_size) - 1.0));
+        let palette = landcover_class(q, tu.lcc_level, tu.lcc_levels, tu.lcc_sub_bits).x;
+        if palette >= arrayLength(&sample_of_class) {
+            continue;
+        }
+        let sample = sample_of_class[palette];
+        if sample == 0u {
+            continue;
+        }
+        let w = mix(1.0 - f.x, f.x, offset.x) * mix(1.0 - f.y, f.y, offset.y);
+        coverage += w;
+        if w > best_weight {
+            best_weight = w;
+            best.sample = sample - 1u;
+        }
+    }
+    best.coverage = coverage;
+    return best;
+}
+
+@fragment
+fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
+    // Derivatives first, in uniform control flow: the mip from the continuous texel coordinate
+    // (the tiling's jumps between tiles would spike it), the imagery's from the grid position.
+    let texel = in.grid_m * (tu.inv_cell_m / f32(TEXCELL_REFERENCE_CELLS) * tu.texels);
+    let footprint = max(length(dpdx(texel)), length(dpdy(texel)));
+    let ground = imagery_albedo(in.grid_m);
+
+    let distance_m = length(in.rel_m);
+    let fade = clamp((distance_m - tu.fade_m.x) / tu.fade_m.y, 0.0, 1.0)
+        * clamp((tu.fade_m.z + tu.fade_m.w - distance_m) / tu.fade_m.w, 0.0, 1.0);
+    let forest = forest_at(in.grid_m);
+    if forest.coverage <= 0.0 || bayer4(vec2<u32>(in.clip.xy), 0u) >= fade {
+        discard;
+    }
+    let lod = max(log2(max(footprint, 1e-6)), f32(in.slice.y));
+    let layer = i32(forest.sample * tu.finest_slices + in.slice.x);
+    let sampled = textureSampleLevel(forest_slices, forest_sampler, forest_uv(in.grid_m), layer, lod);
+    let alpha = sampled.a * forest.coverage;
+    if alpha <= 0.0 {
+        discard;
+    }
+    // The path between two slices, seen along the view, is 1 / cos longer than straight through.
+    let normal = normalize(in.normal);
+    let view = normalize(in.rel_m);
+    let path = min(normal.z / max(abs(dot(normal, view)), 1e-4), tu.opacity_max_factor);
+    let corrected = 1.0 - pow(1.0 - min(alpha, 0.9999), max(path, 0.25));
+
+    var albedo = sampled.rgb / max(sampled.a, 1e-4);
+    if u.has_imagery != 0u {
+        albedo = mix(albedo, ground.rgb, ground.a * tu.ground_blend);
+    }
+    // Lit as the seeds are: a canopy faces the sky, its leaves let light wrap around.
+    let sun = 0.55 * max(dot(normal, u.sun_dir.xyz), 0.0) + 0.35 * max(u.sun_dir.z, 0.0);
+    let lit = albedo * (sun + 0.3);
+    let haze = 1.0 - exp2(-distance_m / u.haze.w);
+    return vec4<f32>(mix(lit, u.haze.rgb, haze) * corrected, corrected);
+}
+
+// --- For the test that holds `forest_uv` equal to its twin (`passes::texcells::gpu::probe`) ---
+
+@group(2) @binding(0) var<storage, read> probe_points: array<vec2<f32>>;
+@group(2) @binding(1) var<storage, read_write> probe_uvs: array<vec2<f32>>;
+
+@compute @workgroup_size(TEXCELL_PROBE_WORKGROUP)
+fn probe_forest_uv(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x < arrayLength(&probe_points) {
+        probe_uvs[id.x] = forest_uv(probe_points[id.x]);
+    }
+}

@@ -1,0 +1,62 @@
+//! How it works: the `[texcells]` table: how far the texcell forest reaches, how many slices its
+//! patches draw, the opacity correction's clamp and the ground colour it takes on; range-checked
+//! like the rest of the settings. See `config/default.toml` for what each buys.
+
+use serde::Deserialize;
+
+use super::{DrawSeedsSettings, SettingsError};
+
+/// Drawing the far forest, see `config/default.toml` `[texcells]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TexcellSettings {
+    /// How far texcells reach, metres; 0: none (no pass runs).
+    pub reach_m: f64,
+    /// Pixels of parallax between slices a patch's slice count aims for.
+    pub slice_px: f64,
+    /// The opacity correction's largest factor (the paper's k_M).
+    pub opacity_max_factor: f64,
+    /// How much of the imagery's colour under them texcells take on (0 to 1).
+    pub ground_blend: f64,
+}
+
+impl TexcellSettings {
+    /// Whether texcells are drawn at all.
+    pub fn enabled(&self) -> bool {
+        self.reach_m > 0.0
+    }
+
+    pub(super) fn validate(&self, draw: &DrawSeedsSettings) -> Result<(), SettingsError> {
+        let last = draw.reach_m[draw.reach_m.len() - 1];
+        let checks: [(bool, &'static str, String, &'static str); 4] = [
+            (
+                self.reach_m == 0.0 || (self.reach_m.is_finite() && self.reach_m > last),
+                "texcells.reach_m",
+                self.reach_m.to_string(),
+                "0 (no texcells) or farther than the last of draw_seeds.reach_m",
+            ),
+            (
+                self.slice_px.is_finite() && self.slice_px >= 0.1,
+                "texcells.slice_px",
+                self.slice_px.to_string(),
+                "at least 0.1 pixels",
+            ),
+            (
+                (1.0..=64.0).contains(&self.opacity_max_factor),
+                "texcells.opacity_max_factor",
+                self.opacity_max_factor.to_string(),
+                "1 (no correction) to 64",
+            ),
+            (
+                (0.0..=1.0).contains(&self.ground_blend),
+                "texcells.ground_blend",
+                self.ground_blend.to_string(),
+                "0 to 1",
+            ),
+        ];
+        match checks.into_iter().find(|(ok, ..)| !ok) {
+            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
+            None => Ok(()),
+        }
+    }
+}
