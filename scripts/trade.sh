@@ -87,14 +87,14 @@ knobs=(
     "seeds.occlusion_tolerance_m=1,2,20"                                   # [5]
     "seeds.density_scale=0.25,0.5,0.75"                                    # [1]
     "seeds.seeds_per_pattern=1024,3072,4096"                               # [2048]
-    "draw_seeds.reach_m=[0,700,1400,3000],[60,700,1400,3000],[300,700,1400,3000]" # mesh reach [120]
+    "draw_seeds.reach_m=[60,700,1400,3000],[120,700,1400,3000],[500,700,1400,3000]" # mesh reach [300]
     "draw_seeds.fade_fraction=0,0.05,0.25"                                 # [0.1]
     "terrain.triangle_px=2,8,16"                                           # [4]
     "cache.imagery_slots=32,48,192"                                        # [96]
     "draw_seeds.samples=4"                                                 # [1]
     "seeds.reference_height_m=2,5,20"                                      # [10]
     # How far seeds reach at all: the last band and the last draw reach together [3000].
-    "tlm.radial_bands_m+draw_seeds.reach_m=[500,1000,2000]+[120,500,1000,2000],[700,1400,4000]+[120,700,1400,4000]"
+    "tlm.radial_bands_m+draw_seeds.reach_m=[500,1000,2000]+[300,500,1000,2000],[700,1400,4000]+[300,700,1400,4000]"
 )
 front=()
 if [[ "${FRONT:-1}" != 0 ]]; then

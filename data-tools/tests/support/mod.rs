@@ -205,3 +205,56 @@ pub fn ground_under_pixels(
         })
         .collect()
 }
+
+/// nc's forest and water codes.
+pub const FOREST: u8 = 5;
+pub const WATER: u8 = 6;
+
+/// A pose over forest with water ahead: grid (x, y) of a level-1 land-cover texel whose
+/// neighbourhood is mostly forest, the closest such to a lake, and the heading to that lake.
+pub fn forest_near_water(dataset: &Dataset) -> ([f64; 2], f64) {
+    let meta = dataset.manifest.landcover.clone().unwrap();
+    let texel_m = 2.0 * meta.layer.texel_m;
+    let [w, h] = dataset.manifest.extent_m();
+    let n = [(w / texel_m) as i64, (h / texel_m) as i64];
+    let code = |q: [i64; 2]| {
+        if q[0] < 0 || q[1] < 0 || q[0] >= n[0] || q[1] >= n[1] {
+            return meta.nodata_code;
+        }
+        let index = dataset.landcover_index(1, [q[0] as u32, q[1] as u32]).unwrap();
+        meta.coding.code_of(index).unwrap_or(meta.nodata_code)
+    };
+    // Codes on a coarse grid (each lookup reads a tile): enough to find a forest and a lake.
+    let step = 8;
+    let g = [n[0] / step, n[1] / step];
+    let grid: Vec<u8> = (0..g[1])
+        .flat_map(|y| (0..g[0]).map(move |x| [x, y]))
+        .map(|[x, y]| code([x * step, y * step]))
+        .collect();
+    let at = |x: i64, y: i64| grid[(y * g[0] + x) as usize];
+    let water: Vec<[i64; 2]> =
+        (0..g[1]).flat_map(|y| (0..g[0]).map(move |x| [x, y])).filter(|&[x, y]| at(x, y) == WATER).collect();
+    assert!(!water.is_empty(), "no water in nc");
+    let mut best: Option<(i64, [i64; 2], [i64; 2])> = None;
+    for y in 2..g[1] - 2 {
+        for x in 2..g[0] - 2 {
+            let forest = (-2..=2)
+                .flat_map(|j| (-2..=2).map(move |i| (x + i, y + j)))
+                .filter(|&(i, j)| at(i, j) == FOREST)
+                .count();
+            if forest < 20 {
+                continue;
+            }
+            let nearest = water.iter().min_by_key(|w| (w[0] - x).pow(2) + (w[1] - y).pow(2)).unwrap();
+            let d = (nearest[0] - x).pow(2) + (nearest[1] - y).pow(2);
+            // Water a little way off: a view across the forest to the lake.
+            if d >= 4 && best.is_none_or(|b| d < b.0) {
+                best = Some((d, [x * step, y * step], [nearest[0] * step, nearest[1] * step]));
+            }
+        }
+    }
+    let (_, at, lake) = best.expect("forest near water in nc");
+    let grid = at.map(|v| (v as f64 + 0.5) * texel_m);
+    let yaw = ((lake[0] - at[0]) as f64).atan2((lake[1] - at[1]) as f64).to_degrees();
+    (grid, yaw)
+}
