@@ -49,6 +49,7 @@ shared="$root/../shared/data"
 mkdir -p "$data" docs/trade
 
 cargo build --release --workspace -q
+started=$(date +%s)
 terramp="$root/target/release/terramp"
 terramp_data="$root/target/release/terramp-data"
 
@@ -110,5 +111,5 @@ for name in ${SWEEP-synthetic nc zion}; do
         --popping-frames "${POPPING_FRAMES:-12}" --settings "$trees" "${front[@]}" 2> >(grep -v XDG_RUNTIME_DIR >&2)
 done
 
-python3 scripts/trade_page.py "$frames" "$warmup" >docs/TRADE.md
+python3 scripts/trade_page.py "$frames" "$warmup" "$((($(date +%s) - started) / 60))" >docs/TRADE.md
 echo "wrote docs/TRADE.md and docs/trade/{synthetic,nc,zion}/" >&2
