@@ -118,9 +118,9 @@ above 0.05, and the figures say what stops it:
 - **Single-sampled foliage.** At the synthetic pose of [truth.md](truth.md) the truth itself,
   every tree its mesh, rendered at one sample per pixel is already 0.035 FLIP from the 4 × 4
   truth. Anti-aliased foliage exists now (`draw_seeds.samples` = 4: alpha-derived coverage over 4
-  samples, resolved) and the front measures it: frame PSNR and SSIM rise and popping halves, but
-  FLIP does not move (its sensitivity is to the leaf texture's contrast, which the truth's box
-  filter smooths and a 4-sample resolve does not), so `accurate` does not pay its 2–3× here.
+  samples, resolved) and the front measures it: frame PSNR and SSIM rise and popping falls, but
+  FLIP barely moves (`balanced` 0.0861 → 0.0866 on the synthetic default, 0.0874 → 0.0852 on
+  `nc/`, 0.0802 → 0.0786 on `zion/`) for 2–3× the frame on lavapipe, so `accurate` does not use it.
 - **The billboard clouds themselves.** Where the trees are large on screen (`nc/`'s low orbit: the
   *clouds 1* and *clouds 2* bands) the 17- and 8-plane clouds are 0.13–0.14 FLIP from the meshes
   they stand for. Meshes farther out are the cure the front finds: `draw_seeds.reach_m[0]` 300 m
@@ -129,8 +129,8 @@ above 0.05, and the figures say what stops it:
   run's noise, so on `nc/` both `balanced` and `accurate` are off the FLIP front by that point: the
   next retune. Better representations of a tree at a distance are issue 15's (Jakulin's slicings
   with view blending) and issue 14's (generated trees, continuous LOD).
-- **The far forest.** The *clouds 3* band (2-plane clouds, 1.4–4 km) is the worst (FLIP 0.2–0.3 on
-  `nc/` and the synthetic default): two crossed quads are a poor tree. Texcells (issue 13; the pass
+- **The far forest.** The *clouds 3* band (2-plane clouds, 1.4–3 km, 4 km in `accurate`) is the
+  worst (FLIP 0.19–0.28 on `nc/` and the synthetic default): two crossed quads are a poor tree. Texcells (issue 13; the pass
   landed, its judgement against a truth to the horizon is that issue's) are the representation
   meant for that band and beyond.
 

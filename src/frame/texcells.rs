@@ -51,6 +51,7 @@ pub(super) struct TexcellStage {
     pass: TexcellsPass,
     bind_group: wgpu::BindGroup,
     shape: SampleShape,
+    band: Band,
     finest_level: u32,
     prepared: PreparedTexcells,
     /// The land-cover tiles under the last frame's patches.
@@ -123,6 +124,8 @@ impl TexcellStage {
             finest_slices: finest,
             tile_cells: tiling::sample_cells_word(),
         };
+        let band = Band::of(settings);
+        let uniforms = texcell_uniforms(settings, dataset, &band, &shape);
         let pass = TexcellsPass::new(
             &gpu.device,
             &gpu.queue,
@@ -130,12 +133,14 @@ impl TexcellStage {
             settings.terrain.node_cells,
             &samples,
             &sample_of_class,
+            &uniforms,
         )?;
         let bind_group = pass.bind_group(&gpu.device, landcover);
         let stage = Self {
             pass,
             bind_group,
             shape,
+            band,
             finest_level: finest.ilog2(),
             prepared: PreparedTexcells::default(),
             wanted_landcover: Vec::new(),
@@ -154,7 +159,6 @@ impl TexcellStage {
         view: &TexcellView,
     ) -> TexcellReport {
         let TexcellView { camera_grid_m, metres_per_px_at_1m } = *view;
-        let band = Band::of(settings);
         let shape = &self.shape;
         let rule = SliceRule {
             metres_per_px_at_1m,
@@ -163,11 +167,10 @@ impl TexcellStage {
             slice_px: settings.texcells.slice_px,
             finest_level: self.finest_level,
         };
-        let patches = place(batches, |q, i| nodes.instance(q, i), camera_grid_m, &band, &rule, shape.slab_m);
+        let patches = place(batches, |q, i| nodes.instance(q, i), camera_grid_m, &self.band, &rule);
         let (records, dropped) = records(&patches, self.finest_level, camera_grid_m.z, shape.slab_m);
         self.wanted_landcover = landcover_tiles(dataset, &patches);
-        let uniforms = texcell_uniforms(settings, dataset, &band, shape);
-        self.prepared = self.pass.prepare(&gpu.queue, &uniforms, &records);
+        self.prepared = self.pass.prepare(&gpu.queue, &records);
         TexcellReport { patches: patches.len() - dropped, slices: records.len(), patches_dropped: dropped }
     }
 

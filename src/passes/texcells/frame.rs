@@ -105,13 +105,12 @@ pub fn place(
     camera_grid_m: DVec3,
     band: &Band,
     rule: &SliceRule,
-    slab_m: f64,
 ) -> Vec<Patch> {
     let mut patches = Vec::new();
     for (q, boxes) in batches.boxes.iter().enumerate() {
         for (i, b) in boxes.iter().enumerate() {
             let Some(instance) = instance(q, i) else { continue };
-            let canopy = QuadrantBox { min_m: b.min_m, max_m: b.max_m + DVec3::new(0.0, 0.0, slab_m) };
+            let canopy = QuadrantBox { min_m: b.min_m, max_m: b.max_m + DVec3::new(0.0, 0.0, rule.slab_m) };
             let nearest_m = canopy.distance_m(camera_grid_m);
             if nearest_m >= band.reach_m || canopy.farthest_m(camera_grid_m) <= band.fade_in_m {
                 continue;
@@ -274,7 +273,7 @@ mod tests {
         let camera = DVec3::new(0.0, 0.0, 600.0);
         // Near (inside the seed band), straddling its end, far, beyond the reach.
         let b = batches(&[(0.0, 0.0), (2500.0, 0.0), (6000.0, 0.0), (12_000.0, 0.0)]);
-        let patches = place(&b, |_, i| Some(i as u32), camera, &band, &rule(), 20.0);
+        let patches = place(&b, |_, i| Some(i as u32), camera, &band, &rule());
         let kept: Vec<u32> = patches.iter().map(|p| p.instance).collect();
         assert_eq!(kept, [2, 1]);
         let (drawn, dropped) = records(&patches, 5, camera.z, 20.0);
@@ -298,6 +297,6 @@ mod tests {
             "{order:?}"
         );
         // Instances the terrain did not upload carry no texcells.
-        assert!(place(&b, |_, _| None, camera, &band, &rule(), 20.0).is_empty());
+        assert!(place(&b, |_, _| None, camera, &band, &rule()).is_empty());
     }
 }

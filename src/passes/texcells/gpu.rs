@@ -1,6 +1,6 @@
 //! The texcell pass's GPU half: the forest samples' texture array and the class → sample table
-//! (uploaded once in `new`), the pipeline over the terrain's bind group and its own, the quadrant
-//! grid's index buffer; `prepare` uploads the frame's uniforms and slice instances and `encode`
+//! and the uniforms (the settings' and samples', fixed: uploaded once in `new`), the pipeline over the terrain's bind group and its own, the quadrant
+//! grid's index buffer; `prepare` uploads the frame's slice instances and `encode`
 //! draws them over the frame, blended, depth-tested against the ground, writing no depth.
 
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
@@ -83,6 +83,7 @@ impl TexcellsPass {
         node_cells: u32,
         samples: &[ForestSample],
         sample_of_class: &[u32],
+        uniforms: &TexcellUniforms,
     ) -> Result<Self, TexcellsError> {
         let first = samples.first().ok_or(TexcellsError::NoSamples)?;
         let (texels, finest) = (first.texels(), first.slice_count());
@@ -135,8 +136,7 @@ impl TexcellsPass {
         use wgpu::BufferUsages as U;
         let table = if sample_of_class.is_empty() { &[0][..] } else { sample_of_class };
         let sample_of_class = buffer_init(device, "texcell classes", bytemuck::cast_slice(table), U::STORAGE);
-        let uniforms =
-            buffer(device, "texcell uniforms", size_of::<TexcellUniforms>() as u64, U::UNIFORM | U::COPY_DST);
+        let uniforms = buffer_init(device, "texcell uniforms", bytemuck::bytes_of(uniforms), U::UNIFORM);
         let records_bytes = u64::from(MAX_RECORDS) * size_of::<TexcellRecord>() as u64;
         let records = buffer(device, "texcell records", records_bytes, U::STORAGE | U::COPY_DST);
         let index_data = quadrant_indices(node_cells / 2);
@@ -174,15 +174,9 @@ impl TexcellsPass {
         )
     }
 
-    /// Uploads the frame's uniforms and slice instances (at most `MAX_RECORDS`).
-    pub fn prepare(
-        &self,
-        queue: &wgpu::Queue,
-        uniforms: &TexcellUniforms,
-        records: &[TexcellRecord],
-    ) -> PreparedTexcells {
+    /// Uploads the frame's slice instances (at most `MAX_RECORDS`).
+    pub fn prepare(&self, queue: &wgpu::Queue, records: &[TexcellRecord]) -> PreparedTexcells {
         let kept = &records[..records.len().min(MAX_RECORDS as usize)];
-        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
         if !kept.is_empty() {
             queue.write_buffer(&self.records, 0, bytemuck::cast_slice(kept));
         }
