@@ -128,6 +128,26 @@ impl Recording {
     pub fn profiled_seeds(&self) -> impl Iterator<Item = &SeedSample> {
         self.seeds.values().filter(|s| self.is_profiled(s.frame))
     }
+
+    /// Adds `other`'s frames after this recording's, renumbered past its last frame, so that
+    /// flights of separate renderers (each numbering its frames from 0) pool into one recording.
+    /// The start times stay on each renderer's own clock: only wall times are pooled.
+    pub fn append(&mut self, other: Recording) {
+        let last = [
+            self.frames.last().map(|f| f.frame),
+            self.scopes.keys().next_back().copied(),
+            self.seeds.keys().next_back().copied(),
+        ];
+        let offset = last.into_iter().flatten().max().map_or(0, |f| f + 1);
+        self.frames.extend(other.frames.into_iter().map(|f| FrameSample { frame: f.frame + offset, ..f }));
+        self.scopes.extend(other.scopes.into_iter().map(|(frame, scopes)| (frame + offset, scopes)));
+        self.seeds.extend(
+            other
+                .seeds
+                .into_iter()
+                .map(|(frame, s)| (frame + offset, SeedSample { frame: frame + offset, ..s })),
+        );
+    }
 }
 
 /// How the paper's Table 1 names a pass, for the labels it has a row for.

@@ -21,6 +21,7 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
         .unwrap();
     let output = Command::new(env!("CARGO_BIN_EXE_terramp"))
         .args(["sweep", "--presets", "fast,accurate", "--frames", "4", "--warmup", "2", "--samples", "2"])
+        .args(["--timing-rounds", "2"])
         .args(["--width", "160", "--height", "90", "--knob", "seeds.frustum_epsilon=0,0.05"])
         .args(["--truth-supersample", "2", "--truth-reach-m", "1500"])
         .args(["--popping-frames", "4", "--popping-step-m", "3"])
@@ -45,6 +46,7 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
 
     assert_eq!(json["schema"], "terramp-trade/3");
     assert_eq!(json["popping_flight"]["frames"], 4);
+    assert_eq!((json["frames"].as_u64(), json["timing_rounds"].as_u64()), (Some(4), Some(2)));
     assert_eq!(json["resolution"], serde_json::json!([160, 90]));
     let points = json["points"].as_array().unwrap();
     let labels: Vec<&str> = points.iter().map(|p| p["label"].as_str().unwrap()).collect();

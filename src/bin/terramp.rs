@@ -179,10 +179,11 @@ enum Command {
         settings: SettingsArgs,
     },
     /// Measure the speed trade: fly the same path with every preset (and knob value), timing each
-    /// pass, then at sample poses compare the seeds with the exact oracle (recall, precision, height
-    /// error) and the images with an all-resident render of the accurate preset (ground PSNR, frame
-    /// PSNR and SSIM). Writes trade.csv, trade.json, trade.png and trade.md (Markdown tables) into
-    /// --out and prints a table.
+    /// pass in interleaved rounds, then at sample poses judge each against the ground truth of its
+    /// own world (any-part recall, precision and pixel-weighted recall; frame PSNR, SSIM, FLIP and
+    /// forest cover, whole and per distance band; popping) and the exact summit oracle (recall,
+    /// precision, height error). Writes trade.csv, trade.json, trade.png and trade.md (Markdown
+    /// tables) into --out and prints a table.
     Sweep(sweep::SweepArgs),
     /// Describe a dataset: frame, extent, layers.
     Info {

@@ -287,6 +287,24 @@ mod tests {
     }
 
     #[test]
+    fn appended_flights_pool_their_frames_without_colliding() {
+        let mut pooled = recording();
+        let mut slower = recording();
+        for f in &mut slower.frames {
+            f.wall_ms = 40.0;
+        }
+        pooled.append(slower);
+        let summary = Summary::new(&pooled, test_meta());
+        // Both flights' frames 10..14 kept apart: 8 profiled frames, 4 at 20 ms and 4 at 40 ms.
+        assert_eq!(summary.frames.profiled, 8);
+        assert_eq!(summary.totals.frame_wall.unwrap().median_ms, 30.0);
+        assert_eq!(summary.passes[0].stat.samples, 8);
+        assert_eq!(summary.seeds.frames, 8);
+        // The second flight's warm-up arrivals stay out of the profiled figures.
+        assert_eq!(summary.passes[0].stat.p95_ms, 7.0);
+    }
+
+    #[test]
     fn an_empty_recording_summarises_to_nothing() {
         let summary = Summary::new(&Recording::default(), test_meta());
         assert!(summary.passes.is_empty() && summary.fps.is_none() && summary.seeds.checked_median.is_none());

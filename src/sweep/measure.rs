@@ -1,14 +1,15 @@
-//! How it works: one point of a sweep, judged against the ground truths (`truths`). Each point
-//! gets a fresh renderer (own device, cold caches), so points do not inherit each other's resident
-//! tiles: the timed flight through `profile::Session` (one step per frame) and its summary; then at
-//! each sample pose the settled view's seeds go to the exact summit oracle (height error, and
-//! agreement with pass 3's rule) and to the any-part oracle of its world's truth (rendered first,
-//! in a renderer of its own), and its frame is judged against that truth, whole and per distance
-//! band (`truth::compare`). Then, from the popping flight's first pose settled, it flies the popping
-//! flight frame by frame as a user would (streaming and readbacks a frame or two behind), and its
-//! frames' changes are judged against the truth's along the same flight (`frame_change::Popping`).
-//! With seeds drawn, a second renderer of the same settings without impostors settles the same
-//! poses for the ground alone, judged against the truth's ground.
+//! How it works: one point of a sweep, timed and judged against the ground truths (`truths`).
+//! Every flight gets a fresh renderer (own device, cold caches), so points do not inherit each
+//! other's resident tiles. `time_round` flies one timing round (warm-up, then its share of the
+//! timed frames through `profile::Session`, one step per frame); the rounds' recordings pool into
+//! one `Timed`. `measure` then settles each sample pose: its seeds go to the exact summit oracle
+//! (height error, and agreement with pass 3's rule) and to the any-part oracle of its world's
+//! truth (rendered first, in a renderer of its own), and its frame is judged against that truth,
+//! whole and per distance band (`truth::compare`). Then, from the popping flight's first pose
+//! settled, it flies the popping flight frame by frame as a user would (streaming and readbacks a
+//! frame or two behind), and its frames' changes are judged against the truth's along the same
+//! flight (`frame_change::Popping`). With seeds drawn, a second renderer of the same settings
+//! without impostors settles the same poses for the ground alone, judged against the truth's ground.
 
 use std::path::Path;
 
@@ -23,9 +24,10 @@ use crate::config::Settings;
 use crate::dataset::Dataset;
 use crate::frame::Renderer;
 use crate::gpu::Gpu;
+use crate::gpu::TimeSource;
 use crate::gpu::gpu_types::SeedRecord;
 use crate::path::CameraPath;
-use crate::profile::{Meta, Session, Summary, timing_of};
+use crate::profile::{Meta, Recording, Session, Summary, timing_of};
 use crate::reference::accuracy::{HeightError, SeedAgreement};
 use crate::reference::frame_change::Popping;
 use crate::reference::image_metrics::{capped_psnr_db, mse, psnr_of_mse};
@@ -42,6 +44,22 @@ pub(super) struct Flight<'a> {
     pub popping: &'a [Camera],
     pub warmup: u32,
     pub frames: u32,
+}
+
+/// A point's timed frames (one round, or its rounds pooled by `Recording::append`), with how
+/// they were timed.
+pub(super) struct Timed {
+    pub adapter: String,
+    pub timing: TimeSource,
+    pub timing_note: String,
+    pub recording: Recording,
+}
+
+impl Timed {
+    /// Pools `other`'s frames into these.
+    pub fn append(&mut self, other: Timed) {
+        self.recording.append(other.recording);
+    }
 }
 
 /// A measured point, with how it was timed.
@@ -106,48 +124,65 @@ impl Flight<'_> {
         Ok(frames)
     }
 
-    /// Times `point` along the path, then measures it at every pose against `references`.
+    /// Times one round of `label`'s flight in a fresh renderer: the `round`-th of `rounds`
+    /// consecutive shares of the `frames` timed frames spread along the whole path, after `warmup`
+    /// frames where the share starts. The rounds together fly every timed frame once, each share
+    /// as the one block of a single round would (consecutive frames as far apart along the path),
+    /// so the frames see the same streaming and culling as `profile::fly`'s.
+    pub fn time_round(
+        &self,
+        label: &str,
+        settings: &Settings,
+        (round, rounds): (u32, u32),
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<Timed, SweepError> {
+        let mut renderer = self.renderer(settings.clone())?;
+        let adapter = renderer.gpu.describe();
+        let (timing, timing_note) = timing_of(&renderer);
+        let (fov_deg, near_m) = (settings.render.fov_deg, settings.render.near_m);
+        let share = |r: u32| (u64::from(self.frames) * u64::from(r) / u64::from(rounds.max(1))) as u32;
+        let t_of = |j: u32| f64::from(j) / f64::from(self.frames.max(2) - 1);
+        let timed = share(round)..share(round + 1);
+        let mut session = Session::new(&mut renderer, self.warmup);
+        let flown = (0..self.warmup).map(|_| t_of(timed.start)).chain(timed.clone().map(t_of));
+        let total = self.warmup as usize + timed.len();
+        for (i, t) in flown.enumerate() {
+            let what = if session.warming_up() { "warm-up" } else { "timed" };
+            progress(Progress::Step(&format!(
+                "{label}: round {} of {rounds}, {what} frame {} of {total}",
+                round + 1,
+                i + 1
+            )));
+            session.frame(&self.path.camera_at(t, fov_deg, near_m))?;
+        }
+        Ok(Timed { adapter, timing, timing_note, recording: session.finish()? })
+    }
+
+    /// Measures `point` at every pose against its truths, with its timing pooled from its rounds.
     pub fn measure(
         &self,
         point: &Point,
         settings: Settings,
+        timed: Timed,
         truths: &mut Truths,
         progress: &mut dyn FnMut(Progress),
     ) -> Result<Measured, SweepError> {
         let label = point.label();
         let draws_seeds = !settings.draw_seeds.impostors.is_empty();
-        let mut renderer = self.renderer(settings.clone())?;
-        let adapter = renderer.gpu.describe();
-        let (timing, timing_note) = timing_of(&renderer);
-        let summary = {
-            let (fov_deg, near_m) = (settings.render.fov_deg, settings.render.near_m);
-            let mut session = Session::new(&mut renderer, self.warmup);
-            for i in 0..self.warmup + self.frames {
-                // As `profile::fly`: warm-up at the start, timed frames spread over the whole path.
-                let t = f64::from(i.saturating_sub(self.warmup)) / f64::from(self.frames.max(2) - 1);
-                let what = if session.warming_up() { "warm-up" } else { "timed" };
-                progress(Progress::Step(&format!(
-                    "{label}: {what} frame {} of {}",
-                    i + 1,
-                    self.warmup + self.frames
-                )));
-                session.frame(&self.path.camera_at(t, fov_deg, near_m))?;
-            }
-            let recording = session.finish()?;
-            let r = &settings.render;
-            let meta = Meta {
-                adapter: adapter.clone(),
-                timing,
-                timing_note: timing_note.clone(),
-                resolution: [r.width, r.height],
-                preset: label.clone(),
-                settings: None,
-                dataset: self.dataset_dir.display().to_string(),
-                path: String::new(),
-                warmup: self.warmup,
-            };
-            Summary::new(&recording, meta)
+        let r = &settings.render;
+        let meta = Meta {
+            adapter: timed.adapter.clone(),
+            timing: timed.timing,
+            timing_note: timed.timing_note.clone(),
+            resolution: [r.width, r.height],
+            preset: label.clone(),
+            settings: None,
+            dataset: self.dataset_dir.display().to_string(),
+            path: String::new(),
+            warmup: self.warmup,
         };
+        let summary = Summary::new(&timed.recording, meta);
+        let mut renderer = self.renderer(settings.clone())?;
 
         // The any-part oracle, where the truth drew seeds (impostors given): the truths of the
         // point's own world, rendered before its poses are settled (a separate renderer).
@@ -193,14 +228,17 @@ impl Flight<'_> {
         let mut samples = Vec::with_capacity(frames.len());
         let mut errors = Vec::with_capacity(frames.len());
         let mut ground_mse = 0.0;
-        let (near_m, bands) = (settings.render.near_m, bands(&settings));
+        let truth_reach_m = truths.options().reach_m;
+        let (near_m, bands) = (settings.render.near_m, bands(&settings, truth_reach_m));
         // Its own world's truths, or without seeds in the truths, the reference's (the ground).
         let image_truths = if world.is_empty() { truths.images() } else { world };
         for (i, (frame, truth)) in frames.iter().zip(image_truths).enumerate() {
             let ground = grounds.as_ref().map_or(frame, |g| &g[i]);
             let g_mse = mse(ground, &truth.ground)?;
             ground_mse += g_mse;
-            let error = frame_error(truth, near_m, frame, &bands)?;
+            // Forest cover where the truth grew seeds and the frame has its own ground to tell them.
+            let own_ground = grounds.as_ref().filter(|_| truth_reach_m > 0.0).map(|g| &g[i]);
+            let error = frame_error(truth, near_m, frame, own_ground, &bands)?;
             samples.push(SampleFigures {
                 t: self.poses[i].0,
                 ground_psnr_db: capped_psnr_db(psnr_of_mse(g_mse)),
@@ -248,7 +286,7 @@ impl Flight<'_> {
             error,
             samples,
         };
-        Ok(Measured { adapter, timing_note, point })
+        Ok(Measured { adapter: timed.adapter, timing_note: timed.timing_note, point })
     }
 }
 

@@ -1,9 +1,12 @@
 //! How it works: `terramp sweep` measures the speed trade (DESIGN.md, "Accuracy, and the speed
 //! trade"). Its points are presets, optionally crossed with knob values (`knobs`). Every point
 //! flies the same camera path (`--path`, or the dataset's default as `terramp profile` chooses it)
-//! in a fresh renderer, timed by the profiling session (`profile::Session`): warm-up frames, then
-//! the timed frames, reduced by `profile::Summary` to per-pass GPU medians and the frame's median
-//! wall time. Then, at a few sample poses spread along the same path, it settles the view
+//! in fresh renderers, timed by the profiling session (`profile::Session`) in interleaved rounds:
+//! each round flies every point in turn (warm-up frames, then its consecutive share of the timed
+//! frames, as far apart along the path as in one block), so
+//! that the host's load drifting over the sweep falls on all points alike; the rounds' frames pool
+//! (`Recording::append`) into per-pass GPU medians and the frame's median wall time
+//! (`profile::Summary`). Then, at a few sample poses spread along the same path, it settles the view
 //! (`render_resolved`: everything the view asked for is resident) and measures it (`measure`)
 //! against two references, neither of them the thing measured:
 //! - the **ground truth** (`truth`, through `truths`) of the point's own seeded world (every seed
@@ -119,8 +122,13 @@ pub struct SweepOptions {
     pub settings: Option<PathBuf>,
     /// Timed frames per point, spread evenly along the path, after `warmup` frames at its start.
     pub frames: u32,
-    /// Untimed frames per point at the path's start, so caches fill and shaders compile first.
+    /// Untimed frames per point and round at the path's start, so caches fill and shaders
+    /// compile first.
     pub warmup: u32,
+    /// Rounds the timed frames are split into: every round times each point in turn (a fresh
+    /// renderer, `warmup` frames, then its consecutive share of the timed frames), so a slow drift
+    /// of the machine's load falls on every point alike instead of on whichever was timed then.
+    pub timing_rounds: u32,
     /// Poses along the path where accuracy is measured, at t = (i + ½) / samples.
     pub samples: u32,
     /// Override of `render.width` for every point and the reference, pixels.
@@ -160,6 +168,12 @@ pub const MARKDOWN_FILE: &str = "trade.md";
 pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result<Trade, SweepError> {
     if options.frames == 0 || options.samples == 0 || options.presets.is_empty() {
         return Err(SweepError::Options("--frames, --samples and --presets need at least one".into()));
+    }
+    if options.timing_rounds == 0 || options.timing_rounds > options.frames {
+        return Err(SweepError::Options(format!(
+            "--timing-rounds {} must be between 1 and --frames ({})",
+            options.timing_rounds, options.frames
+        )));
     }
     let user = match &options.settings {
         Some(file) => {
@@ -216,7 +230,7 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
 
     let per_point = |s: &Settings| {
         let grounds = if s.draw_seeds.impostors.is_empty() { 0 } else { 1 };
-        u64::from(options.warmup + options.frames)
+        u64::from(options.warmup * options.timing_rounds + options.frames)
             + u64::from(options.samples) * (1 + grounds)
             + popping.len() as u64
     };
@@ -244,9 +258,22 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         frames: options.frames,
     };
     let mut truths = truths::Truths::new(&flight, &reference_settings, truth.clone(), progress)?;
+    // Timing first, round-robin over the points, then each point's accuracy.
+    let mut timed: Vec<Option<measure::Timed>> = points.iter().map(|_| None).collect();
+    for round in 0..options.timing_rounds {
+        for ((point, settings), pooled) in points.iter().zip(&settings).zip(&mut timed) {
+            let this =
+                flight.time_round(&point.label(), settings, (round, options.timing_rounds), progress)?;
+            match pooled {
+                Some(pooled) => pooled.append(this),
+                None => *pooled = Some(this),
+            }
+        }
+    }
     let mut measured = Vec::with_capacity(points.len());
-    for (point, settings) in points.iter().zip(settings) {
-        measured.push(flight.measure(point, settings, &mut truths, progress)?);
+    for ((point, settings), timed) in points.iter().zip(settings).zip(timed) {
+        let timed = timed.ok_or_else(|| SweepError::Options("a point was never timed".into()))?;
+        measured.push(flight.measure(point, settings, timed, &mut truths, progress)?);
     }
     let first = measured.first();
     Ok(Trade {
@@ -258,6 +285,7 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
         resolution: [reference_settings.render.width, reference_settings.render.height],
         warmup: options.warmup,
         frames: options.frames,
+        timing_rounds: options.timing_rounds,
         sample_t: poses.iter().map(|(t, _)| *t).collect(),
         popping_flight: (!popping.is_empty()).then_some(PoppingFlight {
             frames: popping.len() as u32,

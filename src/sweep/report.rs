@@ -7,7 +7,8 @@
 //! The JSON:
 //! ```text
 //! { "schema": "terramp-trade/3", "adapter": str, "timing": str, "dataset": str, "path": str,
-//!   "resolution": [w, h], "warmup": int, "frames": int, "sample_t": [float],
+//!   "resolution": [w, h], "warmup": int, "frames": int, "timing_rounds": int,
+//!   "sample_t": [float],
 //!   "popping_flight": { "frames": int, "step_m": float, "from_t": float } | null,
 //!   "reference": str, "settings": str | null,
 //!   "points": [ { "label": str, "preset": str, "knobs": { key: value },
@@ -27,7 +28,8 @@
 //! "pixel_weighted_recall_pct": float, "missed_pct": { "reach", "density", "frustum",
 //! "summit_hidden", "selection": float } }` (the truth's any-part oracle; why the missed samples
 //! are missed, `truth::visibility::Missed`) and region is `{ "band":
-//! { "name", "from_m", "to_m" }, "pixels", "mse", "psnr_db", "ssim", "flip" }` (`truth::compare`;
+//! { "name", "from_m", "to_m" }, "pixels", "mse", "psnr_db", "ssim", "flip",
+//! "cover": { "truth_px", "drawn_px", "both_px": int } | null }` (`truth::compare`;
 //! an infinite `to_m` and a figure of an empty band are `null`); popping is in levels of 255
 //! (`reference::frame_change`). The CSV has the same figures under the same names (pass medians
 //! as `<label>_ms`, seed figures without their `seeds.` prefix, the missed shares as
@@ -62,10 +64,12 @@ pub struct Trade {
     pub path: String,
     /// Viewport of every point and the reference, `[width, height]` in pixels.
     pub resolution: [u32; 2],
-    /// Untimed frames each point renders at the path's start.
+    /// Untimed frames each point renders at the path's start, in every timing round.
     pub warmup: u32,
     /// Timed frames each point renders, spread evenly along the path.
     pub frames: u32,
+    /// Rounds the timed frames were split into, every round timing each point in turn.
+    pub timing_rounds: u32,
     /// Path parameters of the sample poses.
     pub sample_t: Vec<f64>,
     /// The flight popping is measured along (`None`: not measured).
@@ -437,6 +441,7 @@ pub(crate) mod tests {
             resolution: [64, 36],
             warmup: 2,
             frames: 4,
+            timing_rounds: 2,
             sample_t: vec![0.25, 0.75],
             popping_flight: Some(PoppingFlight { frames: 8, step_m: 2.0, from_t: 0.75 }),
             reference: "accurate".into(),

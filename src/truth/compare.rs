@@ -2,8 +2,16 @@
 //! band, so each representation is judged where it is drawn. A pixel's distance is that of the
 //! nearest of its truth samples (reversed-Z: the largest depth), so a tree in front of far terrain
 //! counts in the tree's band; the sky is in no band, only in the whole frame. Bands come from the
-//! settings measured (`bands`): the mesh reach, each billboard cloud's reach, then beyond the last
-//! (reaches are those of a seed of `seeds.reference_height_m`; smaller seeds switch sooner).
+//! settings measured (`bands`): the mesh reach, each billboard cloud's reach, the texcells out to
+//! their reach or the truth's, whichever is nearer (beyond the truth's reach it grows no tree to
+//! judge them by), then beyond the last (reaches are those of a seed of
+//! `seeds.reference_height_m`; smaller seeds switch sooner).
+//!
+//! Per region also the **forest cover** (`Cover`), when the frame's own ground is given: the
+//! truth's forest pixels (at least half their samples on a seed) against the frame's drawn pixels
+//! (those its seeds and texcells change from its ground by `DRAWN_MIN_LEVELS` or more), so that a
+//! representation is judged on where it puts forest (recall: the truth's forest it covers;
+//! precision: its cover that lies on the truth's forest) apart from how it colours it.
 //!
 //! Three errors, each from one whole-frame map averaged over the band's pixels:
 //! - **PSNR**: the mean squared error over R, G and B (`image_metrics::squared_errors`);
@@ -33,8 +41,10 @@ pub struct Band {
     pub to_m: f64,
 }
 
-/// The bands of `settings`: up to each `draw_seeds.reach_m`, then beyond the last.
-pub fn bands(settings: &Settings) -> Vec<Band> {
+/// The bands of `settings` judged against a truth whose seeds grow to `truth_reach_m`: up to each
+/// `draw_seeds.reach_m`, the texcells (when drawn) to the nearer of their reach and the truth's,
+/// then beyond the last.
+pub fn bands(settings: &Settings, truth_reach_m: f64) -> Vec<Band> {
     let mut out = Vec::new();
     let mut from_m = 0.0;
     for (lod, &to_m) in settings.draw_seeds.reach_m.iter().enumerate() {
@@ -44,6 +54,11 @@ pub fn bands(settings: &Settings) -> Vec<Band> {
         let name = if lod == 0 { "meshes".to_owned() } else { format!("clouds {lod}") };
         out.push(Band { name, from_m, to_m });
         from_m = to_m;
+    }
+    let texcells_to_m = settings.texcells.reach_m.min(truth_reach_m);
+    if settings.texcells.enabled() && texcells_to_m > from_m {
+        out.push(Band { name: "texcells".into(), from_m, to_m: texcells_to_m });
+        from_m = texcells_to_m;
     }
     out.push(Band { name: "beyond".into(), from_m, to_m: f64::INFINITY });
     out
@@ -64,6 +79,77 @@ pub struct RegionError {
     pub ssim: f64,
     /// Mean FLIP error of its pixels (NaN without pixels).
     pub flip: f64,
+    /// Where the frame puts forest against where the truth has it (`None`: no ground given).
+    pub cover: Option<Cover>,
+}
+
+/// A frame pixel counts as drawn (seeds or texcells on it) when one of its channels differs from
+/// the frame's own ground by this many 8-bit levels or more: above rounding and dither noise.
+pub const DRAWN_MIN_LEVELS: u8 = 3;
+
+/// Forest cover in a region: the truth's forest pixels, the frame's drawn ones, and both.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Cover {
+    /// Pixels at least half of whose truth samples show a seed.
+    pub truth_px: u64,
+    /// Pixels the frame's seeds and texcells change from its ground (`DRAWN_MIN_LEVELS`).
+    pub drawn_px: u64,
+    /// Pixels both.
+    pub both_px: u64,
+}
+
+impl Cover {
+    /// Share of the truth's forest pixels the frame covers, % (NaN without any).
+    pub fn recall_pct(&self) -> f64 {
+        100.0 * self.both_px as f64 / self.truth_px as f64
+    }
+
+    /// Share of the frame's drawn pixels that lie on the truth's forest, % (NaN without any).
+    pub fn precision_pct(&self) -> f64 {
+        100.0 * self.both_px as f64 / self.drawn_px as f64
+    }
+
+    fn add(&mut self, other: &Cover) {
+        self.truth_px += other.truth_px;
+        self.drawn_px += other.drawn_px;
+        self.both_px += other.both_px;
+    }
+}
+
+/// One value per pixel of `truth` (row by row), from the indices of its samples.
+fn per_pixel<T>(truth: &Truth, of_samples: impl Fn(&mut dyn Iterator<Item = usize>) -> T) -> Vec<T> {
+    let [w, h] = truth.size_px;
+    let ss = truth.supersample as usize;
+    let row = w as usize * ss;
+    let mut out = Vec::with_capacity((w * h) as usize);
+    for y in 0..h as usize {
+        for x in 0..w as usize {
+            let mut samples = (0..ss).flat_map(|sy| (0..ss).map(move |sx| (y * ss + sy) * row + x * ss + sx));
+            out.push(of_samples(&mut samples));
+        }
+    }
+    out
+}
+
+/// Per pixel of `truth`: whether at least half its samples show a seed.
+pub fn truth_forest(truth: &Truth) -> Vec<bool> {
+    let ss = truth.supersample as usize;
+    per_pixel(truth, |samples| {
+        let on_seeds = samples.filter(|&i| truth.seed_ids.get(i).is_some_and(|&id| id != 0)).count();
+        2 * on_seeds >= ss * ss
+    })
+}
+
+/// Per pixel: whether `frame` differs from `ground` by `DRAWN_MIN_LEVELS` or more in a channel.
+pub fn drawn(frame: &image::RgbaImage, ground: &image::RgbaImage) -> Result<Vec<bool>, ImageMetricError> {
+    if frame.dimensions() != ground.dimensions() {
+        return Err(ImageMetricError::SizeMismatch { a: frame.dimensions(), b: ground.dimensions() });
+    }
+    Ok(frame
+        .pixels()
+        .zip(ground.pixels())
+        .map(|(f, g)| (0..3).any(|c| f[c].abs_diff(g[c]) >= DRAWN_MIN_LEVELS))
+        .collect())
 }
 
 /// A frame against its truth: the whole frame, then each band.
@@ -77,20 +163,10 @@ pub struct FrameError {
 
 /// The distance of each pixel of `truth`, metres (∞ for the sky): its nearest sample's.
 pub fn pixel_distances_m(truth: &Truth, near_m: f64) -> Vec<f64> {
-    let [w, h] = truth.size_px;
-    let ss = truth.supersample as usize;
-    let row = w as usize * ss;
-    let mut out = Vec::with_capacity((w * h) as usize);
-    for y in 0..h as usize {
-        for x in 0..w as usize {
-            let nearest = (0..ss)
-                .flat_map(|sy| (0..ss).map(move |sx| (y * ss + sy) * row + x * ss + sx))
-                .map(|i| truth.depth.get(i).copied().unwrap_or(0.0))
-                .fold(0.0f32, f32::max);
-            out.push(if nearest > 0.0 { near_m / f64::from(nearest) } else { f64::INFINITY });
-        }
-    }
-    out
+    per_pixel(truth, |samples| {
+        let nearest = samples.map(|i| truth.depth.get(i).copied().unwrap_or(0.0)).fold(0.0f32, f32::max);
+        if nearest > 0.0 { near_m / f64::from(nearest) } else { f64::INFINITY }
+    })
 }
 
 /// The FLIP error map of `test` against `reference` (sRGB, alpha ignored), one value per pixel.
@@ -127,6 +203,10 @@ pub fn pool(errors: &[FrameError]) -> Option<FrameError> {
             psnr_db: if pixels == 0 { f64::NAN } else { capped_psnr_db(psnr_of_mse(mse)) },
             ssim: mean(&|r| r.ssim),
             flip: mean(&|r| r.flip),
+            cover: regions.iter().try_fold(Cover::default(), |mut sum, r| {
+                sum.add(r.cover.as_ref()?);
+                Some(sum)
+            }),
         }
     };
     Some(FrameError {
@@ -137,11 +217,13 @@ pub fn pool(errors: &[FrameError]) -> Option<FrameError> {
     })
 }
 
-/// `frame` against `truth`'s image, whole and per band of `bands`.
+/// `frame` against `truth`'s image, whole and per band of `bands`; with the frame's own `ground`
+/// (the same view without seeds or texcells), each region's forest cover too.
 pub fn frame_error(
     truth: &Truth,
     near_m: f64,
     frame: &image::RgbaImage,
+    ground: Option<&image::RgbaImage>,
     bands: &[Band],
 ) -> Result<FrameError, ImageMetricError> {
     let reference = &truth.colour;
@@ -149,6 +231,8 @@ pub fn frame_error(
     let ssim = ssim_map(reference, frame)?;
     let flip = flip_map(reference, frame)?;
     let distance = pixel_distances_m(truth, near_m);
+    let forest = ground.map(|ground| Ok::<_, ImageMetricError>((truth_forest(truth), drawn(frame, ground)?)));
+    let forest = forest.transpose()?;
     let width = reference.width() as usize;
     let region = |band: Band, within: &dyn Fn(f64) -> bool| {
         let pixels: Vec<usize> = (0..distance.len()).filter(|&i| within(distance[i])).collect();
@@ -168,6 +252,14 @@ pub fn frame_error(
             psnr_db: if pixels.is_empty() { f64::NAN } else { capped_psnr_db(psnr_of_mse(mse)) },
             ssim: windows.iter().sum::<f64>() / windows.len() as f64,
             flip: pixels.iter().map(|&i| f64::from(flip[i])).sum::<f64>() / n,
+            cover: forest.as_ref().map(|(truth, drawn)| {
+                let count = |f: &dyn Fn(usize) -> bool| pixels.iter().filter(|&&i| f(i)).count() as u64;
+                Cover {
+                    truth_px: count(&|i| truth[i]),
+                    drawn_px: count(&|i| drawn[i]),
+                    both_px: count(&|i| truth[i] && drawn[i]),
+                }
+            }),
         }
     };
     let whole = Band { name: "frame".into(), from_m: 0.0, to_m: f64::INFINITY };
@@ -193,6 +285,7 @@ pub(crate) mod tests {
             psnr_db,
             ssim,
             flip,
+            cover: None,
         };
         FrameError {
             frame: region("frame", 0.0, f64::INFINITY, 200),
@@ -234,17 +327,62 @@ pub(crate) mod tests {
     fn bands_follow_the_reaches_and_end_beyond_the_last() {
         let mut settings = Settings::default();
         settings.draw_seeds.reach_m = [100.0, 700.0, 700.0, 3000.0];
-        let names: Vec<(String, f64, f64)> =
-            bands(&settings).into_iter().map(|b| (b.name, b.from_m, b.to_m)).collect();
-        assert_eq!(
-            names,
-            [
-                ("meshes".into(), 0.0, 100.0),
-                ("clouds 1".into(), 100.0, 700.0),
-                ("clouds 3".into(), 700.0, 3000.0),
-                ("beyond".into(), 3000.0, f64::INFINITY)
-            ]
-        );
+        let names = |settings: &Settings, truth_reach_m| -> Vec<(String, f64, f64)> {
+            bands(settings, truth_reach_m).into_iter().map(|b| (b.name, b.from_m, b.to_m)).collect()
+        };
+        let clouds = [
+            ("meshes".into(), 0.0, 100.0),
+            ("clouds 1".into(), 100.0, 700.0),
+            ("clouds 3".into(), 700.0, 3000.0),
+        ];
+        // Texcells out to the truth's reach (8 km), nearer than theirs (12 km).
+        settings.texcells.reach_m = 12000.0;
+        let with: Vec<_> = clouds
+            .iter()
+            .cloned()
+            .chain([("texcells".into(), 3000.0, 8000.0), ("beyond".into(), 8000.0, f64::INFINITY)])
+            .collect();
+        assert_eq!(names(&settings, 8000.0), with);
+        // A truth no farther than the clouds judges no texcells; without texcells there are none.
+        let without: Vec<_> =
+            clouds.iter().cloned().chain([("beyond".into(), 3000.0, f64::INFINITY)]).collect();
+        assert_eq!(names(&settings, 3000.0), without);
+        settings.texcells.reach_m = 0.0;
+        assert_eq!(names(&settings, 8000.0), without);
+    }
+
+    #[test]
+    fn cover_counts_the_truths_forest_against_the_frames_drawn_pixels() {
+        let mut truth = truth();
+        // Truth forest: the left half of the middle third, at 3 of 4 samples (one at 1 of 4 is not).
+        let (w, ss) = (32usize, 2usize);
+        for y in 8..16 {
+            for x in 0..16 {
+                for (sy, sx) in [(0, 0), (0, 1), (1, 0)] {
+                    truth.seed_ids[(y * ss + sy) * w * ss + x * ss + sx] = 1;
+                }
+            }
+            truth.seed_ids[(y * ss) * w * ss + 20 * ss] = 1;
+        }
+        // The frame draws the middle third's columns 8..24: half on the truth's forest.
+        let ground = truth.colour.clone();
+        let mut frame = ground.clone();
+        for y in 8..16 {
+            for x in 8..24 {
+                frame.get_pixel_mut(x, y).0[0] ^= 0x40;
+            }
+        }
+        // Two levels is below the drawn threshold.
+        frame.get_pixel_mut(0, 20).0[1] = frame.get_pixel(0, 20).0[1].saturating_add(2).min(253);
+        let bands = [Band { name: "all".into(), from_m: 0.0, to_m: f64::INFINITY }];
+        let e = frame_error(&truth, 0.1, &frame, Some(&ground), &bands).unwrap();
+        let cover = e.bands[0].cover.unwrap();
+        assert_eq!(cover, Cover { truth_px: 8 * 16, drawn_px: 8 * 16, both_px: 8 * 8 });
+        assert_eq!((cover.recall_pct(), cover.precision_pct()), (50.0, 50.0));
+        assert!(frame_error(&truth, 0.1, &frame, None, &bands).unwrap().bands[0].cover.is_none());
+        // Pooled, the counts add up.
+        let pooled = pool(&[e.clone(), e]).unwrap();
+        assert_eq!(pooled.bands[0].cover.unwrap().both_px, 2 * 8 * 8);
     }
 
     #[test]
@@ -254,7 +392,7 @@ pub(crate) mod tests {
             Band { name: "near".into(), from_m: 0.0, to_m: 100.0 },
             Band { name: "far".into(), from_m: 100.0, to_m: f64::INFINITY },
         ];
-        let same = frame_error(&truth, 0.1, &truth.colour, &bands).unwrap();
+        let same = frame_error(&truth, 0.1, &truth.colour, None, &bands).unwrap();
         for r in std::iter::once(&same.frame).chain(&same.bands) {
             assert_eq!((r.psnr_db, r.ssim, r.flip), (100.0, 1.0, 0.0), "{r:?}");
         }
@@ -266,7 +404,7 @@ pub(crate) mod tests {
                 frame.get_pixel_mut(x, y).0[1] /= 2;
             }
         }
-        let e = frame_error(&truth, 0.1, &frame, &bands).unwrap();
+        let e = frame_error(&truth, 0.1, &frame, None, &bands).unwrap();
         let (near, far) = (&e.bands[0], &e.bands[1]);
         assert!(near.psnr_db < 20.0 && near.flip > 0.1 && near.ssim < 0.95, "{near:?}");
         assert_eq!(far.psnr_db, 100.0);

@@ -31,9 +31,13 @@ pub struct SweepArgs {
     /// Timed frames per point, spread evenly along the path.
     #[arg(long, default_value_t = 60)]
     frames: u32,
-    /// Unprofiled frames at the path's start before the timed ones.
+    /// Unprofiled frames at the path's start before the timed ones, in every timing round.
     #[arg(long, default_value_t = 10)]
     warmup: u32,
+    /// Rounds the timed frames are split into, each round timing every point in turn (a fresh
+    /// renderer each), so that the machine's load drifting over the sweep is shared by all points.
+    #[arg(long, default_value_t = 3)]
+    timing_rounds: u32,
     /// Poses along the path where accuracy is measured.
     #[arg(long, default_value_t = 3)]
     samples: u32,
@@ -78,6 +82,7 @@ impl SweepArgs {
             settings: self.settings,
             frames: self.frames,
             warmup: self.warmup,
+            timing_rounds: self.timing_rounds,
             samples: self.samples,
             width: self.width,
             height: self.height,
