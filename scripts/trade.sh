@@ -20,7 +20,8 @@
 # time from the `balanced` preset (`--series --series-from balanced`), so that trade.png shows a
 # front of some thirty points.
 #
-# Environment: FRAMES (60 timed frames per point), WARMUP (10), SAMPLES (3 poses), PRESETS
+# Environment: FRAMES (60 timed frames per point), WARMUP (10 per round), ROUNDS (3: the timed
+# frames split into rounds that each time every point in turn), SAMPLES (3 poses), PRESETS
 # (fast,balanced,accurate), SERIES_FROM (balanced), FRONT (1; 0 measures the presets alone),
 # POPPING_FRAMES (12), WIDTH × HEIGHT (1280 × 720), TRUTH_SUPERSAMPLE (4), TRUTH_REACH_M (4000),
 # DATA_DIR, SWEEP ("synthetic nc zion": the datasets to sweep again; the page is always written
@@ -50,36 +51,8 @@ mkdir -p "$data" docs/trade
 
 cargo build --release --workspace -q
 started=$(date +%s)
-terramp="$root/target/release/terramp"
-terramp_data="$root/target/release/terramp-data"
-
-# build NAME ARGS...: a dataset, unless a readable one is already there.
-build() {
-    local name="$1"
-    shift
-    if "$terramp" info --dataset "$data/$name" >/dev/null 2>&1; then
-        echo "dataset $name: reusing $data/$name" >&2
-    else
-        echo "dataset $name: building into $data/$name" >&2
-        "$@" --out "$data/$name" >/dev/null
-    fi
-}
-build nc "$terramp_data" build --dem "$shared/nc/elev_ned_30m.tif" --imagery "$shared/nc/landsat_multiband.tif" \
-    --bands 3,2,1 --landcover "$shared/nc/landuse_r.tif" --classes nc
-build zion "$terramp_data" build --dem "$shared/zion/dem_utm12n_30m.tif" \
-    --landcover "$shared/zion/nlcd_utm12n_30m.tif" --classes nlcd
-build synthetic "$terramp_data" synth --size 1024
-
-impostors="$data/impostors"
-models=(Birch_1 Birch_4 BushBerries_1 Bush_1 DeadTree_1 Pine_1 Pine_3 Rock_1 Rock_Moss_1 Tree_1 Tree_3)
-if [[ ! -d "$impostors/Tree_3" ]]; then
-    args=()
-    for m in "${models[@]}"; do args+=(--model "$shared/models/$m.glb"); done
-    "$terramp_data" bake "${args[@]}" --out "$impostors" --texels 256 >/dev/null
-fi
-trees="$data/trees.toml"
-printf '# Written by scripts/trade.sh: draw the seeds with the baked impostors.\n[draw_seeds]\nimpostors = "%s"\n' \
-    "$(cd "$impostors" && pwd)" >"$trees"
+# The datasets, the impostors and the settings layer $trees that draws with them.
+source scripts/trade_data.sh
 
 # The front's knobs: three values each besides balanced's own (in brackets).
 knobs=(
@@ -88,14 +61,14 @@ knobs=(
     "seeds.occlusion_tolerance_m=1,2,20"                                   # [5]
     "seeds.density_scale=0.25,0.5,0.75"                                    # [1]
     "seeds.seeds_per_pattern=1024,3072,4096"                               # [2048]
-    "draw_seeds.reach_m=[60,700,1400,3000],[120,700,1400,3000],[500,700,1400,3000]" # mesh reach [300]
+    "draw_seeds.reach_m=[300,700,1400,3000],[800,1000,1400,3000],[1200,1300,1400,3000]" # mesh reach [500]
     "draw_seeds.fade_fraction=0,0.05,0.25"                                 # [0.1]
     "terrain.triangle_px=2,8,16"                                           # [4]
     "cache.imagery_slots=32,48,192"                                        # [96]
     "draw_seeds.samples=4"                                                 # [1]
     "seeds.reference_height_m=2,5,20"                                      # [10]
     # How far seeds reach at all: the last band and the last draw reach together [3000].
-    "tlm.radial_bands_m+draw_seeds.reach_m=[500,1000,2000]+[300,500,1000,2000],[700,1400,4000]+[300,700,1400,4000]"
+    "tlm.radial_bands_m+draw_seeds.reach_m=[500,1000,2000]+[500,700,1000,2000],[700,1400,4000]+[500,700,1400,4000]"
 )
 front=()
 if [[ "${FRONT:-1}" != 0 ]]; then
@@ -106,7 +79,7 @@ fi
 for name in ${SWEEP-synthetic nc zion}; do
     echo "## sweep $name" >&2
     "$terramp" sweep --dataset "$data/$name" --out "docs/trade/$name" --presets "$presets" \
-        --frames "$frames" --warmup "$warmup" --samples "$samples" --width "$width" --height "$height" \
+        --frames "$frames" --warmup "$warmup" --timing-rounds "${ROUNDS:-3}" --samples "$samples" --width "$width" --height "$height" \
         --truth-supersample "${TRUTH_SUPERSAMPLE:-4}" --truth-reach-m "${TRUTH_REACH_M:-4000}" \
         --popping-frames "${POPPING_FRAMES:-12}" --settings "$trees" "${front[@]}" 2> >(grep -v XDG_RUNTIME_DIR >&2)
 done

@@ -3,7 +3,7 @@
 
 Usage: scripts/trade_page.py FRAMES WARMUP   (scripts/trade.sh runs it after the sweeps)
 """
-import json, sys
+import json, sys, tomllib
 frames, warmup = sys.argv[1:3]
 names = {"synthetic": "The synthetic default (`terramp-data synth --size 1024`: 10 km, 10 m heights, 2.5 m imagery, 5 m land cover)",
          "nc": "`nc/` (USGS NED 30 m, Landsat 7 at 28.5 m, land use at 10 m)",
@@ -49,9 +49,11 @@ time smaller than that spread are not findings; the accuracy figures are determi
 balanced --knob key=v1,v2,v3 ...`, at {first['resolution'][0]} × {first['resolution'][1]}, every
 frame showing its trees (`draw_seeds.impostors` set by a settings layer over each preset).
 
-- **Time**: each point flies the dataset's default path in a fresh renderer: {warmup} warm-up frames,
-  then {frames} timed frames spread along the whole path, at most two frames in flight (the
-  `terramp profile` session). *frame ms* is the median wall time per frame, *GPU ms* the median sum
+- **Time**: {frames} timed frames spread along the dataset's default path, at most two frames in
+  flight (the `terramp profile` session), flown in {first.get('timing_rounds', 1)} interleaved rounds: each round flies
+  every point in turn, in a fresh renderer, {warmup} warm-up frames where its share starts and then
+  its consecutive share of the timed frames, so that the host's load drifting over the run falls
+  on every point alike; the medians pool the rounds' frames. *frame ms* is the median wall time per frame, *GPU ms* the median sum
   of the GPU passes; the pass table gives each pass's median.
 - **Accuracy**, at {samples} poses along the same path (path parameter t = {poses}), each view settled
   (every tile it asks for resident), against two references, neither of them the thing measured:
@@ -110,35 +112,70 @@ for name, title in names.items():
     print(presets_only(open(f"docs/trade/{name}/trade.md").read()))
     print(f"\nEvery point's tables: [trade/{name}/trade.md](trade/{name}/trade.md).\n")
 print("## Acceptance (issue 12)\n")
-print("""`accurate` draws every tree pixel of the truth it should: pixel-weighted recall 99.96–100 % on
-all three datasets (it was 84.8–97.4 % before it was retuned against the truth: seeds checked and
-drawn out to the truth's 4 km, and small seeds, bushes and rocks, as far as trees). Its FLIP stays
-above 0.05, and the figures say what stops it:
+
+
+def by_label(t):
+    return {p["label"]: p for p in t["points"]}
+
+
+def band_flip(p, band):
+    return next((b["flip"] for b in p["error"]["bands"] if b["band"]["name"] == band and b["pixels"]), None)
+
+
+def span(values, digits=2):
+    values = [v for v in values if v is not None]
+    lo, hi = min(values), max(values)
+    return f"{lo:.{digits}f}" if f"{lo:.{digits}f}" == f"{hi:.{digits}f}" else f"{lo:.{digits}f}–{hi:.{digits}f}"
+
+
+recalls = [by_label(t)["accurate"]["any_part"]["pixel_weighted_recall_pct"] for t in trades.values()]
+msaa = []
+for name, t in trades.items():
+    by = by_label(t)
+    m = by.get("balanced draw_seeds.samples=4")
+    if m:
+        msaa.append(f"{by['balanced']['frame_flip']:.4f} → {m['frame_flip']:.4f} on `{name}/`")
+nc = by_label(trades["nc"])
+clouds_12 = [band_flip(nc["accurate"], b) for b in ("clouds 1", "clouds 2")]
+reach_points = [p for p in trades["nc"]["points"] if p["preset"] == "balanced" and set(p["knobs"]) <= {"draw_seeds.reach_m"}]
+# balanced's own reaches: the defaults (config/default.toml), which its preset file leaves alone.
+with open("config/default.toml", "rb") as f:
+    balanced_reach = tomllib.load(f)["draw_seeds"]["reach_m"]
+
+
+def mesh_reach(p):
+    v = p["knobs"].get("draw_seeds.reach_m")
+    return json.loads(v)[0] if v else balanced_reach[0]
+
+
+reach_text = "; ".join(
+    f"{mesh_reach(p):.0f} m{' (its own)' if not p['knobs'] else ''}: FLIP {p['frame_flip']:.4f}, {p['frame_ms']:.0f} ms"
+    for p in sorted(reach_points, key=mesh_reach))
+far = [band_flip(by_label(trades[n])[q], "clouds 3") for n in ("nc", "synthetic") for q in ("balanced", "accurate")]
+print(f"""`accurate` draws every tree pixel of the truth it should: pixel-weighted recall
+{span(recalls)} % on the three datasets. Its FLIP stays above 0.05, and the figures say what stops it:
 
 - **Single-sampled foliage.** At the synthetic pose of [truth.md](truth.md) the truth itself,
   every tree its mesh, rendered at one sample per pixel is already 0.035 FLIP from the 4 × 4
-  truth. Anti-aliased foliage exists now (`draw_seeds.samples` = 4: alpha-derived coverage over 4
-  samples, resolved) and the front measures it: frame PSNR and SSIM rise and popping falls, but
-  FLIP barely moves (`balanced` 0.0861 → 0.0866 on the synthetic default, 0.0874 → 0.0852 on
-  `nc/`, 0.0802 → 0.0786 on `zion/`) for 2–3× the frame on lavapipe, so `accurate` does not use it.
-- **The billboard clouds themselves.** Where the trees are large on screen (`nc/`'s low orbit: the
-  *clouds 1* and *clouds 2* bands) the 17- and 8-plane clouds are 0.13–0.14 FLIP from the meshes
-  they stand for. Meshes farther out are the cure the front finds: `draw_seeds.reach_m[0]` 300 m
-  (retuned from 120 m in `balanced` and 200 m in `accurate`, after the previous run) took `nc/`'s
-  `balanced` frame from 0.0975 to 0.0874, and 500 m takes it to 0.0737 at a frame time within this
-  run's noise, so on `nc/` both `balanced` and `accurate` are off the FLIP front by that point: the
-  next retune. Better representations of a tree at a distance are issue 15's (Jakulin's slicings
-  with view blending) and issue 14's (generated trees, continuous LOD).
-- **The far forest.** The *clouds 3* band (2-plane clouds, 1.4–3 km, 4 km in `accurate`) is the
-  worst (FLIP 0.19–0.28 on `nc/` and the synthetic default): two crossed quads are a poor tree. Texcells (issue 13; the pass
-  landed, its judgement against a truth to the horizon is that issue's) are the representation
-  meant for that band and beyond.
+  truth. Anti-aliased foliage exists (`draw_seeds.samples` = 4: alpha-derived coverage over 4
+  samples, resolved) and the front measures it on `balanced`: FLIP {", ".join(msaa)}, for 2–3× the
+  frame on lavapipe, so `accurate` does not use it.
+- **The billboard clouds themselves.** Where the trees are large on screen (`nc/`'s low orbit),
+  `accurate`'s *clouds 1* and *clouds 2* bands (17- and 8-plane clouds) are {span(clouds_12, 3)} FLIP from
+  the meshes they stand for. Meshes farther out are the cure the front measures: `balanced` on
+  `nc/` with the mesh reach `draw_seeds.reach_m[0]` at {reach_text}. Better representations of a
+  tree at a distance are issue 15's (Jakulin's slicings with view blending) and issue 14's
+  (generated trees, continuous LOD).
+- **The far forest.** The *clouds 3* band (2-plane clouds, out to 3 km, 4 km in `accurate`) is the
+  worst ({span(far, 2)} FLIP on `nc/` and the synthetic default for `balanced` and `accurate`): two
+  crossed quads are a poor tree. The front runs without texcells, the representation meant for
+  that band and beyond, because its truths grow trees to 4 km only; texcells are judged against a
+  truth grown to the horizon in [texcells.md](texcells.md).
 
 `fast` is several times faster than `accurate` on every dataset, at the error the last columns
 state, and on both fronts. Off-the-front ratios below each dataset's timing noise (stated with its
-table) are not findings: that noise comes from the shared host (times drift over a run with
-nothing else running here), and timing the points in interleaved rounds, not one block each, is
-what would shrink it.
+table) are not findings: that noise comes from the shared host, and the points are timed in
+{first.get('timing_rounds', 1)} interleaved rounds so that its drift over the run falls on all of them alike.
 """)
 print("| dataset | accurate pixel-weighted recall ≥ 99.5 % | accurate FLIP ≤ 0.05 | fast vs accurate frame time | fast's error |")
 print("|---|---|---|---|---|")
