@@ -181,8 +181,13 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     if u.has_imagery != 0u {
         albedo = mix(albedo, ground.rgb, ground.a * tu.ground_blend);
     }
-    // Lit as the seeds are: a canopy faces the sky, its leaves let light wrap around.
-    let sun = 0.55 * max(dot(normal, u.sun_dir.xyz), 0.0) + 0.35 * max(u.sun_dir.z, 0.0);
+    // Lit as the seeds are, on average: the leaves the eye sees face it (the seeds turn every
+    // surface towards the eye), their normals spread over the half of directions facing it, whose
+    // mean clamped cosine towards the sun is (1 + cos(eye, sun)) / 4. Lighting the slices by
+    // the ground's normal instead made the far forest a quarter brighter than the clouds before it.
+    let towards_eye = -view;
+    let facing = 0.25 * (1.0 + dot(towards_eye, u.sun_dir.xyz));
+    let sun = 0.55 * facing + 0.35 * max(u.sun_dir.z, 0.0);
     let lit = albedo * (sun + 0.3);
     let haze = 1.0 - exp2(-distance_m / u.haze.w);
     return vec4<f32>(mix(lit, u.haze.rgb, haze) * corrected, corrected);

@@ -11,6 +11,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use std::sync::OnceLock;
 
 use terramp::bake::forest::{ForestOptions, bake_forests};
@@ -20,9 +21,12 @@ use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::{FrameReport, Renderer};
 use terramp::gpu::{AdapterChoice, Gpu};
+use terramp::passes::texcells::frame::Band;
+use terramp::reference::frame_change::{BLOCK_PX, block_changes};
 use terramp_testkit::{TempDir, shared_data};
 
-use support::{FOREST, PixelGround, WATER, build_nc, code_at, ground_under_pixels};
+use gdal::GeoTransform;
+use support::{FOREST, PixelGround, WATER, build, build_nc, code_at, ground_under_pixels, write_geotiff};
 
 const SIZE: [u32; 2] = [480, 270];
 /// The camera's height above the ground at the map's centre, and its pitch.
@@ -42,6 +46,26 @@ fn samples() -> &'static Path {
         let gpu = Gpu::new(AdapterChoice::Auto).unwrap();
         let baked = bake_forests(Some(&gpu), &table, &models, &out, &options, &mut |_| {}).unwrap();
         assert_eq!(baked.iter().map(|r| r.class_code).collect::<Vec<_>>(), [FOREST]);
+        out
+    })
+}
+
+/// The nc table's species as impostors and its forest sample beside them, baked once per test
+/// process through the command line (`terramp-data bake --model ... --classes nc`).
+fn trees_and_forest() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("texcells-trees-and-forest");
+        let models = shared_data().expect("../shared/data").join("models");
+        let table = ClassTable::load("nc").unwrap();
+        let mut bake = Command::new(env!("CARGO_BIN_EXE_terramp-data"));
+        bake.arg("bake");
+        for s in &table.species {
+            bake.arg("--model").arg(models.join(format!("{}.glb", s.model)));
+        }
+        bake.args(["--classes", "nc", "--texels", "256", "--models"]).arg(&models).arg("--out").arg(&out);
+        let output = bake.output().unwrap();
+        assert!(output.status.success(), "bake failed:\n{}", String::from_utf8_lossy(&output.stderr));
         out
     })
 }
@@ -68,23 +92,86 @@ fn towards_far_water(dataset: &Dataset) -> ([f64; 2], f64) {
     (centre, yaw)
 }
 
-fn render(dataset: Dataset, reach_m: f64) -> (image::RgbaImage, Vec<f32>, FrameReport, Camera) {
+/// Renders nc's centre, looking towards its far water from `[above_m, pitch_deg]`, with the
+/// impostors (and forest samples) in `impostors` and texcells to `reach_m` (0: none), settled.
+fn render(
+    dataset: Dataset,
+    impostors: &Path,
+    reach_m: f64,
+    [above_m, pitch]: [f64; 2],
+) -> (Renderer, image::RgbaImage, Vec<f32>, FrameReport, Camera) {
+    render_from(dataset, impostors, reach_m, &|r| {
+        let (centre, yaw) = towards_far_water(&r.dataset);
+        terramp_testkit::camera::over(r, centre, above_m, yaw, pitch)
+    })
+}
+
+/// As `render`, from the camera `camera_of` places in the renderer.
+fn render_from(
+    dataset: Dataset,
+    impostors: &Path,
+    reach_m: f64,
+    camera_of: &dyn Fn(&Renderer) -> Camera,
+) -> (Renderer, image::RgbaImage, Vec<f32>, FrameReport, Camera) {
     let mut settings = Settings::preset("balanced").unwrap();
     [settings.render.width, settings.render.height] = SIZE;
-    settings.draw_seeds.impostors = samples().display().to_string();
+    settings.draw_seeds.impostors = impostors.display().to_string();
     settings.texcells.reach_m = reach_m;
     let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
-    let [above_m, pitch] = VIEW;
-    let (centre, yaw) = towards_far_water(&r.dataset);
-    let camera = terramp_testkit::camera::over(&r, centre, above_m, yaw, pitch);
+    let camera = camera_of(&r);
     r.render_resolved(&camera).unwrap();
     // The land cover under the texcells streams a frame after they are placed.
     let mut report = r.render(&camera).unwrap();
     for _ in 0..6 {
         report = r.render(&camera).unwrap();
     }
-    (r.read_colour().unwrap(), r.read_depth().unwrap(), report, camera)
+    let (colour, depth) = (r.read_colour().unwrap(), r.read_depth().unwrap());
+    (r, colour, depth, report, camera)
+}
+
+/// Whether texcells changed pixel `i` of `bare` in `forest` (by more than rounding).
+fn changed(bare: &image::RgbaImage, forest: &image::RgbaImage, i: usize) -> bool {
+    let (a, b) = (&bare.as_raw()[4 * i..4 * i + 3], &forest.as_raw()[4 * i..4 * i + 3]);
+    a.iter().zip(b).any(|(a, b)| a.abs_diff(*b) > 2)
+}
+
+/// Whether the level-1 land-cover texels within `r` of `q` are all of `code` (`all`), or all free
+/// of it.
+fn neighbourhood(dataset: &Dataset, q: [u32; 2], r: i64, all: bool, code: u8) -> bool {
+    (-r..=r).flat_map(|j| (-r..=r).map(move |i| (i, j))).all(|(i, j)| {
+        let at = [q[0] as i64 + i, q[1] as i64 + j];
+        let c = (at[0] >= 0 && at[1] >= 0).then(|| code_at(dataset, [at[0] as u32, at[1] as u32])).flatten();
+        (c == Some(code)) == all
+    })
+}
+
+/// The texcell band of the balanced preset with texcells to `REACH_M`.
+fn band() -> Band {
+    let mut s = Settings::preset("balanced").unwrap();
+    s.texcells.reach_m = REACH_M;
+    Band::of(&s)
+}
+
+/// Pixels of deep forest (forest all around its land-cover texel) whose ground lies inside the
+/// texcell band, and how many of them texcells changed.
+fn deep_forest(
+    ground: &[Option<PixelGround>],
+    dataset: &Dataset,
+    changed: &dyn Fn(usize) -> bool,
+) -> (usize, usize) {
+    let band = band();
+    let (mut deep, mut deep_changed) = (0, 0);
+    for (i, g) in ground.iter().enumerate() {
+        let Some(g) = *g else { continue };
+        let inside = g.distance_m > band.fade_in_m + band.fade_in_width_m
+            && g.distance_m < band.reach_m - band.fade_out_width_m;
+        if g.code == FOREST && inside && neighbourhood(dataset, g.texel, 1, true, FOREST) {
+            deep += 1;
+            deep_changed += usize::from(changed(i));
+        }
+    }
+    (deep, deep_changed)
 }
 
 #[test]
@@ -95,8 +182,8 @@ fn nc_texcells_cover_the_far_forest_and_no_water() {
     let dir = TempDir::new("texcells-nc");
     let path = dir.path().join("nc");
     let dataset = build_nc(&path);
-    let (bare, depth, bare_report, camera) = render(Dataset::open(&path).unwrap(), 0.0);
-    let (forest, _, report, _) = render(dataset, REACH_M);
+    let (_, bare, depth, bare_report, camera) = render(Dataset::open(&path).unwrap(), samples(), 0.0, VIEW);
+    let (_, forest, _, report, _) = render(dataset, samples(), REACH_M, VIEW);
     assert_eq!(bare_report.texcells.slices, 0, "the control draws no texcells");
     let shots = Path::new(env!("CARGO_TARGET_TMPDIR"));
     bare.save(shots.join("texcells_nc_without.png")).unwrap();
@@ -107,25 +194,8 @@ fn nc_texcells_cover_the_far_forest_and_no_water() {
 
     let reopened = Dataset::open(&path).unwrap();
     let ground = ground_under_pixels(&reopened, &camera, SIZE, &depth);
-    let changed = |i: usize| {
-        let (a, b) = (&bare.as_raw()[4 * i..4 * i + 3], &forest.as_raw()[4 * i..4 * i + 3]);
-        a.iter().zip(b).any(|(a, b)| a.abs_diff(*b) > 2)
-    };
-    // Whether the texels within `r` of a texel are all of `code`, or all free of it.
-    let neighbourhood = |q: [u32; 2], r: i64, all: bool, code: u8| {
-        (-r..=r).flat_map(|j| (-r..=r).map(move |i| (i, j))).all(|(i, j)| {
-            let at = [q[0] as i64 + i, q[1] as i64 + j];
-            let c = (at[0] >= 0 && at[1] >= 0)
-                .then(|| code_at(&reopened, [at[0] as u32, at[1] as u32]))
-                .flatten();
-            (c == Some(code)) == all
-        })
-    };
-    let band = terramp::passes::texcells::frame::Band::of(&{
-        let mut s = Settings::preset("balanced").unwrap();
-        s.texcells.reach_m = REACH_M;
-        s
-    });
+    let changed = |i: usize| changed(&bare, &forest, i);
+    let band = band();
     // Forest pixels that a texcell slab standing in front could cover: up to its height above the
     // ground in pixels at that distance, over any ground.
     let [w, h] = SIZE;
@@ -142,20 +212,14 @@ fn nc_texcells_cover_the_far_forest_and_no_water() {
             shadow[(yy * i64::from(w) + x) as usize] = true;
         }
     }
-    let (mut deep, mut deep_changed, mut water, mut water_changed, mut near, mut near_changed) =
-        (0, 0, 0, 0, 0, 0);
+    let (deep, deep_changed) = deep_forest(&ground, &reopened, &changed);
+    let (mut water, mut water_changed, mut near, mut near_changed) = (0, 0, 0, 0);
     for (i, g) in ground.iter().enumerate() {
         let Some(g) = *g else { continue };
-        let inside = g.distance_m > band.fade_in_m + band.fade_in_width_m
-            && g.distance_m < band.reach_m - band.fade_out_width_m;
         // A far pixel spans several texels: its neighbourhood grows with its footprint.
         let texel_m = 2.0 * reopened.manifest.landcover.as_ref().unwrap().layer.texel_m;
         let r = 1 + (camera.metres_per_pixel(g.distance_m, h) / texel_m).ceil() as i64;
-        if g.code == FOREST && inside && neighbourhood(g.texel, 1, true, FOREST) {
-            deep += 1;
-            deep_changed += usize::from(changed(i));
-        }
-        if g.code == WATER && !shadow[i] && neighbourhood(g.texel, r, false, FOREST) {
+        if g.code == WATER && !shadow[i] && neighbourhood(&reopened, g.texel, r, false, FOREST) {
             water += 1;
             water_changed += usize::from(changed(i));
             if changed(i) {
@@ -186,3 +250,199 @@ fn nc_texcells_cover_the_far_forest_and_no_water() {
     assert!(near > 1000, "only {near} pixels nearer than the band");
     assert_eq!(near_changed, 0, "texcells nearer than their band");
 }
+
+/// The extremes of DESIGN.md for texcells, over a flat forest (a 12 km square at 30 m, nc's forest
+/// class everywhere, no seeds drawn so that the texcells alone are seen):
+/// - **grazing**: the eye 8.7 m above the canopy's top, pitched 0.1° down, so the central ray
+///   meets the canopy at 89.9° incidence 5 km out; through a 4° lens, so the band is rows tall,
+///   and texcells to 12 km. Every pixel whose ray crosses the canopy's upper half (the crowns)
+///   inside the texcell band crosses every slice there: at least 90 % of them must show forest
+///   (the oblique opacity correction keeps edge-on slices dense: no see-through gaps);
+/// - **inside the canopy**: the eye 12 m up, level (slices above it seen from below).
+///
+/// Neither gives a pixel black or white where the ground was not (a NaN or an infinity in the
+/// slices' opacity).
+#[test]
+fn texcells_at_grazing_incidence_and_inside_the_canopy_leave_no_gaps() {
+    if shared_data().is_none() {
+        return;
+    }
+    let dir = TempDir::new("texcells-extremes");
+    const SIZE_PX: [usize; 2] = [400, 400];
+    const GROUND_M: f32 = 100.0;
+    let grid: GeoTransform = [500_000.0, 30.0, 0.0, 5_000_000.0, 0.0, -30.0];
+    let n = SIZE_PX[0] * SIZE_PX[1];
+    let dem = write_geotiff(&dir.path().join("flat.tif"), SIZE_PX, vec![GROUND_M; n], grid, 32633, None);
+    let cover =
+        write_geotiff(&dir.path().join("forest.tif"), SIZE_PX, vec![FOREST; n], grid, 32633, Some(255.0));
+    let args = ["--dem", dem.to_str().unwrap(), "--landcover", cover.to_str().unwrap(), "--classes", "nc"];
+    let path = dir.path().join("out");
+    let (dataset, _) = build(&path, &args);
+    let [_, north_m] = dataset.manifest.extent_m();
+    let canopy_m = f64::from(terramp::texcell::load(samples(), FOREST).unwrap().unwrap().height_m);
+    let grazing = [canopy_m + 5000.0 * 0.1f64.to_radians().tan(), -0.1, 4.0];
+    const FAR_M: f64 = 12000.0;
+    for (what, [above_m, pitch, fov_deg]) in
+        [("grazing (89.9°)", grazing), ("inside the canopy", [12.0, 0.0, 60.0])]
+    {
+        let band = {
+            let mut s = Settings::preset("balanced").unwrap();
+            s.texcells.reach_m = FAR_M;
+            Band::of(&s)
+        };
+        let camera_of = |r: &Renderer| Camera {
+            fov_deg,
+            ..terramp_testkit::camera::over(r, [300.0, north_m / 2.0], above_m, 90.0, pitch)
+        };
+        let (_, bare, depth, _, camera) =
+            render_from(Dataset::open(&path).unwrap(), samples(), 0.0, &camera_of);
+        let (_, forest, _, report, _) =
+            render_from(Dataset::open(&path).unwrap(), samples(), FAR_M, &camera_of);
+        let ground = ground_under_pixels(&dataset, &camera, SIZE, &depth);
+        // Rays through the crowns (the canopy's upper half) within the band's inside.
+        let inside =
+            |d: f64| d > band.fade_in_m + band.fade_in_width_m && d < band.reach_m - band.fade_out_width_m;
+        let through: Vec<usize> = (0..ground.len())
+            .filter(|&i| {
+                ground[i].is_some_and(|g| {
+                    inside(g.distance_m * (1.0 - 0.5 * canopy_m / above_m))
+                        && inside(g.distance_m * (1.0 - canopy_m / above_m))
+                })
+            })
+            .collect();
+        let covered = through.iter().filter(|&&i| changed(&bare, &forest, i)).count();
+        let extreme = |p: &[u8]| p[..3].iter().all(|&c| c < 4) || p[..3].iter().all(|&c| c > 251);
+        let broken = (0..(SIZE[0] * SIZE[1]) as usize)
+            .filter(|&i| {
+                extreme(&forest.as_raw()[4 * i..4 * i + 4]) && !extreme(&bare.as_raw()[4 * i..4 * i + 4])
+            })
+            .count();
+        println!(
+            "{what}: {} slices; {covered} of {} pixels seen through the whole canopy in the band show forest; {broken} black or white",
+            report.texcells.slices,
+            through.len()
+        );
+        let shots = Path::new(env!("CARGO_TARGET_TMPDIR"));
+        forest.save(shots.join(format!("texcells_flat_{}.png", what.split(' ').next().unwrap()))).unwrap();
+        assert_eq!(broken, 0, "{what}: pixels black or white from the texcells");
+        if what.starts_with("grazing") {
+            assert!(
+                through.len() > 500,
+                "{what}: only {} pixels see the canopy in the band: a weak test",
+                through.len()
+            );
+            assert!(
+                covered * 10 >= through.len() * 9,
+                "{what}: gaps: {covered} of {} pixels show forest",
+                through.len()
+            );
+        }
+    }
+}
+
+/// Popping across the last switch, billboard clouds → texcells, against the cloud → cloud switches,
+/// measured as the seeds' cross-fade test does: the camera stays, every reach shrinks by 0.2 % a
+/// frame (`draw_seeds.reach_m` and the texcell band that follows its last), and the largest change
+/// of a 4 × 4 block's mean luma between frames is taken among the blocks whose ground lies near
+/// each switch (within 8 % of its distance). The clouds → texcells switch cross-fades no worse
+/// than the clouds' own.
+#[test]
+fn the_switch_from_clouds_to_texcells_pops_no_more_than_the_cloud_switches() {
+    if shared_data().is_none() {
+        return;
+    }
+    let dir = TempDir::new("texcells-popping");
+    let path = dir.path().join("nc");
+    build_nc(&path);
+    let (mut r, first, depth, _, camera) =
+        render(Dataset::open(&path).unwrap(), trees_and_forest(), REACH_M, VIEW);
+    let ground = ground_under_pixels(&Dataset::open(&path).unwrap(), &camera, SIZE, &depth);
+    // The forest's colour and cover either side of the switch, in the first frame: the mean
+    // colour of the forest pixels (land cover) within 3–15 % of the switch's distance, and the
+    // share of them the trees or texcells change from the ground.
+    let switch_m = Settings::preset("balanced").unwrap().draw_seeds.reach_m[3];
+    let (_, bare, ..) = render(Dataset::open(&path).unwrap(), samples(), 0.0, VIEW);
+    let side = |from: f64, to: f64| {
+        let pixels: Vec<usize> = (0..ground.len())
+            .filter(|&i| {
+                ground[i].is_some_and(|g| g.code == FOREST && (from..to).contains(&(g.distance_m / switch_m)))
+            })
+            .collect();
+        let mean = |c: usize| {
+            pixels.iter().map(|&i| f64::from(first.as_raw()[4 * i + c])).sum::<f64>() / pixels.len() as f64
+        };
+        let cover =
+            pixels.iter().filter(|&&i| changed(&bare, &first, i)).count() as f64 / pixels.len() as f64;
+        (pixels.len(), [mean(0), mean(1), mean(2)], cover)
+    };
+    let (clouds_side, texcells_side) = (side(0.85, 0.97), side(1.03, 1.15));
+    for (what, (n, rgb, cover)) in [("clouds", clouds_side), ("texcells", texcells_side)] {
+        println!(
+            "{what} side of {switch_m:.0} m: {n} forest pixels, mean colour {:.0} {:.0} {:.0}, {:.0} % covered",
+            rgb[0],
+            rgb[1],
+            rgb[2],
+            100.0 * cover
+        );
+    }
+    // Luma (Rec. 709) of the two sides' mean colours.
+    let luma = |rgb: [f64; 3]| 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    let brighter = luma(texcells_side.1) / luma(clouds_side.1);
+    assert!(
+        (clouds_side.2 - texcells_side.2).abs() < 0.05 && (0.85..1.2).contains(&brighter),
+        "the forest changes across the switch: cover {:.2} → {:.2}, luma ×{brighter:.2}",
+        clouds_side.2,
+        texcells_side.2
+    );
+    let mut frames = vec![first];
+    for _ in 0..FADE_FRAMES {
+        for reach_m in &mut r.settings.draw_seeds.reach_m {
+            *reach_m *= 0.998;
+        }
+        // Pass 3 runs a frame behind the draw's constants: two frames per step.
+        r.render(&camera).unwrap();
+        r.render(&camera).unwrap();
+        frames.push(r.read_colour().unwrap());
+    }
+    let [w, _] = SIZE;
+    let blocks_x = (w / BLOCK_PX) as usize;
+    let distance_of_block = |b: usize| {
+        let (x, y) = (
+            (b % blocks_x) as u32 * BLOCK_PX + BLOCK_PX / 2,
+            (b / blocks_x) as u32 * BLOCK_PX + BLOCK_PX / 2,
+        );
+        ground[(y * w + x) as usize].map(|g| g.distance_m)
+    };
+    let changes: Vec<Vec<f64>> = frames.windows(2).map(|f| block_changes(&f[0], &f[1]).unwrap()).collect();
+    let reaches = Settings::preset("balanced").unwrap().draw_seeds.reach_m;
+    let largest_near = |switch_m: f64| {
+        let near = |b: usize| distance_of_block(b).is_some_and(|d| (d / switch_m - 1.0).abs() < 0.08);
+        let blocks = (0..changes[0].len()).filter(|&b| near(b)).count();
+        let largest =
+            changes.iter().flat_map(|c| c.iter().enumerate().filter(|&(b, _)| near(b)).map(|(_, &v)| v));
+        (blocks, largest.fold(0.0, f64::max))
+    };
+    let clouds: Vec<(f64, (usize, f64))> = reaches[1..3].iter().map(|&d| (d, largest_near(d))).collect();
+    let texcells = largest_near(reaches[3]);
+    for (d, (blocks, largest)) in &clouds {
+        println!("clouds → clouds at {d:.0} m: {blocks} blocks, largest change {largest:.1} of 255");
+    }
+    println!(
+        "clouds → texcells at {:.0} m: {} blocks, largest change {:.1} of 255",
+        reaches[3], texcells.0, texcells.1
+    );
+    assert!(
+        clouds.iter().all(|(_, (blocks, _))| *blocks > 20) && texcells.0 > 20,
+        "too few blocks near a switch"
+    );
+    let worst_cloud = clouds.iter().map(|(_, (_, v))| *v).fold(0.0, f64::max);
+    assert!(worst_cloud > 0.0, "no cloud switch changed anything: a void test");
+    assert!(
+        texcells.1 <= worst_cloud,
+        "clouds → texcells change a block by {:.1}, the cloud switches by {worst_cloud:.1}",
+        texcells.1
+    );
+}
+
+/// Steps of the slow distance change.
+const FADE_FRAMES: usize = 24;

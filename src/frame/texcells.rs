@@ -2,7 +2,8 @@
 //! dataset has land cover, and its class table marks classes as dense that the land cover holds:
 //! then each such class's forest sample is read once from `draw_seeds.impostors`/texcells/ (a
 //! dense class without one is reported and shows bare ground; no sample at all: no stage, no
-//! pass), uploaded, and bound with the land-cover cache. Each frame it places patches on the
+//! pass), uploaded, and bound with the land-cover cache. Each frame it rewrites the uniforms if the
+//! settings changed them (the band follows `draw_seeds.reach_m`), places patches on the
 //! terrain's instances (`passes::texcells::frame`), uploads their slices, and keeps the land-cover
 //! tiles under them for the next frame's streaming (a frame late, like the Tile Load Map's).
 
@@ -14,6 +15,7 @@ use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::Gpu;
+use crate::gpu::gpu_types::TexcellUniforms;
 use crate::gpu::layout::{TEXCELL_MAX_SAMPLES, TEXCELL_MAX_SLICES};
 use crate::passes::terrain::frame::NodeBatches;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
@@ -52,6 +54,9 @@ pub(super) struct TexcellStage {
     bind_group: wgpu::BindGroup,
     shape: SampleShape,
     band: Band,
+    /// The uniforms last written: rewritten when the settings change them (a viewer's knob, a
+    /// test's shrinking reaches), so the band follows `draw_seeds.reach_m` like the seeds do.
+    uniforms: TexcellUniforms,
     finest_level: u32,
     prepared: PreparedTexcells,
     /// The land-cover tiles under the last frame's patches.
@@ -141,6 +146,7 @@ impl TexcellStage {
             bind_group,
             shape,
             band,
+            uniforms,
             finest_level: finest.ilog2(),
             prepared: PreparedTexcells::default(),
             wanted_landcover: Vec::new(),
@@ -159,6 +165,12 @@ impl TexcellStage {
         view: &TexcellView,
     ) -> TexcellReport {
         let TexcellView { camera_grid_m, metres_per_px_at_1m } = *view;
+        let band = Band::of(settings);
+        let uniforms = texcell_uniforms(settings, dataset, &band, &self.shape);
+        if bytemuck::bytes_of(&uniforms) != bytemuck::bytes_of(&self.uniforms) {
+            self.pass.write_uniforms(&gpu.queue, &uniforms);
+            (self.band, self.uniforms) = (band, uniforms);
+        }
         let shape = &self.shape;
         let rule = SliceRule {
             metres_per_px_at_1m,

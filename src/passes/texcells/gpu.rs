@@ -1,7 +1,8 @@
 //! The texcell pass's GPU half: the forest samples' texture array and the class → sample table
-//! and the uniforms (the settings' and samples', fixed: uploaded once in `new`), the pipeline over the terrain's bind group and its own, the quadrant
-//! grid's index buffer; `prepare` uploads the frame's slice instances and `encode`
-//! draws them over the frame, blended, depth-tested against the ground, writing no depth.
+//! (fixed: uploaded once in `new`), the uniforms (the settings' and samples': rewritten by
+//! `write_uniforms` when the settings change them), the pipeline over the terrain's bind group and
+//! its own, the quadrant grid's index buffer; `prepare` uploads the frame's slice instances and
+//! `encode` draws them over the frame, blended, depth-tested against the ground, writing no depth.
 
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
@@ -136,7 +137,8 @@ impl TexcellsPass {
         use wgpu::BufferUsages as U;
         let table = if sample_of_class.is_empty() { &[0][..] } else { sample_of_class };
         let sample_of_class = buffer_init(device, "texcell classes", bytemuck::cast_slice(table), U::STORAGE);
-        let uniforms = buffer_init(device, "texcell uniforms", bytemuck::bytes_of(uniforms), U::UNIFORM);
+        let uniforms =
+            buffer_init(device, "texcell uniforms", bytemuck::bytes_of(uniforms), U::UNIFORM | U::COPY_DST);
         let records_bytes = u64::from(MAX_RECORDS) * size_of::<TexcellRecord>() as u64;
         let records = buffer(device, "texcell records", records_bytes, U::STORAGE | U::COPY_DST);
         let index_data = quadrant_indices(node_cells / 2);
@@ -172,6 +174,11 @@ impl TexcellsPass {
                 R::TextureView(&landcover.view),
             ],
         )
+    }
+
+    /// Replaces the uniforms (the band, opacity and colour settings) from the next frame on.
+    pub fn write_uniforms(&self, queue: &wgpu::Queue, uniforms: &TexcellUniforms) {
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
     }
 
     /// Uploads the frame's slice instances (at most `MAX_RECORDS`).
