@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Writes docs/TRADE.md (to stdout) from docs/trade/{synthetic,nc,zion}/trade.json and trade.md.
 
-Usage: scripts/trade_page.py FRAMES WARMUP   (scripts/trade.sh runs it after the sweeps)
+Usage: scripts/trade_page.py FRAMES WARMUP [MINUTES]   (scripts/trade.sh runs it after the sweeps;
+TRADE_NOTE, if set, is printed after the introduction: what else shared the machine during the run)
 """
-import json, sys, tomllib
+import json, os, sys, tomllib
 frames, warmup = sys.argv[1:3]
 names = {"synthetic": "The synthetic default (`terramp-data synth --size 1024`: 10 km, 10 m heights, 2.5 m imagery, 5 m land cover)",
          "nc": "`nc/` (USGS NED 30 m, Landsat 7 at 28.5 m, land use at 10 m)",
@@ -28,6 +29,8 @@ def clone_spread(t):
 
 
 took = f", {minutes} minutes on 2 cores" if minutes else ""
+# What else shared the machine during the run, in words (TRADE_NOTE), for the reader to weigh times.
+run_note = f"\n\n{os.environ['TRADE_NOTE']}" if os.environ.get("TRADE_NOTE") else ""
 flight = first.get("popping_flight") or {}
 print(f"""# The speed trade
 
@@ -41,7 +44,7 @@ Adapter: {first['adapter']}. GPU passes timed with {first['timing']}. lavapipe's
 the machine's 2 shared cores, so times move between points for no reason of theirs: every dataset
 below has a dozen or more knob values that change no pixel and no seed (clones of `balanced`), and
 the spread of their frame times is the run's timing noise, stated with each table. Differences in
-time smaller than that spread are not findings; the accuracy figures are deterministic.
+time smaller than that spread are not findings; the accuracy figures are deterministic.{run_note}
 
 ## How it is measured
 
