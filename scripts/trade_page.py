@@ -54,7 +54,7 @@ frame showing its trees (`draw_seeds.impostors` set by a settings layer over eac
 
 - **Time**: {frames} timed frames spread along the dataset's default path, at most two frames in
   flight (the `terramp profile` session), flown in {first.get('timing_rounds', 1)} interleaved rounds: each round flies
-  every point in turn, in a fresh renderer, {warmup} warm-up frames where its share starts and then
+  every point in turn (odd rounds in reverse order), in a fresh renderer, {warmup} warm-up frames where its share starts and then
   its consecutive share of the timed frames, so that the host's load drifting over the run falls
   on every point alike; the medians pool the rounds' frames. *frame ms* is the median wall time per frame, *GPU ms* the median sum
   of the GPU passes; the pass table gives each pass's median.

@@ -3,8 +3,9 @@
 //! flies the same camera path (`--path`, or the dataset's default as `terramp profile` chooses it)
 //! in fresh renderers, timed by the profiling session (`profile::Session`) in interleaved rounds:
 //! each round flies every point in turn (warm-up frames, then its consecutive share of the timed
-//! frames, as far apart along the path as in one block), so
-//! that the host's load drifting over the sweep falls on all points alike; the rounds' frames pool
+//! frames, as far apart along the path as in one block), odd rounds in reverse order, so that
+//! the host's load drifting over the sweep (even steadily, from the first point to the last)
+//! falls on all points alike; the rounds' frames pool
 //! (`Recording::append`) into per-pass GPU medians and the frame's median wall time
 //! (`profile::Summary`). Then, at a few sample poses spread along the same path, it settles the view
 //! (`render_resolved`: everything the view asked for is resident) and measures it (`measure`)
@@ -261,12 +262,16 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
     // Timing first, round-robin over the points, then each point's accuracy.
     let mut timed: Vec<Option<measure::Timed>> = points.iter().map(|_| None).collect();
     for round in 0..options.timing_rounds {
-        for ((point, settings), pooled) in points.iter().zip(&settings).zip(&mut timed) {
-            let this =
-                flight.time_round(&point.label(), settings, (round, options.timing_rounds), progress)?;
-            match pooled {
+        for index in round_order(points.len(), round) {
+            let this = flight.time_round(
+                &points[index].label(),
+                &settings[index],
+                (round, options.timing_rounds),
+                progress,
+            )?;
+            match &mut timed[index] {
                 Some(pooled) => pooled.append(this),
-                None => *pooled = Some(this),
+                None => timed[index] = Some(this),
             }
         }
     }
@@ -304,6 +309,14 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
     })
 }
 
+/// The order round `round` times the points in: forward in even rounds, backward in odd ones, so
+/// that a load that rises or falls steadily over the sweep gives every point the same mean load
+/// over two rounds (in one direction only, the last points would always fly latest).
+fn round_order(points: usize, round: u32) -> impl Iterator<Item = usize> {
+    let backward = round % 2 == 1;
+    (0..points).map(move |i| if backward { points - 1 - i } else { i })
+}
+
 /// Writes `trade.csv`, `trade.json`, `trade.png` and `trade.md` (the tables in Markdown) into `dir`
 /// (created if missing).
 pub fn write_outputs(trade: &Trade, dir: &Path) -> Result<(), SweepError> {
@@ -317,4 +330,26 @@ pub fn write_outputs(trade: &Trade, dir: &Path) -> Result<(), SweepError> {
     std::fs::write(&markdown, tables::markdown(trade))
         .map_err(io(format!("writing {}", markdown.display())))?;
     plot::write(trade, &dir.join(PLOT_FILE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_order;
+
+    #[test]
+    fn rounds_alternate_direction_so_a_steady_drift_averages_out() {
+        let order = |round| round_order(4, round).collect::<Vec<_>>();
+        assert_eq!(order(0), [0, 1, 2, 3]);
+        assert_eq!(order(1), [3, 2, 1, 0]);
+        assert_eq!(order(2), [0, 1, 2, 3]);
+        // A load rising one unit per slot: over two rounds every point's summed slot is the same.
+        let mut slot_sum = [0usize; 4];
+        for round in 0..2 {
+            for (slot, point) in round_order(4, round).enumerate() {
+                slot_sum[point] += slot + 4 * round as usize;
+            }
+        }
+        assert!(slot_sum.iter().all(|&s| s == slot_sum[0]), "{slot_sum:?}");
+        assert_eq!(round_order(0, 1).count(), 0);
+    }
 }
