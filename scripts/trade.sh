@@ -66,7 +66,7 @@ knobs=(
     "terrain.triangle_px=2,8,16"                                           # [4]
     "cache.imagery_slots=32,48,192"                                        # [96]
     "draw_seeds.samples=4"                                                 # [1]
-    "seeds.reference_height_m=2,5,20"                                      # [10]
+    "seeds.reference_height_m=1,5,10"                                      # [2]
     # How far seeds reach at all: the last band and the last draw reach together [3000].
     "tlm.radial_bands_m+draw_seeds.reach_m=[500,1000,2000]+[500,700,1000,2000],[700,1400,4000]+[500,700,1400,4000]"
 )
