@@ -12,6 +12,14 @@
 // (A' = 1 − (1 − A)^k, k = 1 / cos of the view to the ground's normal, clamped), its colour lit
 // like the seeds' and blended towards the imagery under it, hazed like the ground, and it fades in
 // (dithered) where the last billboard clouds fade out, and out before the reach.
+//
+// Where the view grazes the canopy a patch also draws a silhouette instance (Decaudin & Neyret
+// § 6): the slab's top face, each fragment of which samples the 3D texture where its ray crosses
+// the paper's camera-facing slices (planes across the view, a fixed spacing apart from the
+// node's origin, so they stay put as the eye moves), one voxel of the 3D mip level the pixel
+// needs apart (the paper's slicing rate), from the top to the ground or out of the slab again,
+// composited front to back. The two kinds share a patch's pixels by an ordered dither on how
+// steeply the pixel's ray descends.
 
 struct TexcellUniforms {
     lcc_levels: array<vec4<u32>, 4>,
@@ -28,6 +36,13 @@ struct TexcellUniforms {
     finest_slices: u32,
     opacity_max_factor: f32,
     ground_blend: f32,
+    silhouette_sin: vec2<f32>,
+    metres_per_px_at_1m: f32,
+    silhouette_steps: u32,
+    sample_count: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct TexcellRecord {
@@ -42,6 +57,7 @@ struct TexcellRecord {
 @group(1) @binding(4) var<storage, read> sample_of_class: array<u32>;
 @group(1) @binding(5) var<storage, read> lcc_page_table: array<u32>;
 @group(1) @binding(6) var lcc_tiles: texture_2d_array<u32>;
+@group(1) @binding(7) var forest_volume: texture_3d<f32>;
 
 struct TexcellOut {
     @builtin(position) clip: vec4<f32>,
@@ -51,6 +67,8 @@ struct TexcellOut {
     // The slice (its index among the finest slices: the texture layer within a sample) and the
     // slice pyramid level: the coarsest mip it may read.
     @location(3) @interpolate(flat) slice: vec2<u32>,
+    // The record's kind (`TEXCELL_REGULAR`, ...) and its terrain node.
+    @location(4) @interpolate(flat) kind_node: vec2<u32>,
 }
 
 @vertex
@@ -65,7 +83,10 @@ fn vs_texcell(@builtin(vertex_index) vertex: u32, @builtin(instance_index) insta
     let g = min(quadrant + vec2<f32>(f32(vertex % row), f32(vertex / row)), node.cells_inside);
     let surface = surface_vertex(node, g);
     let slices = tu.finest_slices >> s.level;
-    let lift = (f32(s.index) + 0.5) / f32(slices) * tu.slab_height_m;
+    var lift = (f32(s.index) + 0.5) / f32(slices) * tu.slab_height_m;
+    if s.kind == TEXCELL_SILHOUETTE {
+        lift = tu.slab_height_m;
+    }
 
     var out: TexcellOut;
     out.rel_m = vec3<f32>(surface.xy, surface.z + lift);
@@ -73,6 +94,7 @@ fn vs_texcell(@builtin(vertex_index) vertex: u32, @builtin(instance_index) insta
     out.grid_m = u.camera_grid_m.xy + surface.xy;
     out.normal = surface.normal;
     out.slice = vec2<u32>(s.index << s.level, s.level);
+    out.kind_node = vec2<u32>(s.kind, record.node);
     return out;
 }
 
@@ -160,8 +182,26 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     let distance_m = length(in.rel_m);
     let fade = clamp((distance_m - tu.fade_m.x) / tu.fade_m.y, 0.0, 1.0)
         * clamp((tu.fade_m.z + tu.fade_m.w - distance_m) / tu.fade_m.w, 0.0, 1.0);
+    let view = normalize(in.rel_m);
+    let pixel = vec2<u32>(in.clip.xy);
+    // The share of a patch's pixels its regular slices keep: all of them unless it has a
+    // silhouette too; then from none where the view grazes to all where it is steep enough.
+    var regular = 1.0;
+    if in.kind_node.x != TEXCELL_REGULAR {
+        let sin_e = -view.z;
+        regular = clamp((sin_e - tu.silhouette_sin.x) / (tu.silhouette_sin.y - tu.silhouette_sin.x), 0.0, 1.0);
+    }
+    if bayer4(pixel, 0u) >= fade {
+        discard;
+    }
+    if in.kind_node.x == TEXCELL_SILHOUETTE {
+        if bayer4(pixel, 5u) < regular {
+            discard;
+        }
+        return silhouette(in.rel_m, in.kind_node.y, view, distance_m, ground);
+    }
     let forest = forest_at(in.grid_m);
-    if forest.coverage <= 0.0 || bayer4(vec2<u32>(in.clip.xy), 0u) >= fade {
+    if forest.coverage <= 0.0 || bayer4(pixel, 5u) >= regular {
         discard;
     }
     let lod = max(log2(max(footprint, 1e-6)), f32(in.slice.y));
@@ -173,24 +213,105 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     }
     // The path between two slices, seen along the view, is 1 / cos longer than straight through.
     let normal = normalize(in.normal);
-    let view = normalize(in.rel_m);
     let path = min(normal.z / max(abs(dot(normal, view)), 1e-4), tu.opacity_max_factor);
     let corrected = 1.0 - pow(1.0 - min(alpha, 0.9999), max(path, 0.25));
 
-    var albedo = sampled.rgb / max(sampled.a, 1e-4);
+    return shade(sampled.rgb / max(sampled.a, 1e-4), ground, view, distance_m, corrected);
+}
+
+// The premultiplied colour of forest of colour `albedo` and opacity `opacity`, seen along `view`
+// at `distance_m`, over ground of imagery colour `ground`.
+fn shade(albedo: vec3<f32>, ground: vec4<f32>, view: vec3<f32>, distance_m: f32, opacity: f32) -> vec4<f32> {
+    var tinted = albedo;
     if u.has_imagery != 0u {
-        albedo = mix(albedo, ground.rgb, ground.a * tu.ground_blend);
+        tinted = mix(albedo, ground.rgb, ground.a * tu.ground_blend);
     }
     // Lit as the seeds are, on average: the leaves the eye sees face it (the seeds turn every
     // surface towards the eye), their normals spread over the half of directions facing it, whose
     // mean clamped cosine towards the sun is (1 + cos(eye, sun)) / 4. Lighting the slices by
     // the ground's normal instead made the far forest a quarter brighter than the clouds before it.
-    let towards_eye = -view;
-    let facing = 0.25 * (1.0 + dot(towards_eye, u.sun_dir.xyz));
+    let facing = 0.25 * (1.0 - dot(view, u.sun_dir.xyz));
     let sun = 0.55 * facing + 0.35 * max(u.sun_dir.z, 0.0);
-    let lit = albedo * (sun + 0.3);
+    let lit = tinted * (sun + 0.3);
     let haze = 1.0 - exp2(-distance_m / u.haze.w);
-    return vec4<f32>(mix(lit, u.haze.rgb, haze) * corrected, corrected);
+    return vec4<f32>(mix(lit, u.haze.rgb, haze) * opacity, opacity);
+}
+
+// A silhouette texcell's fragment on the slab's top: its ray through the 3D texture, sampled where
+// it crosses the camera-facing slices, front to back, until it reaches the ground, leaves the slab
+// or is opaque. The first half of `silhouette_steps` are one voxel of the 3D level the pixel's cone
+// needs apart (the paper's slicing rate: where the ray enters the canopy, which draws the skyline);
+// the rest grow apart evenly so that all of them span the ray's path through a flat slab
+// (slab / sin of the ray's descent), each read at the level its spacing needs.
+fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f32, ground: vec4<f32>) -> vec4<f32> {
+    let node = nodes[node_index];
+    let slab_m = tu.slab_height_m;
+    let texel_m = f32(TEXCELL_REFERENCE_CELLS) / (tu.inv_cell_m * tu.texels);
+    let slice_m = slab_m / f32(tu.finest_slices);
+    let coarsest = log2(f32(tu.finest_slices));
+    let base_m = max(distance_m * tu.metres_per_px_at_1m, texel_m);
+    let even = tu.silhouette_steps / 2u;
+    let growing = f32(tu.silhouette_steps - even);
+    let rest_m = slab_m / max(-view.z, 1e-3) - f32(even) * base_m;
+    let growth = max(0.0, (rest_m / base_m - growing) * 2.0 / (growing * (growing + 1.0)));
+    // The slices lie at odd multiples of half a base step along the view from the node's origin,
+    // so they stay put as the eye moves.
+    let origin = vec3<f32>(node.origin_rel_m, -u.camera_grid_m.z);
+    let along = dot(rel_m - origin, view);
+    var t = (ceil(along / base_m - 0.5) + 0.5) * base_m - along;
+
+    var colour = vec3<f32>(0.0);
+    var transmit = 1.0;
+    var entered = false;
+    var hit_m = distance_m;
+    for (var k = 0u; k < tu.silhouette_steps; k += 1u) {
+        let step_m = base_m * (1.0 + growth * f32(max(k + 1u, even) - even));
+        let p = rel_m + view * t;
+        t += step_m;
+        let above_m = p.z - (height_at(node, (p.xy - node.origin_rel_m) / node.cell_m) - u.camera_grid_m.z);
+        if above_m < 0.0 {
+            break;
+        }
+        if above_m > slab_m {
+            if entered {
+                break;
+            }
+            continue;
+        }
+        entered = true;
+        let grid = u.camera_grid_m.xy + p.xy;
+        let forest = forest_at(grid);
+        if forest.coverage <= 0.0 {
+            continue;
+        }
+        // The level whose voxels are as tall as the step: the canopy's relief is vertical, and
+        // the volume has far fewer texels up than across (a finer level across than the cone
+        // needs only sharpens the crowns a ray passes).
+        let lod = clamp(log2(step_m / slice_m), 0.0, coarsest);
+        // The depth coordinate stays half a texel of the coarser level read inside this sample.
+        let margin = 0.5 / max(f32(tu.finest_slices) / exp2(ceil(lod)), 1.0);
+        let w = (f32(forest.sample) + clamp(above_m / slab_m, margin, 1.0 - margin)) / f32(tu.sample_count);
+        let voxel = textureSampleLevel(forest_volume, forest_sampler, vec3<f32>(forest_uv(grid), w), lod);
+        let a = voxel.a * forest.coverage;
+        if a <= 0.0 {
+            continue;
+        }
+        // A voxel's opacity is the slice's: through `slice_m` of canopy; the ray crosses `step_m`.
+        let alpha = 1.0 - pow(1.0 - min(a, 0.9999), step_m / slice_m);
+        if transmit == 1.0 {
+            hit_m = distance_m + t;
+        }
+        colour += transmit * alpha * (voxel.rgb / max(voxel.a, 1e-4));
+        transmit *= 1.0 - alpha;
+        if transmit < 0.01 {
+            break;
+        }
+    }
+    let opacity = 1.0 - transmit;
+    if opacity <= 0.0 {
+        discard;
+    }
+    return shade(colour / opacity, ground, view, hit_m, opacity);
 }
 
 // --- For the test that holds `forest_uv` equal to its twin (`passes::texcells::gpu::probe`) ---

@@ -14,41 +14,22 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
-use terramp::bake::forest::{ForestOptions, bake_forests};
 use terramp::camera::Camera;
 use terramp::classes::ClassTable;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
-use terramp::frame::{FrameReport, Renderer};
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::passes::texcells::frame::Band;
 use terramp::reference::frame_change::{BLOCK_PX, block_changes};
 use terramp_testkit::{TempDir, shared_data};
 
-use gdal::GeoTransform;
-use support::{FOREST, PixelGround, WATER, build, build_nc, code_at, ground_under_pixels, write_geotiff};
+use support::texcells::{Frame, SIZE, changed, render_from, samples};
+use support::{FOREST, PixelGround, WATER, build_nc, code_at, ground_under_pixels};
 
-const SIZE: [u32; 2] = [480, 270];
 /// The camera's height above the ground at the map's centre, and its pitch.
 const VIEW: [f64; 2] = [350.0, -4.0];
 /// Where the view looks for water: inside the texcell band.
 const WATER_AT_M: [f64; 2] = [3500.0, 6500.0];
 const REACH_M: f64 = 8000.0;
-
-/// The nc table's forest sample, baked once per test process (small: 128 texels, 16 slices).
-fn samples() -> &'static Path {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("texcells-samples");
-        let models = shared_data().expect("../shared/data").join("models");
-        let table = ClassTable::load("nc").unwrap();
-        let options = ForestOptions { texels: 128, slices: 16, ..ForestOptions::default() };
-        let gpu = Gpu::new(AdapterChoice::Auto).unwrap();
-        let baked = bake_forests(Some(&gpu), &table, &models, &out, &options, &mut |_| {}).unwrap();
-        assert_eq!(baked.iter().map(|r| r.class_code).collect::<Vec<_>>(), [FOREST]);
-        out
-    })
-}
 
 /// The nc table's species as impostors and its forest sample beside them, baked once per test
 /// process through the command line (`terramp-data bake --model ... --classes nc`).
@@ -94,46 +75,11 @@ fn towards_far_water(dataset: &Dataset) -> ([f64; 2], f64) {
 
 /// Renders nc's centre, looking towards its far water from `[above_m, pitch_deg]`, with the
 /// impostors (and forest samples) in `impostors` and texcells to `reach_m` (0: none), settled.
-fn render(
-    dataset: Dataset,
-    impostors: &Path,
-    reach_m: f64,
-    [above_m, pitch]: [f64; 2],
-) -> (Renderer, image::RgbaImage, Vec<f32>, FrameReport, Camera) {
-    render_from(dataset, impostors, reach_m, &|r| {
+fn render(dataset: Dataset, impostors: &Path, reach_m: f64, [above_m, pitch]: [f64; 2]) -> Frame {
+    render_from(dataset, impostors, reach_m, &|_| {}, &|r| {
         let (centre, yaw) = towards_far_water(&r.dataset);
         terramp_testkit::camera::over(r, centre, above_m, yaw, pitch)
     })
-}
-
-/// As `render`, from the camera `camera_of` places in the renderer.
-fn render_from(
-    dataset: Dataset,
-    impostors: &Path,
-    reach_m: f64,
-    camera_of: &dyn Fn(&Renderer) -> Camera,
-) -> (Renderer, image::RgbaImage, Vec<f32>, FrameReport, Camera) {
-    let mut settings = Settings::preset("balanced").unwrap();
-    [settings.render.width, settings.render.height] = SIZE;
-    settings.draw_seeds.impostors = impostors.display().to_string();
-    settings.texcells.reach_m = reach_m;
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
-    let mut r = Renderer::new(gpu, dataset, settings).unwrap();
-    let camera = camera_of(&r);
-    r.render_resolved(&camera).unwrap();
-    // The land cover under the texcells streams a frame after they are placed.
-    let mut report = r.render(&camera).unwrap();
-    for _ in 0..6 {
-        report = r.render(&camera).unwrap();
-    }
-    let (colour, depth) = (r.read_colour().unwrap(), r.read_depth().unwrap());
-    (r, colour, depth, report, camera)
-}
-
-/// Whether texcells changed pixel `i` of `bare` in `forest` (by more than rounding).
-fn changed(bare: &image::RgbaImage, forest: &image::RgbaImage, i: usize) -> bool {
-    let (a, b) = (&bare.as_raw()[4 * i..4 * i + 3], &forest.as_raw()[4 * i..4 * i + 3]);
-    a.iter().zip(b).any(|(a, b)| a.abs_diff(*b) > 2)
 }
 
 /// Whether the level-1 land-cover texels within `r` of `q` are all of `code` (`all`), or all free
@@ -251,95 +197,6 @@ fn nc_texcells_cover_the_far_forest_and_no_water() {
     assert_eq!(near_changed, 0, "texcells nearer than their band");
 }
 
-/// The extremes of DESIGN.md for texcells, over a flat forest (a 12 km square at 30 m, nc's forest
-/// class everywhere, no seeds drawn so that the texcells alone are seen):
-/// - **grazing**: the eye 8.7 m above the canopy's top, pitched 0.1° down, so the central ray
-///   meets the canopy at 89.9° incidence 5 km out; through a 4° lens, so the band is rows tall,
-///   and texcells to 12 km. Every pixel whose ray crosses the canopy's upper half (the crowns)
-///   inside the texcell band crosses every slice there: at least 90 % of them must show forest
-///   (the oblique opacity correction keeps edge-on slices dense: no see-through gaps);
-/// - **inside the canopy**: the eye 12 m up, level (slices above it seen from below).
-///
-/// Neither gives a pixel black or white where the ground was not (a NaN or an infinity in the
-/// slices' opacity).
-#[test]
-fn texcells_at_grazing_incidence_and_inside_the_canopy_leave_no_gaps() {
-    if shared_data().is_none() {
-        return;
-    }
-    let dir = TempDir::new("texcells-extremes");
-    const SIZE_PX: [usize; 2] = [400, 400];
-    const GROUND_M: f32 = 100.0;
-    let grid: GeoTransform = [500_000.0, 30.0, 0.0, 5_000_000.0, 0.0, -30.0];
-    let n = SIZE_PX[0] * SIZE_PX[1];
-    let dem = write_geotiff(&dir.path().join("flat.tif"), SIZE_PX, vec![GROUND_M; n], grid, 32633, None);
-    let cover =
-        write_geotiff(&dir.path().join("forest.tif"), SIZE_PX, vec![FOREST; n], grid, 32633, Some(255.0));
-    let args = ["--dem", dem.to_str().unwrap(), "--landcover", cover.to_str().unwrap(), "--classes", "nc"];
-    let path = dir.path().join("out");
-    let (dataset, _) = build(&path, &args);
-    let [_, north_m] = dataset.manifest.extent_m();
-    let canopy_m = f64::from(terramp::texcell::load(samples(), FOREST).unwrap().unwrap().height_m);
-    let grazing = [canopy_m + 5000.0 * 0.1f64.to_radians().tan(), -0.1, 4.0];
-    const FAR_M: f64 = 12000.0;
-    for (what, [above_m, pitch, fov_deg]) in
-        [("grazing (89.9°)", grazing), ("inside the canopy", [12.0, 0.0, 60.0])]
-    {
-        let band = {
-            let mut s = Settings::preset("balanced").unwrap();
-            s.texcells.reach_m = FAR_M;
-            Band::of(&s)
-        };
-        let camera_of = |r: &Renderer| Camera {
-            fov_deg,
-            ..terramp_testkit::camera::over(r, [300.0, north_m / 2.0], above_m, 90.0, pitch)
-        };
-        let (_, bare, depth, _, camera) =
-            render_from(Dataset::open(&path).unwrap(), samples(), 0.0, &camera_of);
-        let (_, forest, _, report, _) =
-            render_from(Dataset::open(&path).unwrap(), samples(), FAR_M, &camera_of);
-        let ground = ground_under_pixels(&dataset, &camera, SIZE, &depth);
-        // Rays through the crowns (the canopy's upper half) within the band's inside.
-        let inside =
-            |d: f64| d > band.fade_in_m + band.fade_in_width_m && d < band.reach_m - band.fade_out_width_m;
-        let through: Vec<usize> = (0..ground.len())
-            .filter(|&i| {
-                ground[i].is_some_and(|g| {
-                    inside(g.distance_m * (1.0 - 0.5 * canopy_m / above_m))
-                        && inside(g.distance_m * (1.0 - canopy_m / above_m))
-                })
-            })
-            .collect();
-        let covered = through.iter().filter(|&&i| changed(&bare, &forest, i)).count();
-        let extreme = |p: &[u8]| p[..3].iter().all(|&c| c < 4) || p[..3].iter().all(|&c| c > 251);
-        let broken = (0..(SIZE[0] * SIZE[1]) as usize)
-            .filter(|&i| {
-                extreme(&forest.as_raw()[4 * i..4 * i + 4]) && !extreme(&bare.as_raw()[4 * i..4 * i + 4])
-            })
-            .count();
-        println!(
-            "{what}: {} slices; {covered} of {} pixels seen through the whole canopy in the band show forest; {broken} black or white",
-            report.texcells.slices,
-            through.len()
-        );
-        let shots = Path::new(env!("CARGO_TARGET_TMPDIR"));
-        forest.save(shots.join(format!("texcells_flat_{}.png", what.split(' ').next().unwrap()))).unwrap();
-        assert_eq!(broken, 0, "{what}: pixels black or white from the texcells");
-        if what.starts_with("grazing") {
-            assert!(
-                through.len() > 500,
-                "{what}: only {} pixels see the canopy in the band: a weak test",
-                through.len()
-            );
-            assert!(
-                covered * 10 >= through.len() * 9,
-                "{what}: gaps: {covered} of {} pixels show forest",
-                through.len()
-            );
-        }
-    }
-}
-
 /// Popping across the last switch, billboard clouds → texcells, against the cloud → cloud switches,
 /// measured as the seeds' cross-fade test does: the camera stays, every reach shrinks by 0.2 % a
 /// frame (`draw_seeds.reach_m` and the texcell band that follows its last), and the largest change
@@ -442,6 +299,62 @@ fn the_switch_from_clouds_to_texcells_pops_no_more_than_the_cloud_switches() {
         "clouds → texcells change a block by {:.1}, the cloud switches by {worst_cloud:.1}",
         texcells.1
     );
+
+    // The regular → silhouette switch, the same way: the reaches stay, silhouettes are drawn below
+    // 3° (a ray that steep meets the forest 6.7 km out), that angle shrinks by 0.2 % a frame (its
+    // distance grows by as much), and blocks are those whose ray's angle below the horizon lies
+    // within 8 % of the dithered band [θ, 1.5 θ].
+    let theta_deg = 3.0;
+    r.settings.texcells.silhouette_deg = theta_deg;
+    r.render(&camera).unwrap();
+    let mut frames = vec![r.read_colour().unwrap()];
+    for _ in 0..FADE_FRAMES {
+        r.settings.texcells.silhouette_deg *= 0.998;
+        r.render(&camera).unwrap();
+        frames.push(r.read_colour().unwrap());
+    }
+    let descent = ray_descents_deg(&camera);
+    let in_band = |b: usize| {
+        let (x, y) = (
+            (b % blocks_x) as u32 * BLOCK_PX + BLOCK_PX / 2,
+            (b / blocks_x) as u32 * BLOCK_PX + BLOCK_PX / 2,
+        );
+        let e = descent[(y * w + x) as usize];
+        let near_texcells = distance_of_block(b).is_some_and(|d| d > 1.1 * reaches[3] && d < 0.9 * REACH_M);
+        near_texcells
+            && e > 0.92 * theta_deg * 0.998f64.powi(FADE_FRAMES as i32)
+            && e < 1.08 * 1.5 * theta_deg
+    };
+    let changes: Vec<Vec<f64>> = frames.windows(2).map(|f| block_changes(&f[0], &f[1]).unwrap()).collect();
+    let blocks = (0..changes[0].len()).filter(|&b| in_band(b)).count();
+    let largest = changes
+        .iter()
+        .flat_map(|c| c.iter().enumerate().filter(|&(b, _)| in_band(b)).map(|(_, &v)| v))
+        .fold(0.0, f64::max);
+    println!(
+        "regular → silhouette texcells at {theta_deg}°: {blocks} blocks, largest change {largest:.1} of 255"
+    );
+    assert!(blocks > 20, "only {blocks} blocks in the silhouettes' dithered band");
+    assert!(
+        largest <= worst_cloud,
+        "regular → silhouette texcells change a block by {largest:.1}, the cloud switches by {worst_cloud:.1}"
+    );
+}
+
+/// Each pixel's ray's angle below the horizon, degrees, for a `SIZE` frame seen from `camera`:
+/// what the texcell shader decides the kind from.
+fn ray_descents_deg(camera: &Camera) -> Vec<f64> {
+    let [w, h] = SIZE;
+    let world_from_clip = (camera.clip_from_view(w, h).unwrap() * camera.view_from_world()).inverse();
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (f64::from(i % w) + 0.5, f64::from(i / w) + 0.5);
+            let ndc = glam::DVec4::new(2.0 * x / f64::from(w) - 1.0, 1.0 - 2.0 * y / f64::from(h), 0.5, 1.0);
+            let p = world_from_clip * ndc;
+            let ray = (p.truncate() / p.w).normalize();
+            (-ray.z).asin().to_degrees()
+        })
+        .collect()
 }
 
 /// Steps of the slow distance change.

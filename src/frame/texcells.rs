@@ -21,7 +21,7 @@ use crate::passes::terrain::frame::NodeBatches;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
 use crate::passes::texcells::TexcellsError;
 use crate::passes::texcells::frame::{
-    Band, SampleShape, SliceRule, landcover_tiles, place, records, texcell_uniforms,
+    Band, SampleShape, Silhouettes, SliceRule, landcover_tiles, place, records, texcell_uniforms,
 };
 use crate::passes::texcells::gpu::{PreparedTexcells, TexcellsPass};
 use crate::streaming::TileCache;
@@ -43,8 +43,10 @@ pub(super) struct TexcellView {
 pub struct TexcellReport {
     /// Node quadrants carrying texcells.
     pub patches: usize,
-    /// Slice instances drawn.
+    /// Regular slice instances drawn.
     pub slices: usize,
+    /// Silhouette texcells drawn (one per patch that has one).
+    pub silhouettes: usize,
     /// Farthest patches left out because the frame's instances were full.
     pub patches_dropped: usize,
 }
@@ -128,9 +130,11 @@ impl TexcellStage {
             texels: first.texels(),
             finest_slices: finest,
             tile_cells: tiling::sample_cells_word(),
+            samples: samples.len() as u32,
         };
         let band = Band::of(settings);
-        let uniforms = texcell_uniforms(settings, dataset, &band, &shape);
+        // The pixel's footprint comes with the first frame's view, which rewrites the uniforms.
+        let uniforms = texcell_uniforms(settings, dataset, &band, &shape, 0.0);
         let pass = TexcellsPass::new(
             &gpu.device,
             &gpu.queue,
@@ -166,7 +170,7 @@ impl TexcellStage {
     ) -> TexcellReport {
         let TexcellView { camera_grid_m, metres_per_px_at_1m } = *view;
         let band = Band::of(settings);
-        let uniforms = texcell_uniforms(settings, dataset, &band, &self.shape);
+        let uniforms = texcell_uniforms(settings, dataset, &band, &self.shape, metres_per_px_at_1m);
         if bytemuck::bytes_of(&uniforms) != bytemuck::bytes_of(&self.uniforms) {
             self.pass.write_uniforms(&gpu.queue, &uniforms);
             (self.band, self.uniforms) = (band, uniforms);
@@ -179,11 +183,25 @@ impl TexcellStage {
             slice_px: settings.texcells.slice_px,
             finest_level: self.finest_level,
         };
-        let patches = place(batches, |q, i| nodes.instance(q, i), camera_grid_m, &self.band, &rule);
+        let silhouettes = Silhouettes::of(settings);
+        let patches = place(
+            batches,
+            |q, i| nodes.instance(q, i),
+            camera_grid_m,
+            &self.band,
+            &rule,
+            silhouettes.as_ref(),
+        );
         let (records, dropped) = records(&patches, self.finest_level, camera_grid_m.z, shape.slab_m);
         self.wanted_landcover = landcover_tiles(dataset, &patches);
         self.prepared = self.pass.prepare(&gpu.queue, &records);
-        TexcellReport { patches: patches.len() - dropped, slices: records.len(), patches_dropped: dropped }
+        let silhouettes = patches[dropped..].iter().filter(|p| p.kinds.silhouette).count();
+        TexcellReport {
+            patches: patches.len() - dropped,
+            slices: records.len() - silhouettes,
+            silhouettes,
+            patches_dropped: dropped,
+        }
     }
 
     /// Draws the frame's texcells over `colour`.

@@ -344,6 +344,14 @@ wgsl_constants! { texcell_constants:
     pub const TEXCELL_MAX_SLICES: u32 = 64;
     /// Points per workgroup of the shader's probe of its tiling (`passes::texcells::gpu::probe`).
     pub const TEXCELL_PROBE_WORKGROUP: u32 = 64;
+    /// `TexcellSlice::kind`: a regular slice of a patch drawn with regular slices only.
+    pub const TEXCELL_REGULAR: u32 = 0;
+    /// `TexcellSlice::kind`: a regular slice of a patch that silhouette texcells share (its
+    /// fragments give way to them where the view grazes).
+    pub const TEXCELL_REGULAR_SHARED: u32 = 1;
+    /// `TexcellSlice::kind`: a patch's silhouette texcell, the slab's top face whose fragments
+    /// march their ray through the 3D texture.
+    pub const TEXCELL_SILHOUETTE: u32 = 2;
 }
 
 packed_word! {
@@ -357,6 +365,8 @@ packed_word! {
         /// The slice pyramid's level: the patch draws `S_level` (`2^(N − level)` slices, each
         /// aggregating `2^level` of the finest) and samples mips at or above `level`.
         level: 4,
+        /// `TEXCELL_REGULAR`, `TEXCELL_REGULAR_SHARED` or `TEXCELL_SILHOUETTE`.
+        kind: 2,
     }
 }
 

@@ -14,6 +14,8 @@ use gdal::{DriverManager, GeoTransform};
 use terramp::dataset::{Dataset, Pyramid, Sampling, TileId};
 use terramp_testkit::shared_data;
 
+pub mod texcells;
+
 /// Writes a one-band GeoTIFF of `size` values (row by row from the north) in EPSG `epsg`.
 pub fn write_geotiff<T: GdalType + Copy>(
     path: &Path,

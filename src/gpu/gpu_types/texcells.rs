@@ -39,6 +39,17 @@ gpu_struct! {
         pub opacity_max_factor: f32,
         /// How much of the imagery's colour under them texcells take on (0 to 1).
         pub ground_blend: f32,
+        /// Sines of a pixel's ray's angle below the horizon under which silhouette texcells show
+        /// alone (x) and over which regular ones do (y), between them dithered; 0, 0: none.
+        pub silhouette_sin: [f32; 2],
+        /// A pixel's footprint per metre of distance, metres: the silhouettes' 3D mip level.
+        pub metres_per_px_at_1m: f32,
+        /// The most samples a silhouette's ray takes through the slab.
+        pub silhouette_steps: u32,
+        /// Forest samples in the 3D texture, stacked along its depth.
+        pub sample_count: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
+        pub _pad: [u32; 3],
     }
 }
 

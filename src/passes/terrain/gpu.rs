@@ -28,11 +28,12 @@ pub const BINDINGS: BindingTable<6> = BindingTable {
     label: "terrain",
     bindings: [
         Binding::uniform::<TerrainUniforms>(0, "u", Stage::VERTEX_FRAGMENT),
-        Binding::storage_array::<TerrainNode>(1, "nodes", Stage::VERTEX, Access::Read),
+        // The texcells' silhouettes read the ground under their rays in the fragment stage.
+        Binding::storage_array::<TerrainNode>(1, "nodes", Stage::VERTEX_FRAGMENT, Access::Read),
         Binding::texture(
             2,
             "height_tiles",
-            Stage::VERTEX,
+            Stage::VERTEX_FRAGMENT,
             TextureSampleType::Float { filterable: false },
             TextureViewDimension::D2Array,
         ),

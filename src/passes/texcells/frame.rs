@@ -10,13 +10,22 @@
 //! seen from above) and what the slab's parallax needs (`slice_px` pixels per slice, seen
 //! edge-on) allows. Patches are drawn far to near, each one's slices farthest from the eye's
 //! height first: premultiplied "over" blending then composites them in depth order.
+//!
+//! Where the view grazes the canopy, horizontal slices show their gaps and a flat top, so a patch
+//! seen from above by rays descending less than `texcells.silhouette_deg` also gets a *silhouette*
+//! instance: the slab's top face, whose fragments march their ray through the 3D texture
+//! (`Silhouettes`). Which kinds a patch draws is decided from the range of angles below the
+//! horizon its box can be seen at, bounded exactly, so no fragment ever wants a kind its patch did
+//! not draw; between the two angles the fragments themselves dither from one kind to the other.
 
 use glam::DVec3;
 
 use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::gpu_types::{TexcellRecord, TexcellUniforms};
-use crate::gpu::layout::{LCC_PACKED_LEVEL, TexcellSlice};
+use crate::gpu::layout::{
+    LCC_PACKED_LEVEL, TEXCELL_REGULAR, TEXCELL_REGULAR_SHARED, TEXCELL_SILHOUETTE, TexcellSlice,
+};
 use crate::passes::terrain::frame::{NodeBatches, QuadrantBox};
 use crate::streaming::page_levels;
 
@@ -82,6 +91,64 @@ impl SliceRule {
     }
 }
 
+/// Where silhouette texcells take over: the sines of a ray's angle below the horizon under which
+/// they show alone, and over which regular texcells do (dithered between).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Silhouettes {
+    /// Silhouettes alone below this sine.
+    pub sin_start: f64,
+    /// Regular slices alone above this one.
+    pub sin_end: f64,
+}
+
+impl Silhouettes {
+    /// The transition of `settings`, over `[θ, 1.5 θ]` for `texcells.silhouette_deg` = θ; `None`
+    /// when silhouettes are off.
+    pub fn of(settings: &Settings) -> Option<Self> {
+        let t = &settings.texcells;
+        t.silhouettes().then(|| {
+            let deg = t.silhouette_deg;
+            Self { sin_start: deg.to_radians().sin(), sin_end: (1.5 * deg).min(89.0).to_radians().sin() }
+        })
+    }
+
+    /// Which kinds a patch whose canopy fills `canopy` draws from `camera_grid_m`: silhouettes
+    /// when the eye is above its top and some ray to it rises less than `sin_end` (the lowest is
+    /// to its top's farthest corner), regular slices when some ray to it is steeper than
+    /// `sin_start` (the steepest is to its ground's nearest point) or the eye is not above it.
+    pub fn kinds(&self, canopy: &QuadrantBox, camera_grid_m: DVec3) -> Kinds {
+        let (near_m, far_m) = horizontal_range_m(canopy, camera_grid_m);
+        let sine = |drop_m: f64, across_m: f64| drop_m / drop_m.hypot(across_m).max(1e-9);
+        let above = camera_grid_m.z > canopy.max_m.z;
+        let lowest = sine(camera_grid_m.z - canopy.max_m.z, far_m);
+        let steepest = sine(camera_grid_m.z - canopy.min_m.z, near_m);
+        Kinds { regular: !above || steepest > self.sin_start, silhouette: above && lowest < self.sin_end }
+    }
+}
+
+/// The nearest and farthest horizontal distances from `eye` to a point of `b`'s footprint.
+fn horizontal_range_m(b: &QuadrantBox, eye: DVec3) -> (f64, f64) {
+    let gap = |lo: f64, hi: f64, p: f64| (lo - p).max(p - hi).max(0.0);
+    let reach = |lo: f64, hi: f64, p: f64| (p - lo).abs().max((hi - p).abs());
+    let near = gap(b.min_m.x, b.max_m.x, eye.x).hypot(gap(b.min_m.y, b.max_m.y, eye.y));
+    let far = reach(b.min_m.x, b.max_m.x, eye.x).hypot(reach(b.min_m.y, b.max_m.y, eye.y));
+    (near, far)
+}
+
+/// The kinds of texcell a patch draws (at least one).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Kinds {
+    /// Horizontal slices.
+    pub regular: bool,
+    /// The slab's top face, marching the 3D texture.
+    pub silhouette: bool,
+}
+
+impl Kinds {
+    /// Regular slices alone.
+    pub const REGULAR: Self = Self { regular: true, silhouette: false };
+}
+
 /// One node quadrant carrying texcells.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Patch {
@@ -93,18 +160,22 @@ pub struct Patch {
     pub level: u32,
     /// The distance to its nearest point, metres.
     pub nearest_m: f64,
-    /// Its ground's box.
+    /// Its canopy's box: the ground's, raised by the slab.
     pub bounds: QuadrantBox,
+    /// Which kinds it draws.
+    pub kinds: Kinds,
 }
 
 /// The patches of a frame's node instances (`batches`, of which `instance(q, i)` names the ones
-/// uploaded) in `band` seen from `camera_grid_m`, far to near.
+/// uploaded) in `band` seen from `camera_grid_m`, far to near, each with the kinds `silhouettes`
+/// gives it (regular slices alone without).
 pub fn place(
     batches: &NodeBatches,
     instance: impl Fn(usize, usize) -> Option<u32>,
     camera_grid_m: DVec3,
     band: &Band,
     rule: &SliceRule,
+    silhouettes: Option<&Silhouettes>,
 ) -> Vec<Patch> {
     let mut patches = Vec::new();
     for (q, boxes) in batches.boxes.iter().enumerate() {
@@ -116,25 +187,30 @@ pub fn place(
                 continue;
             }
             let level = rule.level(nearest_m);
-            patches.push(Patch { instance, quadrant: q as u32, level, nearest_m, bounds: canopy });
+            let kinds = silhouettes.map_or(Kinds::REGULAR, |s| s.kinds(&canopy, camera_grid_m));
+            patches.push(Patch { instance, quadrant: q as u32, level, nearest_m, bounds: canopy, kinds });
         }
     }
     patches.sort_by(|a, b| b.nearest_m.total_cmp(&a.nearest_m).then(a.instance.cmp(&b.instance)));
     patches
 }
 
-/// The instances drawing `patches` (2^(N − level) slices each), at most `MAX_RECORDS`: the
-/// farthest patches are left out first. A patch's slices go farthest from the eye's height first
-/// (its ground taken at the middle of its height range, under a slab `slab_m` thick): bottom up
-/// seen from above the canopy, top down from below it, so "over" blending composites each patch
-/// in depth order. Also the patches left out.
+/// The instances drawing `patches` (2^(N − level) slices each if regular, and one silhouette
+/// first if it has one), at most `MAX_RECORDS`: the farthest patches are left out first. A patch's
+/// slices go farthest from the eye's height first (its ground taken at the middle of its height
+/// range, under a slab `slab_m` thick): bottom up seen from above the canopy, top down from below
+/// it, so "over" blending composites each patch in depth order (its silhouette's fragments and its
+/// slices' never cover the same pixel). Also the patches left out.
 pub fn records(
     patches: &[Patch],
     finest_level: u32,
     camera_z_m: f64,
     slab_m: f64,
 ) -> (Vec<TexcellRecord>, usize) {
-    let slices = |p: &Patch| 1usize << finest_level.saturating_sub(p.level);
+    let slices = |p: &Patch| {
+        usize::from(p.kinds.silhouette)
+            + if p.kinds.regular { 1usize << finest_level.saturating_sub(p.level) } else { 0 }
+    };
     let mut total: usize = patches.iter().map(slices).sum();
     let mut skip = 0;
     while total > MAX_RECORDS as usize {
@@ -143,16 +219,24 @@ pub fn records(
     }
     let mut records = Vec::with_capacity(total);
     for p in &patches[skip..] {
-        let n = slices(p) as u32;
+        let record = |index: u32, kind: u32| TexcellRecord {
+            node: p.instance,
+            slice: TexcellSlice { quadrant: p.quadrant, index, level: p.level, kind }.pack(),
+        };
+        if p.kinds.silhouette {
+            records.push(record(0, TEXCELL_SILHOUETTE));
+        }
+        if !p.kinds.regular {
+            continue;
+        }
+        let kind = if p.kinds.silhouette { TEXCELL_REGULAR_SHARED } else { TEXCELL_REGULAR };
+        let n = 1u32 << finest_level.saturating_sub(p.level);
         let ground_m = 0.5 * (p.bounds.min_m.z + p.bounds.max_m.z - slab_m);
         let below_eye =
             |index: u32| camera_z_m - (ground_m + (f64::from(index) + 0.5) / f64::from(n) * slab_m);
         let mut order: Vec<u32> = (0..n).collect();
         order.sort_by(|&a, &b| below_eye(b).abs().total_cmp(&below_eye(a).abs()).then(a.cmp(&b)));
-        records.extend(order.into_iter().map(|index| TexcellRecord {
-            node: p.instance,
-            slice: TexcellSlice { quadrant: p.quadrant, index, level: p.level }.pack(),
-        }));
+        records.extend(order.into_iter().map(|index| record(index, kind)));
     }
     (records, skip)
 }
@@ -194,16 +278,21 @@ pub struct SampleShape {
     pub finest_slices: u32,
     /// `texcell::tiling::sample_cells_word`.
     pub tile_cells: u32,
+    /// Forest samples (one per dense class baked).
+    pub samples: u32,
 }
 
-/// The pass's uniforms.
+/// The pass's uniforms, for a view whose pixels are `metres_per_px_at_1m` wide a metre away.
 pub fn texcell_uniforms(
     settings: &Settings,
     dataset: &Dataset,
     band: &Band,
     shape: &SampleShape,
+    metres_per_px_at_1m: f64,
 ) -> TexcellUniforms {
     let t = &settings.texcells;
+    let silhouette_sin =
+        Silhouettes::of(settings).map_or([0.0; 2], |s| [s.sin_start as f32, s.sin_end as f32]);
     let mut u = TexcellUniforms {
         fade_m: [
             band.fade_in_m as f32,
@@ -219,6 +308,10 @@ pub fn texcell_uniforms(
         finest_slices: shape.finest_slices,
         opacity_max_factor: t.opacity_max_factor as f32,
         ground_blend: t.ground_blend as f32,
+        silhouette_sin,
+        metres_per_px_at_1m: metres_per_px_at_1m as f32,
+        silhouette_steps: t.silhouette_steps,
+        sample_count: shape.samples,
         lcc_level: LCC_PACKED_LEVEL,
         ..Default::default()
     };
@@ -273,7 +366,7 @@ mod tests {
         let camera = DVec3::new(0.0, 0.0, 600.0);
         // Near (inside the seed band), straddling its end, far, beyond the reach.
         let b = batches(&[(0.0, 0.0), (2500.0, 0.0), (6000.0, 0.0), (12_000.0, 0.0)]);
-        let patches = place(&b, |_, i| Some(i as u32), camera, &band, &rule());
+        let patches = place(&b, |_, i| Some(i as u32), camera, &band, &rule(), None);
         let kept: Vec<u32> = patches.iter().map(|p| p.instance).collect();
         assert_eq!(kept, [2, 1]);
         let (drawn, dropped) = records(&patches, 5, camera.z, 20.0);
@@ -297,6 +390,54 @@ mod tests {
             "{order:?}"
         );
         // Instances the terrain did not upload carry no texcells.
-        assert!(place(&b, |_, _| None, camera, &band, &rule()).is_empty());
+        assert!(place(&b, |_, _| None, camera, &band, &rule(), None).is_empty());
+    }
+
+    #[test]
+    fn silhouettes_go_where_the_view_grazes_the_canopy_from_above() {
+        // 5°: silhouettes alone below 5°, regular slices alone above 7.5°.
+        let s = Silhouettes { sin_start: 5f64.to_radians().sin(), sin_end: 7.5f64.to_radians().sin() };
+        // A 500 m square of canopy from 100 to 150 m, 4 km north of the eye.
+        let min_m = DVec3::new(-250.0, 4000.0, 100.0);
+        let canopy = QuadrantBox { min_m, max_m: min_m + DVec3::new(500.0, 500.0, 50.0) };
+        let eye = |z: f64| DVec3::new(0.0, 0.0, z);
+        let kinds = |z: f64| s.kinds(&canopy, eye(z));
+        // 2 km up it is seen at 22–25°: regular slices only.
+        assert_eq!(kinds(2000.0), Kinds::REGULAR);
+        // 200 m up, at 0.6–1.4°: silhouettes only.
+        assert_eq!(kinds(200.0), Kinds { regular: false, silhouette: true });
+        // 560 m up, at 5.2° (the top's far corner) to 6.5° (the ground's near edge): both.
+        assert_eq!(kinds(560.0), Kinds { regular: true, silhouette: true });
+        // An eye below the canopy's top sees no silhouette; one inside its footprint sees slices.
+        assert_eq!(kinds(140.0), Kinds::REGULAR);
+        assert!(s.kinds(&canopy, DVec3::new(0.0, 4200.0, 400.0)).regular);
+        // Every ray to the box lies in the range the kinds were chosen from: sample the box.
+        for z in [180.0, 400.0, 560.0, 700.0, 900.0] {
+            let k = kinds(z);
+            for (fx, fy, fz) in
+                [(0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (0.5, 0.0, 1.0), (0.0, 1.0, 0.5), (1.0, 0.3, 0.0)]
+            {
+                let q = canopy.min_m + (canopy.max_m - canopy.min_m) * DVec3::new(fx, fy, fz);
+                let sin_e = (z - q.z) / (eye(z) - q).length();
+                assert!(sin_e >= s.sin_end || k.silhouette, "{z} m: {sin_e} wants a silhouette");
+                assert!(sin_e <= s.sin_start || k.regular, "{z} m: {sin_e} wants slices");
+            }
+        }
+        // A patch with a silhouette draws it first, then its slices, marked as shared.
+        let patch = Patch {
+            instance: 3,
+            quadrant: 1,
+            level: 2,
+            nearest_m: 4000.0,
+            bounds: canopy,
+            kinds: kinds(560.0),
+        };
+        let (drawn, _) = records(&[patch], 5, 560.0, 50.0);
+        let kind = |r: &TexcellRecord| TexcellSlice::unpack(r.slice).kind;
+        assert_eq!(drawn.len(), 1 + 8);
+        assert_eq!(kind(&drawn[0]), TEXCELL_SILHOUETTE);
+        assert!(drawn[1..].iter().all(|r| kind(r) == TEXCELL_REGULAR_SHARED));
+        let alone = Patch { kinds: Kinds { regular: false, silhouette: true }, ..patch };
+        assert_eq!(records(&[alone], 5, 200.0, 50.0).0.len(), 1);
     }
 }

@@ -1,5 +1,5 @@
-//! The texcell pass's GPU half: the forest samples' texture array and the class → sample table
-//! (fixed: uploaded once in `new`), the uniforms (the settings' and samples': rewritten by
+//! The texcell pass's GPU half: the forest samples' texture array, their 3D texture (the
+//! silhouettes') and the class → sample table (fixed: uploaded once in `new`), the uniforms (the settings' and samples': rewritten by
 //! `write_uniforms` when the settings change them), the pipeline over the terrain's bind group and
 //! its own, the quadrant grid's index buffer; `prepare` uploads the frame's slice instances and
 //! `encode` draws them over the frame, blended, depth-tested against the ground, writing no depth.
@@ -28,7 +28,7 @@ pub const SHADER: WgslSource = WgslSource {
 };
 
 /// Group 1 of the pass (group 0 is the terrain's, `terrain::gpu::BINDINGS`).
-pub const BINDINGS: BindingTable<7> = BindingTable {
+pub const BINDINGS: BindingTable<8> = BindingTable {
     label: "texcells",
     bindings: [
         Binding::uniform::<TexcellUniforms>(0, "tu", Stage::VERTEX_FRAGMENT),
@@ -50,6 +50,13 @@ pub const BINDINGS: BindingTable<7> = BindingTable {
             TextureSampleType::Uint,
             TextureViewDimension::D2Array,
         ),
+        Binding::texture(
+            7,
+            "forest_volume",
+            Stage::FRAGMENT,
+            TextureSampleType::Float { filterable: true },
+            TextureViewDimension::D3,
+        ),
     ],
 };
 
@@ -62,6 +69,7 @@ pub struct TexcellsPass {
     indices: wgpu::Buffer,
     index_count: u32,
     slices: wgpu::TextureView,
+    volume: wgpu::TextureView,
     sampler: wgpu::Sampler,
     sample_of_class: wgpu::Buffer,
 }
@@ -124,6 +132,7 @@ impl TexcellsPass {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
+        let volume = volume_texture(device, queue, samples, texels, finest).create_view(&Default::default());
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("forest slices"),
             // The sample wraps like a torus: its tiles' neighbours are compatible tiles.
@@ -153,6 +162,7 @@ impl TexcellsPass {
             indices,
             index_count: index_data.len() as u32,
             slices,
+            volume,
             sampler,
             sample_of_class,
         })
@@ -172,6 +182,7 @@ impl TexcellsPass {
                 self.sample_of_class.as_entire_binding(),
                 landcover.page_table.as_entire_binding(),
                 R::TextureView(&landcover.view),
+                R::TextureView(&self.volume),
             ],
         )
     }
@@ -210,6 +221,43 @@ impl TexcellsPass {
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.index_count, 0, 0..prepared.instances);
     }
+}
+
+/// The samples' 3D textures stacked along z (sample `s` at depths `s · D` to `(s + 1) · D` for `D`
+/// finest slices), with the mips that keep them apart: down to one texel of depth each (level
+/// log2 D), whose side, L / D texels, is the coarsest the silhouettes read.
+fn volume_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    samples: &[ForestSample],
+    texels: u32,
+    finest: u32,
+) -> wgpu::Texture {
+    let mips = finest.ilog2().min(texels.ilog2()) + 1;
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("forest volume"),
+        size: wgpu::Extent3d {
+            width: texels,
+            height: texels,
+            depth_or_array_layers: finest * samples.len() as u32,
+        },
+        mip_level_count: mips,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (s, sample) in samples.iter().enumerate() {
+        for (mip, level) in sample.volume.iter().enumerate().take(mips as usize) {
+            let slice_bytes = (4 * level.side * level.side) as usize;
+            for (z, bytes) in level.bytes.chunks_exact(slice_bytes).enumerate() {
+                let depth = s as u32 * level.depth + z as u32;
+                write_rgba8_layer(queue, &texture, depth, mip as u32, [level.side, level.side], bytes);
+            }
+        }
+    }
+    texture
 }
 
 /// The blended slice pipeline: premultiplied "over", both faces (a camera inside the canopy sees

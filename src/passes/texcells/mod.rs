@@ -9,7 +9,10 @@
 //! dense class, maps the sample aperiodically over the ground (eight edge-compatible tiles chosen by
 //! hashed edge colours, `texcell::tiling`), corrects each slice's opacity for the oblique path
 //! between slices, lights it with the ground's sun and tints it with the imagery under it, and
-//! dithers it in where the last billboard clouds dither out.
+//! dithers it in where the last billboard clouds dither out. Where the view grazes the canopy
+//! (`texcells.silhouette_deg`), a patch also draws its slab's top face once, whose fragments march
+//! their ray through the samples' 3D texture (the paper's silhouette texcells), the two kinds
+//! sharing the patch's pixels by a dither on each ray's angle below the horizon.
 
 pub mod frame;
 pub mod gpu;

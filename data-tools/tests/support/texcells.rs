@@ -1,0 +1,71 @@
+//! Helpers of the texcell tests: the nc table's forest sample baked once per test process, a
+//! texcell frame rendered and settled, and which pixels texcells changed.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use terramp::bake::forest::{ForestOptions, bake_forests};
+use terramp::camera::Camera;
+use terramp::classes::ClassTable;
+use terramp::config::Settings;
+use terramp::dataset::Dataset;
+use terramp::frame::{FrameReport, Renderer};
+use terramp::gpu::{AdapterChoice, Gpu};
+use terramp_testkit::shared_data;
+
+use super::FOREST;
+
+/// The frames' size.
+pub const SIZE: [u32; 2] = [480, 270];
+
+/// The nc table's forest sample, baked once per test process (small: 128 texels, 16 slices).
+pub fn samples() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("texcells-samples");
+        let models = shared_data().expect("../shared/data").join("models");
+        let table = ClassTable::load("nc").unwrap();
+        let options = ForestOptions { texels: 128, slices: 16, ..ForestOptions::default() };
+        let gpu = Gpu::new(AdapterChoice::Auto).unwrap();
+        let baked = bake_forests(Some(&gpu), &table, &models, &out, &options, &mut |_| {}).unwrap();
+        assert_eq!(baked.iter().map(|r| r.class_code).collect::<Vec<_>>(), [FOREST]);
+        out
+    })
+}
+
+/// A rendered, settled frame: the renderer, its colour, its depth, its report and its camera.
+pub type Frame = (Renderer, image::RgbaImage, Vec<f32>, FrameReport, Camera);
+
+/// Renders `dataset` at `SIZE` with the balanced preset, the impostors (and forest samples) in
+/// `impostors`, texcells to `reach_m` (0: none) and whatever `tune` changes, from the camera
+/// `camera_of` places in the renderer, settled (the land cover under the texcells streams a frame
+/// after they are placed).
+pub fn render_from(
+    dataset: Dataset,
+    impostors: &Path,
+    reach_m: f64,
+    tune: &dyn Fn(&mut Settings),
+    camera_of: &dyn Fn(&Renderer) -> Camera,
+) -> Frame {
+    let mut settings = Settings::preset("balanced").unwrap();
+    [settings.render.width, settings.render.height] = SIZE;
+    settings.draw_seeds.impostors = impostors.display().to_string();
+    settings.texcells.reach_m = reach_m;
+    tune(&mut settings);
+    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let mut r = Renderer::new(gpu, dataset, settings).unwrap();
+    let camera = camera_of(&r);
+    r.render_resolved(&camera).unwrap();
+    let mut report = r.render(&camera).unwrap();
+    for _ in 0..6 {
+        report = r.render(&camera).unwrap();
+    }
+    let (colour, depth) = (r.read_colour().unwrap(), r.read_depth().unwrap());
+    (r, colour, depth, report, camera)
+}
+
+/// Whether texcells changed pixel `i` of `bare` in `forest` (by more than rounding).
+pub fn changed(bare: &image::RgbaImage, forest: &image::RgbaImage, i: usize) -> bool {
+    let (a, b) = (&bare.as_raw()[4 * i..4 * i + 3], &forest.as_raw()[4 * i..4 * i + 3]);
+    a.iter().zip(b).any(|(a, b)| a.abs_diff(*b) > 2)
+}
