@@ -28,4 +28,6 @@ pub mod sweep;
 #[cfg(feature = "synth")]
 pub mod synth;
 pub mod texcell;
+#[cfg(feature = "synth")]
+pub mod tree;
 pub mod truth;

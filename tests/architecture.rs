@@ -100,7 +100,7 @@ const LAYERS: &[&[&str]] = &[
     &["gpu", "camera"],
     &["config", "dataset", "path", "impostor"],
     &["classes", "streaming"],
-    &["seeds", "synth"],
+    &["seeds", "synth", "tree"],
     &["texcell"],
     &["passes", "bake"],
     &["reference"],

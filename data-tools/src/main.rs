@@ -1,10 +1,12 @@
 //! `terramp-data`: builds terramp datasets from GeoTIFF (`build`), synthesizes stress datasets
-//! (`synth`) and bakes impostors from glTF models (`bake`). GDAL does the reading and
+//! (`synth`), bakes impostors from glTF models (`bake`), generates trees as glTF (`tree`) and
+//! draws models side by side (`preview`). GDAL does the reading and
 //! reprojection here, and only here: the runtime crate reads nothing but its own packs. Baking
 //! lives in the library (`terramp::bake`, which the demo also uses): `bake` only parses its
 //! arguments.
 
 mod build;
+mod models;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -38,6 +40,10 @@ enum Command {
     /// Bake impostors (billboard clouds at 3 LODs, atlases with mips, the mesh) from glTF models,
     /// and with --classes the forest samples (texcells) of a class table's dense classes.
     Bake(BakeArgs),
+    /// Generate a tree (Weber & Penn, with the Virtual Forest's health) as a glTF binary.
+    Tree(models::TreeArgs),
+    /// Draw glTF models side by side on one scale, as the baker sees them, into a PNG.
+    Preview(models::PreviewArgs),
 }
 
 #[derive(clap::Args)]
@@ -100,6 +106,8 @@ fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Build(args) => build::run(&args),
         Command::Bake(args) => bake(args),
+        Command::Tree(args) => models::tree(&args),
+        Command::Preview(args) => models::preview(&args),
         Command::Synth { size, out, seed } => {
             let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
             let dir = terramp::synth::synthesize(&out, &params, true)?;

@@ -17,6 +17,7 @@ pub mod forest;
 mod model;
 mod pack;
 mod render;
+mod sheet;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -28,9 +29,10 @@ use crate::gpu::{AdapterChoice, Gpu, GpuError};
 use crate::impostor::{BoundingSphere, Impostor, ImpostorError, ImpostorLod, Mesh, Plane, build_mip_chain};
 pub use fit::FitError;
 use fit::{FitParams, FittedPlane};
-pub use model::ModelError;
+pub use model::{ModelError, load as load_model};
 pub use render::RenderError;
 use render::{Baker, PlaneDraw, UploadedMesh};
+pub use sheet::contact_sheet;
 
 /// Atlas texels below this alpha are not the model (the leaves' glTF cutoff).
 pub const ALPHA_CUTOFF: f32 = 0.5;
