@@ -160,3 +160,22 @@ fn missing_corrupt_and_same_named_models_are_named() {
     let err = bake(&[corrupt, twin]).unwrap_err();
     assert!(matches!(&err, BakeError::SameName(name) if name == "Broken"), "{err}");
 }
+
+#[test]
+fn generated_trees_are_baked_by_name_with_no_model_file() {
+    // What the demo does on a clone without ../shared: the table names `tree-…` models.
+    let out = TempDir::new("bake-generated");
+    let nowhere = out.path().join("no-models-here");
+    let names = ["tree-bush-s3-h90", "Nothing"];
+    let options = BakeOptions { texels: 256, ..Default::default() };
+    let missing = terramp::bake::bake_missing(&nowhere, &names, out.path(), &options, false).unwrap();
+    assert_eq!(missing.baked.iter().map(|r| r.name.as_str()).collect::<Vec<_>>(), ["tree-bush-s3-h90"]);
+    assert_eq!(missing.absent, [nowhere.join("Nothing.glb")]);
+    let impostor = terramp::impostor::load(out.path(), "tree-bush-s3-h90").unwrap();
+    let tree = terramp::tree::generate("bush", 3, 0.9).unwrap();
+    assert_eq!(missing.baked[0].triangles, tree.mesh.bark.triangles() + tree.mesh.leaves.triangles());
+    assert_eq!(impostor.lods.len(), options.planes.len());
+    // Baked once: a second call finds it current and bakes nothing.
+    let again = terramp::bake::bake_missing(&nowhere, &names, out.path(), &options, false).unwrap();
+    assert!(again.baked.is_empty());
+}

@@ -88,3 +88,16 @@ fn check(scheme: &str, s: &ForestSample) {
     println!("{what}: change across the wrap {seam:.3}, between neighbours inside {inside:.3}");
     assert!(seam < 1.5 * inside, "{what}: the sample does not wrap ({seam} across, {inside} inside)");
 }
+
+#[test]
+fn the_generated_table_bakes_its_forest_with_no_model_folder_at_all() {
+    // The embedded default's table names generated trees only: the baker grows them.
+    let out = target_tmp_dir().join("texcell-bake-generated");
+    let _ = std::fs::remove_dir_all(&out);
+    let table = ClassTable::load("nc-generated").unwrap();
+    let nowhere = out.join("no-models-here");
+    let reports = bake_forests(Some(&gpu()), &table, &nowhere, &out, &OPTIONS, &mut |_| {}).unwrap();
+    assert_eq!(reports.iter().map(|r| r.class_code).collect::<Vec<_>>(), [5]);
+    check("nc-generated", &texcell::load(&out, 5).unwrap().unwrap());
+    let _ = std::fs::remove_dir_all(&out);
+}

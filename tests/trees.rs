@@ -13,7 +13,8 @@ const CELL: [u32; 2] = [160, 320];
 /// Reads `tree` back through the baker, as any model.
 fn baked_mesh(name: &str, seed: u64, health: f32) -> Mesh {
     let tree = terramp::tree::generate(name, seed, health).unwrap();
-    let dir = std::env::temp_dir().join(format!("terramp-trees-{}-{name}-{seed}-{health}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("terramp-trees-{}-{name}-{seed}-{health}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("tree.glb");
     std::fs::write(&file, tree.to_glb()).unwrap();
@@ -55,7 +56,12 @@ fn a_tree_shows_less_of_itself_as_its_health_falls() {
         let shown: Vec<usize> = coverage(&rgba, size, meshes.len()).iter().map(|c| c.0).collect();
         println!("{name}: texels shown at health {healths:?}: {shown:?}");
         assert!(shown.windows(2).all(|w| w[1] < w[0]), "{name}: {shown:?} does not fall with health");
-        assert!(shown[3] * 3 < shown[0], "{name}: a dying tree still shows {} of {} texels", shown[3], shown[0]);
+        assert!(
+            shown[3] * 3 < shown[0],
+            "{name}: a dying tree still shows {} of {} texels",
+            shown[3],
+            shown[0]
+        );
     }
 }
 

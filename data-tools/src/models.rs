@@ -29,12 +29,13 @@ pub fn tree(args: &TreeArgs) -> Result<()> {
     std::fs::write(&args.out, &bytes).with_context(|| format!("writing {}", args.out.display()))?;
     let mesh = &tree.mesh;
     println!(
-        "{} seed {} health {:.2}: {:.1} m, {:?} stems per level, {} leaves, {} bark + {} leaf triangles, \
+        "{} seed {} health {:.2}: {:.1} m (bounding sphere {:.2} per metre), {:?} stems per level, {} leaves, {} bark + {} leaf triangles, \
          {} KiB in {:.2} s: {}",
         tree.species,
         tree.seed,
         tree.health,
         mesh.height_m,
+        tree.radius_per_height(),
         mesh.stems_per_level,
         mesh.leaf_count,
         mesh.bark.triangles(),

@@ -14,6 +14,7 @@
 
 mod fit;
 pub mod forest;
+mod generated;
 mod model;
 mod pack;
 mod render;
@@ -29,6 +30,7 @@ use crate::gpu::{AdapterChoice, Gpu, GpuError};
 use crate::impostor::{BoundingSphere, Impostor, ImpostorError, ImpostorLod, Mesh, Plane, build_mip_chain};
 pub use fit::FitError;
 use fit::{FitParams, FittedPlane};
+pub use generated::ModelSource;
 pub use model::{ModelError, load as load_model};
 pub use render::RenderError;
 use render::{Baker, PlaneDraw, UploadedMesh};
@@ -111,6 +113,14 @@ pub enum BakeError {
     Forest {
         /// The land-cover class's name.
         class: String,
+        /// What went wrong.
+        problem: String,
+    },
+    /// A generated tree a name asks for (`tree::ModelName`) could not be made.
+    #[error("generated tree {name}: {problem}")]
+    Generated {
+        /// The model name.
+        name: String,
         /// What went wrong.
         problem: String,
     },
@@ -238,8 +248,9 @@ pub struct Missing {
 }
 
 /// Bakes into `out` each of `names` (model file stems) whose impostor is missing there or of
-/// another format ([`crate::impostor::is_current`]), from `models/<name>.glb`; the others are
-/// left as they are. Names without a model file are reported, not an error.
+/// another format ([`crate::impostor::is_current`]), from `models/<name>.glb` or, for a
+/// generated tree's name, the generator ([`ModelSource`]); the others are left as they are.
+/// Names without a model are reported, not an error.
 pub fn bake_missing(
     models: &Path,
     names: &[&str],
@@ -251,8 +262,14 @@ pub fn bake_missing(
         names.iter().copied().filter(|n| !crate::impostor::is_current(out, n)).collect();
     names.sort_unstable();
     names.dedup();
-    let (found, absent): (Vec<PathBuf>, Vec<PathBuf>) =
-        names.iter().map(|n| models.join(format!("{n}.glb"))).partition(|p| p.is_file());
+    let mut source = ModelSource::new(models);
+    let (mut found, mut absent) = (Vec::new(), Vec::new());
+    for name in names {
+        match source.file(name)? {
+            Some(file) => found.push(file),
+            None => absent.push(models.join(format!("{name}.glb"))),
+        }
+    }
     let baked =
         if found.is_empty() { Vec::new() } else { bake_models(None, &found, out, options, progress)? };
     Ok(Missing { baked, absent })

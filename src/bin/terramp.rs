@@ -109,11 +109,13 @@ enum Command {
         /// Frames rendered first at the start, neither written nor profiled.
         #[arg(long, default_value_t = 4)]
         warmup: u32,
-        /// Impostor folder (baked there from --models when a species' model is missing), unless
-        /// the settings name one (`seeds.impostors`).
+        /// Impostor folder (baked there when a species' model is missing: generated trees by the
+        /// generator, others from --models), unless the settings name one (`draw_seeds.impostors`).
         #[arg(long, default_value = "data/impostors")]
         impostors: PathBuf,
-        /// The glTF models (.glb) the class table's species name.
+        /// The glTF models (.glb) the class table's species name, unless generated trees: the
+        /// demo's default table (`nc-generated`) needs none; `seeds.class_table = "nc"` in a
+        /// settings file draws the shared models instead.
         #[arg(long, default_value = "../shared/data/models")]
         models: PathBuf,
         #[command(flatten)]

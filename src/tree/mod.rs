@@ -13,6 +13,7 @@
 mod glb;
 mod grow;
 mod mesh;
+mod name;
 mod species;
 mod textures;
 
@@ -21,6 +22,7 @@ use thiserror::Error;
 pub use glb::{Alpha, Material};
 pub use grow::{branch_keep, leaf_keep};
 pub use mesh::{Part, TreeMesh};
+pub use name::ModelName;
 pub use species::{LeafKind, Leaves, Level, NAMES, Shape, Species, species};
 pub use textures::LEAF_TEXELS;
 
@@ -82,6 +84,17 @@ pub fn generate_species(species: &Species, seed: u64, health: f32) -> Result<Tre
 }
 
 impl Tree {
+    /// Radius of the bounding sphere centred at half the tree's height, per metre of height: the
+    /// class tables' `radius_per_height`, for culling.
+    pub fn radius_per_height(&self) -> f32 {
+        let parts = [&self.mesh.bark, &self.mesh.leaves];
+        let top_m = parts.iter().flat_map(|p| &p.positions).map(|p| p[1]).fold(1e-3, f32::max);
+        let centre = glam::Vec3::new(0.0, 0.5 * top_m, 0.0);
+        let radius_m =
+            parts.iter().flat_map(|p| &p.positions).map(|&p| centre.distance(p.into())).fold(0.0, f32::max);
+        radius_m / top_m
+    }
+
     /// The tree as a glTF 2.0 binary (`.glb`): a bark primitive and, unless it has none, a leaf
     /// primitive (alpha-masked, two-sided).
     pub fn to_glb(&self) -> Vec<u8> {

@@ -81,6 +81,7 @@ pub fn bake_forest(
         )));
     }
     let baker = Baker::new(gpu);
+    let mut source = super::ModelSource::new(models);
     let mut models_read: Vec<Model> = Vec::new();
     let mut grown = Vec::new();
     for rule in &class.seeds {
@@ -89,8 +90,9 @@ pub fn bake_forest(
             .iter()
             .find(|s| s.name == rule.species)
             .ok_or_else(|| bad(format!("no species {:?}", rule.species)))?;
-        let path = models.join(format!("{}.glb", species.model));
         if !models_read.iter().any(|m| m.name == species.model) {
+            let path =
+                source.file(&species.model)?.unwrap_or_else(|| models.join(format!("{}.glb", species.model)));
             let mesh = model::load(&path)
                 .map_err(|e| BakeError::Model { path: path.clone(), source: Box::new(e) })?;
             let height_m = mesh.vertices.iter().map(|v| v.position_model_m[1]).fold(0.0f32, f32::max);

@@ -1,7 +1,9 @@
 //! How it works: `terramp demo`, the main job on the embedded default. The default dataset is
-//! synthesized when missing (or of a format this build no longer reads); the species models its
-//! class table names are baked into impostors the first time (from `--models`, the shared glTF
-//! models), so seeds are drawn; then a straight flight across the dataset is rendered through a
+//! synthesized when missing (or of a format this build no longer reads); its seeds grow from the
+//! built-in table of generated trees for its scheme (`nc-generated`), unless the settings name a
+//! class table (`seeds.class_table = "nc"` for the shared models), and the models that table names
+//! are baked into impostors the first time (generated trees by the generator, others from
+//! `--models`), so seeds are drawn on a clone with nothing beside it; then a straight flight across the dataset is rendered through a
 //! profiling session: a few warm-up frames at its start, then every frame written as PNG and
 //! timed, and the profile table (per pass: median and 95th percentile) printed and written beside
 //! the frames (`profile.txt`, `profile.json`). Without models the flight still runs, its seeds
@@ -39,6 +41,13 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let mut settings = Settings::load(&args.preset, args.settings_file.as_deref())?;
     ensure_dataset(&args.dataset)?;
     let dataset = Dataset::open(&args.dataset)?;
+    let scheme = dataset.manifest.landcover.as_ref().map(|l| l.scheme.as_str());
+    if let (true, Some(table)) =
+        (settings.seeds.class_table.is_empty(), scheme.and_then(ClassTable::generated_for))
+    {
+        eprintln!("terramp: seeds grow from the class table {table} (generated trees)");
+        settings.seeds.class_table = table.to_string();
+    }
     if settings.draw_seeds.impostors.is_empty() {
         let baked = ensure_impostors(&dataset, &settings, &args.impostors, &args.models)?;
         settings.draw_seeds.impostors = baked.map(|d| d.display().to_string()).unwrap_or_default();

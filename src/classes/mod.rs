@@ -23,9 +23,13 @@ pub const MAX_SPECIES_PER_CLASS: usize = layout::MAX_SPECIES_PER_CLASS as usize;
 pub const MAX_PER_KM2: f32 = 100_000.0;
 
 const BUILTIN: &[(&str, &str)] = &[
-    ("nc", include_str!("../config/classes/nc.toml")),
-    ("nlcd", include_str!("../config/classes/nlcd.toml")),
+    ("nc", include_str!("../../config/classes/nc.toml")),
+    ("nlcd", include_str!("../../config/classes/nlcd.toml")),
+    ("nc-generated", include_str!("../../config/classes/nc_generated.toml")),
 ];
+
+/// Suffix of the built-in table that grows a scheme's classes with generated trees.
+const GENERATED_SUFFIX: &str = "-generated";
 
 /// Why a class table could not be loaded; each names the table and the class, species or key at
 /// fault.
@@ -197,6 +201,12 @@ pub struct ClassTable {
 }
 
 impl ClassTable {
+    /// The built-in table growing `scheme`'s classes with generated trees (`tree::ModelName`
+    /// models, no model files needed), if there is one: `nc-generated` for `nc`.
+    pub fn generated_for(scheme: &str) -> Option<&'static str> {
+        BUILTIN.iter().map(|(name, _)| *name).find(|name| name.strip_suffix(GENERATED_SUFFIX) == Some(scheme))
+    }
+
     /// A built-in table by name (`nc`, `nlcd`), else a TOML file at that path.
     pub fn load(name_or_path: &str) -> Result<Self, ClassTableError> {
         if let Some((_, text)) = BUILTIN.iter().find(|(name, _)| *name == name_or_path) {
@@ -337,141 +347,4 @@ fn check_species(s: &Species) -> Result<(), (&'static str, String, &'static str)
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const SPECIES: &str = "[[species]]\nname = \"pine\"\nkind = \"tree\"\nmodel = \"Pine_1\"\n\
-        height_m = [6.0, 12.0]\nradius_per_height = 0.65\nmax_slope_deg = 40.0\n";
-
-    /// A one-class table with the pine species, `species_extra` appended to the species and
-    /// `rules` as the class's seed rules.
-    fn table(species_extra: &str, rules: &str) -> String {
-        format!(
-            "scheme = \"x\"\nnodata_code = 0\n{SPECIES}{species_extra}\n\
-             [[class]]\ncode = 5\nname = \"forest\"\nseeds = [{rules}]\n"
-        )
-    }
-
-    fn error(text: &str) -> String {
-        ClassTable::parse(text, "t.toml").unwrap_err().to_string()
-    }
-
-    #[test]
-    fn builtins_parse() {
-        let nc = ClassTable::load("nc").unwrap();
-        assert_eq!(nc.classes.len(), 7);
-        assert!(nc.contains(6) && !nc.contains(8));
-        let nlcd = ClassTable::load("nlcd").unwrap();
-        assert!(nlcd.contains(41) && nlcd.contains(95) && !nlcd.contains(255));
-        assert_eq!(nc.names()[4], ClassName { code: 5, name: "forest".into() });
-        assert_eq!(nc.names().len(), nc.classes.len());
-    }
-
-    #[test]
-    fn builtin_rules_name_known_species_and_respect_the_ecology() {
-        for name in ["nc", "nlcd"] {
-            let t = ClassTable::load(name).unwrap();
-            assert!(!t.species.is_empty() && t.species.len() <= MAX_SPECIES, "{name}");
-            for class in &t.classes {
-                for rule in &class.seeds {
-                    assert!(
-                        t.species_index(&rule.species).is_some(),
-                        "{name} {}: {}",
-                        class.code,
-                        rule.species
-                    );
-                }
-            }
-            for s in &t.species {
-                let max_slope = match s.kind {
-                    SpeciesKind::Tree => 40.0,
-                    SpeciesKind::Bush => 50.0,
-                    SpeciesKind::Rock => 70.0,
-                };
-                assert!(s.max_slope_deg <= max_slope, "{name}: {}", s.name);
-            }
-        }
-        let nc = ClassTable::load("nc").unwrap();
-        let kinds = |t: &ClassTable, code| -> Vec<SpeciesKind> {
-            let rules = &t.class(code).unwrap().seeds;
-            rules.iter().map(|r| t.species[t.species_index(&r.species).unwrap()].kind).collect()
-        };
-        assert!(nc.density_per_km2(5) >= 10_000.0, "{}", nc.density_per_km2(5));
-        assert_eq!(nc.density_per_km2(6), 0.0);
-        assert_eq!(nc.density_per_km2(200), 0.0);
-        assert!(!kinds(&nc, 1).contains(&SpeciesKind::Tree));
-        let nlcd = ClassTable::load("nlcd").unwrap();
-        for code in [11, 12, 22, 23, 24, 81, 82, 95] {
-            assert!(kinds(&nlcd, code).iter().all(|&k| k == SpeciesKind::Bush), "nlcd {code}");
-        }
-        for code in [41, 42, 43] {
-            assert!(nlcd.density_per_km2(code) >= 10_000.0, "nlcd {code}");
-        }
-        let conifer_line = nlcd.species.iter().filter(|s| s.model.starts_with("Pine"));
-        assert!(conifer_line.clone().count() > 0);
-        assert!(conifer_line.into_iter().all(|s| (3000.0..=3800.0).contains(&s.altitude_m[1])));
-    }
-
-    #[test]
-    fn a_valid_table_reads_back() {
-        let t = ClassTable::parse(&table("", "{ species = \"pine\", per_km2 = 900.0 }"), "t.toml").unwrap();
-        assert_eq!(t.species_index("pine"), Some(0));
-        assert_eq!(t.species_index("oak"), None);
-        assert_eq!(t.species[0].altitude_m, [-1.0e4, 1.0e4]);
-        assert_eq!(t.species[0].kind, SpeciesKind::Tree);
-        assert_eq!(t.density_per_km2(5), 900.0);
-        assert_eq!(t.class(5).unwrap().seeds[0].species, "pine");
-    }
-
-    #[test]
-    fn errors_name_the_problem() {
-        let err = ClassTable::load("/no/such/table.toml").unwrap_err().to_string();
-        assert!(err.contains("nc, nlcd"), "{err}");
-        let dup = "scheme = \"x\"\nnodata_code = 0\n[[class]]\ncode = 3\nname = \"a\"\n[[class]]\ncode = 3\nname = \"b\"\n";
-        assert!(matches!(ClassTable::parse(dup, "dup"), Err(ClassTableError::Duplicate { code: 3, .. })));
-        let typo = "scheme = \"x\"\nnodata_code = 0\nclases = []\n";
-        let err = ClassTable::parse(typo, "typo").unwrap_err().to_string();
-        assert!(err.contains("clases"), "{err}");
-    }
-
-    #[test]
-    fn species_and_rule_errors_name_table_class_and_key() {
-        let err = error(&table(SPECIES, ""));
-        assert!(err.contains("t.toml") && err.contains("`pine` is listed twice"), "{err}");
-        let err = error(&table("", "{ species = \"oak\", per_km2 = 1.0 }"));
-        assert!(
-            err.contains("class 5 (forest)") && err.contains("`oak`") && err.contains("no species"),
-            "{err}"
-        );
-        let twice = "{ species = \"pine\", per_km2 = 1.0 }, { species = \"pine\", per_km2 = 2.0 }";
-        assert!(error(&table("", twice)).contains("twice"));
-        let err = error(&table("", "{ species = \"pine\", per_km2 = 100001.0 }"));
-        assert!(err.contains("class 5 (forest)") && err.contains("per_km2"), "{err}");
-        assert!(error(&table("", "{ species = \"pine\", per_km2 = -1.0 }")).contains("per_km2"));
-
-        let many: String =
-            (0..5).map(|i| SPECIES.replace("\"pine\"", &format!("\"p{i}\""))).collect::<Vec<_>>().join("");
-        let rules: Vec<String> = (0..5).map(|i| format!("{{ species = \"p{i}\", per_km2 = 1.0 }}")).collect();
-        let err = error(&table(&many, &rules.join(", ")));
-        assert!(err.contains("class 5 (forest)") && err.contains("5 seed rules"), "{err}");
-        let seventeen: String = (0..MAX_SPECIES)
-            .map(|i| SPECIES.replace("\"pine\"", &format!("\"q{i}\"")))
-            .collect::<Vec<_>>()
-            .join("");
-        assert!(error(&table(&seventeen, "")).contains("17 species"));
-
-        for (from, to, key) in [
-            ("height_m = [6.0, 12.0]", "height_m = [0.0, 12.0]", "height_m"),
-            ("height_m = [6.0, 12.0]", "height_m = [13.0, 12.0]", "height_m"),
-            ("radius_per_height = 0.65", "radius_per_height = 0.0", "radius_per_height"),
-            ("max_slope_deg = 40.0", "max_slope_deg = 91.0", "max_slope_deg"),
-            ("max_slope_deg = 40.0", "max_slope_deg = -1.0", "max_slope_deg"),
-            ("max_slope_deg = 40.0", "max_slope_deg = 40.0\naltitude_m = [3000.0, 100.0]", "altitude_m"),
-        ] {
-            let err = error(&table("", "").replace(from, to));
-            assert!(err.contains("species `pine`") && err.contains(key) && err.contains("t.toml"), "{err}");
-        }
-        let err = error(&table("", "").replace("kind = \"tree\"", "kind = \"fern\""));
-        assert!(err.contains("fern"), "{err}");
-    }
-}
+mod tests;
