@@ -267,6 +267,7 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
     for (var k = 0u; k < tu.silhouette_steps; k += 1u) {
         let step_m = base_m * (1.0 + growth * f32(max(k + 1u, even) - even));
         let p = rel_m + view * t;
+        let p_along_m = t;
         t += step_m;
         let above_m = p.z - (height_at(node, (p.xy - node.origin_rel_m) / node.cell_m) - u.camera_grid_m.z);
         if above_m < 0.0 {
@@ -299,7 +300,7 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
         // A voxel's opacity is the slice's: through `slice_m` of canopy; the ray crosses `step_m`.
         let alpha = 1.0 - pow(1.0 - min(a, 0.9999), step_m / slice_m);
         if transmit == 1.0 {
-            hit_m = distance_m + t;
+            hit_m = distance_m + p_along_m;
         }
         colour += transmit * alpha * (voxel.rgb / max(voxel.a, 1e-4));
         transmit *= 1.0 - alpha;

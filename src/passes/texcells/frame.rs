@@ -207,10 +207,10 @@ pub fn records(
     camera_z_m: f64,
     slab_m: f64,
 ) -> (Vec<TexcellRecord>, usize) {
-    let slices = |p: &Patch| {
-        usize::from(p.kinds.silhouette)
-            + if p.kinds.regular { 1usize << finest_level.saturating_sub(p.level) } else { 0 }
-    };
+    // Regular slices a patch draws (its level's), and its records (plus a silhouette).
+    let regular = |p: &Patch| 1u32 << finest_level.saturating_sub(p.level);
+    let slices =
+        |p: &Patch| usize::from(p.kinds.silhouette) + if p.kinds.regular { regular(p) as usize } else { 0 };
     let mut total: usize = patches.iter().map(slices).sum();
     let mut skip = 0;
     while total > MAX_RECORDS as usize {
@@ -230,7 +230,7 @@ pub fn records(
             continue;
         }
         let kind = if p.kinds.silhouette { TEXCELL_REGULAR_SHARED } else { TEXCELL_REGULAR };
-        let n = 1u32 << finest_level.saturating_sub(p.level);
+        let n = regular(p);
         let ground_m = 0.5 * (p.bounds.min_m.z + p.bounds.max_m.z - slab_m);
         let below_eye =
             |index: u32| camera_z_m - (ground_m + (f64::from(index) + 0.5) / f64::from(n) * slab_m);
