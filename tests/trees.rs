@@ -2,7 +2,8 @@
 //! (`bake::contact_sheet`, side views on one scale) after a glTF round trip through the baker's
 //! reader, as the demo's first run bakes them. A tree covers fewer texels as its health falls (the
 //! Virtual Forest's health parameter seen, not counted), stands as tall as its mesh, and a bush is
-//! a fraction of a tree.
+//! a fraction of a tree. The baker reads a generated tree as written, and the embedded default's
+//! class table names generated trees only.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use terramp::impostor::Mesh;
@@ -84,4 +85,33 @@ fn trees_stand_as_tall_as_their_meshes_and_a_bush_is_small() {
     }
     let bush = cells[4].0;
     assert!(cells[..4].iter().all(|c| c.0 > 20 * bush), "{cells:?}: a bush is not small beside the trees");
+}
+
+#[test]
+fn the_baker_reads_a_generated_tree_like_any_model() {
+    let tree = terramp::tree::generate("pine", 3, 0.9).unwrap();
+    let mesh = baked_mesh("pine", 3, 0.9);
+    assert_eq!(mesh.materials.len(), 2);
+    assert_eq!(mesh.indices.len(), tree.mesh.bark.indices.len() + tree.mesh.leaves.indices.len());
+    let masked = mesh.materials.iter().filter(|m| m.alpha_mode == terramp::impostor::AlphaMode::Mask).count();
+    assert_eq!(masked, 1);
+}
+
+#[test]
+fn the_generated_table_grows_the_same_classes_with_generated_trees_only() {
+    use terramp::classes::ClassTable;
+    assert_eq!(ClassTable::generated_for("nc"), Some("nc-generated"));
+    assert_eq!(ClassTable::generated_for("nlcd"), None);
+    let nc = ClassTable::load("nc").unwrap();
+    let generated = ClassTable::load(ClassTable::generated_for("nc").unwrap()).unwrap();
+    assert_eq!((generated.scheme.as_str(), generated.names()), (nc.scheme.as_str(), nc.names()));
+    for s in &generated.species {
+        assert!(terramp::tree::ModelName::parse(&s.model).is_some(), "{}: {}", s.name, s.model);
+    }
+    for code in [1, 2, 3, 4, 5, 7] {
+        assert!(generated.density_per_km2(code) > 0.0, "class {code} grows nothing");
+    }
+    assert_eq!(generated.density_per_km2(5), nc.density_per_km2(5));
+    let forest = generated.class(5).unwrap();
+    assert!(forest.texcells);
 }

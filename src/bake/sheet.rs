@@ -55,9 +55,9 @@ pub fn contact_sheet(
         })
         .collect();
     let mut rgba = baker.render_instances(gpu, &batches, size)?;
+    let ground_from = (0.95 * cell[1] as f32) as u32;
     for (texel, chunk) in rgba.chunks_exact_mut(4).enumerate() {
         let y_in_cell = (texel as u32 / size[0]) % cell[1];
-        let ground_from = (0.95 * cell[1] as f32) as u32;
         let behind = if y_in_cell >= ground_from { GROUND } else { SKY };
         if chunk[3] == 0 {
             chunk.copy_from_slice(&[behind[0], behind[1], behind[2], 255]);

@@ -67,25 +67,6 @@ fn builtin_rules_name_known_species_and_respect_the_ecology() {
     assert!(conifer_line.into_iter().all(|s| (3000.0..=3800.0).contains(&s.altitude_m[1])));
 }
 
-#[cfg(feature = "synth")]
-#[test]
-fn the_generated_table_grows_the_same_classes_with_generated_trees_only() {
-    assert_eq!(ClassTable::generated_for("nc"), Some("nc-generated"));
-    assert_eq!(ClassTable::generated_for("nlcd"), None);
-    let nc = ClassTable::load("nc").unwrap();
-    let generated = ClassTable::load(ClassTable::generated_for("nc").unwrap()).unwrap();
-    assert_eq!((generated.scheme.as_str(), generated.names()), (nc.scheme.as_str(), nc.names()));
-    for s in &generated.species {
-        assert!(crate::tree::ModelName::parse(&s.model).is_some(), "{}: {}", s.name, s.model);
-    }
-    for code in [1, 2, 3, 4, 5, 7] {
-        assert!(generated.density_per_km2(code) > 0.0, "class {code} grows nothing");
-    }
-    assert_eq!(generated.density_per_km2(5), nc.density_per_km2(5));
-    let forest = generated.class(5).unwrap();
-    assert!(forest.texcells);
-}
-
 #[test]
 fn a_valid_table_reads_back() {
     let t = ClassTable::parse(&table("", "{ species = \"pine\", per_km2 = 900.0 }"), "t.toml").unwrap();

@@ -140,19 +140,3 @@ fn the_glb_reads_back_with_the_gltf_crate_as_written() {
         }
     }
 }
-
-#[cfg(feature = "bake")]
-#[test]
-fn the_baker_reads_a_generated_tree_like_any_model() {
-    let dir = std::env::temp_dir().join(format!("terramp-tree-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let tree = generate("pine", 3, 0.9).unwrap();
-    let file = dir.join("pine.glb");
-    std::fs::write(&file, tree.to_glb()).unwrap();
-    let mesh = crate::bake::load_model(&file).unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
-    assert_eq!(mesh.materials.len(), 2);
-    assert_eq!(mesh.indices.len(), tree.mesh.bark.indices.len() + tree.mesh.leaves.indices.len());
-    let masked = mesh.materials.iter().filter(|m| m.alpha_mode == crate::impostor::AlphaMode::Mask).count();
-    assert_eq!(masked, 1);
-}

@@ -3,10 +3,10 @@
 //! built-in table of generated trees for its scheme (`nc-generated`), unless the settings name a
 //! class table (`seeds.class_table = "nc"` for the shared models), and the models that table names
 //! are baked into impostors the first time (generated trees by the generator, others from
-//! `--models`), so seeds are drawn on a clone with nothing beside it; then a straight flight across the dataset is rendered through a
-//! profiling session: a few warm-up frames at its start, then every frame written as PNG and
-//! timed, and the profile table (per pass: median and 95th percentile) printed and written beside
-//! the frames (`profile.txt`, `profile.json`). Without models the flight still runs, its seeds
+//! `--models`), so seeds are drawn on a clone with nothing beside it; then a straight flight
+//! across the dataset is rendered through a profiling session: a few warm-up frames at its start,
+//! then every frame written as PNG and timed, and the profile table (per pass: median and 95th
+//! percentile) printed and written beside the frames (`profile.txt`, `profile.json`). Without models the flight still runs, its seeds
 //! selected but not drawn, and says so.
 
 use std::path::{Path, PathBuf};
