@@ -2,7 +2,7 @@
 # release binaries built): builds the datasets into $data (each reused while `terramp info` reads
 # it): nc/ (DEM, Landsat bands 3,2,1, land use) and zion/ (DEM, NLCD) as data-tools/tests/support
 # builds them, and the synthetic default (`synth --size 1024`); bakes the 11 shared models into
-# $data/impostors (reused when present) and writes $trees, a settings layer that points
+# $data/impostors (those missing or of an older format) and writes $trees, a settings layer that points
 # `draw_seeds.impostors` at them.
 terramp="$root/target/release/terramp"
 terramp_data="$root/target/release/terramp-data"
@@ -26,11 +26,10 @@ build synthetic "$terramp_data" synth --size 1024
 
 impostors="$data/impostors"
 models=(Birch_1 Birch_4 BushBerries_1 Bush_1 DeadTree_1 Pine_1 Pine_3 Rock_1 Rock_Moss_1 Tree_1 Tree_3)
-if [[ ! -d "$impostors/Tree_3" ]]; then
-    args=()
-    for m in "${models[@]}"; do args+=(--model "$shared/models/$m.glb"); done
-    "$terramp_data" bake "${args[@]}" --out "$impostors" --texels 256 >/dev/null
-fi
+args=()
+for m in "${models[@]}"; do args+=(--model "$shared/models/$m.glb"); done
+# Only what is missing or of an older format.
+"$terramp_data" bake "${args[@]}" --out "$impostors" --texels 256 --missing >/dev/null
 trees="$data/trees.toml"
 printf '# Written by scripts/trade.sh: draw the seeds with the baked impostors.\n[draw_seeds]\nimpostors = "%s"\n' \
     "$(cd "$impostors" && pwd)" >"$trees"

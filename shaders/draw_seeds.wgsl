@@ -3,9 +3,10 @@
 // real mesh, 1 to 3 the billboard clouds; model space: metres, +Y up, base at y = 0), then the
 // next LOD's, for the cross-fade. An instance reads its record through `order`, places the model
 // at the record's camera-relative anchor, scaled to its height and turned about the vertical by
-// its jitter, and projects it like the terrain. Fragments take their material's colour (times a
-// layer of the texture array), are alpha-tested, tinted a little towards the ground colour and by
-// the seed's colour variation, lit and hazed like the ground.
+// its jitter, bent by the wind (`shared/wind.wgsl`: the same field for every LOD, so a cross-fade
+// shows one plant swaying), and projects it like the terrain. Fragments take their material's
+// colour (times a layer of the texture array), are alpha-tested, tinted a little towards the
+// ground colour and by the seed's colour variation, lit and hazed like the ground.
 //
 // Cross-fade: over the outer `fade_fraction` of its LOD's reach a seed's fade f falls from 1 to
 // 0. Its own geometry keeps the pixels whose ordered-dither threshold t (Bayer 4×4, shifted per
@@ -22,6 +23,13 @@ struct DrawSeedsUniforms {
     sink_fraction: f32,
     fade_fraction: f32,
     ground_blend: f32,
+    wind: vec4<f32>,
+    wind_wave: vec4<f32>,
+}
+
+struct SeedShape {
+    inv_model_height_m: f32,
+    wind_bend: f32,
 }
 
 struct SeedMaterial {
@@ -35,7 +43,7 @@ struct SeedMaterial {
 @group(0) @binding(0) var<uniform> u: DrawSeedsUniforms;
 @group(0) @binding(1) var<storage, read> records: array<SeedRecord>;
 @group(0) @binding(2) var<storage, read> order: array<u32>;
-@group(0) @binding(3) var<storage, read> inv_model_height_m: array<f32>;
+@group(0) @binding(3) var<storage, read> shapes: array<SeedShape>;
 @group(0) @binding(4) var<storage, read> materials: array<SeedMaterial>;
 @group(0) @binding(5) var textures: texture_2d_array<f32>;
 @group(0) @binding(6) var clamp_sampler: sampler;
@@ -46,6 +54,7 @@ struct VertexIn {
     @location(1) normal_model: vec3<f32>,
     @location(2) uv: vec2<f32>,
     @location(3) material: u32,
+    @location(4) pivot_model_m: vec3<f32>,
 }
 
 struct VertexOut {
@@ -105,8 +114,21 @@ fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     }
     let jitter = unpack_seed_jitter(record.jitter);
     let angle = f32(jitter.angle) * (6.2831853 / 65536.0);
-    let scale = record.height_m * inv_model_height_m[min(species, arrayLength(&inv_model_height_m) - 1u)];
-    let rel_m = record.position_rel_m + model_to_world(in.position_model_m * scale, angle);
+    let shape = shapes[min(species, arrayLength(&shapes) - 1u)];
+    let scale = record.height_m * shape.inv_model_height_m;
+    // Still air (or a rock) leaves every vertex where it was, bit for bit: this expression is
+    // the one the pass had before the wind, and nothing else uses its products (a compiler may
+    // fuse a product into the add only where the product has no other use).
+    var rel_m = record.position_rel_m + model_to_world(in.position_model_m * scale, angle);
+    // In wind, a leaf turns about where it hangs, then the whole plant bends.
+    if u.wind.z > 0.0 && shape.wind_bend > 0.0 {
+        let pivot_m = model_to_world(in.pivot_model_m * scale, angle);
+        let leaf_m = model_to_world((in.position_model_m - in.pivot_model_m) * scale, angle);
+        let fluttered = wind_flutter(u.wind, u.wind_wave, leaf_m, in.pivot_model_m, record.height_m);
+        let top_m = wind_top_m(u.wind, u.wind_wave, record.position_rel_m, record.height_m, record.jitter);
+        let bent = wind_bend(pivot_m + fluttered, top_m * shape.wind_bend, record.height_m);
+        rel_m = record.position_rel_m + bent;
+    }
     out.clip = u.clip_from_view_world * vec4<f32>(rel_m, 1.0);
     out.rel_m = rel_m;
     out.normal = model_to_world(in.normal_model, angle);

@@ -5,8 +5,8 @@
 // quadtree (any resident level: the coding makes them agree), a species by its rank, checked
 // against its species' altitude and slope rules, sized by its hash, cut at the radial LOD distance
 // for its size, culled by frustum (bounding sphere, NDC tolerance) and by occlusion (its summit
-// against the terrain's depth, with a tolerance growing with distance), and written out with its
-// ground colour from the imagery around it.
+// against the terrain's depth, with a tolerance growing with distance), both bounds grown by the
+// wind's reach for plants, and written out with its ground colour from the imagery around it.
 //
 // Exactness: the CPU twin (`reference/seed_select.rs`) must take the same decisions, so the
 // shader avoids division and transcendental functions, and every product goes through `mul`,
@@ -51,7 +51,8 @@ struct SeedUniforms {
     camera_sample_frac: vec2<f32>,
     refine_max_steps: u32,
     active_ranks: u32,
-    _pad: array<u32, 2>,
+    wind_reach_per_height: f32,
+    _pad: u32,
     height_levels: array<vec4<u32>, MAX_LEVELS>,
     lcc_levels: array<vec4<u32>, 4>,
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
@@ -344,7 +345,12 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     out.count = COUNT_FRUSTUM;
     let sink_m = mul(height_m, u.sink_fraction);
     let base_rel_m = ground_rel_m - sink_m;
-    let radius_m = mul(height_m, species.radius_per_height);
+    // The wind moves no point of a plant farther than this (`seeds::wind`): its bounds grow by it.
+    var sway_m = 0.0;
+    if species.kind != KIND_ROCK {
+        sway_m = mul(height_m, u.wind_reach_per_height);
+    }
+    let radius_m = mul(height_m, species.radius_per_height) + sway_m;
     let centre = to_clip(vec3<f32>(rel_xy, base_rel_m + mul(height_m, 0.5)));
     if centre.w < -radius_m {
         return out;
@@ -358,7 +364,9 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     // Occlusion: the summit's distance against the terrain depth around it (the nearest edge
     // pixels when it is off screen), with the tolerance the coarse far mesh needs.
     out.count = COUNT_OCCLUSION;
-    let summit = to_clip(vec3<f32>(rel_xy, base_rel_m + height_m));
+    // Swaying, the summit may rise into view by as much (and come as much nearer).
+    let summit_rel_z = base_rel_m + height_m + sway_m;
+    let summit = to_clip(vec3<f32>(rel_xy, summit_rel_z));
     if summit.w > u.near_m {
         let px = vec2<i32>(i32(pixel_of(summit.x, summit.w, u.screen_px.x, u.ndc_per_px.x)),
                            i32(pixel_of(-summit.y, summit.w, u.screen_px.y, u.ndc_per_px.y)));
@@ -375,14 +383,14 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
                 nearest = max(nearest, d);
             }
         }
-        let tolerance_m = u.occlusion_tolerance_m + mul(u.occlusion_tolerance_per_m, summit.w);
+        let tolerance_m = u.occlusion_tolerance_m + mul(u.occlusion_tolerance_per_m, summit.w) + sway_m;
         let behind_m = summit.w - tolerance_m;
         var hidden = mul(behind_m, farthest) > u.near_m;
         if !hidden && mul(behind_m, nearest) > u.near_m {
             if u.refine_max_steps == 0u {
                 hidden = mul(behind_m, textureLoad(depth, px, 0)) > u.near_m;
             } else {
-                hidden = dem_blocks(vec3<f32>(rel_xy, base_rel_m + height_m));
+                hidden = dem_blocks(vec3<f32>(rel_xy, summit_rel_z));
             }
         }
         if hidden {

@@ -18,11 +18,13 @@ mod draw_seeds;
 mod seeds;
 mod texcells;
 mod tlm;
+mod wind;
 
 pub use draw_seeds::DrawSeedsSettings;
 pub use seeds::{OcclusionTolerance, SeedSettings};
 pub use texcells::TexcellSettings;
 pub use tlm::TlmSettings;
+pub use wind::{MAX_WIND_M_S, WindSettings};
 
 const DEFAULTS: &str = include_str!("../config/default.toml");
 /// The named presets (`--preset`) and their TOML text, compiled in from `config/presets/`; each is
@@ -122,6 +124,8 @@ pub struct Settings {
     pub draw_seeds: DrawSeedsSettings,
     /// `[texcells]`: the far forest, beyond the last seed band.
     pub texcells: TexcellSettings,
+    /// `[wind]`: how the plants sway.
+    pub wind: WindSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -324,10 +328,19 @@ impl Settings {
         self.seeds.validate()?;
         self.draw_seeds.validate(&self.tlm)?;
         self.texcells.validate(&self.draw_seeds)?;
-        match checks.into_iter().find(|(ok, ..)| !ok) {
-            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
-            None => Ok(()),
-        }
+        self.wind.validate()?;
+        first_out_of_range(checks)
+    }
+}
+
+/// A range check: whether it holds, the full key, its value as text, and the rule in words.
+type RangeCheck = (bool, &'static str, String, &'static str);
+
+/// The first check that fails, as `SettingsError::OutOfRange`.
+fn first_out_of_range(checks: impl IntoIterator<Item = RangeCheck>) -> Result<(), SettingsError> {
+    match checks.into_iter().find(|(ok, ..)| !ok) {
+        Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
+        None => Ok(()),
     }
 }
 

@@ -46,8 +46,13 @@ pub use manifest::{AlphaMode, BoundingSphere, Plane, Submesh};
 pub use mips::{MipChain, TexelRect, build_mip_chain, mip_size};
 pub use store::{is_current, load, models, replace_folder, save};
 
-/// The on-disk format's version: a reader refuses any other.
-pub const FORMAT_VERSION: u32 = 1;
+/// The on-disk format's version: a reader refuses any other. 2: mesh vertices carry their leaf's
+/// pivot (the wind's flutter).
+pub const FORMAT_VERSION: u32 = 2;
+/// The glTF vertex attribute that holds each vertex's leaf pivot ([`MeshVertex::pivot_model_m`]):
+/// an application attribute (glTF names those with a leading underscore), written by the tree
+/// generator and read by the baker.
+pub const PIVOT_ATTRIBUTE: &str = "_PIVOT";
 /// The manifest's name inside a model's folder.
 pub const MANIFEST_FILE: &str = "impostor.toml";
 /// The real mesh's name inside a model's folder.
@@ -178,7 +183,7 @@ impl ImpostorLod {
     }
 }
 
-/// A mesh vertex (`mesh.bin` stores these as they are, 32 bytes each).
+/// A mesh vertex (`mesh.bin` stores these as they are, 44 bytes each).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct MeshVertex {
@@ -188,6 +193,10 @@ pub struct MeshVertex {
     pub normal_model: [f32; 3],
     /// Base-colour texture coordinates ((0, 0) at the image's top left, repeating).
     pub uv: [f32; 2],
+    /// Where the vertex's leaf hangs from its stem, model space: the wind turns the leaf about it
+    /// (`seeds::wind`). The vertex's own position where nothing flutters: bark, rigid parts, and
+    /// every vertex of a model without the glTF attribute `_PIVOT`.
+    pub pivot_model_m: [f32; 3],
 }
 
 /// The real mesh: one vertex buffer, one index buffer, one submesh per material.

@@ -1,5 +1,5 @@
 //! Pass 3 on a synthetic dataset: the GPU equals its CPU twin (read in block-table order, in the
-//! same order too), runs and paths agree, seeds sit on the drawn ground, a too-small output is
+//! same order too; in still air and in wind), runs and paths agree, seeds sit on the drawn ground, a too-small output is
 //! flagged without corrupting what it keeps, and compaction's draw order is the same in every run
 //! and equals its twin's.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
@@ -31,48 +31,57 @@ fn sorted(mut records: Vec<SeedRecord>) -> Vec<SeedRecord> {
 #[test]
 fn gpu_seed_selection_equals_its_cpu_twin() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
-    let mut r = terramp_testkit::renderer(&dataset, terramp_testkit::small_settings(320, 180));
-    for (i, camera) in cameras(&r).iter().enumerate() {
-        r.render_resolved(camera).unwrap();
-        let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
-        let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
-        let diff = SeedComparison::of(&gpu, &twin);
-        println!(
-            "view {i}: {} seeds ({} checked), {} common, max length error {:.2e} m, colour {}/255",
-            twin.len(),
-            twin_counters.checked,
-            diff.common,
-            diff.max_length_error_m,
-            diff.max_colour_error
-        );
-        assert!(twin_counters.checked > 0 && !twin.is_empty(), "view {i} checks no seeds: {twin_counters:?}");
-        assert_eq!(gpu_counters, twin_counters, "view {i}");
-        assert!(diff.only_gpu.is_empty() && diff.only_twin.is_empty(), "view {i}: {diff:?}");
-        assert!(diff.mismatched.is_empty(), "view {i}: {:?}", diff.mismatched);
-        // Same f32 operations in the same order: positions agree to the bit; colours decode
-        // sRGB texels (the driver's table against the formula) and may round one step apart.
-        assert!(diff.non_finite.is_empty(), "view {i}: not finite: {:?}", diff.non_finite);
-        assert_eq!(diff.max_length_error_m, 0.0, "view {i}");
-        // A NaN in one field of one GPU record fails the comparison (`f32::max` would drop it).
-        let mut poisoned = gpu.clone();
-        poisoned[gpu.len() / 2].ground_m = f32::NAN;
-        let bad = SeedComparison::of(&poisoned, &twin);
-        assert!(
-            bad.max_length_error_m.is_nan() && bad.non_finite.len() == 1,
-            "view {i}: {:?}",
-            bad.non_finite
-        );
-        assert!(diff.max_colour_error <= 1, "view {i}: {}", diff.max_colour_error);
-        // Read in block-table order, the GPU's records come in the twin's order, whatever order
-        // the blocks landed in; the block tables agree entry for entry.
-        let output = r.read_seed_output().unwrap().unwrap();
-        let (twin_output, _) = r.compact_twin().unwrap().unwrap();
-        assert_eq!(identities(&output.in_block_order()), identities(&twin), "view {i}");
-        let counts = |o: &terramp::passes::seed_select::frame::SeedOutput| {
-            o.blocks.iter().map(|b| b.count).collect::<Vec<_>>()
-        };
-        assert_eq!(counts(&output), counts(&twin_output), "view {i}");
-        assert_eq!(output.keys.len(), output.records.len());
+    // Still air, and a wind whose sway grows every plant's bounds (rocks' not).
+    for wind_m_s in [0.0, 25.0] {
+        let mut settings = terramp_testkit::small_settings(320, 180);
+        settings.wind.speed_m_s = wind_m_s;
+        let mut r = terramp_testkit::renderer(&dataset, settings);
+        for (i, camera) in cameras(&r).iter().enumerate() {
+            let i = format!("{i} (wind {wind_m_s} m/s)");
+            r.render_resolved(camera).unwrap();
+            let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
+            let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
+            let diff = SeedComparison::of(&gpu, &twin);
+            println!(
+                "view {i}: {} seeds ({} checked), {} common, max length error {:.2e} m, colour {}/255",
+                twin.len(),
+                twin_counters.checked,
+                diff.common,
+                diff.max_length_error_m,
+                diff.max_colour_error
+            );
+            assert!(
+                twin_counters.checked > 0 && !twin.is_empty(),
+                "view {i} checks no seeds: {twin_counters:?}"
+            );
+            assert_eq!(gpu_counters, twin_counters, "view {i}");
+            assert!(diff.only_gpu.is_empty() && diff.only_twin.is_empty(), "view {i}: {diff:?}");
+            assert!(diff.mismatched.is_empty(), "view {i}: {:?}", diff.mismatched);
+            // Same f32 operations in the same order: positions agree to the bit; colours decode
+            // sRGB texels (the driver's table against the formula) and may round one step apart.
+            assert!(diff.non_finite.is_empty(), "view {i}: not finite: {:?}", diff.non_finite);
+            assert_eq!(diff.max_length_error_m, 0.0, "view {i}");
+            // A NaN in one field of one GPU record fails the comparison (`f32::max` would drop it).
+            let mut poisoned = gpu.clone();
+            poisoned[gpu.len() / 2].ground_m = f32::NAN;
+            let bad = SeedComparison::of(&poisoned, &twin);
+            assert!(
+                bad.max_length_error_m.is_nan() && bad.non_finite.len() == 1,
+                "view {i}: {:?}",
+                bad.non_finite
+            );
+            assert!(diff.max_colour_error <= 1, "view {i}: {}", diff.max_colour_error);
+            // Read in block-table order, the GPU's records come in the twin's order, whatever order
+            // the blocks landed in; the block tables agree entry for entry.
+            let output = r.read_seed_output().unwrap().unwrap();
+            let (twin_output, _) = r.compact_twin().unwrap().unwrap();
+            assert_eq!(identities(&output.in_block_order()), identities(&twin), "view {i}");
+            let counts = |o: &terramp::passes::seed_select::frame::SeedOutput| {
+                o.blocks.iter().map(|b| b.count).collect::<Vec<_>>()
+            };
+            assert_eq!(counts(&output), counts(&twin_output), "view {i}");
+            assert_eq!(output.keys.len(), output.records.len());
+        }
     }
 }
 

@@ -2,7 +2,8 @@
 //! (`bake::contact_sheet`, side views on one scale) after a glTF round trip through the baker's
 //! reader, as the demo's first run bakes them. A tree covers fewer texels as its health falls (the
 //! Virtual Forest's health parameter seen, not counted), stands as tall as its mesh, and a bush is
-//! a fraction of a tree. The baker reads a generated tree as written, and the embedded default's
+//! a fraction of a tree. The baker reads a generated tree as written (each leaf's pivot for the
+//! wind too), and the embedded default's
 //! class table names generated trees only.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
@@ -95,6 +96,30 @@ fn the_baker_reads_a_generated_tree_like_any_model() {
     assert_eq!(mesh.indices.len(), tree.mesh.bark.indices.len() + tree.mesh.leaves.indices.len());
     let masked = mesh.materials.iter().filter(|m| m.alpha_mode == terramp::impostor::AlphaMode::Mask).count();
     assert_eq!(masked, 1);
+
+    // Each vertex keeps its leaf's pivot (`_PIVOT`): bark is rigid (its own pivot); every leaf
+    // corner hangs from a point within a leaf's length of it (under 2 m: the pine's tufts are the
+    // longest, 1 m), a quad's corners from one point
+    // (leaves at a twig's very tip share theirs).
+    for submesh in &mesh.submeshes {
+        let leaves =
+            mesh.materials[submesh.material as usize].alpha_mode == terramp::impostor::AlphaMode::Mask;
+        let range = submesh.first_index as usize..(submesh.first_index + submesh.index_count) as usize;
+        let mut pivots = std::collections::HashSet::new();
+        for &i in &mesh.indices[range] {
+            let v = mesh.vertices[i as usize];
+            let reach_m = glam::Vec3::from(v.position_model_m).distance(v.pivot_model_m.into());
+            pivots.insert(v.pivot_model_m.map(f32::to_bits));
+            match leaves {
+                true => assert!(reach_m > 0.0 && reach_m < 2.0, "a leaf corner {reach_m} m from its pivot"),
+                false => assert_eq!(reach_m, 0.0, "a bark vertex off its pivot"),
+            }
+        }
+        if leaves {
+            let (pivots, leaves) = (pivots.len() as u32, tree.mesh.leaf_count);
+            assert!(pivots <= leaves && 2 * pivots > leaves, "{pivots} pivots for {leaves} leaves");
+        }
+    }
 }
 
 #[test]

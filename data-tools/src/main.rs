@@ -67,13 +67,25 @@ struct BakeArgs {
     /// Width and height of each LOD's atlas in texels (a power of two, 64 to 8192).
     #[arg(long, default_value_t = terramp::bake::BakeOptions::default().texels)]
     texels: u32,
+    /// Skip the models already baked into --out in this build's format (resumes a bake; a folder
+    /// of an older format is baked again).
+    #[arg(long)]
+    missing: bool,
 }
 
 fn bake(args: BakeArgs) -> Result<()> {
     let started = Instant::now();
-    if !args.models.is_empty() {
+    let stale = |model: &PathBuf| {
+        let name = model.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        !(args.missing && terramp::impostor::is_current(&args.out, &name))
+    };
+    let models: Vec<PathBuf> = args.models.iter().filter(|m| stale(m)).cloned().collect();
+    if args.missing && models.len() < args.models.len() {
+        println!("{} models already baked in {}", args.models.len() - models.len(), args.out.display());
+    }
+    if !models.is_empty() {
         let options = terramp::bake::BakeOptions { planes: args.planes, texels: args.texels };
-        let reports = terramp::bake::bake_models(None, &args.models, &args.out, &options, true)?;
+        let reports = terramp::bake::bake_models(None, &models, &args.out, &options, true)?;
         println!(
             "baked {} models into {} in {:.1} s",
             reports.len(),

@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 use glam::{Mat3, Mat4, Vec3};
 use thiserror::Error;
 
-use crate::impostor::{AlphaMode, Material, Mesh, MeshVertex, MipChain, Submesh, build_mip_chain};
+use crate::impostor::{
+    AlphaMode, Material, Mesh, MeshVertex, MipChain, PIVOT_ATTRIBUTE, Submesh, build_mip_chain,
+};
 
 /// What makes a model unreadable. The error carrying it names the model's file.
 #[derive(Debug, Error)]
@@ -74,6 +76,13 @@ pub enum ModelError {
     /// A primitive's index count is not a multiple of 3, or an index points past its vertices.
     #[error("unusable glTF model: mesh {mesh}: bad triangle indices")]
     BadIndices {
+        /// The glTF index of the mesh holding the primitive.
+        mesh: usize,
+    },
+    /// A primitive's `_PIVOT` attribute (each vertex's leaf pivot) is not one float VEC3 per
+    /// vertex, or its data lies outside its buffer.
+    #[error("unusable glTF model: mesh {mesh}: _PIVOT is not one float VEC3 per vertex")]
+    BadPivots {
         /// The glTF index of the mesh holding the primitive.
         mesh: usize,
     },
@@ -184,10 +193,21 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
             let mut uvs: Vec<[f32; 2]> =
                 reader.read_tex_coords(set).map(|t| t.into_f32().collect()).unwrap_or_default();
             uvs.resize(positions.len(), [0.0; 2]);
-            vertices.extend(positions.iter().zip(&normals).zip(&uvs).map(|((p, n), uv)| MeshVertex {
+            let pivots = match primitive.get(&gltf::Semantic::Extras(PIVOT_ATTRIBUTE[1..].into())) {
+                Some(accessor) => {
+                    let data = |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice);
+                    let pivots = read_pivots(accessor, positions.len(), data)
+                        .ok_or(ModelError::BadPivots { mesh: mesh.index() })?;
+                    pivots.into_iter().map(|p| world.transform_point3(p)).collect()
+                }
+                None => positions.clone(),
+            };
+            let attributes = positions.iter().zip(&normals).zip(&uvs).zip(&pivots);
+            vertices.extend(attributes.map(|(((p, n), uv), pivot)| MeshVertex {
                 position_model_m: p.to_array(),
                 normal_model: n.to_array(),
                 uv: *uv,
+                pivot_model_m: pivot.to_array(),
             }));
             by_material[material].extend(indices.iter().map(|i| base + i));
         }
@@ -215,6 +235,23 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
         return Err(ModelError::NoTriangles);
     }
     Ok(Mesh { vertices, indices, submeshes, materials })
+}
+
+/// A `_PIVOT` accessor's `count` points, if it holds that many float VEC3s inside its buffer.
+fn read_pivots<'a, 's>(
+    accessor: gltf::Accessor<'a>,
+    count: usize,
+    buffer_data: impl Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+) -> Option<Vec<Vec3>> {
+    use gltf::accessor::{DataType, Dimensions};
+    let float_vec3 = accessor.data_type() == DataType::F32 && accessor.dimensions() == Dimensions::Vec3;
+    // (The reader computes the data's end from the count: a count of 0 must not reach it.)
+    if !float_vec3 || accessor.count() != count || count == 0 {
+        return None;
+    }
+    let points: Vec<Vec3> =
+        gltf::accessor::Iter::<[f32; 3]>::new(accessor, buffer_data)?.map(Vec3::from).collect();
+    (points.len() == count).then_some(points)
 }
 
 /// Area-weighted vertex normals of a triangle list.

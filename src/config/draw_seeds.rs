@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use super::{SettingsError, TlmSettings};
+use super::{SettingsError, TlmSettings, first_out_of_range};
 use crate::gpu::layout::{SEED_LODS, SEED_SAMPLES};
 
 /// Drawing the seeds, see `config/default.toml` `[draw_seeds]`.
@@ -60,9 +60,6 @@ impl DrawSeedsSettings {
                 "1 (alpha test) or 4 (multisampled, coverage from alpha)",
             ),
         ];
-        match checks.into_iter().find(|(ok, ..)| !ok) {
-            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
-            None => Ok(()),
-        }
+        first_out_of_range(checks)
     }
 }

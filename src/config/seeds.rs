@@ -17,7 +17,7 @@ pub struct SeedSettings {
     /// counted as overflow.
     pub capacity: u32,
     /// Margin of the frustum test, NDC units (0 to 1): each side plane moves out by this fraction
-    /// of the half-screen, so swaying seeds at the edge do not pop.
+    /// of the half-screen (the wind's sway grows the spheres themselves, `seeds::wind`).
     pub frustum_epsilon: f64,
     /// Constant part of the summit's occlusion tolerance, metres behind the terrain depth.
     pub occlusion_tolerance_m: f64,

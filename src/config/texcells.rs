@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use super::{DrawSeedsSettings, SettingsError};
+use super::{DrawSeedsSettings, SettingsError, first_out_of_range};
 
 /// The most samples `texcells.silhouette_steps` may ask for.
 pub const SILHOUETTE_MAX_STEPS: u32 = 256;
@@ -80,9 +80,6 @@ impl TexcellSettings {
                 "1 to 256 samples",
             ),
         ];
-        match checks.into_iter().find(|(ok, ..)| !ok) {
-            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
-            None => Ok(()),
-        }
+        first_out_of_range(checks)
     }
 }

@@ -3,8 +3,8 @@
 
 use serde::Deserialize;
 
-use super::SettingsError;
 use super::seeds::OcclusionTolerance;
+use super::{SettingsError, first_out_of_range};
 use crate::gpu::layout::{TLM_MAX_RINGS, TLM_RADIAL_BANDS};
 
 /// The Tile Load Map (pass 1): camera-centred rings of cells, see `passes::tile_load_map`.
@@ -94,9 +94,6 @@ impl TlmSettings {
                 "C⁴ for C corner colours: 1, 16 or 81 (a cell's pattern is its four corners' colours)",
             ),
         ];
-        match checks.into_iter().find(|(ok, ..)| !ok) {
-            Some((_, key, value, rule)) => Err(SettingsError::OutOfRange { key, value, rule }),
-            None => Ok(()),
-        }
+        first_out_of_range(checks)
     }
 }

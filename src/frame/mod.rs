@@ -27,6 +27,7 @@ use crate::passes::tile_load_map::analysis::{LoadMaps, analyse};
 use crate::passes::tile_load_map::frame::{TlmFrame, height_tile_ranges};
 use crate::passes::tile_load_map::gpu::{TileLoadMapPass, TlmBindings};
 use crate::passes::tile_load_map::layout::TlmLayout;
+use crate::seeds::wind::{Wind, WindFrame};
 use crate::streaming::{CacheStats, Loader, LoaderError, TileCache};
 
 mod clearance;
@@ -234,6 +235,8 @@ pub struct Renderer {
     load_maps: Option<LoadMaps>,
     last: Option<LastFrame>,
     frame: u64,
+    /// Wind time of the frames rendered from now on, seconds (`set_wind_time_s`).
+    wind_time_s: f64,
     /// Pass timings of the most recent frame whose timings are in (a frame or two behind).
     last_timings: Vec<PassTiming>,
 }
@@ -292,6 +295,7 @@ impl Renderer {
             load_maps: None,
             last: None,
             frame: 0,
+            wind_time_s: 0.0,
             last_timings: Vec::new(),
         })
     }
@@ -310,6 +314,18 @@ impl Renderer {
     /// The terrain's reversed-Z depth of the last frame (1 near, 0 at infinity), for later passes.
     pub fn depth_texture(&self) -> &wgpu::Texture {
         &self.targets.depth
+    }
+
+    /// Sets the wind time of the frames rendered from now on, seconds (0 at first): a flight's
+    /// frame n is at `settings.wind.time_of_frame_s(n)`, so a frame number shows the same sway.
+    pub fn set_wind_time_s(&mut self, time_s: f64) {
+        self.wind_time_s = time_s;
+    }
+
+    /// The wind's constants for a frame from `camera` at the current wind time.
+    pub fn wind_frame(&self, camera: &Camera) -> WindFrame {
+        let p = camera.position_m;
+        Wind::new(&self.settings.wind).frame(self.wind_time_s, [p.x, p.y])
     }
 
     /// Renders one frame from `camera`.

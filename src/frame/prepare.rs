@@ -179,6 +179,7 @@ impl Renderer {
         terrain: &TerrainUniforms,
         report: &mut FrameReport,
     ) -> Result<(), RenderError> {
+        let wind = self.wind_frame(view.camera);
         let Some(stage) = self.seeds.as_mut() else { return Ok(()) };
         let cells = self.load_maps.as_ref().map_or(&[][..], |m| &m.seed_cells[..]);
         let ranks = stage.tables.active_ranks();
@@ -187,7 +188,7 @@ impl Renderer {
         let frame = stage.prepare(&self.gpu, &inputs)?;
         report.seed_cells = frame.cells.len();
         report.seed_cells_dropped = frame.cells_dropped;
-        stage.prepare_draw(&self.gpu, &self.settings, terrain);
+        stage.prepare_draw(&self.gpu, &self.settings, terrain, &wind);
         (report.seed_species_drawn, report.seed_species_undrawn) = stage.species_counts();
         Ok(())
     }

@@ -26,6 +26,7 @@ use crate::passes::seed_select::frame::{SeedCellRef, SeedFrame, SeedInputs};
 use crate::passes::seed_select::gpu::{SeedSelectPass, SeedSources};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
+use crate::seeds::wind::WindFrame;
 
 use super::{Caches, RenderError, Targets};
 
@@ -147,10 +148,10 @@ impl SeedStage {
         self.draw.as_ref().map_or((0, self.table.species.len()), |(draw, _)| draw.species_counts())
     }
 
-    /// Writes pass 4's constants for this frame (the terrain's matrix, sun and haze).
-    pub fn prepare_draw(&self, gpu: &Gpu, settings: &Settings, terrain: &TerrainUniforms) {
+    /// Writes pass 4's constants for this frame (the terrain's matrix, sun and haze, the wind).
+    pub fn prepare_draw(&self, gpu: &Gpu, settings: &Settings, terrain: &TerrainUniforms, wind: &WindFrame) {
         if let Some((draw, _)) = &self.draw {
-            draw.prepare(&gpu.queue, &draw_uniforms(settings, terrain));
+            draw.prepare(&gpu.queue, &draw_uniforms(settings, terrain, wind));
         }
     }
 
@@ -243,7 +244,7 @@ fn draw_pass(
     targets: &Targets,
 ) -> Result<(DrawSeedsPass, wgpu::BindGroup), RenderError> {
     let impostors = load_impostors(dir, &table.species)?;
-    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors)?;
+    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species)?;
     if settings.draw_seeds.samples > 1 {
         draw = draw.multisampled(&gpu.device, &targets.colour, &targets.depth);
     }

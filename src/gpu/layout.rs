@@ -20,6 +20,13 @@ impl WgslLiteral for u32 {
     }
 }
 
+impl WgslLiteral for f32 {
+    fn wgsl(&self) -> (&'static str, String) {
+        // Debug always writes a decimal point or an exponent: a float literal to WGSL too.
+        ("f32", format!("{self:?}"))
+    }
+}
+
 impl WgslLiteral for i32 {
     fn wgsl(&self) -> (&'static str, String) {
         ("i32", format!("{self}i"))
@@ -331,6 +338,29 @@ wgsl_constants! { draw_constants:
 const _: () = assert!(SEED_GROUPS <= COMPACT_CHUNK, "a lane per group sums or scans a column");
 const _: () = assert!(COMPACT_CHUNK * SEED_GROUPS * 4 <= 16384, "the chunk's table fits workgroup memory");
 
+// --- Wind (`seeds::wind`) ---
+wgsl_constants! { wind_constants:
+    /// Share of a plant's mean lean that gusts take away between their crests (0: no gusts).
+    pub const WIND_GUST_DEPTH: f32 = 0.4;
+    /// A plant's own sway along the wind, as a share of its mean lean.
+    pub const WIND_SWAY_OF_LEAN: f32 = 0.5;
+    /// Its sway across the wind, as a share of its sway along it (an elliptical swing).
+    pub const WIND_CROSS_OF_SWAY: f32 = 0.3;
+    /// The frequency of the swing across the wind, as a multiple of the one along it.
+    pub const WIND_CROSS_HZ_RATIO: f32 = 1.31;
+    /// A plant 1 m tall sways at this frequency, Hz; one H metres tall at this / √H (at most this).
+    pub const WIND_SWAY_HZ_AT_1M: f32 = 2.2;
+    /// A leaf's flutter about its pivot, radians per unit of mean lean (0.36 rad at 10 m/s)...
+    pub const WIND_FLUTTER_RAD_PER_LEAN: f32 = 9.0;
+    /// ... and at most this, radians.
+    pub const WIND_FLUTTER_MAX_RAD: f32 = 0.6;
+    /// A leaf's flutter frequency, Hz, at the slowest; each leaf's lies up to half as much above.
+    pub const WIND_FLUTTER_HZ: f32 = 2.0;
+    /// The farthest a flutter moves a vertex, as a fraction of the plant's height (a bound that
+    /// culling can rely on whatever the model's leaves).
+    pub const WIND_FLUTTER_MAX_PER_HEIGHT: f32 = 0.02;
+}
+
 // --- Texcells ---
 wgsl_constants! { texcell_constants:
     /// Most forest samples (dense classes with a baked sample) a renderer draws: the class
@@ -398,6 +428,7 @@ pub fn wgsl_constants() -> Vec<(&'static str, &'static str, String)> {
         seed_constants(),
         draw_constants(),
         texcell_constants(),
+        wind_constants(),
     ]
     .concat()
 }

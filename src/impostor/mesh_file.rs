@@ -1,5 +1,5 @@
 //! How it works: `mesh.bin` is a 24-byte header, then the vertices as [`MeshVertex`] structs
-//! (32 bytes each), then the `u32` indices, all little-endian (the layout of every target terramp
+//! (44 bytes each), then the `u32` indices, all little-endian (the layout of every target terramp
 //! builds for). The header holds the magic `TRMPMESH`, the format version, both counts and a
 //! CRC-32 of everything after it, so a truncated or damaged file is an error naming it, never
 //! garbage on the GPU.

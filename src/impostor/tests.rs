@@ -29,8 +29,12 @@ fn sample() -> Impostor {
     };
     let rects =
         [TexelRect { x: 0, y: 0, width: 8, height: 8 }, TexelRect { x: 8, y: 0, width: 8, height: 8 }];
-    let vertex =
-        |p: [f32; 3]| MeshVertex { position_model_m: p, normal_model: [0.0, 0.0, 1.0], uv: [p[0], p[1]] };
+    let vertex = |p: [f32; 3]| MeshVertex {
+        position_model_m: p,
+        normal_model: [0.0, 0.0, 1.0],
+        uv: [p[0], p[1]],
+        pivot_model_m: p,
+    };
     Impostor {
         name: "Quads".into(),
         bounding_sphere: BoundingSphere { centre_model_m: [1.0, 0.5, 0.0], radius_m: 1.2 },
@@ -76,7 +80,11 @@ fn other_versions_and_damaged_meshes_are_named() {
     let folder = save(&dir, &sample()).unwrap();
     let manifest = folder.join(MANIFEST_FILE);
     let text = std::fs::read_to_string(&manifest).unwrap();
-    std::fs::write(&manifest, text.replace("format_version = 1", "format_version = 99")).unwrap();
+    std::fs::write(
+        &manifest,
+        text.replace(&format!("format_version = {FORMAT_VERSION}"), "format_version = 99"),
+    )
+    .unwrap();
     let error = load(&dir, "Quads").unwrap_err();
     assert!(matches!(error, ImpostorError::Version { found: 99, .. }), "{error}");
     assert!(!is_current(&dir, "Quads") && !is_current(&dir, "Absent"));

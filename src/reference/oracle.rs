@@ -8,9 +8,11 @@
 //! (i, j) at grid (i·spacing, j·spacing)), each cell split into two triangles as the mesh splits
 //! it (`dataset::surface`); a seed's slope is that triangle's gradient. Its class is the level-1
 //! land-cover texel under it, the land-cover grid starting half a spacing south-west of grid
-//! space's origin. Its bounding sphere (centred half-way up its sunk trunk) must reach the inner
-//! side of each of the five planes of the view (left, right, bottom, top, near). Occlusion is
-//! exact: the eye→summit segment (bar its last 1e-6) must never pass strictly below that ground.
+//! space's origin. Its bounding sphere (centred half-way up its sunk trunk, grown for a plant by
+//! how far the wind moves it: pass 3's rule, `seeds::wind`) must reach the inner side of each of
+//! the five planes of the view (left, right, bottom, top, near). Occlusion is exact: the
+//! eye→summit segment (bar its last 1e-6; the summit raised by the same sway) must never pass
+//! strictly below that ground.
 //! The walk visits the DEM cells the segment's horizontal projection crosses, in order (2D DDA,
 //! each crossing's parameter computed directly, so no error accumulates); in a cell the ground
 //! along the segment is linear on each side of the cell's diagonal and the segment's height
@@ -31,7 +33,9 @@ use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::{Dataset, PackError};
 use crate::gpu::gpu_types::SeedSpecies;
+use crate::gpu::layout::KIND_ROCK;
 use crate::seeds::patterns::SeedPatterns;
+use crate::seeds::wind::Wind;
 use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, species_of_rank};
 use ground::{DemWindow, LandcoverTiles};
 
@@ -274,7 +278,18 @@ impl ViewFrame {
         let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= extent_m[0] && p.y <= extent_m[1];
         // An eye below the ground sees nothing (every seed reaching the occlusion test is hidden).
         let eye_underground = inside(eye.truncate()) && eye.z < dem.ground(eye.truncate()).0;
-        Ok(View { inputs, culls, dem, landcover, planes, eye, eye_underground, extent_m })
+        let wind_reach_per_height = Wind::new(&inputs.settings.wind).reach_per_height();
+        Ok(View {
+            inputs,
+            culls,
+            dem,
+            landcover,
+            planes,
+            eye,
+            eye_underground,
+            extent_m,
+            wind_reach_per_height,
+        })
     }
 }
 
@@ -336,6 +351,8 @@ struct View<'a> {
     eye: DVec3,
     eye_underground: bool,
     extent_m: [f64; 2],
+    /// How far the wind moves a plant's points at most, per metre of its height (pass 3's).
+    wind_reach_per_height: f64,
 }
 
 impl View<'_> {
@@ -406,10 +423,12 @@ impl View<'_> {
         let Some(lod) = lod else {
             return Ok(Fate::Distance);
         };
-        if !self.in_frustum(species, rel, height_m) {
+        let sway_m = self.sway_m(species, height_m);
+        if !self.in_frustum(species, rel, height_m, sway_m) {
             return Ok(Fate::Frustum);
         }
-        let summit = DVec3::new(p.x, p.y, ground_m - seeds.sink_fraction * height_m + height_m);
+        // Pass 3's rule: swaying, the summit may rise into view by as far as the wind moves it.
+        let summit = DVec3::new(p.x, p.y, ground_m - seeds.sink_fraction * height_m + height_m + sway_m);
         if self.culls.occlusion
             && (self.eye_underground
                 || self.dem.min_clearance_m(self.eye, summit, 1.0 - SEGMENT_END_SKIP, true) < 0.0)
@@ -427,12 +446,17 @@ impl View<'_> {
         }))
     }
 
-    /// Whether the bounding sphere of a seed whose ground point is `ground_rel_m` from the eye
-    /// reaches inside every plane of the view.
-    fn in_frustum(&self, species: &SeedSpecies, ground_rel_m: DVec3, height_m: f64) -> bool {
+    /// How far the wind moves any point of a seed of `species` `height_m` tall (none for rocks).
+    fn sway_m(&self, species: &SeedSpecies, height_m: f64) -> f64 {
+        if species.kind == KIND_ROCK { 0.0 } else { height_m * self.wind_reach_per_height }
+    }
+
+    /// Whether the bounding sphere of a seed whose ground point is `ground_rel_m` from the eye,
+    /// grown by its sway `sway_m`, reaches inside every plane of the view.
+    fn in_frustum(&self, species: &SeedSpecies, ground_rel_m: DVec3, height_m: f64, sway_m: f64) -> bool {
         let sink_fraction = self.inputs.settings.seeds.sink_fraction;
         let centre = ground_rel_m + DVec3::Z * (height_m * (0.5 - sink_fraction));
-        let radius_m = height_m * f64::from(species.radius_per_height);
+        let radius_m = height_m * f64::from(species.radius_per_height) + sway_m;
         self.planes.iter().all(|plane| plane.truncate().dot(centre) + plane.w >= -radius_m)
     }
 }

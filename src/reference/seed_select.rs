@@ -16,8 +16,8 @@ use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedU
 use crate::gpu::layout::{
     COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_OVERFLOW, COUNT_RULE,
     COUNT_SELECTED, GROUND_SAMPLES, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_TILE_TEXELS,
-    LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS,
-    SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group,
+    KIND_ROCK, LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX,
+    SEED_COUNTERS, SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group,
 };
 use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
 use crate::seeds::{SeedTables, pcg, seed_hash, unit};
@@ -416,7 +416,8 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
 
     let sink_m = height_m * u.sink_fraction;
     let base_rel_m = ground_rel_m - sink_m;
-    let radius_m = height_m * species.radius_per_height;
+    let sway_m = if species.kind == KIND_ROCK { 0.0 } else { height_m * u.wind_reach_per_height };
+    let radius_m = height_m * species.radius_per_height + sway_m;
     let centre = to_clip(u, [rel_xy[0], rel_xy[1], base_rel_m + height_m * 0.5]);
     if centre[3] < -radius_m {
         return Err(COUNT_FRUSTUM);
@@ -428,7 +429,8 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         return Err(COUNT_FRUSTUM);
     }
 
-    let summit = to_clip(u, [rel_xy[0], rel_xy[1], base_rel_m + height_m]);
+    let summit_rel_z = base_rel_m + height_m + sway_m;
+    let summit = to_clip(u, [rel_xy[0], rel_xy[1], summit_rel_z]);
     if summit[3] > u.near_m {
         let px = pixel_of(summit[0], summit[3], u.screen_px[0], u.ndc_per_px[0]);
         let py = pixel_of(-summit[1], summit[3], u.screen_px[1], u.ndc_per_px[1]);
@@ -446,14 +448,14 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
                 nearest = nearest.max(d);
             }
         }
-        let tolerance_m = u.occlusion_tolerance_m + u.occlusion_tolerance_per_m * summit[3];
+        let tolerance_m = u.occlusion_tolerance_m + u.occlusion_tolerance_per_m * summit[3] + sway_m;
         let behind_m = summit[3] - tolerance_m;
         let mut hidden = behind_m * farthest > u.near_m;
         if !hidden && behind_m * nearest > u.near_m {
             hidden = if u.refine_max_steps == 0 {
                 behind_m * depth_at(px as i32, py as i32) > u.near_m
             } else {
-                dem_blocks(u, inputs.heights, [rel_xy[0], rel_xy[1], base_rel_m + height_m])
+                dem_blocks(u, inputs.heights, [rel_xy[0], rel_xy[1], summit_rel_z])
             };
         }
         if hidden {

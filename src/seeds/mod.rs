@@ -15,6 +15,7 @@
 
 pub mod patterns;
 pub mod spacing;
+pub mod wind;
 
 use thiserror::Error;
 

@@ -21,7 +21,7 @@ use crate::truth::{Truth, TruthOptions, TruthRenderer};
 fn world_key(s: &Settings) -> String {
     let (t, seeds) = (&s.tlm, &s.seeds);
     format!(
-        "{}|{}|{}|{}|{}|{}|{}|{}x{}|{}",
+        "{}|{}|{}|{}|{}|{}|{}|{}x{}|{}|{}|{}",
         t.cell_m,
         t.patterns,
         t.seed,
@@ -31,7 +31,9 @@ fn world_key(s: &Settings) -> String {
         seeds.ground_colour_radius_m,
         s.render.width,
         s.render.height,
-        s.render.fov_deg
+        s.render.fov_deg,
+        s.wind.speed_m_s,
+        s.wind.from_deg
     )
 }
 
@@ -69,6 +71,7 @@ impl Truths {
             for (i, camera) in flight.popping.iter().enumerate() {
                 let n = flight.popping.len();
                 progress(Progress::Step(&format!("truth: popping flight, frame {} of {n}", i + 1)));
+                renderer.set_wind_time_s(reference.wind.time_of_frame_s(i));
                 truths.flight.push(renderer.render(camera)?.colour);
             }
         }

@@ -1,6 +1,6 @@
 //! How it works: a small glTF 2.0 binary writer for what the generator makes: one mesh of
-//! indexed triangle primitives (positions with their bounds, normals, texture coordinates, u32
-//! indices), each with a material whose base colour is an embedded PNG (sampled with repeat and
+//! indexed triangle primitives (positions with their bounds, normals, texture coordinates, each
+//! vertex's leaf pivot as the application attribute `_PIVOT`, u32 indices), each with a material whose base colour is an embedded PNG (sampled with repeat and
 //! trilinear filtering), opaque or alpha-masked, one- or two-sided; one node, one scene. The JSON
 //! chunk comes first, then the binary chunk holding every buffer view back to back, each 4-byte
 //! aligned, as the specification requires; both chunks are padded to 4 bytes (JSON with spaces,
@@ -10,6 +10,7 @@
 use serde_json::{Value, json};
 
 use super::mesh::Part;
+use crate::impostor::PIVOT_ATTRIBUTE;
 
 /// How a material's alpha is used.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,6 +89,7 @@ pub fn write(name: &str, primitives: &[(&Part, Material)]) -> Vec<u8> {
         );
         let normal = accessor(bytemuck::cast_slice(&part.normals), ARRAY_BUFFER, n, "VEC3", FLOAT, json!({}));
         let uv = accessor(bytemuck::cast_slice(&part.uvs), ARRAY_BUFFER, n, "VEC2", FLOAT, json!({}));
+        let pivot = accessor(bytemuck::cast_slice(&part.pivots), ARRAY_BUFFER, n, "VEC3", FLOAT, json!({}));
         let indices = accessor(
             bytemuck::cast_slice(&part.indices),
             ELEMENT_ARRAY_BUFFER,
@@ -96,8 +98,10 @@ pub fn write(name: &str, primitives: &[(&Part, Material)]) -> Vec<u8> {
             UNSIGNED_INT,
             json!({}),
         );
+        let mut attributes = json!({ "POSITION": position, "NORMAL": normal, "TEXCOORD_0": uv });
+        attributes[PIVOT_ATTRIBUTE] = json!(pivot);
         gltf_primitives.push(json!({
-            "attributes": { "POSITION": position, "NORMAL": normal, "TEXCOORD_0": uv },
+            "attributes": attributes,
             "indices": indices,
             "material": index,
             "mode": 4,

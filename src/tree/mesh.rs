@@ -18,7 +18,7 @@ use super::grow::{Grown, Leaf, Tube};
 /// Bark texture: texels around the stem and along it (along is twice around).
 pub const BARK_TEXELS: [u32; 2] = [64, 128];
 
-/// One triangle list: positions (metres, +Y up), normals, texture coordinates, indices.
+/// One triangle list: positions (metres, +Y up), normals, texture coordinates, pivots, indices.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Part {
     /// Vertex positions, metres.
@@ -27,6 +27,9 @@ pub struct Part {
     pub normals: Vec<[f32; 3]>,
     /// Texture coordinates (glTF: v down the image).
     pub uvs: Vec<[f32; 2]>,
+    /// Where each vertex's leaf hangs from its stem (the wind turns the leaf about it); the vertex
+    /// itself for bark (glTF: `_PIVOT`, `bake::model::PIVOT_ATTRIBUTE`).
+    pub pivots: Vec<[f32; 3]>,
     /// Triangle indices into the vertices.
     pub indices: Vec<u32>,
 }
@@ -37,9 +40,12 @@ impl Part {
         self.indices.len() / 3
     }
 
-    fn push(&mut self, position: Vec3, normal: Vec3, uv: [f32; 2]) -> u32 {
+    /// A vertex whose leaf hangs from `pivot` (`None`: rigid, the vertex itself).
+    fn push(&mut self, position: Vec3, normal: Vec3, uv: [f32; 2], pivot: Option<Vec3>) -> u32 {
         let index = self.positions.len() as u32;
-        self.positions.push([position.x, position.y.max(0.0), position.z]);
+        let on_ground = |p: Vec3| [p.x, p.y.max(0.0), p.z];
+        self.positions.push(on_ground(position));
+        self.pivots.push(on_ground(pivot.unwrap_or(position)));
         self.normals.push(normal.normalize_or(Vec3::Y).to_array());
         self.uvs.push(uv);
         index
@@ -108,7 +114,8 @@ fn tube_mesh(part: &mut Part, tube: &Tube) {
         for i in 0..=sides {
             let angle = TAU * i as f32 / sides as f32;
             let outward = frame * Vec3::new(angle.cos(), 0.0, angle.sin());
-            part.push(centre + outward * radius, outward, [i as f32 / sides as f32, along_m * v_per_m]);
+            let uv = [i as f32 / sides as f32, along_m * v_per_m];
+            part.push(centre + outward * radius, outward, uv, None);
         }
         if k > 0 {
             for i in 0..sides {
@@ -140,7 +147,7 @@ fn leaf_quad(part: &mut Part, leaf: &Leaf) {
     ];
     let first = part.positions.len() as u32;
     for (position, uv) in corners {
-        part.push(position, normal, uv);
+        part.push(position, normal, uv, Some(leaf.base));
     }
     part.indices.extend_from_slice(&[first, first + 1, first + 2, first, first + 2, first + 3]);
 }

@@ -201,6 +201,11 @@ impl TruthRenderer {
         Ok(Self { renderer, meshes: MeshDrawer::new(impostors), options: options.clone() })
     }
 
+    /// Sets the wind time of the truths rendered from now on (`Renderer::set_wind_time_s`).
+    pub fn set_wind_time_s(&mut self, time_s: f64) {
+        self.renderer.set_wind_time_s(time_s);
+    }
+
     /// The truth of the view from `camera`.
     pub fn render(&mut self, camera: &Camera) -> Result<Truth, TruthError> {
         let renderer = &mut self.renderer;
@@ -251,7 +256,7 @@ impl MeshDrawer {
                     return Err(TruthError::NoImpostors);
                 }
                 let impostors = load_impostors(&self.dir, species)?;
-                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors)?;
+                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species)?;
                 let pipeline = draw.truth_pipeline(&gpu.device);
                 (draw, pipeline)
             }
@@ -314,7 +319,7 @@ fn draw_seeds(
         let (gpu, settings) = (&renderer.gpu, &renderer.settings);
         let dir = meshes.dir.clone();
         let (draw, pipeline) = meshes.get(gpu, &table.species)?;
-        let mut uniforms = draw_uniforms(settings, canvas.terrain);
+        let mut uniforms = draw_uniforms(settings, canvas.terrain, &renderer.wind_frame(camera));
         uniforms.draw_reach_m = [NO_FADE_REACH_M; 4];
         draw.prepare(&gpu.queue, &uniforms);
         let mut draws = Vec::new();

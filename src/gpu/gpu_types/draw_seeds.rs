@@ -27,6 +27,22 @@ gpu_struct! {
         pub fade_fraction: f32,
         /// How much of the ground colour the seeds take on (0 to 1).
         pub ground_blend: f32,
+        /// The wind (`seeds::wind::WindFrame::wind`): downwind unit vector (xy), a top's mean lean
+        /// and sway per metre of height (zw); lean 0: still air, no vertex moves.
+        pub wind: [f32; 4],
+        /// Wind time, seconds (x), the gusts' wavenumber per metre (y) and phase at the camera (z).
+        pub wind_wave: [f32; 4],
+    }
+}
+
+gpu_struct! {
+    /// What pass 4 knows of a species besides its geometry. WGSL: `SeedShape`.
+    #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+    pub struct SeedShape {
+        /// 1 / the model's height (top above base), per metre; 0 for species not drawn.
+        pub inv_model_height_m: f32,
+        /// How much the wind bends it (`seeds::wind::bend_of`): 1 a plant, 0 a rock.
+        pub wind_bend: f32,
     }
 }
 
@@ -63,5 +79,8 @@ gpu_struct! {
         pub uv: [f32; 2],
         /// Index into the draw pass's `SeedMaterial` table.
         pub material: u32,
+        /// Where the vertex's leaf hangs, model space (`MeshVertex::pivot_model_m`): the wind turns
+        /// the leaf about it; the vertex itself where nothing flutters (bark, billboard clouds).
+        pub pivot_model_m: [f32; 3],
     }
 }

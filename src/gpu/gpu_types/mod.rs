@@ -12,7 +12,7 @@ mod texcells;
 mod tile_load_map;
 
 pub use compact::{CompactParams, SeedBlock, SeedDrawArgs};
-pub use draw_seeds::{DrawSeedsUniforms, SeedMaterial, SeedVertex};
+pub use draw_seeds::{DrawSeedsUniforms, SeedMaterial, SeedShape, SeedVertex};
 pub use seed_select::{SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms};
 pub use terrain::{TerrainNode, TerrainUniforms};
 pub use texcells::{TexcellRecord, TexcellUniforms};
@@ -40,6 +40,7 @@ pub fn layouts() -> Vec<StructLayout> {
         CompactParams::layout(),
         DrawSeedsUniforms::layout(),
         SeedMaterial::layout(),
+        SeedShape::layout(),
         TexcellUniforms::layout(),
         TexcellRecord::layout(),
     ]

@@ -81,8 +81,12 @@ gpu_struct! {
         pub refine_max_steps: u32,
         /// Ranks checked per cell: none beyond the densest class's last rank limit grows anything.
         pub active_ranks: u32,
+        /// The farthest the wind moves any point of a plant, per metre of its height
+        /// (`seeds::wind::Wind::reach_per_height`): plants' spheres grow by it, and their summits
+        /// rise and come nearer by it, so a swaying crown is never culled; 0 in still air.
+        pub wind_reach_per_height: f32,
         /// Padding to the WGSL struct's alignment (always 0).
-        pub _pad: [u32; 2],
+        pub _pad: u32,
         /// Page tables per level (first entry, tiles along x, tiles along y, 0).
         pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
         /// The land-cover page table per LCC level, laid out as `height_levels` (0 without land

@@ -115,11 +115,13 @@ pub fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsErr
                 lod: k as u32 + 1,
                 flags: MATERIAL_TEXTURED,
             });
+            // A plane's texels are baked leaves: it bends with the plant, nothing flutters.
             let vertices = level.vertices().into_iter().map(|v| SeedVertex {
                 position_model_m: v.position_model_m,
                 normal_model: v.normal_model,
                 uv: v.uv_atlas,
                 material,
+                pivot_model_m: v.position_model_m,
             });
             lods[k + 1] = out.push(vertices, &level.indices());
         }
@@ -173,6 +175,7 @@ fn push_mesh(out: &mut SeedAssets, impostor: &Impostor) -> SeedDrawArgs {
                     normal_model: v.normal_model,
                     uv: v.uv,
                     material,
+                    pivot_model_m: v.pivot_model_m,
                 });
                 vertices.len() as u32 - 1
             });

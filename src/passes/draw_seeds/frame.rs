@@ -7,6 +7,7 @@ use crate::classes::Species;
 use crate::config::Settings;
 use crate::gpu::gpu_types::{DrawSeedsUniforms, TerrainUniforms};
 use crate::impostor::{Impostor, MANIFEST_FILE};
+use crate::seeds::wind::WindFrame;
 
 use super::DrawSeedsError;
 
@@ -34,8 +35,8 @@ pub fn load_impostors(dir: &Path, species: &[Species]) -> Result<Vec<Option<Impo
     Ok(loaded)
 }
 
-/// The frame's constants from the settings and the terrain's matrix, sun and haze.
-pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms) -> DrawSeedsUniforms {
+/// The frame's constants from the settings, the terrain's matrix, sun and haze, and the wind.
+pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &WindFrame) -> DrawSeedsUniforms {
     DrawSeedsUniforms {
         clip_from_view_world: terrain.clip_from_view_world,
         sun_dir: terrain.sun_dir,
@@ -45,5 +46,7 @@ pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms) -> DrawSeed
         sink_fraction: settings.seeds.sink_fraction as f32,
         fade_fraction: settings.draw_seeds.fade_fraction as f32,
         ground_blend: GROUND_BLEND,
+        wind: wind.wind,
+        wind_wave: wind.wave,
     }
 }

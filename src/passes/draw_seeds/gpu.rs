@@ -7,14 +7,18 @@ use std::ops::Range;
 use bytemuck::Zeroable;
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
+use crate::classes::Species;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
-use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedVertex};
+use crate::gpu::gpu_types::{
+    DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedShape, SeedVertex,
+};
 use crate::gpu::layout::SEED_LODS;
 use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
-use crate::gpu::shaders::{DITHER, SEED_RECORD, WgslSource};
+use crate::gpu::shaders::{DITHER, HASH, SEED_RECORD, WIND, WgslSource};
 use crate::gpu::struct_layout::GpuLayout;
 use crate::impostor::{Impostor, mip_size};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
+use crate::seeds::wind::bend_of;
 
 use super::DrawSeedsError;
 use super::assets;
@@ -25,18 +29,18 @@ pub mod multisample;
 /// Pass 4's shader.
 pub const SHADER: WgslSource = WgslSource {
     name: "draw_seeds",
-    parts: &[SEED_RECORD, DITHER, include_str!("../../../shaders/draw_seeds.wgsl")],
+    parts: &[SEED_RECORD, DITHER, HASH, WIND, include_str!("../../../shaders/draw_seeds.wgsl")],
 };
 
 /// Pass 4's bindings: the frame's constants, pass 3's records through compaction's order, and the
-/// species' scales, materials and textures.
+/// species' shapes (scale, bend), materials and textures.
 pub const BINDINGS: BindingTable<8> = BindingTable {
     label: "draw_seeds",
     bindings: [
         Binding::uniform::<DrawSeedsUniforms>(0, "u", Stage::VERTEX_FRAGMENT),
         Binding::storage_array::<SeedRecord>(1, "records", Stage::VERTEX, Access::Read),
         Binding::storage_array::<u32>(2, "order", Stage::VERTEX, Access::Read),
-        Binding::storage_array::<f32>(3, "inv_model_height_m", Stage::VERTEX, Access::Read),
+        Binding::storage_array::<SeedShape>(3, "shapes", Stage::VERTEX, Access::Read),
         Binding::storage_array::<SeedMaterial>(4, "materials", Stage::VERTEX_FRAGMENT, Access::Read),
         Binding::texture(
             5,
@@ -83,11 +87,13 @@ pub struct DrawSeedsPass {
 }
 
 impl DrawSeedsPass {
-    /// Uploads the species' impostors (`None`: not drawn) and builds the pipeline.
+    /// Uploads the impostors of `species` (by species index; `None`: not drawn) and builds the
+    /// pipeline.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         impostors: &[Option<Impostor>],
+        species: &[Species],
     ) -> Result<Self, DrawSeedsError> {
         if !device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE) {
             return Err(DrawSeedsError::NoFirstInstance);
@@ -142,6 +148,12 @@ impl DrawSeedsPass {
         let pipeline =
             pipeline(device, &layout, "fs_main", &[Some(COLOUR_FORMAT.into())], Default::default());
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
+        let shapes: Vec<SeedShape> = (built.inv_model_height_m.iter().enumerate())
+            .map(|(i, &inv_model_height_m)| SeedShape {
+                inv_model_height_m,
+                wind_bend: species.get(i).map_or(0.0, |s| bend_of(s.kind)),
+            })
+            .collect();
         Ok(Self {
             pipeline,
             layout,
@@ -152,11 +164,7 @@ impl DrawSeedsPass {
                 wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             ),
             materials: buffer_of("seed materials", &materials, storage),
-            species: buffer_of(
-                "seed species scale",
-                bytemuck::cast_slice(&built.inv_model_height_m),
-                storage,
-            ),
+            species: buffer_of("seed species shapes", bytemuck::cast_slice(&shapes), storage),
             vertices: buffer_of("seed vertices", &vertices, wgpu::BufferUsages::VERTEX),
             indices: buffer_of("seed indices", &indices, wgpu::BufferUsages::INDEX),
             texture_view,

@@ -19,8 +19,12 @@ fn impostor(name: &str, planes: [usize; 3], sizes: [u32; 3], with_mesh: bool) ->
         uv_min: [0.0, 0.0],
         uv_max: [1.0, 1.0],
     };
-    let vertex =
-        |y: f32| MeshVertex { position_model_m: [0.0, y, 0.0], normal_model: [0.0; 3], uv: [0.0; 2] };
+    let vertex = |y: f32| MeshVertex {
+        position_model_m: [0.0, y, 0.0],
+        normal_model: [0.0; 3],
+        uv: [0.0; 2],
+        pivot_model_m: [0.0, y, 0.0],
+    };
     let material = |texture: Option<MipChain>| Material {
         name: "m".into(),
         base_color_factor: [0.5, 0.6, 0.7, 1.0],

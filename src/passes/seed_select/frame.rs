@@ -8,6 +8,7 @@ use crate::config::Settings;
 use crate::dataset::Dataset;
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{LCC_LEVELS, MAX_LEVELS};
+use crate::seeds::wind::Wind;
 use crate::seeds::{max_cells, workgroups_per_cell};
 use crate::streaming::page_levels;
 
@@ -137,7 +138,8 @@ impl SeedFrame {
             camera_sample_frac: [0.0; 2],
             refine_max_steps: seeds.occlusion_refine_steps,
             active_ranks: inputs.active_ranks.min(seeds.seeds_per_pattern),
-            _pad: [0; 2],
+            wind_reach_per_height: Wind::new(&s.wind).reach_per_height() as f32,
+            _pad: 0,
             height_levels: page_levels(&dataset.height.pyramid),
             lcc_levels: [[0; 4]; 4],
             imagery_levels: [[0; 4]; MAX_LEVELS as usize],
