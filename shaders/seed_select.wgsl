@@ -78,7 +78,7 @@ struct SeedSpecies {
     max_slope_tan_sq: f32,
     radius_per_height: f32,
     kind: u32,
-    _pad: u32,
+    wind_bend: f32,
 }
 
 struct SeedClass {
@@ -346,10 +346,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     let sink_m = mul(height_m, u.sink_fraction);
     let base_rel_m = ground_rel_m - sink_m;
     // The wind moves no point of a plant farther than this (`seeds::wind`): its bounds grow by it.
-    var sway_m = 0.0;
-    if species.kind != KIND_ROCK {
-        sway_m = mul(height_m, u.wind_reach_per_height);
-    }
+    let sway_m = mul(height_m, mul(species.wind_bend, u.wind_reach_per_height));
     let radius_m = mul(height_m, species.radius_per_height) + sway_m;
     let centre = to_clip(vec3<f32>(rel_xy, base_rel_m + mul(height_m, 0.5)));
     if centre.w < -radius_m {

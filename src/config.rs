@@ -262,7 +262,7 @@ impl Settings {
         let r = &self.render;
         let t = &self.terrain;
         let c = &self.cache;
-        let checks: [(bool, &'static str, String, &'static str); 13] = [
+        let checks: [RangeCheck; 13] = [
             (r.width >= 1 && r.width <= 16384, "render.width", r.width.to_string(), "1 to 16384 pixels"),
             (r.height >= 1 && r.height <= 16384, "render.height", r.height.to_string(), "1 to 16384 pixels"),
             (

@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use super::{SettingsError, TlmSettings, first_out_of_range};
+use super::{RangeCheck, SettingsError, TlmSettings, first_out_of_range};
 use crate::gpu::layout::{SEED_LODS, SEED_SAMPLES};
 
 /// Drawing the seeds, see `config/default.toml` `[draw_seeds]`.
@@ -31,7 +31,7 @@ impl DrawSeedsSettings {
     pub(super) fn validate(&self, tlm: &TlmSettings) -> Result<(), SettingsError> {
         let r = self.reach_m;
         let last_band = tlm.radial_bands_m[tlm.radial_bands_m.len() - 1];
-        let checks: [(bool, &'static str, String, &'static str); 4] = [
+        let checks: [RangeCheck; 4] = [
             (
                 r[0] >= 0.0
                     && r[1] > 0.0

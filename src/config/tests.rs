@@ -120,7 +120,7 @@ fn builtin_class_tables_fit_every_preset() {
 #[test]
 fn the_wind_is_still_by_default_and_its_ranges_are_checked() {
     let d = Settings::default().wind;
-    assert!(!d.blowing(), "the accuracy tests and the trade run in still air");
+    assert_eq!(d.speed_m_s, 0.0, "the accuracy tests and the trade run in still air");
     assert_eq!(d.time_of_frame_s(90), 90.0 / d.frame_rate_hz);
     for (bad, key) in [
         ("speed_m_s = -1.0", "wind.speed_m_s"),
@@ -132,5 +132,5 @@ fn the_wind_is_still_by_default_and_its_ranges_are_checked() {
         assert!(err.contains(key), "{bad}: {err}");
     }
     let w = with("[wind]\nspeed_m_s = 12\nfrom_deg = 90\n").unwrap().wind;
-    assert!(w.blowing() && w.from_deg == 90.0);
+    assert!(w.speed_m_s == 12.0 && w.from_deg == 90.0);
 }

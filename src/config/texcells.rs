@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use super::{DrawSeedsSettings, SettingsError, first_out_of_range};
+use super::{DrawSeedsSettings, RangeCheck, SettingsError, first_out_of_range};
 
 /// The most samples `texcells.silhouette_steps` may ask for.
 pub const SILHOUETTE_MAX_STEPS: u32 = 256;
@@ -42,7 +42,7 @@ impl TexcellSettings {
 
     pub(super) fn validate(&self, draw: &DrawSeedsSettings) -> Result<(), SettingsError> {
         let last = draw.reach_m[draw.reach_m.len() - 1];
-        let checks: [(bool, &'static str, String, &'static str); 6] = [
+        let checks: [RangeCheck; 6] = [
             (
                 self.reach_m == 0.0 || (self.reach_m.is_finite() && self.reach_m > last),
                 "texcells.reach_m",

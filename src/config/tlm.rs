@@ -4,7 +4,7 @@
 use serde::Deserialize;
 
 use super::seeds::OcclusionTolerance;
-use super::{SettingsError, first_out_of_range};
+use super::{RangeCheck, SettingsError, first_out_of_range};
 use crate::gpu::layout::{TLM_MAX_RINGS, TLM_RADIAL_BANDS};
 
 /// The Tile Load Map (pass 1): camera-centred rings of cells, see `passes::tile_load_map`.
@@ -50,7 +50,7 @@ impl TlmSettings {
 
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
         let r = self.radial_bands_m;
-        let checks: [(bool, &'static str, String, &'static str); 7] = [
+        let checks: [RangeCheck; 7] = [
             (
                 self.cell_m.is_finite() && self.cell_m >= 1.0,
                 "tlm.cell_m",

@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use super::{SettingsError, first_out_of_range};
+use super::{RangeCheck, SettingsError, first_out_of_range};
 
 /// The fastest wind `wind.speed_m_s` accepts, metres per second (a storm).
 pub const MAX_WIND_M_S: f64 = 40.0;
@@ -22,18 +22,13 @@ pub struct WindSettings {
 }
 
 impl WindSettings {
-    /// Whether anything moves.
-    pub fn blowing(&self) -> bool {
-        self.speed_m_s > 0.0
-    }
-
     /// Wind time of a flight's frame `n`, seconds.
     pub fn time_of_frame_s(&self, n: usize) -> f64 {
         n as f64 / self.frame_rate_hz
     }
 
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
-        let checks: [(bool, &'static str, String, &'static str); 3] = [
+        let checks: [RangeCheck; 3] = [
             (
                 (0.0..=MAX_WIND_M_S).contains(&self.speed_m_s),
                 "wind.speed_m_s",

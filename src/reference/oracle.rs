@@ -33,7 +33,6 @@ use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::{Dataset, PackError};
 use crate::gpu::gpu_types::SeedSpecies;
-use crate::gpu::layout::KIND_ROCK;
 use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::wind::Wind;
 use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, species_of_rank};
@@ -448,7 +447,7 @@ impl View<'_> {
 
     /// How far the wind moves any point of a seed of `species` `height_m` tall (none for rocks).
     fn sway_m(&self, species: &SeedSpecies, height_m: f64) -> f64 {
-        if species.kind == KIND_ROCK { 0.0 } else { height_m * self.wind_reach_per_height }
+        height_m * f64::from(species.wind_bend) * self.wind_reach_per_height
     }
 
     /// Whether the bounding sphere of a seed whose ground point is `ground_rel_m` from the eye,

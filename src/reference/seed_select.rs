@@ -16,8 +16,8 @@ use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedU
 use crate::gpu::layout::{
     COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_OVERFLOW, COUNT_RULE,
     COUNT_SELECTED, GROUND_SAMPLES, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_TILE_TEXELS,
-    KIND_ROCK, LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX,
-    SEED_COUNTERS, SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group,
+    LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS,
+    SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group,
 };
 use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
 use crate::seeds::{SeedTables, pcg, seed_hash, unit};
@@ -416,7 +416,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
 
     let sink_m = height_m * u.sink_fraction;
     let base_rel_m = ground_rel_m - sink_m;
-    let sway_m = if species.kind == KIND_ROCK { 0.0 } else { height_m * u.wind_reach_per_height };
+    let sway_m = height_m * (species.wind_bend * u.wind_reach_per_height);
     let radius_m = height_m * species.radius_per_height + sway_m;
     let centre = to_clip(u, [rel_xy[0], rel_xy[1], base_rel_m + height_m * 0.5]);
     if centre[3] < -radius_m {

@@ -160,7 +160,7 @@ impl SeedTables {
                         SpeciesKind::Bush => KIND_BUSH,
                         SpeciesKind::Rock => KIND_ROCK,
                     },
-                    _pad: 0,
+                    wind_bend: wind::bend_of(s.kind),
                 }
             })
             .collect();

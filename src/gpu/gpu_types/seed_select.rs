@@ -142,8 +142,9 @@ gpu_struct! {
         pub radius_per_height: f32,
         /// What it is: `KIND_TREE`, `KIND_BUSH` or `KIND_ROCK`.
         pub kind: u32,
-        /// Padding to the WGSL struct's alignment (always 0).
-        pub _pad: u32,
+        /// How much the wind bends it (`seeds::wind::bend_of`): 1 a plant, 0 a rock; its bounds
+        /// grow by this times `SeedUniforms::wind_reach_per_height` times its height.
+        pub wind_bend: f32,
     }
 }
 
