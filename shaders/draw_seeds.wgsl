@@ -8,6 +8,10 @@
 // colour (times a layer of the texture array), are alpha-tested, tinted a little towards the
 // ground colour and by the seed's colour variation, lit and hazed like the ground.
 //
+// Continuous LOD (`draw_seeds.continuous_lod`, `u.focal_px` > 0): a mesh whose materials say how
+// they shed detail thins its leaves and its thin stems as they shrink on screen, per seed
+// (`detail_position`), and serves LOD 1 too: its materials' `last_lod`.
+//
 // Cross-fade: over the outer `fade_fraction` of its LOD's reach a seed's fade f falls from 1 to
 // 0. Its own geometry keeps the pixels whose ordered-dither threshold t (Bayer 4×4, shifted per
 // seed so neighbours do not share a pattern) is below f, the next LOD's geometry those at or above
@@ -25,6 +29,10 @@ struct DrawSeedsUniforms {
     ground_blend: f32,
     wind: vec4<f32>,
     wind_wave: vec4<f32>,
+    focal_px: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct SeedShape {
@@ -38,6 +46,10 @@ struct SeedMaterial {
     alpha_cutoff: f32,
     lod: u32,
     flags: u32,
+    last_lod: u32,
+    detail_m: f32,
+    first_leaf_vertex: u32,
+    leaf_count: u32,
 }
 
 @group(0) @binding(0) var<uniform> u: DrawSeedsUniforms;
@@ -81,10 +93,14 @@ fn model_to_world(v: vec3<f32>, angle: f32) -> vec3<f32> {
     return vec3<f32>(c * w.x - s * w.y, s * w.x + c * w.y, w.z);
 }
 
-// 1 inside the seed's LOD reach, falling to 0 over the last `fade_fraction` of it.
-fn band_fade(record: SeedRecord, lod: u32) -> f32 {
+// How far the seed's foot is from the eye (its anchor was sunk by pass 3), metres.
+fn seed_distance_m(record: SeedRecord) -> f32 {
     let ground_rel = record.position_rel_m + vec3<f32>(0.0, 0.0, record.height_m * u.sink_fraction);
-    let distance_m = length(ground_rel);
+    return length(ground_rel);
+}
+
+// 1 inside the seed's LOD reach, falling to 0 over the last `fade_fraction` of it.
+fn band_fade(record: SeedRecord, lod: u32, distance_m: f32) -> f32 {
     let size_scale = min(1.0, record.height_m * u.inv_reference_height_m);
     let reach = u.draw_reach_m[min(lod, SEED_LODS - 1u)] * size_scale;
     // Without a band (fade_fraction 0) a seed is whole up to its reach, then the next LOD's.
@@ -92,19 +108,73 @@ fn band_fade(record: SeedRecord, lod: u32) -> f32 {
     return clamp((reach - distance_m) / width, 0.0, 1.0);
 }
 
+// Continuous LOD (`impostor::detail`, same steps as its Rust): where vertex `vertex` of material
+// `material_index` lies (model space, w = 1) on seed `seed_bits` drawn `scale` times its model's
+// size `distance_m` away, or w = 0 when its primitive is left out. Leaves below DETAIL_FULL_PX
+// keep the last (ratio to it)² share of them in buffer order, each grown about its pivot back to
+// DETAIL_FULL_PX; stems narrower than DETAIL_MIN_PX are widened along their normals to it where
+// the hash of the stem (its base, which its pivot holds) and the seed falls below the ratio.
+fn detail_position(in: VertexIn, vertex: u32, scale: f32, distance_m: f32, seed_bits: u32) -> vec4<f32> {
+    let material = materials[in.material];
+    if (material.flags & (MATERIAL_LEAVES | MATERIAL_STEMS)) == 0u {
+        return vec4<f32>(in.position_model_m, 1.0);
+    }
+    let size_px = material.detail_m * scale * u.focal_px / max(distance_m, 1e-3);
+    if (material.flags & MATERIAL_STEMS) != 0u {
+        if size_px >= DETAIL_MIN_PX {
+            return vec4<f32>(in.position_model_m, 1.0);
+        }
+        var share = 0.0;
+        if size_px > 0.0 {
+            share = size_px / DETAIL_MIN_PX;
+        }
+        // Each stem its own draw, hashed from its base (its pivot) and the seed.
+        let base = bitcast<vec3<u32>>(in.pivot_model_m);
+        let unit = f32(pcg(seed_bits ^ pcg(base.x ^ pcg(base.y ^ pcg(base.z)))) >> 8u) / 16777216.0;
+        if unit >= share {
+            return vec4<f32>(0.0);
+        }
+        let widen_m = 0.5 * material.detail_m * (DETAIL_MIN_PX / max(size_px, 1e-6) - 1.0);
+        return vec4<f32>(in.position_model_m + in.normal_model * widen_m, 1.0);
+    }
+    var ratio = 0.0;
+    if size_px > 0.0 {
+        ratio = min(size_px / DETAIL_FULL_PX, 1.0);
+    }
+    if ratio >= 1.0 {
+        return vec4<f32>(in.position_model_m, 1.0);
+    }
+    let leaf = (vertex - material.first_leaf_vertex) / 4u;
+    let share = ratio * ratio;
+    if f32(material.leaf_count - min(leaf, material.leaf_count)) - 0.5 >= share * f32(material.leaf_count) {
+        return vec4<f32>(0.0);
+    }
+    let growth = 1.0 / max(ratio, 1e-6);
+    return vec4<f32>(in.pivot_model_m + (in.position_model_m - in.pivot_model_m) * growth, 1.0);
+}
+
 @vertex
-fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
+fn vs_main(
+    in: VertexIn,
+    @builtin(instance_index) instance: u32,
+    @builtin(vertex_index) vertex: u32,
+) -> VertexOut {
     let record = records[order[instance]];
     let seed = unpack_species_lod(record.species_lod);
     let species = seed.species;
     let lod = seed.lod;
     let material = materials[in.material];
-    let fade = band_fade(record, lod);
+    let distance_m = seed_distance_m(record);
+    var fade = band_fade(record, lod, distance_m);
+    if material.lod <= lod && lod < material.last_lod {
+        // Its own geometry goes on as the next LOD (continuous LOD): nothing to cross-fade.
+        fade = 1.0;
+    }
     var out: VertexOut;
     out.record = order[instance];
     // The group's own geometry keeps thresholds below the fade, the next LOD's the rest.
     out.keep = vec3<f32>(0.0, fade, f32(record.rank & 15u));
-    if material.lod != lod {
+    if lod < material.lod || lod > material.last_lod {
         out.keep = vec3<f32>(fade, 2.0, f32(record.rank & 15u));
         if fade >= 1.0 {
             // Not in the band: nothing to cross-fade. Every vertex at one point outside the view.
@@ -116,15 +186,29 @@ fn vs_main(in: VertexIn, @builtin(instance_index) instance: u32) -> VertexOut {
     let angle = f32(jitter.angle) * (6.2831853 / 65536.0);
     let shape = shapes[min(species, arrayLength(&shapes) - 1u)];
     let scale = record.height_m * shape.inv_model_height_m;
+    var position_model_m = in.position_model_m;
+    if u.focal_px > 0.0 {
+        let detailed = detail_position(in, vertex, scale, distance_m, record.jitter);
+        if detailed.w == 0.0 {
+            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+            return out;
+        }
+        position_model_m = detailed.xyz;
+    }
     // Still air (or a rock) leaves every vertex where it was, bit for bit: this expression is
     // the one the pass had before the wind, and nothing else uses its products (a compiler may
     // fuse a product into the add only where the product has no other use).
-    var rel_m = record.position_rel_m + model_to_world(in.position_model_m * scale, angle);
+    var rel_m = record.position_rel_m + model_to_world(position_model_m * scale, angle);
     // In wind, a leaf turns about where it hangs, then the whole plant bends.
     if u.wind.z > 0.0 && shape.wind_bend > 0.0 {
-        let pivot_m = model_to_world(in.pivot_model_m * scale, angle);
-        let leaf_m = model_to_world((in.position_model_m - in.pivot_model_m) * scale, angle);
-        let fluttered = wind_flutter(u.wind, u.wind_wave, leaf_m, in.pivot_model_m, record.height_m);
+        // (A stem's pivot names it for the continuous LOD: stems do not flutter.)
+        var pivot_model_m = in.pivot_model_m;
+        if (material.flags & MATERIAL_STEMS) != 0u {
+            pivot_model_m = position_model_m;
+        }
+        let pivot_m = model_to_world(pivot_model_m * scale, angle);
+        let leaf_m = model_to_world((position_model_m - pivot_model_m) * scale, angle);
+        let fluttered = wind_flutter(u.wind, u.wind_wave, leaf_m, pivot_model_m, record.height_m);
         let top_m = wind_top_m(u.wind, u.wind_wave, record.position_rel_m, record.height_m, record.jitter);
         let bent = wind_bend(pivot_m + fluttered, top_m * shape.wind_bend, record.height_m);
         rel_m = record.position_rel_m + bent;

@@ -32,6 +32,7 @@
 //! is either the previous complete impostor or the new one. A folder of another format version is
 //! reported as such ([`ImpostorError::Version`]): bake it again.
 
+pub mod detail;
 pub mod manifest;
 pub mod mesh_file;
 pub mod mips;
@@ -42,13 +43,14 @@ use std::path::PathBuf;
 use bytemuck::{Pod, Zeroable};
 use thiserror::Error;
 
+pub use detail::Detail;
 pub use manifest::{AlphaMode, BoundingSphere, Plane, Submesh};
 pub use mips::{MipChain, TexelRect, build_mip_chain, mip_size};
 pub use store::{is_current, load, models, replace_folder, save};
 
 /// The on-disk format's version: a reader refuses any other. 2: mesh vertices carry their leaf's
-/// pivot (the wind's flutter).
-pub const FORMAT_VERSION: u32 = 2;
+/// pivot (the wind's flutter). 3: materials may carry their continuous LOD ([`Detail`]).
+pub const FORMAT_VERSION: u32 = 3;
 /// The glTF vertex attribute that holds each vertex's leaf pivot ([`MeshVertex::pivot_model_m`]):
 /// an application attribute (glTF names those with a leading underscore), written by the tree
 /// generator and read by the baker.
@@ -239,6 +241,8 @@ pub struct Material {
     pub double_sided: bool,
     /// RGBA8 sRGB, straight alpha, with mips; `None` for a plain colour.
     pub texture: Option<MipChain>,
+    /// How its primitives shed detail with distance (generated trees); `None`: drawn whole.
+    pub detail: Option<Detail>,
 }
 
 #[cfg(test)]

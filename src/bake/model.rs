@@ -3,16 +3,19 @@
 //! transforms applied (normals by the inverse transpose, winding flipped under a mirroring
 //! transform), grouped into one submesh per material. Materials keep what foliage and rocks use:
 //! the base-colour factor and texture (decoded by `image`: PNG and JPEG; coverage-preserving mips
-//! for alpha-masked ones), the alpha mode and cutoff, double-sidedness. Missing normals are
-//! computed from the faces; missing texture coordinates are 0.
+//! for alpha-masked ones), the alpha mode and cutoff, double-sidedness, and the continuous LOD the
+//! tree generator writes in a material's `extras` (`impostor::Detail`, in the mesh's own units:
+//! the generator's nodes are not transformed). Missing normals are computed from the faces;
+//! missing texture coordinates are 0.
 
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Vec3};
 use thiserror::Error;
 
+use crate::impostor::detail::DETAIL_EXTRAS;
 use crate::impostor::{
-    AlphaMode, Material, Mesh, MeshVertex, MipChain, PIVOT_ATTRIBUTE, Submesh, build_mip_chain,
+    AlphaMode, Detail, Material, Mesh, MeshVertex, MipChain, PIVOT_ATTRIBUTE, Submesh, build_mip_chain,
 };
 
 /// What makes a model unreadable. The error carrying it names the model's file.
@@ -86,6 +89,15 @@ pub enum ModelError {
         /// The glTF index of the mesh holding the primitive.
         mesh: usize,
     },
+    /// A material's `extras` hold a `terramp_detail` (continuous LOD) that does not parse or
+    /// gives no positive size.
+    #[error("unusable glTF model: material {material}: terramp_detail: {reason}")]
+    BadDetail {
+        /// The material's glTF index.
+        material: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// The scene holds no triangle at all (non-triangle primitives are skipped).
     #[error("unusable glTF model: no triangles")]
     NoTriangles,
@@ -142,6 +154,8 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
                 None
             }
         };
+        let detail = read_detail(material.extras())
+            .map_err(|reason| ModelError::BadDetail { material: materials.len(), reason })?;
         materials.push(Material {
             name: material.name().map_or_else(|| format!("material{}", materials.len()), str::to_owned),
             base_color_factor: pbr.base_color_factor(),
@@ -149,6 +163,7 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
             alpha_cutoff,
             double_sided: material.double_sided(),
             texture,
+            detail,
         });
     }
     let default_material = materials.len();
@@ -222,6 +237,7 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
             alpha_cutoff: 0.5,
             double_sided: false,
             texture: None,
+            detail: None,
         });
     }
     let mut indices = Vec::new();
@@ -235,6 +251,24 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
         return Err(ModelError::NoTriangles);
     }
     Ok(Mesh { vertices, indices, submeshes, materials })
+}
+
+/// A material's continuous LOD, from its `extras` (`{"terramp_detail": {...}}`); `None` when it
+/// has none; what is wrong with it otherwise.
+fn read_detail(extras: &gltf::json::Extras) -> Result<Option<Detail>, String> {
+    let Some(raw) = extras else { return Ok(None) };
+    let object: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(raw.get()).map_err(|e| e.to_string())?;
+    let Some(value) = object.get(DETAIL_EXTRAS) else { return Ok(None) };
+    let detail: Detail = serde_json::from_value(value.clone()).map_err(|e| e.to_string())?;
+    let size_m = match detail {
+        Detail::Leaves { size_m } => size_m,
+        Detail::Stems { diameter_m } => diameter_m,
+    };
+    if !(size_m.is_finite() && size_m > 0.0) {
+        return Err(format!("size {size_m} m is not a positive length"));
+    }
+    Ok(Some(detail))
 }
 
 /// A `_PIVOT` accessor's `count` points, if it holds that many float VEC3s inside its buffer.

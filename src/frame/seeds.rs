@@ -148,10 +148,23 @@ impl SeedStage {
         self.draw.as_ref().map_or((0, self.table.species.len()), |(draw, _)| draw.species_counts())
     }
 
-    /// Writes pass 4's constants for this frame (the terrain's matrix, sun and haze, the wind).
-    pub fn prepare_draw(&self, gpu: &Gpu, settings: &Settings, terrain: &TerrainUniforms, wind: &WindFrame) {
+    /// Writes pass 4's constants for this frame (the terrain's matrix, sun and haze, the wind),
+    /// and, with continuous LOD, the draws' index ranges for this frame's lens (when they change).
+    pub fn prepare_draw(
+        &mut self,
+        gpu: &Gpu,
+        settings: &Settings,
+        terrain: &TerrainUniforms,
+        wind: &WindFrame,
+    ) {
         if let Some((draw, _)) = &self.draw {
-            draw.prepare(&gpu.queue, &draw_uniforms(settings, terrain, wind));
+            let uniforms = draw_uniforms(settings, terrain, wind);
+            draw.prepare(&gpu.queue, &uniforms);
+            if let Some(templates) = draw.frame_templates(settings, uniforms.focal_px)
+                && templates != self.compact.templates()
+            {
+                self.compact.set_templates(&gpu.queue, &templates);
+            }
         }
     }
 
@@ -244,7 +257,8 @@ fn draw_pass(
     targets: &Targets,
 ) -> Result<(DrawSeedsPass, wgpu::BindGroup), RenderError> {
     let impostors = load_impostors(dir, &table.species)?;
-    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species)?;
+    let continuous = settings.draw_seeds.continuous_lod;
+    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, continuous)?;
     if settings.draw_seeds.samples > 1 {
         draw = draw.multisampled(&gpu.device, &targets.colour, &targets.depth);
     }

@@ -7,7 +7,7 @@ use std::time::Duration;
 use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::gpu::GpuError;
-use crate::gpu::gpu_types::{SeedCounters, SeedRecord, TerrainUniforms, TlmCell};
+use crate::gpu::gpu_types::{SeedCounters, SeedDrawArgs, SeedRecord, TerrainUniforms, TlmCell};
 use crate::gpu::readback::read_texture;
 use crate::passes::compact::frame::Compacted;
 use crate::passes::seed_select::frame::{SeedCellRef, SeedOutput};
@@ -217,6 +217,12 @@ impl Renderer {
         let templates = stage.compact.templates();
         let compacted = crate::reference::compact::compact(&output.keys, &output.blocks, templates)?;
         Ok(Some((output, compacted)))
+    }
+
+    /// The index ranges compaction fills the draws from (`SEED_DRAWS`), as the last frame set them
+    /// (continuous LOD narrows them per frame); `None` without land cover.
+    pub fn seed_draw_templates(&self) -> Option<Vec<SeedDrawArgs>> {
+        self.seeds.as_ref().map(|stage| stage.compact.templates().to_vec())
     }
 
     /// Runs pass 3 alone over `cells` seen from `camera`, against the caches and depth as the last

@@ -333,6 +333,18 @@ wgsl_constants! { draw_constants:
     pub const MATERIAL_TEXTURED: u32 = 1;
     /// `SeedMaterial::flags`: texture coordinates wrap (else they clamp).
     pub const MATERIAL_REPEAT: u32 = 2;
+    /// `SeedMaterial::flags`: the material's quads are leaves that thin out as they shrink on
+    /// screen (continuous LOD, `impostor::Detail::Leaves`).
+    pub const MATERIAL_LEAVES: u32 = 4;
+    /// `SeedMaterial::flags`: the material's stems are widened to a pixel on a share of the seeds
+    /// as they shrink below it (continuous LOD, `impostor::Detail::Stems`).
+    pub const MATERIAL_STEMS: u32 = 8;
+    /// Continuous LOD: the projected size, pixels, below which leaves thin out; the kept ones
+    /// grow back to it, so the crown keeps its area and no drawn leaf is smaller.
+    pub const DETAIL_FULL_PX: f32 = 2.0;
+    /// Continuous LOD: stems narrower than this on screen, pixels, are drawn this wide on a share
+    /// of the seeds (their width over this).
+    pub const DETAIL_MIN_PX: f32 = 1.0;
 }
 
 const _: () = assert!(SEED_GROUPS <= COMPACT_CHUNK, "a lane per group sums or scans a column");

@@ -169,4 +169,7 @@ pub struct MaterialEntry {
     /// colour.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub texture: Option<ImageEntry>,
+    /// How its primitives shed detail with distance (continuous LOD); absent: drawn whole.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detail: Option<super::Detail>,
 }

@@ -79,6 +79,7 @@ fn write_all(folder: &Path, impostor: &Impostor) -> Result<(), ImpostorError> {
             alpha_cutoff: m.alpha_cutoff,
             double_sided: m.double_sided,
             texture,
+            detail: m.detail,
         });
     }
     let mesh = &impostor.mesh;
@@ -158,6 +159,7 @@ pub fn load(dir: &Path, model: &str) -> Result<Impostor, ImpostorError> {
             alpha_cutoff: m.alpha_cutoff,
             double_sided: m.double_sided,
             texture,
+            detail: m.detail,
         });
     }
     let mesh_path = folder.join(&manifest.mesh.file);

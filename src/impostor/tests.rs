@@ -55,6 +55,7 @@ fn sample() -> Impostor {
                 alpha_cutoff: 0.5,
                 double_sided: true,
                 texture: Some(build_mip_chain(atlas(), [16, 8], 5, Some(0.5), &[])),
+                detail: Some(super::Detail::Leaves { size_m: 0.125 }),
             }],
         },
     }

@@ -1,7 +1,9 @@
 //! How it works: a small glTF 2.0 binary writer for what the generator makes: one mesh of
 //! indexed triangle primitives (positions with their bounds, normals, texture coordinates, each
-//! vertex's leaf pivot as the application attribute `_PIVOT`, u32 indices), each with a material whose base colour is an embedded PNG (sampled with repeat and
-//! trilinear filtering), opaque or alpha-masked, one- or two-sided; one node, one scene. The JSON
+//! vertex's leaf pivot as the application attribute `_PIVOT`, u32 indices), each with a material
+//! whose base colour is an embedded PNG (sampled with repeat and trilinear filtering; materials
+//! with the same PNG share it), opaque or alpha-masked, one- or two-sided, with its continuous
+//! LOD in its `extras` (`impostor::Detail`); one node, one scene. The JSON
 //! chunk comes first, then the binary chunk holding every buffer view back to back, each 4-byte
 //! aligned, as the specification requires; both chunks are padded to 4 bytes (JSON with spaces,
 //! binary with zeros). `serde_json` orders object keys, so the same mesh is the same bytes.
@@ -10,7 +12,8 @@
 use serde_json::{Value, json};
 
 use super::mesh::Part;
-use crate::impostor::PIVOT_ATTRIBUTE;
+use crate::impostor::detail::DETAIL_EXTRAS;
+use crate::impostor::{Detail, PIVOT_ATTRIBUTE};
 
 /// How a material's alpha is used.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,13 +27,15 @@ pub enum Alpha {
 /// One material: a name, its base-colour texture (PNG bytes), its alpha, whether it is two-sided.
 pub struct Material<'a> {
     /// Shown by glTF viewers.
-    pub name: &'a str,
+    pub name: String,
     /// The base-colour texture, PNG-encoded (sRGB).
     pub png: &'a [u8],
     /// Opaque or alpha-masked.
     pub alpha: Alpha,
     /// Drawn from both sides (leaf cards).
     pub double_sided: bool,
+    /// How its primitives shed detail with distance, written to its `extras`.
+    pub detail: Option<Detail>,
 }
 
 /// A glTF binary of one node whose mesh holds one primitive per (part, material) pair; empty
@@ -42,15 +47,24 @@ pub fn write(name: &str, primitives: &[(&Part, Material)]) -> Vec<u8> {
     let mut images = Vec::new();
     let mut textures = Vec::new();
     let mut gltf_primitives = Vec::new();
+    // Materials that share a PNG share its image and texture.
+    let mut pngs: Vec<&[u8]> = Vec::new();
     for (part, material) in primitives.iter().filter(|(part, _)| !part.indices.is_empty()) {
         let index = materials.len();
-        let image_view = binary.view(material.png, None);
-        images.push(json!({ "bufferView": image_view, "mimeType": "image/png" }));
-        textures.push(json!({ "sampler": 0, "source": index }));
+        let texture = match pngs.iter().position(|&png| png == material.png) {
+            Some(texture) => texture,
+            None => {
+                let image_view = binary.view(material.png, None);
+                images.push(json!({ "bufferView": image_view, "mimeType": "image/png" }));
+                textures.push(json!({ "sampler": 0, "source": pngs.len() }));
+                pngs.push(material.png);
+                pngs.len() - 1
+            }
+        };
         let mut gltf_material = json!({
             "name": material.name,
             "pbrMetallicRoughness": {
-                "baseColorTexture": { "index": index },
+                "baseColorTexture": { "index": texture },
                 "metallicFactor": 0.0,
                 "roughnessFactor": 1.0
             },
@@ -59,6 +73,9 @@ pub fn write(name: &str, primitives: &[(&Part, Material)]) -> Vec<u8> {
         if let Alpha::Mask(cutoff) = material.alpha {
             gltf_material["alphaMode"] = json!("MASK");
             gltf_material["alphaCutoff"] = json!(cutoff);
+        }
+        if let Some(detail) = material.detail {
+            gltf_material["extras"] = json!({ DETAIL_EXTRAS: detail });
         }
         materials.push(gltf_material);
 

@@ -19,6 +19,8 @@ mod textures;
 
 use thiserror::Error;
 
+use crate::impostor::Detail;
+
 pub use glb::{Alpha, Material};
 pub use grow::{branch_keep, leaf_keep};
 pub use mesh::{Part, TreeMesh};
@@ -95,18 +97,32 @@ impl Tree {
         radius_m / top_m
     }
 
-    /// The tree as a glTF 2.0 binary (`.glb`): a bark primitive and, unless it has none, a leaf
-    /// primitive (alpha-masked, two-sided).
+    /// The tree as a glTF 2.0 binary (`.glb`): unless it has none, a leaf primitive (alpha-masked,
+    /// two-sided) first, then one bark primitive per branching level, trunk first, each material
+    /// with its continuous LOD (`impostor::Detail`): the baker keeps materials in this order, so
+    /// the mesh's index buffer runs from the first leaves to thin out to the finest twigs.
     pub fn to_glb(&self) -> Vec<u8> {
         let name = format!("{} {} h{:.2}", self.species, self.seed, self.health);
-        let bark = Material { name: "bark", png: &self.bark_png, alpha: Alpha::Opaque, double_sided: false };
         let leaves = Material {
-            name: "leaves",
+            name: "leaves".into(),
             png: &self.leaf_png,
             alpha: Alpha::Mask(LEAF_ALPHA_CUTOFF),
             double_sided: true,
+            detail: Some(Detail::Leaves { size_m: self.mesh.leaf_size_m }),
         };
-        glb::write(&name, &[(&self.mesh.bark, bark), (&self.mesh.leaves, leaves)])
+        let levels = self.mesh.bark_by_level();
+        let mut primitives = vec![(&self.mesh.leaves, leaves)];
+        for (level, (part, &diameter_m)) in levels.iter().zip(&self.mesh.level_diameters_m).enumerate() {
+            let bark = Material {
+                name: format!("bark {level}"),
+                png: &self.bark_png,
+                alpha: Alpha::Opaque,
+                double_sided: false,
+                detail: Some(Detail::Stems { diameter_m }),
+            };
+            primitives.push((part, bark));
+        }
+        glb::write(&name, &primitives)
     }
 }
 

@@ -82,6 +82,20 @@ fn bark_levels_are_contiguous_index_ranges_trunk_first() {
         assert_eq!(mesh.bark_levels.last().unwrap().end as usize, mesh.bark.indices.len());
         assert!(mesh.bark.indices.iter().all(|&i| (i as usize) < mesh.bark.positions.len()));
         assert!(mesh.leaves.indices.iter().all(|&i| (i as usize) < mesh.leaves.positions.len()));
+        // Split by level, the bark is the same vertices in the same order, and each level's stems
+        // are thinner than its parents' (the continuous LOD drops the finest first).
+        let levels = mesh.bark_by_level();
+        let positions: Vec<[f32; 3]> = levels.iter().flat_map(|p| p.positions.clone()).collect();
+        assert_eq!(positions, mesh.bark.positions, "{name}");
+        let kept: Vec<f32> = mesh
+            .level_diameters_m
+            .iter()
+            .zip(&mesh.stems_per_level)
+            .filter(|(_, n)| **n > 0)
+            .map(|(d, _)| *d)
+            .collect();
+        assert!(kept.windows(2).all(|w| w[1] < w[0]), "{name}: diameters {kept:?}");
+        assert!(mesh.leaf_size_m > 0.005 && mesh.leaf_size_m < 1.0, "{name}: leaves {} m", mesh.leaf_size_m);
     }
 }
 
@@ -104,9 +118,18 @@ fn the_glb_reads_back_with_the_gltf_crate_as_written() {
         let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
         let blob = gltf.blob.as_deref().unwrap();
         let mesh = gltf.meshes().next().unwrap();
+        // Leaves first, then each level's bark; empty ones left out.
+        let levels = tree.mesh.bark_by_level();
         let parts: Vec<&Part> =
-            [&tree.mesh.bark, &tree.mesh.leaves].into_iter().filter(|p| !p.indices.is_empty()).collect();
+            std::iter::once(&tree.mesh.leaves).chain(&levels).filter(|p| !p.indices.is_empty()).collect();
         assert_eq!(mesh.primitives().len(), parts.len(), "{name} {health}");
+        assert_eq!(
+            gltf.images().len(),
+            1 + usize::from(!tree.mesh.leaves.indices.is_empty()),
+            "one bark image"
+        );
+        let bark_triangles: usize = levels.iter().map(Part::triangles).sum();
+        assert_eq!(bark_triangles, tree.mesh.bark.triangles());
         for (primitive, part) in mesh.primitives().zip(parts) {
             let reader = primitive.reader(|_| Some(blob));
             let positions: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
@@ -119,6 +142,18 @@ fn the_glb_reads_back_with_the_gltf_crate_as_written() {
             );
             let material = primitive.material();
             let leaves = material.name() == Some("leaves");
+            let extras: serde_json::Value =
+                serde_json::from_str(material.extras().as_ref().unwrap().get()).unwrap();
+            let detail: crate::impostor::Detail =
+                serde_json::from_value(extras[crate::impostor::detail::DETAIL_EXTRAS].clone()).unwrap();
+            let expected = match leaves {
+                true => crate::impostor::Detail::Leaves { size_m: tree.mesh.leaf_size_m },
+                false => {
+                    let level: usize = material.name().unwrap()["bark ".len()..].parse().unwrap();
+                    crate::impostor::Detail::Stems { diameter_m: tree.mesh.level_diameters_m[level] }
+                }
+            };
+            assert_eq!(detail, expected);
             let mode =
                 if leaves { gltf::material::AlphaMode::Mask } else { gltf::material::AlphaMode::Opaque };
             assert_eq!(material.alpha_mode(), mode);

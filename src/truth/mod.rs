@@ -149,6 +149,7 @@ pub fn truth_settings(settings: &Settings, dataset: &Dataset, supersample: u32) 
     s.draw_seeds.impostors.clear();
     // Every tree is its mesh out to the truth's reach: no forest stands in for them.
     s.texcells.reach_m = 0.0;
+    s.draw_seeds.continuous_lod = false;
     let tiles = |count: u64| u32::try_from(count).unwrap_or(u32::MAX);
     s.cache.height_slots = tiles(dataset.height.pyramid.tile_count());
     if let Some(layer) = &dataset.imagery {
@@ -256,7 +257,8 @@ impl MeshDrawer {
                     return Err(TruthError::NoImpostors);
                 }
                 let impostors = load_impostors(&self.dir, species)?;
-                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species)?;
+                // Every seed its whole mesh: no continuous LOD.
+                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species, false)?;
                 let pipeline = draw.truth_pipeline(&gpu.device);
                 (draw, pipeline)
             }

@@ -32,6 +32,11 @@ gpu_struct! {
         pub wind: [f32; 4],
         /// Wind time, seconds (x), the gusts' wavenumber per metre (y) and phase at the camera (z).
         pub wind_wave: [f32; 4],
+        /// The lens's focal length, pixels: what a metre one metre away covers on screen, for the
+        /// continuous LOD (`impostor::detail`); 0 turns it off (`draw_seeds.continuous_lod`).
+        pub focal_px: f32,
+        /// Padding to the struct's 16-byte alignment.
+        pub _pad: [u32; 3],
     }
 }
 
@@ -48,8 +53,9 @@ gpu_struct! {
 
 gpu_struct! {
     /// How a seed vertex is coloured: a base colour times (when `flags` has `MATERIAL_TEXTURED`) a
-    /// layer of the seed texture array, alpha-tested, and the draw LOD of the geometry it belongs to
-    /// (0 the mesh, 1 to 3 the billboard clouds), which tells a group's own draw from its cross-fade.
+    /// layer of the seed texture array, alpha-tested; the draw LODs of the geometry it belongs to
+    /// (0 the mesh, 1 to 3 the billboard clouds), which tell a group's own draw from its
+    /// cross-fade; and how its primitives shed detail (`MATERIAL_LEAVES`, `MATERIAL_STEMS`).
     /// WGSL: `SeedMaterial` in `shaders/draw_seeds.wgsl`.
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
     pub struct SeedMaterial {
@@ -59,10 +65,23 @@ gpu_struct! {
         pub layer: u32,
         /// Fragments with alpha below this are cut out (below 0: opaque).
         pub alpha_cutoff: f32,
-        /// Draw LOD of its geometry: a draw whose seeds are of another LOD is their cross-fade.
+        /// First draw LOD its geometry serves: a draw whose seeds are of a LOD outside `lod` to
+        /// `last_lod` is their cross-fade.
         pub lod: u32,
-        /// `MATERIAL_TEXTURED` | `MATERIAL_REPEAT` (wrap texture coordinates, else clamp).
+        /// `MATERIAL_TEXTURED` | `MATERIAL_REPEAT` (wrap texture coordinates, else clamp) |
+        /// `MATERIAL_LEAVES` or `MATERIAL_STEMS` (continuous LOD).
         pub flags: u32,
+        /// Last draw LOD its geometry serves: `lod`, but for a mesh drawn with continuous LOD,
+        /// which also takes the place of the 17-plane cloud.
+        pub last_lod: u32,
+        /// `MATERIAL_LEAVES`: the leaves' mean size; `MATERIAL_STEMS`: the stems' mean diameter;
+        /// model metres.
+        pub detail_m: f32,
+        /// `MATERIAL_LEAVES`: the vertex (in the pass's vertex buffer) where its leaf quads start,
+        /// four vertices each, in the order they thin out.
+        pub first_leaf_vertex: u32,
+        /// `MATERIAL_LEAVES`: how many leaf quads it has.
+        pub leaf_count: u32,
     }
 }
 

@@ -11,12 +11,21 @@
 //! The templates give each (species, LOD) group its index range, and each group's cross-fade draw
 //! (at `SEED_GROUPS + group`) the next LOD's range. A model baked without a mesh draws its
 //! 17-plane cloud up close instead; a species without an impostor keeps zero-index templates.
+//!
+//! With continuous LOD (`draw_seeds.continuous_lod`), a mesh whose materials say how they shed
+//! detail (`impostor::Detail`, generated trees) also takes LOD 1's place: its 17-plane cloud is
+//! not uploaded, LOD 0 has no cross-fade (the same geometry goes on), and where its leaves and
+//! each level's stems lie in the index buffer is kept ([`MeshDetail`]), for each frame's range.
 
 use std::collections::HashMap;
 
 use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
-use crate::gpu::layout::{MATERIAL_REPEAT, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS};
-use crate::impostor::{AlphaMode, Impostor, MipChain, mip_size};
+use std::ops::Range;
+
+use crate::gpu::layout::{
+    MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_STEMS, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS,
+};
+use crate::impostor::{AlphaMode, Detail, Impostor, MipChain, mip_size};
 
 use super::DrawSeedsError;
 
@@ -38,12 +47,41 @@ pub struct SeedAssets {
     pub materials: Vec<SeedMaterial>,
     /// 1 / each species' model height (top above base), per metre; 0 for species not drawn.
     pub inv_model_height_m: Vec<f32>,
+    /// Each species' mesh (its LOD 0 template), `None` for one baked without.
+    pub meshes: Vec<Option<SeedDrawArgs>>,
+    /// Each species' mesh where it is drawn with continuous LOD, `None` elsewhere.
+    pub details: Vec<Option<MeshDetail>>,
     /// Each layer's mips at the common size, in layer order.
     pub layers: Vec<Vec<Vec<u8>>>,
     /// Edge of every layer's level 0, texels (the largest source, at most `MAX_LAYER_TEXELS`).
     pub size: u32,
     /// Mip levels of every layer: the shortest atlas chain's, so no mip mixes two planes.
     pub mips: u32,
+}
+
+/// Where a mesh drawn with continuous LOD keeps its pieces, as absolute ranges of the index
+/// buffer: what a frame narrows its draw to (`frame::detail_templates`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshDetail {
+    /// The whole mesh (its LOD 0 template).
+    pub whole: SeedDrawArgs,
+    /// The leaf quads, if they are laid out as the continuous LOD reads them.
+    pub leaves: Option<LeafRun>,
+    /// Each branching level's stems: its indices and mean diameter, model metres.
+    pub stems: Vec<(Range<u32>, f32)>,
+    /// The indices of what is drawn whole at any distance (materials without a detail).
+    pub whole_pieces: Vec<Range<u32>>,
+}
+
+/// A run of leaf quads in the index buffer: six indices each, in the order they thin out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LeafRun {
+    /// The first leaf's first index.
+    pub first_index: u32,
+    /// Leaves in the run.
+    pub count: u32,
+    /// Their mean size, model metres.
+    pub size_m: f32,
 }
 
 impl SeedAssets {
@@ -75,8 +113,9 @@ impl SeedAssets {
     }
 }
 
-/// Lays out `impostors` (by species index; `None`: not drawn).
-pub fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsError> {
+/// Lays out `impostors` (by species index; `None`: not drawn), meshes that can drawn with
+/// continuous LOD so if `continuous`.
+pub fn gather(impostors: &[Option<Impostor>], continuous: bool) -> Result<SeedAssets, DrawSeedsError> {
     let species_max = (SEED_GROUPS / SEED_LODS) as usize;
     let present = || impostors.iter().take(species_max).flatten();
     for impostor in present() {
@@ -98,6 +137,8 @@ pub fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsErr
         templates: vec![SeedDrawArgs::default(); SEED_DRAWS as usize],
         materials: Vec::new(),
         inv_model_height_m: vec![0.0; species_max],
+        meshes: vec![None; species_max],
+        details: vec![None; species_max],
         layers: Vec::new(),
         size,
         mips,
@@ -105,8 +146,13 @@ pub fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsErr
     for (species, impostor) in impostors.iter().enumerate().take(species_max) {
         let Some(impostor) = impostor else { continue };
         out.inv_model_height_m[species] = 1.0 / model_height_m(impostor);
+        let detailed = continuous && has_detail(impostor);
         let mut lods = [SeedDrawArgs::default(); SEED_LODS as usize];
         for (k, level) in impostor.lods[..CLOUD_LODS].iter().enumerate() {
+            if detailed && k == 0 {
+                // The mesh takes the 17-plane cloud's place.
+                continue;
+            }
             let layer = out.layer(&level.atlas);
             let material = out.material(SeedMaterial {
                 base_colour: [1.0; 4],
@@ -114,6 +160,8 @@ pub fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsErr
                 alpha_cutoff: impostor.alpha_cutoff,
                 lod: k as u32 + 1,
                 flags: MATERIAL_TEXTURED,
+                last_lod: k as u32 + 1,
+                ..Default::default()
             });
             // A plane's texels are baked leaves: it bends with the plant, nothing flutters.
             let vertices = level.vertices().into_iter().map(|v| SeedVertex {
@@ -125,14 +173,33 @@ pub fn gather(impostors: &[Option<Impostor>]) -> Result<SeedAssets, DrawSeedsErr
             });
             lods[k + 1] = out.push(vertices, &level.indices());
         }
-        lods[0] = if impostor.mesh.indices.is_empty() { lods[1] } else { push_mesh(&mut out, impostor) };
+        if impostor.mesh.indices.is_empty() {
+            lods[0] = lods[1];
+        } else {
+            let detail = push_mesh(&mut out, impostor, detailed);
+            lods[0] = detail.whole;
+            out.meshes[species] = Some(detail.whole);
+            if detailed {
+                lods[1] = detail.whole;
+                out.details[species] = Some(detail);
+            }
+        }
         let first = species * SEED_LODS as usize;
         out.templates[first..first + SEED_LODS as usize].copy_from_slice(&lods);
-        // A group's cross-fade draws the next LOD; the last LOD fades out to nothing.
+        // A group's cross-fade draws the next LOD; the last LOD fades out to nothing, and a mesh
+        // that goes on as LOD 1 needs none.
         let fades = SEED_GROUPS as usize + first;
         out.templates[fades..fades + CLOUD_LODS].copy_from_slice(&lods[1..]);
+        if detailed {
+            out.templates[fades] = SeedDrawArgs::default();
+        }
     }
     Ok(out)
+}
+
+/// Whether the impostor's mesh says how it sheds detail.
+fn has_detail(impostor: &Impostor) -> bool {
+    !impostor.mesh.indices.is_empty() && impostor.mesh.materials.iter().any(|m| m.detail.is_some())
 }
 
 /// The model's height: its mesh's top, or its sphere's (centred at mid-height) without a mesh.
@@ -141,22 +208,34 @@ fn model_height_m(impostor: &Impostor) -> f32 {
     if top > 0.0 { top } else { (impostor.bounding_sphere.centre_model_m[1] * 2.0).max(1e-3) }
 }
 
-/// The mesh, one material per submesh; a vertex two submeshes share is repeated for each.
-fn push_mesh(out: &mut SeedAssets, impostor: &Impostor) -> SeedDrawArgs {
+/// The mesh, one material per submesh (drawn as LODs 0 and 1 when `detailed`); a vertex two
+/// submeshes share is repeated for each. Materials with the same texture share its layer.
+fn push_mesh(out: &mut SeedAssets, impostor: &Impostor, detailed: bool) -> MeshDetail {
     let mesh = &impostor.mesh;
     let mut layers: HashMap<usize, u32> = HashMap::new();
     let mut vertices = Vec::new();
     let mut indices = Vec::with_capacity(mesh.indices.len());
+    let (first_vertex, first_index) = (out.vertices.len() as u32, out.indices.len() as u32);
+    let mut leaves = None;
+    let mut stems = Vec::new();
+    let mut whole_pieces = Vec::new();
     for submesh in &mesh.submeshes {
         let Some(source) = mesh.materials.get(submesh.material as usize) else { continue };
-        let layer = source
-            .texture
-            .as_ref()
-            .map(|chain| *layers.entry(submesh.material as usize).or_insert_with(|| out.layer(chain)));
+        let layer = source.texture.as_ref().map(|chain| {
+            let first_alike = mesh.materials.iter().position(|m| m.texture.as_ref() == Some(chain));
+            *layers
+                .entry(first_alike.unwrap_or(submesh.material as usize))
+                .or_insert_with(|| out.layer(chain))
+        });
         let alpha_cutoff = match source.alpha_mode {
             AlphaMode::Opaque => -1.0,
             // (The baker reads glTF's BLEND as MASK: seeds are not sorted.)
             AlphaMode::Mask => source.alpha_cutoff,
+        };
+        let (detail_flag, detail_m) = match source.detail {
+            Some(Detail::Leaves { size_m }) => (MATERIAL_LEAVES, size_m),
+            Some(Detail::Stems { diameter_m }) => (MATERIAL_STEMS, diameter_m),
+            None => (0, 0.0),
         };
         let material = out.material(SeedMaterial {
             base_colour: source.base_color_factor,
@@ -164,7 +243,11 @@ fn push_mesh(out: &mut SeedAssets, impostor: &Impostor) -> SeedDrawArgs {
             alpha_cutoff,
             lod: 0,
             flags: layer.map_or(0, |_| MATERIAL_TEXTURED | MATERIAL_REPEAT),
+            last_lod: u32::from(detailed),
+            detail_m,
+            ..Default::default()
         });
+        let (submesh_vertex, submesh_index) = (vertices.len() as u32, indices.len() as u32);
         let mut remap: HashMap<u32, u32> = HashMap::new();
         let range = submesh.first_index as usize..(submesh.first_index + submesh.index_count) as usize;
         for &index in mesh.indices.get(range).unwrap_or_default() {
@@ -181,10 +264,59 @@ fn push_mesh(out: &mut SeedAssets, impostor: &Impostor) -> SeedDrawArgs {
             });
             indices.push(local);
         }
+        // A dropped out-of-range index would shift every later triangle: keep whole triangles.
+        indices.truncate(indices.len() - indices.len() % 3);
+        let run = first_index + submesh_index..first_index + indices.len() as u32;
+        let m = &mut out.materials[material as usize];
+        match source.detail {
+            Some(Detail::Leaves { size_m }) => {
+                let quads = &indices[submesh_index as usize..];
+                match leaf_quads(quads, submesh_vertex, vertices.len() as u32) {
+                    Some(count) if leaves.is_none() => {
+                        m.flags |= detail_flag;
+                        m.first_leaf_vertex = first_vertex + submesh_vertex;
+                        m.leaf_count = count;
+                        leaves = Some(LeafRun { first_index: run.start, count, size_m });
+                    }
+                    _ => whole_pieces.push(run),
+                }
+            }
+            Some(Detail::Stems { diameter_m })
+                if stems_named(&indices[submesh_index as usize..], &vertices) =>
+            {
+                m.flags |= detail_flag;
+                stems.push((run, diameter_m));
+            }
+            Some(Detail::Stems { .. }) => whole_pieces.push(run),
+            None => whole_pieces.push(run),
+        }
     }
-    // A dropped out-of-range index would shift every later triangle: keep whole triangles only.
-    indices.truncate(indices.len() - indices.len() % 3);
-    out.push(vertices, &indices)
+    let whole = out.push(vertices, &indices);
+    MeshDetail { whole, leaves, stems, whole_pieces }
+}
+
+/// Whether every triangle of `indices` lies on one stem: its three vertices share a pivot (the
+/// stem's base, as the tree generator writes it), by which the shader draws or leaves out a stem
+/// whole; if not, those stems are drawn whole.
+fn stems_named(indices: &[u32], vertices: &[SeedVertex]) -> bool {
+    indices.chunks_exact(3).all(|t| {
+        let pivot = |i: u32| vertices.get(i as usize).map(|v| v.pivot_model_m.map(f32::to_bits));
+        pivot(t[0]).is_some() && pivot(t[0]) == pivot(t[1]) && pivot(t[0]) == pivot(t[2])
+    })
+}
+
+/// The quads in `indices` (of the vertices `first..end`) if they are leaves as the continuous LOD
+/// reads them, quad i's six indices on vertices `first + 4 i` to `first + 4 i + 3`, which is
+/// what the tree generator writes; `None` if not (those leaves are then drawn whole).
+fn leaf_quads(indices: &[u32], first: u32, end: u32) -> Option<u32> {
+    let count = indices.len() / 6;
+    let laid_out = indices.len() == 6 * count
+        && end - first == 4 * count as u32
+        && indices.chunks_exact(6).enumerate().all(|(i, quad)| {
+            let corner = first + 4 * i as u32;
+            quad.iter().all(|&v| (corner..corner + 4).contains(&v))
+        });
+    laid_out.then_some(count as u32)
 }
 
 /// The level of `chain` nearest `to` texels (the first no larger, else the smallest), resampled

@@ -1,15 +1,25 @@
-//! Pass 4's CPU half: the impostors of a class table's species, read from a folder, and the
-//! frame's constants.
+//! Pass 4's CPU half: the impostors of a class table's species, read from a folder, the frame's
+//! constants, and the frame's index range of each mesh drawn with continuous LOD: LOD 1's seeds
+//! are at least `draw_seeds.reach_m[0]` away (scaled by their size, as pass 3 assigns them), so
+//! the leaves that the nearest of them could keep bound the range (stems stay in it: some seed
+//! may draw them, widened); each seed then sheds what it does not need in the vertex shader.
 
 use std::path::Path;
 
 use crate::classes::Species;
 use crate::config::Settings;
-use crate::gpu::gpu_types::{DrawSeedsUniforms, TerrainUniforms};
+use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, TerrainUniforms};
+use crate::gpu::layout::SEED_LODS;
+use crate::impostor::detail::{first_leaf_kept, leaf_share, projected_px};
 use crate::impostor::{Impostor, MANIFEST_FILE};
 use crate::seeds::wind::WindFrame;
 
 use super::DrawSeedsError;
+use super::assets::MeshDetail;
+
+/// How much nearer than its LOD's reach a seed of LOD 1 may be found when the frame's range is
+/// bounded: pass 3 and the draw measure the same distance in f32, a few ulps apart.
+const NEAREST_MARGIN: f32 = 0.98;
 
 /// How much of the ground colour under a seed it takes on.
 pub const GROUND_BLEND: f32 = 0.2;
@@ -48,5 +58,62 @@ pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &Wind
         ground_blend: GROUND_BLEND,
         wind: wind.wind,
         wind_wave: wind.wave,
+        focal_px: if settings.draw_seeds.continuous_lod {
+            focal_px(terrain, settings.render.height)
+        } else {
+            0.0
+        },
+        _pad: [0; 3],
     }
+}
+
+/// The focal length, pixels, of a view `height_px` tall drawn with `terrain`'s matrix: its
+/// projection's vertical scale (the length of the matrix's second row, the view's rotation
+/// leaving it unchanged) times half the height.
+pub fn focal_px(terrain: &TerrainUniforms, height_px: u32) -> f32 {
+    let m = terrain.clip_from_view_world;
+    let row_y = glam::Vec3::new(m[0][1], m[1][1], m[2][1]);
+    0.5 * height_px as f32 * row_y.length()
+}
+
+/// Each draw's index range for this frame (`templates` as built, `SEED_DRAWS`), the LOD 1 draw of
+/// each species in `details` narrowed to what its nearest possible seed keeps: seeds at least
+/// `reach_m[0]` away scaled by their size (`seeds.reference_height_m` and taller: all of it), of
+/// heights up to `species`' largest, the model `inv_model_height_m` per metre tall.
+pub fn detail_templates(
+    templates: &[SeedDrawArgs],
+    details: &[Option<MeshDetail>],
+    species: &[Species],
+    inv_model_height_m: &[f32],
+    settings: &Settings,
+    focal_px: f32,
+) -> Vec<SeedDrawArgs> {
+    let mut out = templates.to_vec();
+    let reach_m = (settings.draw_seeds.reach_m[0] as f32 * NEAREST_MARGIN).max(1e-3);
+    let reference_m = settings.seeds.reference_height_m as f32;
+    for (s, detail) in details.iter().enumerate() {
+        let (Some(detail), Some(kind)) = (detail, species.get(s)) else { continue };
+        // The seed that projects largest in LOD 1: the tallest at the reach, a smaller one at its
+        // own shorter reach, all alike below the reference height.
+        let scale = kind.height_m[1].max(reference_m) * inv_model_height_m.get(s).copied().unwrap_or(0.0);
+        let px = |size_m: f32| projected_px(size_m, scale, focal_px, reach_m);
+        let mut start = u32::MAX;
+        let mut end = 0;
+        if let Some(leaves) = detail.leaves {
+            let first = first_leaf_kept(leaves.count, leaf_share(px(leaves.size_m)).0);
+            if first < leaves.count {
+                start = leaves.first_index + 6 * first;
+                end = leaves.first_index + 6 * leaves.count;
+            }
+        }
+        // Stems, however thin, are drawn widened on some seeds.
+        let stems = detail.stems.iter().map(|(range, _)| range);
+        for range in stems.chain(&detail.whole_pieces).filter(|r| !r.is_empty()) {
+            (start, end) = (start.min(range.start), end.max(range.end));
+        }
+        let lod1 = &mut out[s * SEED_LODS as usize + 1];
+        (lod1.first_index, lod1.index_count) =
+            if start < end { (start, end - start) } else { (detail.whole.first_index, 0) };
+    }
+    out
 }

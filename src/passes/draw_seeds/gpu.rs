@@ -8,11 +8,11 @@ use bytemuck::Zeroable;
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::classes::Species;
+use crate::config::Settings;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::gpu_types::{
     DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedShape, SeedVertex,
 };
-use crate::gpu::layout::SEED_LODS;
 use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
 use crate::gpu::shaders::{DITHER, HASH, SEED_RECORD, WIND, WgslSource};
 use crate::gpu::struct_layout::GpuLayout;
@@ -21,7 +21,8 @@ use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 use crate::seeds::wind::bend_of;
 
 use super::DrawSeedsError;
-use super::assets;
+use super::assets::{self, MeshDetail};
+use super::frame::detail_templates;
 use multisample::Multisample;
 
 pub mod multisample;
@@ -80,6 +81,12 @@ pub struct DrawSeedsPass {
     clamp_sampler: wgpu::Sampler,
     repeat_sampler: wgpu::Sampler,
     templates: Vec<SeedDrawArgs>,
+    /// Each species' mesh template (`None`: baked without one).
+    meshes: Vec<Option<SeedDrawArgs>>,
+    /// What narrows the LOD 1 draws of meshes drawn with continuous LOD each frame.
+    details: Vec<Option<MeshDetail>>,
+    inv_model_height_m: Vec<f32>,
+    kinds: Vec<Species>,
     species_drawn: usize,
     species_missing: usize,
     /// With `draw_seeds.samples` > 1: the multisampled targets and `fs_coverage`'s pipeline.
@@ -87,18 +94,20 @@ pub struct DrawSeedsPass {
 }
 
 impl DrawSeedsPass {
-    /// Uploads the impostors of `species` (by species index; `None`: not drawn) and builds the
-    /// pipeline.
+    /// Uploads the impostors of `species` (by species index; `None`: not drawn), the meshes that
+    /// can be drawn with continuous LOD so if `continuous` (`draw_seeds.continuous_lod`), and
+    /// builds the pipeline.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         impostors: &[Option<Impostor>],
         species: &[Species],
+        continuous: bool,
     ) -> Result<Self, DrawSeedsError> {
         if !device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE) {
             return Err(DrawSeedsError::NoFirstInstance);
         }
-        let built = assets::gather(impostors)?;
+        let built = assets::gather(impostors, continuous)?;
         let max = device.limits().max_texture_array_layers;
         let layers = built.layers.len().max(1) as u32;
         if layers > max {
@@ -171,6 +180,10 @@ impl DrawSeedsPass {
             clamp_sampler: sampler("seed atlases", wgpu::AddressMode::ClampToEdge),
             repeat_sampler: sampler("seed mesh textures", wgpu::AddressMode::Repeat),
             templates: built.templates,
+            meshes: built.meshes,
+            details: built.details,
+            inv_model_height_m: built.inv_model_height_m,
+            kinds: species.to_vec(),
             species_drawn,
             species_missing: impostors.len() - species_drawn,
             multisample: None,
@@ -194,6 +207,16 @@ impl DrawSeedsPass {
     /// The draws' index ranges, for `CompactPass::set_templates` (`SEED_DRAWS` of them).
     pub fn templates(&self) -> &[SeedDrawArgs] {
         &self.templates
+    }
+
+    /// This frame's index ranges (`frame::detail_templates`: LOD 1's meshes narrowed to what their
+    /// nearest seeds keep through a lens of `focal_px`), `None` when no mesh is drawn with
+    /// continuous LOD (`templates` hold).
+    pub fn frame_templates(&self, settings: &Settings, focal_px: f32) -> Option<Vec<SeedDrawArgs>> {
+        self.details.iter().any(Option::is_some).then(|| {
+            let (details, kinds) = (&self.details, &self.kinds);
+            detail_templates(&self.templates, details, kinds, &self.inv_model_height_m, settings, focal_px)
+        })
     }
 
     /// Species with an impostor, and species left undrawn for want of one.
@@ -230,9 +253,7 @@ impl DrawSeedsPass {
     /// Species `species`'s full mesh (its LOD 0 geometry), or `None` when its model has none
     /// (LOD 0 is then its first billboard cloud) or no impostor.
     pub fn mesh_of(&self, species: u32) -> Option<SeedDrawArgs> {
-        let template = *self.templates.get((species * SEED_LODS) as usize)?;
-        let cloud = self.templates.get((species * SEED_LODS + 1) as usize)?;
-        (template.index_count > 0 && template.first_index != cloud.first_index).then_some(template)
+        self.meshes.get(species as usize).copied().flatten().filter(|t| t.index_count > 0)
     }
 
     /// Records the ground truth's draws into `pass` (its pipeline from `truth_pipeline`, the bind

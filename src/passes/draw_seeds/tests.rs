@@ -1,9 +1,12 @@
 use super::DrawSeedsError;
 use super::assets;
 use super::frame::load_impostors;
-use crate::gpu::layout::{MATERIAL_REPEAT, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS};
+use crate::gpu::layout::{
+    MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_STEMS, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS,
+};
 use crate::impostor::{
-    AlphaMode, BoundingSphere, Impostor, ImpostorLod, Material, Mesh, MeshVertex, MipChain, Plane, Submesh,
+    AlphaMode, BoundingSphere, Detail, Impostor, ImpostorLod, Material, Mesh, MeshVertex, MipChain, Plane,
+    Submesh,
 };
 
 /// A plain atlas of `size`² texels and `mips` levels, every texel `value`.
@@ -32,6 +35,7 @@ fn impostor(name: &str, planes: [usize; 3], sizes: [u32; 3], with_mesh: bool) ->
         alpha_cutoff: 0.3,
         double_sided: true,
         texture,
+        detail: None,
     };
     // Two submeshes sharing vertex 1: bark (plain) and leaves (textured, 16² with 3 mips).
     let mesh = Mesh {
@@ -69,7 +73,7 @@ fn groups_get_their_index_ranges_materials_and_layers_and_missing_species_draw_n
         None,
         Some(impostor("C", [2, 1, 1], [8, 8, 8], false)),
     ];
-    let built = assets::gather(&impostors).unwrap();
+    let built = assets::gather(&impostors, false).unwrap();
     // 16² leaves set the size; the atlases' 2 mips the count; 3 atlases + 1 texture + 3 atlases.
     assert_eq!((built.size, built.mips, built.layers.len()), (16, 2, 7));
     let lods = SEED_LODS as usize;
@@ -102,6 +106,132 @@ fn groups_get_their_index_ranges_materials_and_layers_and_missing_species_draw_n
     assert_eq!(built.layers[1][1].len(), 4 * 8 * 8);
     assert!(built.layers[1][0].iter().all(|&v| v == 10));
     assert!(built.layers[3][1].iter().all(|&v| v == 200));
+    // Nothing is drawn with continuous LOD without materials that say how.
+    assert!(built.details.iter().all(Option::is_none));
+    assert_eq!(assets::gather(&impostors, true).unwrap().templates, built.templates);
+}
+
+/// A generated tree's mesh in miniature: `leaves` leaf quads (leaves first, 0.1 m), then stems of
+/// two levels (0.5 m and 0.01 m across), one triangle each.
+fn detailed(leaves: u32) -> Impostor {
+    let mut tree = impostor("T", [3, 2, 1], [8, 8, 8], true);
+    let vertex = |p: [f32; 3]| MeshVertex {
+        position_model_m: p,
+        normal_model: [0.0; 3],
+        uv: [0.0; 2],
+        pivot_model_m: p,
+    };
+    let mut vertices = Vec::new();
+    let mut indices = Vec::new();
+    for i in 0..leaves {
+        let y = 0.5 + i as f32 * 0.01;
+        vertices.extend([[0.0, y, 0.0], [0.1, y, 0.0], [0.1, y + 0.1, 0.0], [0.0, y + 0.1, 0.0]].map(vertex));
+        let c = 4 * i;
+        indices.extend([c, c + 1, c + 2, c, c + 2, c + 3]);
+    }
+    for _ in 0..2 {
+        let first = vertices.len() as u32;
+        // A stem's vertices name its base as their pivot.
+        let on_stem = |p: [f32; 3]| MeshVertex { pivot_model_m: [0.0; 3], ..vertex(p) };
+        vertices.extend([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 2.0, 0.0]].map(on_stem));
+        indices.extend([first, first + 1, first + 2]);
+    }
+    let material = |detail| Material { detail: Some(detail), ..tree.mesh.materials[0].clone() };
+    let leaf_indices = 6 * leaves;
+    tree.mesh = Mesh {
+        vertices,
+        indices,
+        submeshes: vec![
+            Submesh { material: 0, first_index: 0, index_count: leaf_indices },
+            Submesh { material: 1, first_index: leaf_indices, index_count: 3 },
+            Submesh { material: 2, first_index: leaf_indices + 3, index_count: 3 },
+        ],
+        materials: vec![
+            Material { texture: Some(atlas(16, 3, 200)), ..material(Detail::Leaves { size_m: 0.1 }) },
+            Material { texture: Some(atlas(16, 3, 50)), ..material(Detail::Stems { diameter_m: 0.5 }) },
+            Material { texture: Some(atlas(16, 3, 50)), ..material(Detail::Stems { diameter_m: 0.01 }) },
+        ],
+    };
+    tree
+}
+
+#[test]
+fn a_mesh_with_continuous_lod_stands_for_the_first_cloud_and_keeps_its_pieces() {
+    let built = assets::gather(&[Some(detailed(10))], true).unwrap();
+    let t = &built.templates;
+    let groups = SEED_GROUPS as usize;
+    // Clouds of 2 and 1 planes (LODs 2, 3), then the mesh: 40 leaf vertices and 2 × 3 stems'.
+    assert_eq!([t[2].first_index, t[3].first_index, t[0].first_index], [0, 12, 18]);
+    assert_eq!(t[0].index_count, 60 + 6);
+    assert_eq!(t[1], t[0], "the mesh is LOD 1 too");
+    assert_eq!(t[groups].index_count, 0, "the mesh goes on: LOD 0 has no cross-fade");
+    assert_eq!(&t[groups + 1..groups + 3], &t[2..4]);
+    let m = &built.materials;
+    assert_eq!(
+        m.iter().map(|m| (m.lod, m.last_lod)).collect::<Vec<_>>(),
+        [(2, 2), (3, 3), (0, 1), (0, 1), (0, 1)]
+    );
+    let leaves = &m[2];
+    assert_eq!(leaves.flags & (MATERIAL_LEAVES | MATERIAL_STEMS), MATERIAL_LEAVES);
+    assert_eq!(
+        (leaves.first_leaf_vertex, leaves.leaf_count, leaves.detail_m),
+        (t[0].base_vertex as u32, 10, 0.1)
+    );
+    assert_eq!((m[3].flags & MATERIAL_STEMS, m[3].detail_m, m[4].detail_m), (MATERIAL_STEMS, 0.5, 0.01));
+    // Two clouds' atlases, the leaves' texture, and one layer for the two levels' same bark.
+    assert_eq!((m[2].layer, m[3].layer, m[4].layer, built.layers.len()), (2, 3, 3, 4));
+    let detail = built.details[0].as_ref().unwrap();
+    assert_eq!(detail.leaves.unwrap().first_index, 18);
+    assert_eq!(
+        detail.stems.iter().map(|(r, d)| (r.clone(), *d)).collect::<Vec<_>>(),
+        [(78..81, 0.5), (81..84, 0.01)]
+    );
+    // Stems whose triangles do not share a pivot cannot be told apart: they are drawn whole.
+    let mut unnamed = detailed(10);
+    unnamed.mesh.vertices.iter_mut().for_each(|v| v.pivot_model_m = v.position_model_m);
+    let unnamed = assets::gather(&[Some(unnamed)], true).unwrap();
+    let detail = unnamed.details[0].as_ref().unwrap();
+    assert!(detail.stems.is_empty() && detail.whole_pieces == [78..81, 81..84]);
+    assert!(unnamed.materials[3..].iter().all(|m| m.flags & MATERIAL_STEMS == 0));
+    // Without continuous LOD the same mesh is drawn as any other.
+    let plain = assets::gather(&[Some(detailed(10))], false).unwrap();
+    assert!(plain.details[0].is_none() && plain.templates[1] != plain.templates[0]);
+    assert!(plain.materials.iter().all(|m| m.last_lod == m.lod));
+}
+
+#[test]
+fn each_frame_narrows_lod_1_to_what_its_nearest_seed_keeps() {
+    let built = assets::gather(&[Some(detailed(100))], true).unwrap();
+    let mut settings = crate::config::Settings::preset("balanced").unwrap();
+    settings.draw_seeds.reach_m = [100.0, 200.0, 300.0, 400.0];
+    settings.seeds.reference_height_m = 2.0;
+    let table = crate::classes::ClassTable::load("nc").unwrap();
+    let mut kind = table.species[0].clone();
+    kind.height_m = [2.0, 2.0];
+    let at = |focal_px: f32| {
+        let t = super::frame::detail_templates(
+            &built.templates,
+            &built.details,
+            std::slice::from_ref(&kind),
+            &built.inv_model_height_m,
+            &settings,
+            focal_px,
+        );
+        (t[1].first_index, t[1].index_count, t[0])
+    };
+    let whole = built.templates[0];
+    // The model is 2 m tall: a seed 2 m tall is drawn at scale 1, its leaves 0.1 m, LOD 1 from
+    // 98 m on. At a focal length of 10 000 px a leaf is 10 px there: all is kept.
+    assert_eq!(at(10_000.0), (whole.first_index, whole.index_count, whole));
+    // At 980 px a leaf is 1 px: a quarter of the leaves are kept, the last ones; the stems stay
+    // (some seeds draw a twig of 0.1 px widened).
+    let (first, count, lod0) = at(980.0);
+    assert_eq!(lod0, whole, "LOD 0 is never narrowed");
+    let left_out = (first - whole.first_index) / 6;
+    assert!((74..=76).contains(&left_out), "{left_out} of 100 leaves left out");
+    assert_eq!(first + count, whole.first_index + whole.index_count);
+    // At 10 px no leaf is left: only the stems are drawn.
+    assert_eq!(at(10.0).0..at(10.0).0 + at(10.0).1, whole.first_index + 600..whole.first_index + 606);
 }
 
 #[test]
