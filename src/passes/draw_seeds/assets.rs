@@ -18,10 +18,9 @@
 //! each level's stems lie in the index buffer is kept ([`MeshDetail`]), for each frame's range.
 
 use std::collections::HashMap;
-
-use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
 use std::ops::Range;
 
+use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
 use crate::gpu::layout::{
     MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_STEMS, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS,
 };
@@ -113,8 +112,8 @@ impl SeedAssets {
     }
 }
 
-/// Lays out `impostors` (by species index; `None`: not drawn), meshes that can drawn with
-/// continuous LOD so if `continuous`.
+/// Lays out `impostors` (by species index; `None`: not drawn); with `continuous`, the meshes
+/// that say how they shed detail are laid out for continuous LOD.
 pub fn gather(impostors: &[Option<Impostor>], continuous: bool) -> Result<SeedAssets, DrawSeedsError> {
     let species_max = (SEED_GROUPS / SEED_LODS) as usize;
     let present = || impostors.iter().take(species_max).flatten();
