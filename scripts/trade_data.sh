@@ -4,8 +4,8 @@
 # builds them, and the synthetic default (`synth --size 1024`); bakes the 11 shared models into
 # $data/impostors (those missing or of an older format) and writes $trees, a settings layer that points
 # `draw_seeds.impostors` at them.
-terramp="$root/target/release/terramp"
-terramp_data="$root/target/release/terramp-data"
+terramp="${CARGO_TARGET_DIR:-$root/target}/release/terramp"
+terramp_data="${CARGO_TARGET_DIR:-$root/target}/release/terramp-data"
 
 # build NAME ARGS...: a dataset, unless a readable one is already there.
 build() {
