@@ -23,8 +23,9 @@ pub struct DrawSeedsSettings {
     /// pixel's samples as its (sharpened) alpha says, and resolves into the frame.
     pub samples: u32,
     /// Meshes whose materials say how they shed detail (generated trees) are drawn with continuous
-    /// LOD (Wesslén & Seipel): leaves thin out and twigs go as they shrink on screen, and the
-    /// thinned mesh also takes the 17-plane cloud's place (LOD 1).
+    /// LOD (Wesslén & Seipel, `impostor::detail`): leaves thin out and sub-pixel stems are drawn
+    /// a pixel wide on a share of the seeds as they shrink on screen, and the thinned mesh also
+    /// takes the 17-plane cloud's place (LOD 1).
     pub continuous_lod: bool,
     /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
     /// selected but not drawn. Species whose model is not there are not drawn.
