@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Generated trees measured (issue 14): what the continuous LOD buys and costs against the ground
 # truth, the demo's frame with generated trees against the shared models, and the bake time of
-# each generated tree. One command (needs ../shared/data/models for the shared half):
+# each generated tree. One command (needs ../shared/data: nc/, zion/, models/):
 #
 #   scripts/continuous_lod.sh
 #
@@ -19,16 +19,8 @@
 # (data/trade), CARGO_TARGET_DIR.
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
-export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
-unset RUST_BACKTRACE
+source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" nc zion models
 data="${DATA_DIR:-data/trade}"
-shared="$root/../shared/data"
-[[ -d "$shared/models" ]] || {
-    echo "continuous_lod.sh: $shared/models is missing" >&2
-    exit 1
-}
 mkdir -p "$data" docs/trade
 cargo build --release --workspace -q
 source scripts/trade_data.sh

@@ -21,17 +21,9 @@
 # (docs/texcells).
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
-export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
-unset RUST_BACKTRACE
+source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" nc zion models
 data="${DATA_DIR:-data/trade}"
-shared="$root/../shared/data"
 out="${OUT:-docs/texcells}"
-[[ -d "$shared/nc" && -d "$shared/models" ]] || {
-    echo "texcells_truth.sh: $shared (nc/, models/) is missing" >&2
-    exit 1
-}
 mkdir -p "$data" "$out"
 cargo build --release --workspace -q
 source scripts/trade_data.sh

@@ -29,10 +29,7 @@
 # the page).
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
-export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
-unset RUST_BACKTRACE
+source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" nc zion models
 
 frames="${FRAMES:-60}"
 warmup="${WARMUP:-10}"
@@ -42,11 +39,6 @@ width="${WIDTH:-1280}"
 height="${HEIGHT:-720}"
 # Relative to the repository root, so the figures' paths name no one's machine.
 data="${DATA_DIR:-data/trade}"
-shared="$root/../shared/data"
-[[ -d "$shared/nc" && -d "$shared/zion" && -d "$shared/models" ]] || {
-    echo "trade.sh: $shared (nc/, zion/, models/) is missing" >&2
-    exit 1
-}
 mkdir -p "$data" docs/trade
 
 cargo build --release --workspace -q

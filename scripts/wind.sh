@@ -17,17 +17,10 @@
 # folder, default /tmp/terramp-wind).
 set -euo pipefail
 
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
-export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
+source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" nc zion models
 wind="${WIND:-12}"
 data="${DATA_DIR:-data/trade}"
 out="${OUT:-/tmp/terramp-wind}"
-shared="$root/../shared/data"
-[[ -d "$shared/nc" && -d "$shared/zion" && -d "$shared/models" ]] || {
-    echo "wind.sh: $shared (nc/, zion/, models/) is missing" >&2
-    exit 1
-}
 mkdir -p "$data" "$out"
 cargo build --release --workspace -q
 source scripts/trade_data.sh
