@@ -163,7 +163,6 @@ fn continuous_lod_draws_fewer_primitives_with_distance_and_none_below_a_pixel() 
     use terramp::passes::draw_seeds::{assets, frame::detail_templates};
 
     let focal_px = 360.0 / 30f32.to_radians().tan();
-    let table = terramp::classes::ClassTable::load("nc-generated").unwrap();
     let mut settings = terramp::config::Settings::preset("balanced").unwrap();
     settings.seeds.reference_height_m = 0.1;
     for name in ["spruce", "pine", "birch", "broadleaf", "bush"] {
@@ -203,8 +202,6 @@ fn continuous_lod_draws_fewer_primitives_with_distance_and_none_below_a_pixel() 
             let (a, b, c) = (at(0), at(1), at(2));
             (b - a).length().max((c - b).length())
         };
-        let mut kind = table.species[0].clone();
-        kind.height_m = [top_m, top_m];
         let mut drawn_before = f32::MAX;
         let mut drawn = Vec::new();
         for distance_m in [1.0, 5.0, 20.0, 50.0, 100.0, 200.0, 400.0, 800.0, 1600.0f32] {
@@ -231,7 +228,7 @@ fn continuous_lod_draws_fewer_primitives_with_distance_and_none_below_a_pixel() 
             let frame = detail_templates(
                 &built.templates,
                 &built.details,
-                &[kind.clone()],
+                &[top_m],
                 &built.inv_model_height_m,
                 &settings,
                 focal_px,

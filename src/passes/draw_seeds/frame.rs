@@ -78,12 +78,12 @@ pub fn focal_px(terrain: &TerrainUniforms, height_px: u32) -> f32 {
 
 /// Each draw's index range for this frame (`templates` as built, `SEED_DRAWS`), the LOD 1 draw of
 /// each species in `details` narrowed to what its nearest possible seed keeps: seeds at least
-/// `reach_m[0]` away scaled by their size (`seeds.reference_height_m` and taller: all of it), of
-/// heights up to `species`' largest, the model `inv_model_height_m` per metre tall.
+/// `reach_m[0]` away scaled by their size (`seeds.reference_height_m` and taller: all of it), up
+/// to each species' `tallest_m`, its model `inv_model_height_m` per metre tall.
 pub fn detail_templates(
     templates: &[SeedDrawArgs],
     details: &[Option<MeshDetail>],
-    species: &[Species],
+    tallest_m: &[f32],
     inv_model_height_m: &[f32],
     settings: &Settings,
     focal_px: f32,
@@ -92,10 +92,10 @@ pub fn detail_templates(
     let reach_m = (settings.draw_seeds.reach_m[0] as f32 * NEAREST_MARGIN).max(1e-3);
     let reference_m = settings.seeds.reference_height_m as f32;
     for (s, detail) in details.iter().enumerate() {
-        let (Some(detail), Some(kind)) = (detail, species.get(s)) else { continue };
+        let (Some(detail), Some(&tallest_m)) = (detail, tallest_m.get(s)) else { continue };
         // The seed that projects largest in LOD 1: the tallest at the reach, a smaller one at its
         // own shorter reach, all alike below the reference height.
-        let scale = kind.height_m[1].max(reference_m) * inv_model_height_m.get(s).copied().unwrap_or(0.0);
+        let scale = tallest_m.max(reference_m) * inv_model_height_m.get(s).copied().unwrap_or(0.0);
         let px = |size_m: f32| projected_px(size_m, scale, focal_px, reach_m);
         let mut start = u32::MAX;
         let mut end = 0;

@@ -86,7 +86,8 @@ pub struct DrawSeedsPass {
     /// What narrows the LOD 1 draws of meshes drawn with continuous LOD each frame.
     details: Vec<Option<MeshDetail>>,
     inv_model_height_m: Vec<f32>,
-    kinds: Vec<Species>,
+    /// Each species' tallest seed, metres (the class table's height range).
+    tallest_m: Vec<f32>,
     species_drawn: usize,
     species_missing: usize,
     /// With `draw_seeds.samples` > 1: the multisampled targets and `fs_coverage`'s pipeline.
@@ -183,7 +184,7 @@ impl DrawSeedsPass {
             meshes: built.meshes,
             details: built.details,
             inv_model_height_m: built.inv_model_height_m,
-            kinds: species.to_vec(),
+            tallest_m: species.iter().map(|s| s.height_m[1]).collect(),
             species_drawn,
             species_missing: impostors.len() - species_drawn,
             multisample: None,
@@ -214,8 +215,15 @@ impl DrawSeedsPass {
     /// continuous LOD (`templates` hold).
     pub fn frame_templates(&self, settings: &Settings, focal_px: f32) -> Option<Vec<SeedDrawArgs>> {
         self.details.iter().any(Option::is_some).then(|| {
-            let (details, kinds) = (&self.details, &self.kinds);
-            detail_templates(&self.templates, details, kinds, &self.inv_model_height_m, settings, focal_px)
+            let (details, tallest_m) = (&self.details, &self.tallest_m);
+            detail_templates(
+                &self.templates,
+                details,
+                tallest_m,
+                &self.inv_model_height_m,
+                settings,
+                focal_px,
+            )
         })
     }
 

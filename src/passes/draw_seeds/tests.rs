@@ -205,14 +205,11 @@ fn each_frame_narrows_lod_1_to_what_its_nearest_seed_keeps() {
     let mut settings = crate::config::Settings::preset("balanced").unwrap();
     settings.draw_seeds.reach_m = [100.0, 200.0, 300.0, 400.0];
     settings.seeds.reference_height_m = 2.0;
-    let table = crate::classes::ClassTable::load("nc").unwrap();
-    let mut kind = table.species[0].clone();
-    kind.height_m = [2.0, 2.0];
     let at = |focal_px: f32| {
         let t = super::frame::detail_templates(
             &built.templates,
             &built.details,
-            std::slice::from_ref(&kind),
+            &[2.0],
             &built.inv_model_height_m,
             &settings,
             focal_px,
