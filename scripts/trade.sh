@@ -53,14 +53,14 @@ knobs=(
     "seeds.occlusion_tolerance_m=1,2,20"                                   # [5]
     "seeds.density_scale=0.25,0.5,0.75"                                    # [1]
     "seeds.seeds_per_pattern=1024,3072,4096"                               # [2048]
-    "draw_seeds.reach_m=[300,700,1400,3000],[800,1000,1400,3000],[1200,1300,1400,3000]" # mesh reach [500]
+    "draw_seeds.reach_m=[500,700,1400,3000],[600,1000,1400,3000],[1200,1300,1400,3000]" # mesh reach [800]
     "draw_seeds.fade_fraction=0,0.05,0.25"                                 # [0.1]
     "terrain.triangle_px=2,4,16"                                           # [8]
     "cache.imagery_slots=32,48,192"                                        # [96]
     "draw_seeds.samples=4"                                                 # [1]
     "seeds.reference_height_m=1,5,10"                                      # [2]
     # How far seeds reach at all: the last band and the last draw reach together [3000].
-    "tlm.radial_bands_m+draw_seeds.reach_m=[500,1000,2000]+[500,700,1000,2000],[700,1400,4000]+[500,700,1400,4000]"
+    "tlm.radial_bands_m+draw_seeds.reach_m=[500,1000,2000]+[800,1000,1400,2000],[700,1400,4000]+[800,1000,1400,4000]"
 )
 front=()
 if [[ "${FRONT:-1}" != 0 ]]; then

@@ -72,7 +72,7 @@ fn seed_settings_are_range_checked() {
 #[test]
 fn draw_reaches_are_checked_against_the_tlm_bands() {
     let d = Settings::default();
-    assert_eq!(d.draw_seeds.reach_m, [500.0, 700.0, 1400.0, 3000.0]);
+    assert_eq!(d.draw_seeds.reach_m, [800.0, 1000.0, 1400.0, 3000.0]);
     assert_eq!((d.tlm.occlusion_tolerance_per_km, d.draw_seeds.fade_fraction), (0.0, 0.1));
     for (bad, rule) in [
         ("[draw_seeds]\nreach_m = [120.0, 700.0, 600.0, 3000.0]\n", "increasing"),
