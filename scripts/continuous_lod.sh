@@ -10,7 +10,7 @@
 #    reused while current) into $DATA_DIR/impostors beside the shared models' (scripts/trade_data.sh).
 # 2. Sweeps the synthetic default with those trees (`seeds.class_table = "nc-generated"`) from
 #    `balanced`: draw_seeds.continuous_lod off (mesh → 17-plane cloud) and on (mesh → continuous
-#    range → 8-plane cloud), each with the first cloud reaching 700 m (balanced) and 1000 m,
+#    range → 8-plane cloud), each with the first cloud reaching 1000 m (balanced) and 1400 m,
 #    judged against the truth (every tree its whole mesh) into docs/trade/continuous_lod/.
 # 3. Profiles the demo's flight (config/paths/default.toml) with the generated trees and with the
 #    shared models, in alternating rounds, and prints both medians.
@@ -48,8 +48,8 @@ echo "## sweep: continuous LOD off and on" >&2
     --truth-supersample 4 --truth-reach-m 4000 --popping-frames 12 --settings "$generated" \
     --series --series-from balanced \
     --knob "draw_seeds.continuous_lod=true" \
-    --knob "draw_seeds.reach_m=[500,1000,1400,3000]" \
-    --knob "draw_seeds.continuous_lod+draw_seeds.reach_m=true+[500,1000,1400,3000]" \
+    --knob "draw_seeds.reach_m=[800,1400,2000,3000]" \
+    --knob "draw_seeds.continuous_lod+draw_seeds.reach_m=true+[800,1400,2000,3000]" \
     2> >(grep -v XDG_RUNTIME_DIR >&2)
 
 [[ "${PROFILE_FRAMES:-60}" != 0 ]] || exit 0
