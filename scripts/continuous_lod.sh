@@ -28,7 +28,7 @@ source scripts/trade_data.sh
 models="$data/generated-models"
 mkdir -p "$models"
 echo "## generated trees: grown and baked one at a time (seconds)" >&2
-for name in $(sed -n 's/^model = "\(tree-[a-z]*-s[0-9]*-h[0-9]*\)"$/\1/p' config/classes/nc_generated.toml); do
+for name in $(grep -o 'tree-[a-z]*-s[0-9]*-h[0-9]*' config/classes/nc_generated.toml | sort -u); do
     IFS=- read -r _ species seed health <<<"$name"
     glb="$models/$name.glb"
     [[ -f "$glb" ]] || "$terramp_data" tree --species "$species" --seed "${seed#s}" \

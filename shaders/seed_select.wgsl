@@ -79,6 +79,8 @@ struct SeedSpecies {
     radius_per_height: f32,
     kind: u32,
     wind_bend: f32,
+    variants: u32,
+    _pad: u32,
 }
 
 struct SeedClass {
@@ -119,6 +121,11 @@ fn mul(a: f32, b: f32) -> f32 {
 
 fn seed_hash(address: vec2<i32>, rank: u32) -> u32 {
     return pcg(rank ^ pattern_hash(bitcast<u32>(address.x), bitcast<u32>(address.y), u.seed ^ SEED_SALT));
+}
+
+// Which of its species' `variants` models a seed of hash `hash` is (Rust: `seeds::seed_variant`).
+fn seed_variant(hash: u32, variants: u32) -> u32 {
+    return pcg(hash ^ SEED_VARIANT_SALT) % max(variants, 1u);
 }
 
 fn unit(hash: u32) -> f32 {
@@ -396,14 +403,15 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     }
 
     out.count = COUNT_SELECTED;
-    out.key = seed_group(species_index, lod);
+    let drawn = species_index + seed_variant(hash, species.variants);
+    out.key = seed_group(drawn, lod);
     let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     out.record = SeedRecord(
         vec3<f32>(rel_xy, base_rel_m),
         height_m,
         cell.address,
         rank,
-        pack_species_lod(SpeciesLod(species_index, lod, found.y, ground.level)),
+        pack_species_lod(SpeciesLod(drawn, lod, found.y, ground.level)),
         pcg(hash),
         ground_colour(imagery, hash),
         radius_m,

@@ -30,7 +30,7 @@ fn table_and_impostors() -> (PathBuf, PathBuf) {
         .lines()
         .map(
             |line| {
-                if line.starts_with("model = ") { format!("model = \"{MODEL}\"") } else { line.to_owned() }
+                if line.starts_with("models = ") { format!("model = \"{MODEL}\"") } else { line.to_owned() }
             },
         )
         .collect::<Vec<_>>()

@@ -1,5 +1,6 @@
 //! Pass 3 on a synthetic dataset: the GPU equals its CPU twin (read in block-table order, in the
-//! same order too; in still air and in wind), runs and paths agree, seeds sit on the drawn ground, a too-small output is
+//! same order too; in still air and in wind, with species variants), seeds spread over their
+//! species' variants as the exact oracle picks them, runs and paths agree, seeds sit on the drawn ground, a too-small output is
 //! flagged without corrupting what it keeps, and compaction's draw order is the same in every run
 //! and equals its twin's.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
@@ -31,13 +32,15 @@ fn sorted(mut records: Vec<SeedRecord>) -> Vec<SeedRecord> {
 #[test]
 fn gpu_seed_selection_equals_its_cpu_twin() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
-    // Still air, and a wind whose sway grows every plant's bounds (rocks' not).
-    for wind_m_s in [0.0, 25.0] {
+    // Still air with the scheme's table, and a wind whose sway grows every plant's bounds (rocks'
+    // not) with the generated table, whose species have variants.
+    for (wind_m_s, class_table) in [(0.0, ""), (25.0, "nc-generated")] {
         let mut settings = terramp_testkit::small_settings(320, 180);
         settings.wind.speed_m_s = wind_m_s;
+        settings.seeds.class_table = class_table.to_owned();
         let mut r = terramp_testkit::renderer(&dataset, settings);
         for (i, camera) in cameras(&r).iter().enumerate() {
-            let i = format!("{i} (wind {wind_m_s} m/s)");
+            let i = format!("{i} (wind {wind_m_s} m/s, table {class_table:?})");
             r.render_resolved(camera).unwrap();
             let (gpu, gpu_counters) = r.read_seeds().unwrap().unwrap();
             let (twin, twin_counters) = r.seed_twin().unwrap().unwrap();
@@ -83,6 +86,60 @@ fn gpu_seed_selection_equals_its_cpu_twin() {
             assert_eq!(output.keys.len(), output.records.len());
         }
     }
+}
+
+#[test]
+fn seeds_spread_over_their_species_variants_as_the_oracle_does() {
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let mut settings = terramp_testkit::small_settings(320, 180);
+    settings.seeds.class_table = "nc-generated".to_owned();
+    let mut r = terramp_testkit::renderer(&dataset, settings);
+    let camera = over_fraction(&r, [0.6, 0.5], 300.0, 200.0, -25.0);
+    r.render_resolved(&camera).unwrap();
+    let (gpu, _) = r.read_seeds().unwrap().unwrap();
+    let table = terramp::classes::ClassTable::load("nc-generated").unwrap();
+    // Per species (its first entry), how many seeds each variant got.
+    let mut per_variant = vec![0usize; table.species.len()];
+    for s in &gpu {
+        per_variant[SpeciesLod::unpack(s.species_lod).species as usize] += 1;
+    }
+    for (first, species) in table.species.iter().enumerate().filter(|(_, s)| s.variant == 0) {
+        let counts = &per_variant[first..first + species.variants as usize];
+        let total: usize = counts.iter().sum();
+        println!("{}: {counts:?}", species.name);
+        if total >= 200 {
+            let share = 1.0 / f64::from(species.variants);
+            for &n in counts {
+                assert!((n as f64 / total as f64 - share).abs() < 0.1, "{}: {counts:?}", species.name);
+            }
+        }
+    }
+    assert!(
+        table.species.iter().zip(&per_variant).any(|(s, &n)| s.variant > 0 && n > 0),
+        "no seed drawn as a second variant: {per_variant:?}"
+    );
+    // The exact oracle (and the truth, which draws its seeds) picks the same variant per seed.
+    let (tables, patterns) = r.seed_world().unwrap();
+    let inputs = terramp::reference::oracle::OracleInputs {
+        dataset: &r.dataset,
+        settings: &r.settings,
+        tables,
+        patterns,
+        camera: &camera,
+        viewport_px: [r.settings.render.width, r.settings.render.height],
+    };
+    let (oracle, _) = terramp::reference::oracle::visible_seeds(&inputs).unwrap();
+    let species_of: std::collections::HashMap<([i32; 2], u32), u32> =
+        gpu.iter().map(|s| ((s.address, s.rank), SpeciesLod::unpack(s.species_lod).species)).collect();
+    let mut common = 0;
+    for seed in &oracle {
+        let address = [seed.address[0] as i32, seed.address[1] as i32];
+        if let Some(&species) = species_of.get(&(address, seed.rank)) {
+            assert_eq!(species, seed.species, "seed {address:?} rank {}", seed.rank);
+            common += 1;
+        }
+    }
+    assert!(common > 100, "only {common} seeds in common with the oracle");
 }
 
 /// Who each seed is, in order: cell, rank and what it grows into.

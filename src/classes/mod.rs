@@ -1,7 +1,10 @@
 //! How it works: a land-cover class table names the codes of one classification scheme
-//! (`config/classes/*.toml`) and what grows on each: a list of species (a model, a height range, a
-//! crown width, the altitudes and slopes it tolerates) and, per class, seed rules (a species and its
-//! density in seeds per km²). The built-in tables are compiled in, so `--classes nlcd` works from
+//! (`config/classes/*.toml`) and what grows on each: a list of species (a model, or several
+//! variants of it, a height range, a crown width, the altitudes and slopes it tolerates) and, per
+//! class, seed rules (a species and its density in seeds per km²). A species with `models = [..]`
+//! becomes one entry of `species` per model, consecutive and alike but for the model, so that every
+//! consumer indexes one model per entry as pass 3's records do; the rules name the first, and pass
+//! 3 moves each seed to one of its species' variants by its hash (`seeds::seed_variant`). The built-in tables are compiled in, so `--classes nlcd` works from
 //! anywhere; a path to a TOML file of the same shape works too. Codes outside the table are not an
 //! error: they mean "no class" (no seeds), and the builder counts them. Parsing validates the table
 //! (unique codes and species, rules naming known species, every number in range) and names the
@@ -64,13 +67,23 @@ pub enum ClassTableError {
         /// The species name listed twice.
         name: String,
     },
-    /// The table lists more than `MAX_SPECIES` species.
-    #[error("class table {origin}: {count} species, at most {max} allowed", max = MAX_SPECIES)]
+    /// The table lists more than `MAX_SPECIES` species, each variant counted.
+    #[error("class table {origin}: {count} species, each of a species' models counted, at most {max} allowed", max = MAX_SPECIES)]
     TooManySpecies {
         /// The table, as in `Parse`.
         origin: String,
-        /// How many species it lists.
+        /// How many species it lists, each variant counted.
         count: usize,
+    },
+    /// A species names no model, or names it both ways (`model` and `models`).
+    #[error(
+        "class table {origin}: species `{name}`: give its model as `model = \"..\"` or its variants as `models = [..]`, one of the two"
+    )]
+    Models {
+        /// The table, as in `Parse`.
+        origin: String,
+        /// The species.
+        name: String,
     },
     /// A class has more than `MAX_SPECIES_PER_CLASS` seed rules.
     #[error("class table {origin}: class {code} ({class}) has {count} seed rules, at most {max} allowed", max = MAX_SPECIES_PER_CLASS)]
@@ -132,25 +145,72 @@ pub enum SpeciesKind {
     Rock,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-/// One thing that can grow (`[[species]]` in the table): its model, its size and where it grows.
+#[derive(Debug, Clone, PartialEq)]
+/// One thing that can grow, with one model: a `[[species]]` of the table, or one of its variants
+/// (`models = [..]`), which follow it in `ClassTable::species` with the same name and numbers.
 pub struct Species {
-    /// Unique within the table; the classes' seed rules refer to it by this name.
+    /// Unique within the table but for the variants, which share it; the classes' seed rules
+    /// refer to the species by it.
     pub name: String,
     /// Whether it is a tree, a bush or a rock; sent to the GPU with it (`SeedSpecies::kind`).
     pub kind: SpeciesKind,
-    /// Model stem in ../shared/data/models (e.g. "Pine_1"), for the drawing pass.
+    /// Model stem (e.g. "Pine_1" in ../shared/data/models, or a generated `tree-...`), for the
+    /// drawing pass.
     pub model: String,
+    /// Which of its species' models this is, 0 the first (the one the rules' index names).
+    pub variant: u32,
+    /// How many models its species has (1: no variants).
+    pub variants: u32,
     /// Range of the seed's height (its size), metres; each seed draws one from a hash.
     pub height_m: [f32; 2],
-    /// Bounding-sphere radius per metre of height (crown width), for culling.
+    /// Bounding-sphere radius per metre of height (crown width), for culling; of the widest of
+    /// the variants.
     pub radius_per_height: f32,
     /// Altitude range where it grows (the tree line), metres; default [-1e4, 1e4].
-    #[serde(default = "any_altitude_m")]
     pub altitude_m: [f32; 2],
     /// Steepest ground it grows on, degrees (0..90).
     pub max_slope_deg: f32,
+}
+
+/// A `[[species]]` as the table writes it: `Species` with its model or its variants' models.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpeciesText {
+    name: String,
+    kind: SpeciesKind,
+    #[serde(default)]
+    model: Option<String>,
+    #[serde(default)]
+    models: Vec<String>,
+    height_m: [f32; 2],
+    radius_per_height: f32,
+    #[serde(default = "any_altitude_m")]
+    altitude_m: [f32; 2],
+    max_slope_deg: f32,
+}
+
+impl SpeciesText {
+    /// One `Species` per model, or `None` where it names no model or names it both ways.
+    fn variants(self) -> Option<Vec<Species>> {
+        let models = match (self.model, self.models) {
+            (Some(model), models) if models.is_empty() => vec![model],
+            (None, models) if !models.is_empty() => models,
+            _ => return None,
+        };
+        let variants = models.len() as u32;
+        let species = models.into_iter().enumerate().map(|(variant, model)| Species {
+            name: self.name.clone(),
+            kind: self.kind,
+            model,
+            variant: variant as u32,
+            variants,
+            height_m: self.height_m,
+            radius_per_height: self.radius_per_height,
+            altitude_m: self.altitude_m,
+            max_slope_deg: self.max_slope_deg,
+        });
+        Some(species.collect())
+    }
 }
 
 fn any_altitude_m() -> [f32; 2] {
@@ -185,19 +245,29 @@ pub struct Class {
 }
 
 /// A manifest's class list compares equal to a table's classes when codes and names match.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ClassTable {
     /// The classification scheme, e.g. "nc" or "nlcd", as a dataset's land-cover layer names it.
     pub scheme: String,
     /// The code that means "no data" in the source rasters of this scheme.
     pub nodata_code: u8,
     /// The scheme's classes (`[[class]]`), codes unique; codes absent mean "no class", no seeds.
-    #[serde(rename = "class")]
     pub classes: Vec<Class>,
-    /// What can grow (`[[species]]`, at most `MAX_SPECIES`); pass 3 indexes them in this order.
-    #[serde(default)]
+    /// What can grow (`[[species]]`, each variant its own entry after the first, at most
+    /// `MAX_SPECIES` in all); pass 3 indexes them in this order.
     pub species: Vec<Species>,
+}
+
+/// A `ClassTable` as its TOML writes it.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ClassTableText {
+    scheme: String,
+    nodata_code: u8,
+    #[serde(rename = "class")]
+    classes: Vec<Class>,
+    #[serde(default)]
+    species: Vec<SpeciesText>,
 }
 
 impl ClassTable {
@@ -219,8 +289,15 @@ impl ClassTable {
 
     /// Parses and validates a table's TOML text; `origin` (a name or path) labels the errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self, ClassTableError> {
-        let table: ClassTable = toml::from_str(text)
+        let text: ClassTableText = toml::from_str(text)
             .map_err(|e| ClassTableError::Parse { origin: origin.to_owned(), message: e.to_string() })?;
+        let mut species = Vec::with_capacity(text.species.len());
+        for s in text.species {
+            let name = s.name.clone();
+            species.extend(s.variants().ok_or(ClassTableError::Models { origin: origin.to_owned(), name })?);
+        }
+        let table =
+            ClassTable { scheme: text.scheme, nodata_code: text.nodata_code, classes: text.classes, species };
         table.validate(origin)?;
         Ok(table)
     }
@@ -240,7 +317,8 @@ impl ClassTable {
         self.classes.iter().find(|c| c.code == code)
     }
 
-    /// Position of the species named `name` in `species`: its index in the GPU's species table.
+    /// Position of the species named `name` in `species` (its first variant): its index in the
+    /// GPU's species table.
     pub fn species_index(&self, name: &str) -> Option<usize> {
         self.species.iter().position(|s| s.name == name)
     }
@@ -261,7 +339,7 @@ impl ClassTable {
             return Err(ClassTableError::TooManySpecies { origin, count: self.species.len() });
         }
         for (i, species) in self.species.iter().enumerate() {
-            if self.species[..i].iter().any(|s| s.name == species.name) {
+            if species.variant == 0 && self.species[..i].iter().any(|s| s.name == species.name) {
                 return Err(ClassTableError::DuplicateSpecies { origin, name: species.name.clone() });
             }
             check_species(species).map_err(|(key, value, rule)| ClassTableError::OutOfRange {

@@ -126,3 +126,28 @@ fn species_and_rule_errors_name_table_class_and_key() {
     let err = error(&table("", "").replace("kind = \"tree\"", "kind = \"fern\""));
     assert!(err.contains("fern"), "{err}");
 }
+
+#[test]
+fn a_species_with_models_becomes_its_variants_in_order() {
+    let oak = SPECIES
+        .replace("\"pine\"", "\"oak\"")
+        .replace("model = \"Pine_1\"", "models = [\"A\", \"B\", \"C\"]");
+    let rules = "{ species = \"oak\", per_km2 = 5.0 }, { species = \"pine\", per_km2 = 1.0 }";
+    let t = ClassTable::parse(&table(&oak, rules), "t.toml").unwrap();
+    let drawn: Vec<_> =
+        t.species.iter().map(|s| (s.name.as_str(), s.model.as_str(), s.variant, s.variants)).collect();
+    assert_eq!(drawn, [("pine", "Pine_1", 0, 1), ("oak", "A", 0, 3), ("oak", "B", 1, 3), ("oak", "C", 2, 3)]);
+    assert!(
+        t.species[1..].iter().all(|s| s.height_m == t.species[1].height_m && s.kind == SpeciesKind::Tree)
+    );
+    assert_eq!(t.species_index("oak"), Some(1));
+    // Every variant counts against the GPU's species table.
+    let many = format!("models = [{}]", vec!["\"A\""; MAX_SPECIES].join(", "));
+    let err = error(&table(&oak.replace("models = [\"A\", \"B\", \"C\"]", &many), ""));
+    assert!(err.contains("17 species") && err.contains("each of a species' models counted"), "{err}");
+    // A model given both ways, or none.
+    for models in ["model = \"A\"\nmodels = [\"B\"]", "models = []", ""] {
+        let err = error(&table(&oak.replace("models = [\"A\", \"B\", \"C\"]", models), ""));
+        assert!(err.contains("species `oak`") && err.contains("one of the two"), "{models}: {err}");
+    }
+}

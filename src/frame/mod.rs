@@ -156,7 +156,7 @@ pub struct FrameReport {
     pub seed_cells_dropped: usize,
     /// Pass 3's counters of the latest frame whose counters have arrived (a frame or two old).
     pub seeds: Option<SeedReport>,
-    /// Species drawn with an impostor.
+    /// Species (each variant counted: each of `ClassTable::species`) drawn with an impostor.
     pub seed_species_drawn: usize,
     /// Species selected but not drawn (no `draw_seeds.impostors`, or no model for them).
     pub seed_species_undrawn: usize,

@@ -285,6 +285,9 @@ wgsl_constants! { seed_constants:
     pub const GROUND_SAMPLES: u32 = 4;
     /// Mixed into the seed hash so it never equals the pattern hash of the same cell.
     pub const SEED_SALT: u32 = 0x5eed_5eed;
+    /// Mixed into a seed's hash to pick its species' variant, so the pick is independent of the
+    /// height, turn and colour the same hash gives it.
+    pub const SEED_VARIANT_SALT: u32 = 0x7a41_a7e5;
     /// A land-cover lookup that found no resident level.
     pub const NO_CLASS: u32 = u32::MAX;
 }

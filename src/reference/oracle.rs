@@ -35,7 +35,7 @@ use crate::dataset::{Dataset, PackError};
 use crate::gpu::gpu_types::SeedSpecies;
 use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::wind::Wind;
-use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, species_of_rank};
+use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, seed_variant, species_of_rank};
 use ground::{DemWindow, LandcoverTiles};
 
 /// The fraction of an eye→summit segment, at the summit's end, the occlusion test ignores.
@@ -96,7 +96,7 @@ pub struct OracleSeed {
     pub address: [i64; 2],
     /// Its rank in its cell's pattern: with the address, its identity.
     pub rank: u32,
-    /// Index into `SeedTables::species`.
+    /// Index into `SeedTables::species`: the variant it is drawn as (`seeds::seed_variant`).
     pub species: u32,
     /// Where it stands, grid space, metres.
     pub position_grid_m: [f64; 2],
@@ -411,7 +411,8 @@ impl View<'_> {
             return Ok(Fate::Rule);
         }
         let seeds = &settings.seeds;
-        let height_m = f64::from(seed_height_m(species, seed_hash(i32_address, rank, settings.tlm.seed)));
+        let hash = seed_hash(i32_address, rank, settings.tlm.seed);
+        let height_m = f64::from(seed_height_m(species, hash));
         let rel = DVec3::new(p.x, p.y, ground_m) - self.eye;
         let distance_m = rel.length();
         let scale = (height_m / seeds.reference_height_m).min(1.0);
@@ -437,7 +438,7 @@ impl View<'_> {
         Ok(Fate::Visible(OracleSeed {
             address,
             rank,
-            species: species_index,
+            species: species_index + seed_variant(hash, species.variants),
             position_grid_m: [p.x, p.y],
             ground_m,
             height_m,

@@ -20,7 +20,7 @@ use crate::gpu::layout::{
     SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group,
 };
 use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
-use crate::seeds::{SeedTables, pcg, seed_hash, unit};
+use crate::seeds::{SeedTables, pcg, seed_hash, seed_variant, unit};
 use crate::streaming::TileCache;
 
 mod compare;
@@ -463,13 +463,14 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         }
     }
 
+    let drawn = species_index + seed_variant(hash, species.variants);
     let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     Ok(SeedRecord {
         position_rel_m: [rel_xy[0], rel_xy[1], base_rel_m],
         height_m,
         address: cell.address,
         rank,
-        species_lod: SpeciesLod { species: species_index, lod, lcc_level, height_level: ground.level }.pack(),
+        species_lod: SpeciesLod { species: drawn, lod, lcc_level, height_level: ground.level }.pack(),
         jitter: pcg(hash),
         ground_colour: ground_colour(u, inputs.imagery, &imagery, hash),
         radius_m,

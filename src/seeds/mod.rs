@@ -22,7 +22,7 @@ use thiserror::Error;
 use crate::classes::{ClassTable, MAX_SPECIES, MAX_SPECIES_PER_CLASS, SpeciesKind};
 use crate::dataset::lcc::LccCoding;
 use crate::gpu::gpu_types::{SeedClass, SeedSpecies};
-use crate::gpu::layout::{KIND_BUSH, KIND_ROCK, KIND_TREE, SEED_SALT, SEED_WORKGROUP};
+use crate::gpu::layout::{KIND_BUSH, KIND_ROCK, KIND_TREE, SEED_SALT, SEED_VARIANT_SALT, SEED_WORKGROUP};
 
 /// Cells one dispatch checks at most (a dispatch dimension's limit).
 pub const MAX_SEED_CELLS: u32 = 65535;
@@ -78,6 +78,12 @@ pub fn pcg(v: u32) -> u32 {
     let state = v.wrapping_mul(747796405).wrapping_add(2891336453);
     let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277803737);
     (word >> 22) ^ word
+}
+
+/// Which of its species' `variants` models a seed of hash `hash` is drawn with: the shader's
+/// `seed_variant`. Independent of the seed's height, turn and colour (its own salt).
+pub fn seed_variant(hash: u32, variants: u32) -> u32 {
+    pcg(hash ^ SEED_VARIANT_SALT) % variants.max(1)
 }
 
 /// The seed-pattern hash of ring-0 cell (`x`, `y`) (global address, as two's-complement bits).
@@ -161,6 +167,8 @@ impl SeedTables {
                         SpeciesKind::Rock => KIND_ROCK,
                     },
                     wind_bend: wind::bend_of(s.kind),
+                    variants: s.variants,
+                    _pad: 0,
                 }
             })
             .collect();
@@ -228,6 +236,31 @@ mod tests {
             }
         }
         assert_eq!(max_cells(2048), 32768);
+    }
+
+    #[test]
+    fn variants_share_a_species_evenly_whatever_the_height() {
+        let seeds = 40_000u32;
+        for variants in [1, 2, 3, 4] {
+            // Seeds counted per variant, among all and among the short half (`unit(hash) < 0.5`).
+            let (mut all, mut short) = (vec![0u32; variants as usize], vec![0u32; variants as usize]);
+            for rank in 0..seeds {
+                let hash = seed_hash([rank as i32 % 97, rank as i32 / 97], rank, 7);
+                let v = seed_variant(hash, variants) as usize;
+                all[v] += 1;
+                short[v] += u32::from(unit(hash) < 0.5);
+            }
+            let share = 1.0 / f64::from(variants);
+            let total_short: u32 = short.iter().sum();
+            for (a, s) in all.iter().zip(&short) {
+                assert!((f64::from(*a) / f64::from(seeds) - share).abs() < 0.01, "{variants}: {all:?}");
+                assert!(
+                    (f64::from(*s) / f64::from(total_short) - share).abs() < 0.015,
+                    "{variants}: {short:?}"
+                );
+            }
+        }
+        assert_eq!(seed_variant(12345, 0), 0);
     }
 
     #[test]

@@ -84,12 +84,16 @@ pub fn bake_forest(
     let mut source = super::ModelSource::new(models);
     let mut models_read: Vec<Model> = Vec::new();
     let mut grown = Vec::new();
+    // A species' variants share its density, as pass 3's seeds do.
+    let variants = class.seeds.iter().flat_map(|rule| {
+        table.species.iter().filter(move |s| s.name == rule.species).map(move |s| (rule, s))
+    });
     for rule in &class.seeds {
-        let species = table
-            .species
-            .iter()
-            .find(|s| s.name == rule.species)
-            .ok_or_else(|| bad(format!("no species {:?}", rule.species)))?;
+        if !table.species.iter().any(|s| s.name == rule.species) {
+            return Err(bad(format!("no species {:?}", rule.species)));
+        }
+    }
+    for (rule, species) in variants {
         if !models_read.iter().any(|m| m.name == species.model) {
             let path =
                 source.file(&species.model)?.unwrap_or_else(|| models.join(format!("{}.glb", species.model)));
@@ -108,7 +112,7 @@ pub fn bake_forest(
             .fold(0.0f32, f32::max);
         grown.push(Grown {
             model: species.model.clone(),
-            per_km2: rule.per_km2,
+            per_km2: rule.per_km2 / species.variants as f32,
             height_m: species.height_m,
             crown_per_height: crown_m / m.height_m.max(1e-3),
         });
