@@ -4,7 +4,7 @@
 Usage: scripts/trade_page.py FRAMES WARMUP [MINUTES]   (scripts/trade.sh runs it after the sweeps;
 TRADE_NOTE, if set, is printed after the introduction: what else shared the machine during the run)
 """
-import json, os, sys, tomllib
+import json, os, sys
 frames, warmup = sys.argv[1:3]
 names = {"synthetic": "The synthetic default (`terramp-data synth --size 1024`: 10 km, 10 m heights, 2.5 m imagery, 5 m land cover)",
          "nc": "`nc/` (USGS NED 30 m, Landsat 7 at 28.5 m, land use at 10 m)",
@@ -141,14 +141,12 @@ for name, t in trades.items():
 nc = by_label(trades["nc"])
 clouds_12 = [band_flip(nc["accurate"], b) for b in ("clouds 1", "clouds 2")]
 reach_points = [p for p in trades["nc"]["points"] if p["preset"] == "balanced" and set(p["knobs"]) <= {"draw_seeds.reach_m"}]
-# balanced's own reaches: the defaults (config/default.toml), which its preset file leaves alone.
-with open("config/default.toml", "rb") as f:
-    balanced_reach = tomllib.load(f)["draw_seeds"]["reach_m"]
 
 
 def mesh_reach(p):
-    v = p["knobs"].get("draw_seeds.reach_m")
-    return json.loads(v)[0] if v else balanced_reach[0]
+    # Where the point drew meshes to, as its error bands recorded it when measured (the defaults
+    # may have changed since).
+    return next(b["band"]["to_m"] for b in p["error"]["bands"] if b["band"]["name"] == "meshes")
 
 
 reach_text = "; ".join(
