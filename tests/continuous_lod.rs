@@ -28,11 +28,7 @@ fn table_and_impostors() -> (PathBuf, PathBuf) {
     let text = include_str!("../config/classes/nc_generated.toml");
     let one_model: String = text
         .lines()
-        .map(
-            |line| {
-                if line.starts_with("models = ") { format!("model = \"{MODEL}\"") } else { line.to_owned() }
-            },
-        )
+        .map(|line| if line.starts_with("model") { format!("model = \"{MODEL}\"") } else { line.to_owned() })
         .collect::<Vec<_>>()
         .join("\n");
     let table = dir.join("pines.toml");

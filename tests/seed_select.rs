@@ -1,8 +1,8 @@
 //! Pass 3 on a synthetic dataset: the GPU equals its CPU twin (read in block-table order, in the
 //! same order too; in still air and in wind, with species variants), seeds spread over their
-//! species' variants as the exact oracle picks them, runs and paths agree, seeds sit on the drawn ground, a too-small output is
-//! flagged without corrupting what it keeps, and compaction's draw order is the same in every run
-//! and equals its twin's.
+//! species' variants as the exact oracle picks them, runs and paths agree, seeds sit on the drawn
+//! ground, a too-small output is flagged without corrupting what it keeps, and compaction's draw
+//! order is the same in every run and equals its twin's.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
@@ -97,7 +97,7 @@ fn seeds_spread_over_their_species_variants_as_the_oracle_does() {
     let camera = over_fraction(&r, [0.6, 0.5], 300.0, 200.0, -25.0);
     r.render_resolved(&camera).unwrap();
     let (gpu, _) = r.read_seeds().unwrap().unwrap();
-    let table = terramp::classes::ClassTable::load("nc-generated").unwrap();
+    let table = r.class_table().unwrap();
     // Per species (its first entry), how many seeds each variant got.
     let mut per_variant = vec![0usize; table.species.len()];
     for s in &gpu {

@@ -4,8 +4,8 @@
 //! class, seed rules (a species and its density in seeds per km²). A species with `models = [..]`
 //! becomes one entry of `species` per model, consecutive and alike but for the model, so that every
 //! consumer indexes one model per entry as pass 3's records do; the rules name the first, and pass
-//! 3 moves each seed to one of its species' variants by its hash (`seeds::seed_variant`). The built-in tables are compiled in, so `--classes nlcd` works from
-//! anywhere; a path to a TOML file of the same shape works too. Codes outside the table are not an
+//! 3 moves each seed to one of its species' variants by its hash (`seeds::seed_variant`). The
+//! built-in tables are compiled in, so `--classes nlcd` works from anywhere; a path to a TOML file of the same shape works too. Codes outside the table are not an
 //! error: they mean "no class" (no seeds), and the builder counts them. Parsing validates the table
 //! (unique codes and species, rules naming known species, every number in range) and names the
 //! table, class and key of the first problem, so a typo never reaches the GPU.

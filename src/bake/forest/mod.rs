@@ -84,15 +84,13 @@ pub fn bake_forest(
     let mut source = super::ModelSource::new(models);
     let mut models_read: Vec<Model> = Vec::new();
     let mut grown = Vec::new();
-    // A species' variants share its density, as pass 3's seeds do.
+    if let Some(rule) = class.seeds.iter().find(|rule| table.species_index(&rule.species).is_none()) {
+        return Err(bad(format!("no species {:?}", rule.species)));
+    }
+    // Every variant of each rule's species, sharing its density as pass 3's seeds do.
     let variants = class.seeds.iter().flat_map(|rule| {
         table.species.iter().filter(move |s| s.name == rule.species).map(move |s| (rule, s))
     });
-    for rule in &class.seeds {
-        if !table.species.iter().any(|s| s.name == rule.species) {
-            return Err(bad(format!("no species {:?}", rule.species)));
-        }
-    }
     for (rule, species) in variants {
         if !models_read.iter().any(|m| m.name == species.model) {
             let path =

@@ -145,8 +145,9 @@ gpu_struct! {
         /// How much the wind bends it (`seeds::wind::bend_of`): 1 a plant, 0 a rock; its bounds
         /// grow by this times `SeedUniforms::wind_reach_per_height` times its height.
         pub wind_bend: f32,
-        /// How many models its species has, this entry the first (`classes::Species::variants`):
-        /// a seed of it is drawn as entry `index + seed_variant(hash, variants)`.
+        /// How many models its species has (`classes::Species::variants`, on each of its
+        /// entries): a seed of the entry a rule names is drawn as entry
+        /// `index + seed_variant(hash, variants)`.
         pub variants: u32,
         /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: u32,
