@@ -119,15 +119,7 @@ fn seeds_spread_over_their_species_variants_as_the_oracle_does() {
         "no seed drawn as a second variant: {per_variant:?}"
     );
     // The exact oracle (and the truth, which draws its seeds) picks the same variant per seed.
-    let (tables, patterns) = r.seed_world().unwrap();
-    let inputs = terramp::reference::oracle::OracleInputs {
-        dataset: &r.dataset,
-        settings: &r.settings,
-        tables,
-        patterns,
-        camera: &camera,
-        viewport_px: [r.settings.render.width, r.settings.render.height],
-    };
+    let inputs = r.oracle_inputs(&camera).unwrap();
     let (oracle, _) = terramp::reference::oracle::visible_seeds(&inputs).unwrap();
     let species_of: std::collections::HashMap<([i32; 2], u32), u32> =
         gpu.iter().map(|s| ((s.address, s.rank), SpeciesLod::unpack(s.species_lod).species)).collect();

@@ -11,6 +11,7 @@ use crate::gpu::gpu_types::{SeedCounters, SeedDrawArgs, SeedRecord, TerrainUnifo
 use crate::gpu::readback::read_texture;
 use crate::passes::compact::frame::Compacted;
 use crate::passes::seed_select::frame::{SeedCellRef, SeedOutput};
+use crate::reference::oracle::OracleInputs;
 use crate::reference::seed_select::{SeedSnapshot, seed_select, seed_select_blocks, snapshot_caches};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
@@ -127,6 +128,20 @@ impl Renderer {
     /// The seeded world of this renderer: species tables and patterns (`None` without land cover).
     pub fn seed_world(&self) -> Option<(&SeedTables, &SeedPatterns)> {
         self.seeds.as_ref().map(|s| (&s.tables, &s.patterns))
+    }
+
+    /// What the exact oracle reads to judge this renderer's view from `camera`: its dataset,
+    /// settings and seeded world (`None` without land cover).
+    pub fn oracle_inputs<'a>(&'a self, camera: &'a Camera) -> Option<OracleInputs<'a>> {
+        let (tables, patterns) = self.seed_world()?;
+        Some(OracleInputs {
+            dataset: &self.dataset,
+            settings: &self.settings,
+            tables,
+            patterns,
+            camera,
+            viewport_px: [self.settings.render.width, self.settings.render.height],
+        })
     }
 
     /// The class table the species come from (`None` without land cover).

@@ -31,7 +31,7 @@ use crate::profile::{Meta, Recording, Session, Summary, timing_of};
 use crate::reference::accuracy::{HeightError, SeedAgreement};
 use crate::reference::frame_change::Popping;
 use crate::reference::image_metrics::{capped_psnr_db, mse, psnr_of_mse};
-use crate::reference::oracle::{OracleInputs, visible_seeds};
+use crate::reference::oracle::visible_seeds;
 use crate::truth::compare::{bands, frame_error, pool};
 use crate::truth::visibility::{Missed, Visibility, judge, missed};
 
@@ -207,7 +207,7 @@ impl Flight<'_> {
             }
             let selected: Vec<([i64; 2], u32)> =
                 kept.iter().flatten().map(|s| (s.address.map(i64::from), s.rank)).collect();
-            if let (Some(truth), Some(inputs)) = (world.get(any_part.len()), oracle_inputs(r, camera)) {
+            if let (Some(truth), Some(inputs)) = (world.get(any_part.len()), r.oracle_inputs(camera)) {
                 let visibility = judge(&truth.seeds, &truth.samples, selected.iter().copied());
                 let missed = missed(&inputs, &truth.seeds, &truth.samples, selected.iter().copied())?;
                 any_part.push((visibility, missed));
@@ -293,26 +293,13 @@ impl Flight<'_> {
     }
 }
 
-/// What the exact oracle reads to judge `r`'s view from `camera` (`None` without land cover).
-fn oracle_inputs<'a>(r: &'a Renderer, camera: &'a Camera) -> Option<OracleInputs<'a>> {
-    let (tables, patterns) = r.seed_world()?;
-    Some(OracleInputs {
-        dataset: &r.dataset,
-        settings: &r.settings,
-        tables,
-        patterns,
-        camera,
-        viewport_px: [r.settings.render.width, r.settings.render.height],
-    })
-}
-
 /// The settled view's kept seeds against the summit oracle (`None` without land cover).
 fn seed_figures(
     r: &Renderer,
     camera: &Camera,
     kept: Option<&[SeedRecord]>,
 ) -> Result<Option<(SeedAgreement, HeightError)>, SweepError> {
-    let (Some(inputs), Some(kept)) = (oracle_inputs(r, camera), kept) else {
+    let (Some(inputs), Some(kept)) = (r.oracle_inputs(camera), kept) else {
         return Ok(None);
     };
     let (visible, _) = visible_seeds(&inputs)?;

@@ -42,7 +42,7 @@ use crate::gpu::{Gpu, GpuError};
 use crate::passes::draw_seeds::DrawSeedsError;
 use crate::passes::draw_seeds::frame::{draw_uniforms, load_impostors};
 use crate::passes::draw_seeds::gpu::{DrawSeedsInputs, DrawSeedsPass, SEED_ID_FORMAT};
-use crate::reference::oracle::{Culls, OracleCounts, OracleError, OracleInputs, OracleSeed, judge_seeds};
+use crate::reference::oracle::{Culls, OracleCounts, OracleError, OracleSeed, judge_seeds};
 use scene::TruthScene;
 use visibility::samples_per_seed;
 
@@ -211,17 +211,8 @@ impl TruthRenderer {
     pub fn render(&mut self, camera: &Camera) -> Result<Truth, TruthError> {
         let renderer = &mut self.renderer;
         renderer.render_resolved(camera)?;
-        let (seeds, counts) = match renderer.seed_world() {
-            Some((tables, patterns)) => {
-                let s = &renderer.settings;
-                let inputs = OracleInputs {
-                    dataset: &renderer.dataset,
-                    settings: s,
-                    tables,
-                    patterns,
-                    camera,
-                    viewport_px: [s.render.width, s.render.height],
-                };
+        let (seeds, counts) = match renderer.oracle_inputs(camera) {
+            Some(inputs) => {
                 judge_seeds(&inputs, Culls { reach_m: Some(self.options.reach_m), occlusion: false })?
             }
             None => (Vec::new(), OracleCounts::default()),
