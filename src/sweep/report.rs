@@ -29,7 +29,8 @@
 //! "summit_hidden", "selection": float } }` (the truth's any-part oracle; why the missed samples
 //! are missed, `truth::visibility::Missed`) and region is `{ "band":
 //! { "name", "from_m", "to_m" }, "pixels", "mse", "psnr_db", "ssim", "flip",
-//! "cover": { "truth_px", "drawn_px", "both_px": int } | null }` (`truth::compare`;
+//! "cover": { "truth_px", "drawn_px", "both_px": int, "truth_level_sum", "drawn_level_sum":
+//! float } | null }` (`truth::compare`;
 //! an infinite `to_m` and a figure of an empty band are `null`); popping is in levels of 255
 //! (`reference::frame_change`). The CSV has the same figures under the same names (pass medians
 //! as `<label>_ms`, seed figures without their `seeds.` prefix, the missed shares as

@@ -94,24 +94,26 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
         out,
         "\nFrame error against the truth per distance band (PSNR / SSIM / FLIP; share of pixels; \
          forest cover: of the truth's forest pixels, the share the frame draws on, and of the \
-         pixels it draws on, the share on the truth's forest):\n"
+         pixels it draws on, the share on the truth's forest; forest brightness: the mean level \
+         of the frame's drawn pixels over that of the truth's forest pixels, 1 alike):\n"
     )?;
     writeln!(
         out,
-        "| point | band | from–to m | pixels | PSNR | SSIM | FLIP | cover recall | cover precision |"
+        "| point | band | from–to m | pixels | PSNR | SSIM | FLIP | cover recall | cover precision | forest brightness |"
     )?;
-    writeln!(out, "|---|---|---|---|---|---|---|---|---|")?;
+    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|")?;
     for p in &t.points {
         for r in &p.error.bands {
             let to = if r.band.to_m.is_finite() { format!("{:.0}", r.band.to_m) } else { "∞".into() };
             let share = 100.0 * r.pixels as f64 / p.error.frame.pixels.max(1) as f64;
             // A band with no pixel (or too thin for an SSIM window) has no figure.
             let figure = |v: f64, text: String| if v.is_finite() { text } else { "–".into() };
-            let (recall, precision) =
-                r.cover.map_or((f64::NAN, f64::NAN), |c| (c.recall_pct(), c.precision_pct()));
+            let (recall, precision, brightness) = r.cover.map_or((f64::NAN, f64::NAN, f64::NAN), |c| {
+                (c.recall_pct(), c.precision_pct(), c.brightness_ratio())
+            });
             writeln!(
                 out,
-                "| {} | {} | {:.0}–{to} | {share:.1} % | {} | {} | {} | {} | {} |",
+                "| {} | {} | {:.0}–{to} | {share:.1} % | {} | {} | {} | {} | {} | {} |",
                 p.label,
                 r.band.name,
                 r.band.from_m,
@@ -119,7 +121,8 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
                 figure(r.ssim, format!("{:.4}", r.ssim)),
                 figure(r.flip, format!("{:.4}", r.flip)),
                 figure(recall, format!("{recall:.1} %")),
-                figure(precision, format!("{precision:.1} %"))
+                figure(precision, format!("{precision:.1} %")),
+                figure(brightness, format!("{brightness:.3}"))
             )?;
         }
     }

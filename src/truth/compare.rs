@@ -11,7 +11,10 @@
 //! truth's forest pixels (at least half their samples on a seed) against the frame's drawn pixels
 //! (those its seeds and texcells change from its ground by `DRAWN_MIN_LEVELS` or more), so that a
 //! representation is judged on where it puts forest (recall: the truth's forest it covers;
-//! precision: its cover that lies on the truth's forest) apart from how it colours it.
+//! precision: its cover that lies on the truth's forest) apart from how it colours it; and how
+//! bright each draws its forest (the mean sRGB level of the truth's forest pixels in the truth, of
+//! the drawn pixels in the frame), so that representations meeting at a band's edge are judged on
+//! their colour against the same reference, not against each other.
 //!
 //! Three errors, each from one whole-frame map averaged over the band's pixels:
 //! - **PSNR**: the mean squared error over R, G and B (`image_metrics::squared_errors`);
@@ -87,8 +90,9 @@ pub struct RegionError {
 /// the frame's own ground by this many 8-bit levels or more: above rounding and dither noise.
 pub const DRAWN_MIN_LEVELS: u8 = 3;
 
-/// Forest cover in a region: the truth's forest pixels, the frame's drawn ones, and both.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+/// Forest cover in a region: the truth's forest pixels, the frame's drawn ones, and both; and the
+/// sums of their levels, for their mean brightness.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct Cover {
     /// Pixels at least half of whose truth samples show a seed.
     pub truth_px: u64,
@@ -96,6 +100,11 @@ pub struct Cover {
     pub drawn_px: u64,
     /// Pixels both.
     pub both_px: u64,
+    /// Over the truth's forest pixels, the sum of the truth's mean level of R, G and B (sRGB,
+    /// 0–255).
+    pub truth_level_sum: f64,
+    /// Over the frame's drawn pixels, the sum of the frame's mean level of R, G and B.
+    pub drawn_level_sum: f64,
 }
 
 impl Cover {
@@ -109,10 +118,18 @@ impl Cover {
         100.0 * self.both_px as f64 / self.drawn_px as f64
     }
 
+    /// How bright the frame draws its forest against the truth's forest: the ratio of their mean
+    /// levels (1: alike; NaN without either).
+    pub fn brightness_ratio(&self) -> f64 {
+        (self.drawn_level_sum / self.drawn_px as f64) / (self.truth_level_sum / self.truth_px as f64)
+    }
+
     fn add(&mut self, other: &Cover) {
         self.truth_px += other.truth_px;
         self.drawn_px += other.drawn_px;
         self.both_px += other.both_px;
+        self.truth_level_sum += other.truth_level_sum;
+        self.drawn_level_sum += other.drawn_level_sum;
     }
 }
 
@@ -254,10 +271,18 @@ pub fn frame_error(
             flip: pixels.iter().map(|&i| f64::from(flip[i])).sum::<f64>() / n,
             cover: forest.as_ref().map(|(truth, drawn)| {
                 let count = |f: &dyn Fn(usize) -> bool| pixels.iter().filter(|&&i| f(i)).count() as u64;
+                let level_sum = |image: &image::RgbaImage, f: &dyn Fn(usize) -> bool| {
+                    let level = |i: usize| {
+                        image.as_raw()[4 * i..4 * i + 3].iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0
+                    };
+                    pixels.iter().filter(|&&i| f(i)).map(|&i| level(i)).sum()
+                };
                 Cover {
                     truth_px: count(&|i| truth[i]),
                     drawn_px: count(&|i| drawn[i]),
                     both_px: count(&|i| truth[i] && drawn[i]),
+                    truth_level_sum: level_sum(reference, &|i| truth[i]),
+                    drawn_level_sum: level_sum(frame, &|i| drawn[i]),
                 }
             }),
         }
@@ -363,6 +388,10 @@ pub(crate) mod tests {
                 }
             }
             truth.seed_ids[(y * ss) * w * ss + 20 * ss] = 1;
+            // One colour over the middle third, so that the levels are known: a mean of 90.
+            for x in 0..w as u32 {
+                truth.colour.put_pixel(x, y as u32, image::Rgba([60, 120, 90, 255]));
+            }
         }
         // The frame draws the middle third's columns 8..24: half on the truth's forest.
         let ground = truth.colour.clone();
@@ -377,12 +406,22 @@ pub(crate) mod tests {
         let bands = [Band { name: "all".into(), from_m: 0.0, to_m: f64::INFINITY }];
         let e = frame_error(&truth, 0.1, &frame, Some(&ground), &bands).unwrap();
         let cover = e.bands[0].cover.unwrap();
-        assert_eq!(cover, Cover { truth_px: 8 * 16, drawn_px: 8 * 16, both_px: 8 * 8 });
+        // Drawn pixels are (60 ^ 0x40, 120, 90): a mean of 334 / 3 against the truth's 90.
+        let (truth_px, drawn_px) = (8 * 16, 8 * 16);
+        let levels = (90.0 * truth_px as f64, 334.0 / 3.0 * drawn_px as f64);
+        assert_eq!((cover.truth_px, cover.drawn_px, cover.both_px), (truth_px, drawn_px, 8 * 8));
+        assert!(
+            (cover.truth_level_sum - levels.0).abs() < 1e-9
+                && (cover.drawn_level_sum - levels.1).abs() < 1e-6
+        );
         assert_eq!((cover.recall_pct(), cover.precision_pct()), (50.0, 50.0));
+        assert!((cover.brightness_ratio() - 334.0 / 270.0).abs() < 1e-12, "{}", cover.brightness_ratio());
         assert!(frame_error(&truth, 0.1, &frame, None, &bands).unwrap().bands[0].cover.is_none());
         // Pooled, the counts add up.
         let pooled = pool(&[e.clone(), e]).unwrap();
-        assert_eq!(pooled.bands[0].cover.unwrap().both_px, 2 * 8 * 8);
+        let pooled = pooled.bands[0].cover.unwrap();
+        assert_eq!(pooled.both_px, 2 * 8 * 8);
+        assert!((pooled.brightness_ratio() - cover.brightness_ratio()).abs() < 1e-12);
     }
 
     #[test]
