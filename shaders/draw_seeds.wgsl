@@ -16,7 +16,8 @@
 // 0. Its own geometry keeps the pixels whose ordered-dither threshold t (Bayer 4×4, shifted per
 // seed so neighbours do not share a pattern) is below f, the next LOD's geometry those at or above
 // it: each pixel shows one of the two, and the mix moves smoothly with distance. Outside the band
-// the cross-fade draw collapses its vertices; the last LOD has none and fades out to nothing.
+// the cross-fade draw collapses its vertices; the last LOD has none and fades out to nothing, as
+// does the last LOD a seed's class draws (`SpeciesLod::last`, `classes::Class::seed_lods`).
 
 struct DrawSeedsUniforms {
     clip_from_view_world: mat4x4<f32>,
@@ -166,7 +167,9 @@ fn vs_main(
     let material = materials[in.material];
     let distance_m = seed_distance_m(record);
     var fade = band_fade(record, lod, distance_m);
-    if material.lod <= lod && lod < material.last_lod {
+    // In its class's last LOD a seed fades out to nothing, as in the last band: no next LOD.
+    let last = seed.last != 0u;
+    if material.lod <= lod && lod < material.last_lod && !last {
         // Its own geometry goes on as the next LOD (continuous LOD): nothing to cross-fade.
         fade = 1.0;
     }
@@ -176,8 +179,9 @@ fn vs_main(
     out.keep = vec3<f32>(0.0, fade, f32(record.rank & 15u));
     if lod < material.lod || lod > material.last_lod {
         out.keep = vec3<f32>(fade, 2.0, f32(record.rank & 15u));
-        if fade >= 1.0 {
-            // Not in the band: nothing to cross-fade. Every vertex at one point outside the view.
+        if fade >= 1.0 || (last && lod < material.lod) {
+            // Not in the band, or no next LOD: nothing to cross-fade. Every vertex at one point
+            // outside the view.
             out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
             return out;
         }

@@ -86,6 +86,10 @@ struct SeedSpecies {
 struct SeedClass {
     rank_limit: vec4<f32>,
     species: vec4<u32>,
+    lods: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct SeedCounters {
@@ -332,13 +336,15 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     let rel_xy = cell.rel_m + vec2<f32>(mul(pos_unit.x, u.cell_m), mul(pos_unit.y, u.cell_m));
     let ground_rel_m = ground.height_m - u.camera_z_m;
 
-    // Radial LOD: thresholds shrink with the seed's size below the reference height.
+    // Radial LOD: thresholds shrink with the seed's size below the reference height; a class
+    // stops at its own last LOD.
     out.count = COUNT_DISTANCE;
     let distance_sq = mul(rel_xy.x, rel_xy.x) + mul(rel_xy.y, rel_xy.y) + mul(ground_rel_m, ground_rel_m);
     let size_scale = min(1.0, mul(height_m, u.inv_reference_height_m));
+    let lods = min(seeds.lods, SEED_LODS);
     var lod = 0u;
     loop {
-        if lod >= SEED_LODS {
+        if lod >= lods {
             return out;
         }
         let reach = mul(u.draw_reach_m[lod], size_scale);
@@ -411,7 +417,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
         height_m,
         cell.address,
         rank,
-        pack_species_lod(SpeciesLod(drawn, lod, found.y, ground.level)),
+        pack_species_lod(SpeciesLod(drawn, lod, u32(lod + 1u == lods), found.y, ground.level)),
         pcg(hash),
         ground_colour(imagery, hash),
         radius_m,

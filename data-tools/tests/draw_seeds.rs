@@ -293,7 +293,9 @@ fn frame_change(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, f64) {
 /// what switching at once gives (measured on lavapipe: 7.8 against 19.5). Single pixels still
 /// flip between the two LODs' geometry (up to ~125 levels either way): that is the dither. In a
 /// 12 m/s wind held at one moment the figure stays within 20 % of still air's (issue 14): every
-/// LOD of a seed bends the same way.
+/// LOD of a seed bends the same way. Where a class stops its seeds at an earlier LOD
+/// (`[[class]] seed_lods`), they fade out there just as softly: within the same 12 levels and
+/// half of what stopping at once gives.
 #[test]
 fn lod_changes_cross_fade_instead_of_popping() {
     if shared_data().is_none() {
@@ -303,10 +305,18 @@ fn lod_changes_cross_fade_instead_of_popping() {
     let path = tmp.path().join("nc");
     let pose = forest_near_water(&build_nc(&path));
     let dir = impostors().to_str().unwrap().to_owned();
-    let run = |fade_fraction: f64, wind_m_s: f64| {
+    // nc's table with every class drawing its seeds to the first billboard-cloud band only (the
+    // forest without texcells, which take over only after the last band).
+    let nc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/classes/nc.toml"))
+        .unwrap();
+    let near = nc.replace("texcells = true\n", "").replace("\n[[class]]\n", "\n[[class]]\nseed_lods = 2\n");
+    let near_table = tmp.path().join("near.toml");
+    std::fs::write(&near_table, near).unwrap();
+    let run_with = |fade_fraction: f64, wind_m_s: f64, class_table: &str| {
         let mut settings = Settings::default();
         settings.draw_seeds.fade_fraction = fade_fraction;
         settings.seeds.reference_height_m = 40.0;
+        settings.seeds.class_table = class_table.to_owned();
         settings.wind.speed_m_s = wind_m_s;
         let (mut r, camera, _) =
             open_view(Dataset::open(&path).unwrap(), settings, &dir, [320, 180], pose, [40.0, -12.0]);
@@ -325,11 +335,12 @@ fn lod_changes_cross_fade_instead_of_popping() {
         let changes: Vec<(f64, f64)> = frames.windows(2).map(|f| frame_change(&f[0], &f[1])).collect();
         let worst = changes.iter().fold((0.0f64, 0.0f64), |a, c| (a.0.max(c.0), a.1.max(c.1)));
         println!(
-            "fade {fade_fraction}, wind {wind_m_s} m/s: largest change of a pixel {:.1}, of a 4×4 block {:.1} (of 255)",
+            "fade {fade_fraction}, wind {wind_m_s} m/s, table {class_table:?}: largest change of a pixel {:.1}, of a 4×4 block {:.1} (of 255)",
             worst.0, worst.1
         );
         worst
     };
+    let run = |fade_fraction: f64, wind_m_s: f64| run_with(fade_fraction, wind_m_s, "");
     let (_, faded) = run(0.1, 0.0);
     let (_, popped) = run(0.0, 0.0);
     assert!(popped > 0.0, "nothing changed LOD in {FADE_FRAMES} frames: a void test");
@@ -340,6 +351,14 @@ fn lod_changes_cross_fade_instead_of_popping() {
     assert!(
         windy <= 1.2 * faded,
         "in a 12 m/s wind cross-fades change a block by {windy:.1}, still {faded:.1}"
+    );
+    let near_table = near_table.to_str().unwrap();
+    let (_, class_faded) = run_with(0.1, 0.0, near_table);
+    let (_, class_stopped) = run_with(0.0, 0.0, near_table);
+    assert!(class_stopped > 0.0, "no seed left its class's last LOD in {FADE_FRAMES} frames: a void test");
+    assert!(
+        class_faded <= 12.0 && class_faded <= 0.5 * class_stopped,
+        "fading out at their class's last LOD, seeds change a block by {class_faded:.1}; stopping at once, {class_stopped:.1}"
     );
 }
 

@@ -359,3 +359,39 @@ fn ray_descents_deg(camera: &Camera) -> Vec<f64> {
 
 /// Steps of the slow distance change.
 const FADE_FRAMES: usize = 24;
+
+#[test]
+fn a_scene_without_dense_classes_runs_no_texcell_pass() {
+    if shared_data().is_none() {
+        return;
+    }
+    let dir = TempDir::new("texcells-none-dense");
+    let path = dir.path().join("nc");
+    build_nc(&path);
+    // nc's table, its forest no longer dense: the same samples folder, nothing to draw with it.
+    let nc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../config/classes/nc.toml")).unwrap();
+    let sparse = nc.replace("texcells = true\n", "");
+    assert_ne!(sparse, nc, "nc's table has no dense class");
+    let table = dir.path().join("sparse.toml");
+    std::fs::write(&table, sparse).unwrap();
+    let with_table = |table: Option<&Path>| {
+        let tune = |s: &mut Settings| {
+            if let Some(table) = table {
+                s.seeds.class_table = table.display().to_string();
+            }
+        };
+        let (r, _, _, report, _) =
+            render_from(Dataset::open(&path).unwrap(), samples(), REACH_M, &tune, &|r| {
+                let (centre, yaw) = towards_far_water(&r.dataset);
+                terramp_testkit::camera::over(r, centre, VIEW[0], yaw, VIEW[1])
+            });
+        let timed = r.last_timings().iter().any(|t| t.label == "texcells");
+        (report.texcells, timed)
+    };
+    let (dense, dense_timed) = with_table(None);
+    assert!(dense.patches > 0 && dense_timed, "the control draws no texcells: {dense:?}");
+    let (none, none_timed) = with_table(Some(&table));
+    assert_eq!(none, Default::default(), "texcells drawn without a dense class");
+    assert!(!none_timed, "a texcells pass ran without a dense class");
+}

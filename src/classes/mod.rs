@@ -242,6 +242,16 @@ pub struct Class {
     /// Dense enough to be drawn as a forest far away (texcells): a forest sample is baked for it.
     #[serde(default)]
     pub texcells: bool,
+    /// How many of the draw LODs (`draw_seeds.reach_m`: the mesh, then the billboard-cloud bands)
+    /// its seeds are drawn in, nearest first, 1 to `SEED_LODS` (the default: all of them); past
+    /// the last they fade out as every seed does past the last band. A texcell class uses all of
+    /// them: its texcells take over where the last band ends.
+    #[serde(default = "all_seed_lods")]
+    pub seed_lods: u32,
+}
+
+fn all_seed_lods() -> u32 {
+    layout::SEED_LODS
 }
 
 /// A manifest's class list compares equal to a table's classes when codes and names match.
@@ -351,6 +361,26 @@ impl ClassTable {
             })?;
         }
         for class in &self.classes {
+            let lods_rule = if class.texcells {
+                (
+                    class.seed_lods == layout::SEED_LODS,
+                    "every draw LOD (the default) in a class with texcells: they take over where the last band ends",
+                )
+            } else {
+                (
+                    (1..=layout::SEED_LODS).contains(&class.seed_lods),
+                    "from 1 (the mesh only) to the number of draw_seeds.reach_m bands",
+                )
+            };
+            if !lods_rule.0 {
+                return Err(ClassTableError::OutOfRange {
+                    origin,
+                    place: format!("class {} ({})", class.code, class.name),
+                    key: "seed_lods",
+                    value: class.seed_lods.to_string(),
+                    rule: lods_rule.1,
+                });
+            }
             if class.seeds.len() > MAX_SPECIES_PER_CLASS {
                 return Err(ClassTableError::TooManyRules {
                     origin,

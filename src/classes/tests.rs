@@ -151,3 +151,26 @@ fn a_species_with_models_becomes_its_variants_in_order() {
         assert!(err.contains("species `oak`") && err.contains("one of the two"), "{models}: {err}");
     }
 }
+
+#[test]
+fn a_class_says_how_many_draw_lods_its_seeds_use() {
+    let rules = "{ species = \"pine\", per_km2 = 900.0 }";
+    let all = ClassTable::parse(&table("", rules), "t.toml").unwrap();
+    assert_eq!(all.class(5).unwrap().seed_lods, layout::SEED_LODS, "the default: every band");
+    let near = ClassTable::parse(&format!("{}seed_lods = 2\n", table("", rules)), "t.toml").unwrap();
+    assert_eq!(near.class(5).unwrap().seed_lods, 2);
+
+    for lods in [0, layout::SEED_LODS + 1] {
+        let err = error(&format!("{}seed_lods = {lods}\n", table("", rules)));
+        assert!(
+            err.contains("class 5 (forest)") && err.contains("seed_lods") && err.contains("t.toml"),
+            "{err}"
+        );
+    }
+    // Texcells take over where the last band ends: a texcell class stopping its seeds sooner
+    // would leave a bare ring between the two.
+    let err = error(&format!("{}texcells = true\nseed_lods = 3\n", table("", rules)));
+    assert!(err.contains("seed_lods") && err.contains("texcells"), "{err}");
+    let dense = ClassTable::parse(&format!("{}texcells = true\n", table("", rules)), "t.toml").unwrap();
+    assert!(dense.class(5).unwrap().texcells);
+}

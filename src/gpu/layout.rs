@@ -306,7 +306,10 @@ packed_word! {
         /// Index into the species table.
         species: 8,
         /// Draw LOD (0 the mesh, 1 to 3 the billboard clouds).
-        lod: 4,
+        lod: 3,
+        /// 1 when `lod` is the last its class draws (`SeedClass::lods`): the seed fades out at
+        /// its end instead of into the next LOD.
+        last: 1,
         /// Land-cover level its class was read from.
         lcc_level: 4,
         /// Height level it was placed on.
@@ -458,8 +461,8 @@ mod tests {
 
     #[test]
     fn words_round_trip_and_mask_each_field() {
-        let s = SpeciesLod { species: 9, lod: 3, lcc_level: 2, height_level: 11 };
-        assert_eq!(s.pack(), 9 | 3 << 8 | 2 << 12 | 11 << 16);
+        let s = SpeciesLod { species: 9, lod: 3, last: 1, lcc_level: 2, height_level: 11 };
+        assert_eq!(s.pack(), 9 | 3 << 8 | 1 << 11 | 2 << 12 | 11 << 16);
         assert_eq!(SpeciesLod::unpack(s.pack()), s);
         let wide = LevelRange { min: 0x1ff, max: 1 };
         assert_eq!(LevelRange::unpack(wide.pack()), LevelRange { min: 0xff, max: 1 });

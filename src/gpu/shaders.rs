@@ -97,6 +97,9 @@ mod tests {
         assert!(text.contains("const RADIAL_INACTIVE: u32 = 3u;"), "{text}");
         assert!(text.contains("const OCCLUSION_FOOTPRINT_PX: i32 = 1i;"), "{text}");
         assert!(text.contains("fn unpack_species_lod(word: u32) -> SpeciesLod"), "{text}");
-        assert!(text.contains("((v.lod & 0xfu) << 8u)"), "{text}");
+        assert!(
+            text.contains("((v.lod & 0x7u) << 8u)") && text.contains("((v.last & 0x1u) << 11u)"),
+            "{text}"
+        );
     }
 }

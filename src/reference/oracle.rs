@@ -104,7 +104,8 @@ pub struct OracleSeed {
     pub ground_m: f64,
     /// Its height (its size), metres.
     pub height_m: f64,
-    /// Its draw LOD: the first `draw_seeds.reach_m` (scaled by size) the seed is within.
+    /// Its draw LOD: the first `draw_seeds.reach_m` (scaled by size) the seed is within, among
+    /// the first `SeedClass::lods` of them.
     pub lod: u32,
 }
 
@@ -117,7 +118,7 @@ pub struct OracleCounts {
     pub class: u64,
     /// Culled by the species' altitude or slope rule.
     pub rule: u64,
-    /// Beyond every `draw_seeds.reach_m` scaled by the seed's size.
+    /// Beyond every `draw_seeds.reach_m` its class draws, scaled by the seed's size.
     pub distance: u64,
     /// Bounding sphere outside one of the view's five planes.
     pub frustum: u64,
@@ -398,7 +399,8 @@ impl View<'_> {
             return Ok(Fate::Class);
         }
         let index = self.landcover.index(dataset, p)?;
-        let found = tables.classes.get(index as usize).and_then(|class| species_of_rank(class, rank));
+        let class = tables.classes.get(index as usize);
+        let found = class.and_then(|class| species_of_rank(class, rank));
         let Some((species_index, species)) = found.and_then(|k| Some((k, tables.species.get(k as usize)?)))
         else {
             return Ok(Fate::Class);
@@ -418,7 +420,11 @@ impl View<'_> {
         let scale = (height_m / seeds.reference_height_m).min(1.0);
         let lod = match self.culls.reach_m {
             Some(reach_m) => (distance_m < reach_m).then_some(0),
-            None => settings.draw_seeds.reach_m.iter().position(|&r| distance_m < r * scale),
+            None => {
+                // Its class draws its seeds to its own last LOD (`Class::seed_lods`).
+                let lods = class.map_or(0, |c| c.lods as usize);
+                settings.draw_seeds.reach_m.iter().take(lods).position(|&r| distance_m < r * scale)
+            }
         };
         let Some(lod) = lod else {
             return Ok(Fate::Distance);

@@ -407,7 +407,8 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
 
     let distance_sq = rel_xy[0] * rel_xy[0] + rel_xy[1] * rel_xy[1] + ground_rel_m * ground_rel_m;
     let size_scale = (height_m * u.inv_reference_height_m).min(1.0);
-    let lod = (0..SEED_LODS)
+    let lods = seeds.lods.min(SEED_LODS);
+    let lod = (0..lods)
         .find(|&lod| {
             let reach = u.draw_reach_m[lod as usize] * size_scale;
             distance_sq < reach * reach
@@ -470,7 +471,14 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         height_m,
         address: cell.address,
         rank,
-        species_lod: SpeciesLod { species: drawn, lod, lcc_level, height_level: ground.level }.pack(),
+        species_lod: SpeciesLod {
+            species: drawn,
+            lod,
+            last: u32::from(lod + 1 == lods),
+            lcc_level,
+            height_level: ground.level,
+        }
+        .pack(),
         jitter: pcg(hash),
         ground_colour: ground_colour(u, inputs.imagery, &imagery, hash),
         radius_m,

@@ -179,6 +179,7 @@ impl SeedTables {
             let Some(class) = coding.code_of(index as u32).and_then(|code| table.class(code)) else {
                 continue;
             };
+            entry.lods = class.seed_lods;
             let mut cumulative_per_km2 = 0.0f64;
             for (k, rule) in class.seeds.iter().enumerate().take(MAX_SPECIES_PER_CLASS) {
                 cumulative_per_km2 += f64::from(rule.per_km2) * density_scale;
@@ -265,7 +266,8 @@ mod tests {
 
     #[test]
     fn rank_thinning_picks_species_by_cumulative_density() {
-        let class = SeedClass { rank_limit: [10.0, 15.5, 0.0, 0.0], species: [4, 7, 0, 0] };
+        let class =
+            SeedClass { rank_limit: [10.0, 15.5, 0.0, 0.0], species: [4, 7, 0, 0], ..SeedClass::default() };
         assert_eq!(species_of_rank(&class, 0), Some(4));
         assert_eq!(species_of_rank(&class, 9), Some(4));
         assert_eq!(species_of_rank(&class, 10), Some(7));

@@ -82,7 +82,8 @@ fn record(
         height_m: seed.height_m as f32,
         address,
         rank: seed.rank,
-        species_lod: SpeciesLod { species: seed.species, lod: 0, lcc_level: 0, height_level: 0 }.pack(),
+        species_lod: SpeciesLod { species: seed.species, lod: 0, last: 0, lcc_level: 0, height_level: 0 }
+            .pack(),
         jitter: pcg(hash),
         ground_colour: imagery.ground_colour([x, y], hash)?,
         radius_m: (seed.height_m * radius_per_height) as f32,

@@ -165,6 +165,12 @@ gpu_struct! {
         pub rank_limit: [f32; MAX_SPECIES_PER_CLASS as usize],
         /// The species (index into the species table) each rule grows.
         pub species: [u32; MAX_SPECIES_PER_CLASS as usize],
+        /// How many draw LODs its seeds use, nearest first (`classes::Class::seed_lods`): a seed
+        /// beyond the last is culled by distance, and one in the last fades out at its end
+        /// (`SpeciesLod::last`). 0 for a palette index without a class, which grows nothing.
+        pub lods: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
+        pub _pad: [u32; 3],
     }
 }
 
