@@ -5,8 +5,10 @@
 // at the record's camera-relative anchor, scaled to its height and turned about the vertical by
 // its jitter, bent by the wind (`shared/wind.wgsl`: the same field for every LOD, so a cross-fade
 // shows one plant swaying), and projects it like the terrain. Fragments take their material's
-// colour (times a layer of the texture array), are alpha-tested, tinted a little towards the
-// ground colour and by the seed's colour variation, lit and hazed like the ground.
+// colour (times a layer of the texture array), are alpha-tested, tinted towards the ground colour
+// (foliage, by its species' `ground_blend`; bark keeps its own), by the seed's colour variation
+// and by the luminosity of their place in the plant (`crown_luminosity`), lit (the sun through
+// the clouds, `shared/clouds.wgsl`) and hazed like the ground.
 //
 // Continuous LOD (`draw_seeds.continuous_lod`, `u.focal_px` > 0): a mesh whose materials say how
 // they shed detail thins its leaves and its thin stems as they shrink on screen, per seed
@@ -27,18 +29,18 @@ struct DrawSeedsUniforms {
     inv_reference_height_m: f32,
     sink_fraction: f32,
     fade_fraction: f32,
-    ground_blend: f32,
+    focal_px: f32,
     wind: vec4<f32>,
     wind_wave: vec4<f32>,
-    focal_px: f32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    cloud_field: vec4<f32>,
+    cloud_shift: vec4<f32>,
 }
 
 struct SeedShape {
     inv_model_height_m: f32,
     wind_bend: f32,
+    ground_blend: f32,
+    crown_shading: f32,
 }
 
 struct SeedMaterial {
@@ -84,6 +86,8 @@ struct VertexOut {
     @location(6) @interpolate(flat) keep: vec3<f32>,
     // The seed's record: what the ground truth's id buffer names.
     @location(7) @interpolate(flat) record: u32,
+    // Luminosity by position inside the plant (`crown_luminosity`).
+    @location(8) luminosity: f32,
 }
 
 // Model space (x, y up, z) to world (x east, y north, z up), turned by `angle` about the vertical.
@@ -92,6 +96,24 @@ fn model_to_world(v: vec3<f32>, angle: f32) -> vec3<f32> {
     let c = cos(angle);
     let s = sin(angle);
     return vec3<f32>(c * w.x - s * w.y, s * w.x + c * w.y, w.z);
+}
+
+// Luminosity by position inside the plant (Amara et al. § 5): darker low in its crown and on its
+// side away from the sun, by the species' `crown_shading`, from the vertex's height over the
+// model's and its offset from the axis towards the sun over the crown's half width; exactly 1
+// without crown shading.
+fn crown_luminosity(shape: SeedShape, position_model_m: vec3<f32>, angle: f32) -> f32 {
+    if shape.crown_shading <= 0.0 {
+        return 1.0;
+    }
+    let height = clamp(position_model_m.y * shape.inv_model_height_m, 0.0, 1.0);
+    let offset = model_to_world(position_model_m, angle).xy * shape.inv_model_height_m;
+    let sun_across = length(u.sun_dir.xy);
+    var side = 0.0;
+    if sun_across > 1e-3 {
+        side = clamp(dot(offset, u.sun_dir.xy / sun_across) / CROWN_HALF_WIDTH_PER_HEIGHT, -1.0, 1.0);
+    }
+    return 1.0 - shape.crown_shading * (0.5 * (1.0 - height) + 0.25 * (1.0 - side));
 }
 
 // How far the seed's foot is from the eye (its anchor was sunk by pass 3), metres.
@@ -226,8 +248,14 @@ fn vs_main(
     let shift = vec3<f32>(1.0 + 0.3 * variation, 1.0, 1.0 - 0.3 * variation);
     out.tint = shift * (1.0 + 0.3 * variation);
     out.material = in.material;
+    // Foliage takes on the ground's colour; bark keeps its own.
     let ground = unpack4x8unorm(record.ground_colour);
-    out.ground = vec4<f32>(ground.rgb, ground.a * u.ground_blend);
+    var blend = shape.ground_blend;
+    if (material.flags & MATERIAL_BARK) != 0u {
+        blend = 0.0;
+    }
+    out.ground = vec4<f32>(ground.rgb, ground.a * blend);
+    out.luminosity = crown_luminosity(shape, position_model_m, angle);
     return out;
 }
 
@@ -255,13 +283,14 @@ fn surface(in: VertexOut) -> Surface {
         }
     }
     texel *= material.base_colour;
-    let albedo = mix(texel.rgb, in.ground.rgb, in.ground.w) * in.tint;
+    let albedo = mix(texel.rgb, in.ground.rgb, in.ground.w) * in.tint * in.luminosity;
     // Seen from the side facing the eye (billboards, leaves); foliage lets light wrap around.
     var normal = normalize(in.normal);
     if dot(normal, in.rel_m) > 0.0 {
         normal = -normal;
     }
-    let sun = 0.55 * max(dot(normal, u.sun_dir.xyz), 0.0) + 0.35 * max(u.sun_dir.z, 0.0);
+    let sun = (0.55 * max(dot(normal, u.sun_dir.xyz), 0.0) + 0.35 * max(u.sun_dir.z, 0.0))
+        * sun_through_clouds(u.cloud_field, u.cloud_shift, in.rel_m);
     let sky = 0.3;
     let lit = albedo * (sun + sky);
     let haze = 1.0 - exp2(-length(in.rel_m) / u.haze.w);

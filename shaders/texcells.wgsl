@@ -216,12 +216,12 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     let path = min(normal.z / max(abs(dot(normal, view)), 1e-4), tu.opacity_max_factor);
     let corrected = 1.0 - pow(1.0 - min(alpha, 0.9999), max(path, 0.25));
 
-    return shade(sampled.rgb / max(sampled.a, 1e-4), ground, view, distance_m, corrected);
+    return shade(sampled.rgb / max(sampled.a, 1e-4), ground, in.rel_m, view, distance_m, corrected);
 }
 
-// The premultiplied colour of forest of colour `albedo` and opacity `opacity`, seen along `view`
-// at `distance_m`, over ground of imagery colour `ground`.
-fn shade(albedo: vec3<f32>, ground: vec4<f32>, view: vec3<f32>, distance_m: f32, opacity: f32) -> vec4<f32> {
+// The premultiplied colour of forest of colour `albedo` and opacity `opacity` at `rel_m` from the
+// camera, seen along `view` at `distance_m`, over ground of imagery colour `ground`.
+fn shade(albedo: vec3<f32>, ground: vec4<f32>, rel_m: vec3<f32>, view: vec3<f32>, distance_m: f32, opacity: f32) -> vec4<f32> {
     var tinted = albedo;
     if u.has_imagery != 0u {
         tinted = mix(albedo, ground.rgb, ground.a * tu.ground_blend);
@@ -231,7 +231,7 @@ fn shade(albedo: vec3<f32>, ground: vec4<f32>, view: vec3<f32>, distance_m: f32,
     // mean clamped cosine towards the sun is (1 + cos(eye, sun)) / 4. Lighting the slices by
     // the ground's normal instead made the far forest a quarter brighter than the clouds before it.
     let facing = 0.25 * (1.0 - dot(view, u.sun_dir.xyz));
-    let sun = 0.55 * facing + 0.35 * max(u.sun_dir.z, 0.0);
+    let sun = (0.55 * facing + 0.35 * max(u.sun_dir.z, 0.0)) * sun_through_clouds(u.cloud_field, u.cloud_shift, rel_m);
     let lit = tinted * (sun + 0.3);
     let haze = 1.0 - exp2(-distance_m / u.haze.w);
     return vec4<f32>(mix(lit, u.haze.rgb, haze) * opacity, opacity);
@@ -312,7 +312,8 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
     if opacity <= 0.0 {
         discard;
     }
-    return shade(colour / opacity, ground, view, hit_m, opacity);
+    // Shaded where the ray first met the canopy, as its haze is.
+    return shade(colour / opacity, ground, view * hit_m, view, hit_m, opacity);
 }
 
 // --- For the test that holds `forest_uv` equal to its twin (`passes::texcells::gpu::probe`) ---

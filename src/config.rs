@@ -14,12 +14,14 @@ use toml::{Table, Value};
 
 use crate::gpu::AdapterChoice;
 
+mod clouds;
 mod draw_seeds;
 mod seeds;
 mod texcells;
 mod tlm;
 mod wind;
 
+pub use clouds::CloudSettings;
 pub use draw_seeds::DrawSeedsSettings;
 pub use seeds::{OcclusionTolerance, SeedSettings};
 pub use texcells::TexcellSettings;
@@ -126,6 +128,8 @@ pub struct Settings {
     pub texcells: TexcellSettings,
     /// `[wind]`: how the plants sway.
     pub wind: WindSettings,
+    /// `[clouds]`: the shadows of clouds drifting over the land.
+    pub clouds: CloudSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -329,6 +333,7 @@ impl Settings {
         self.draw_seeds.validate(&self.tlm)?;
         self.texcells.validate(&self.draw_seeds)?;
         self.wind.validate()?;
+        self.clouds.validate()?;
         first_out_of_range(checks)
     }
 }

@@ -245,5 +245,15 @@ pub struct Material {
     pub detail: Option<Detail>,
 }
 
+impl Material {
+    /// Whether it is bark (a trunk, a branch), by its name: glTF says nothing of what a material
+    /// is, and the models name theirs (`Bark`, `Birch_Bark`, the generated trees' `bark 0`). Bark
+    /// keeps its own colour where foliage takes on the ground's, and stays a mesh in slicings.
+    pub fn is_bark(&self) -> bool {
+        let name = self.name.to_ascii_lowercase();
+        ["bark", "trunk", "wood"].iter().any(|word| name.contains(word))
+    }
+}
+
 #[cfg(test)]
 mod tests;

@@ -17,6 +17,7 @@ pub mod dataset;
 pub mod frame;
 pub mod gpu;
 pub mod impostor;
+pub mod light;
 pub mod passes;
 pub mod path;
 pub mod profile;

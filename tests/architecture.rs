@@ -101,7 +101,7 @@ const LAYERS: &[&[&str]] = &[
     &["config", "dataset", "path", "impostor"],
     &["classes", "streaming"],
     &["seeds", "synth", "tree"],
-    &["texcell"],
+    &["texcell", "light"],
     &["passes", "bake"],
     &["reference"],
     &["frame"],

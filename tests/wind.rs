@@ -13,7 +13,7 @@ use std::collections::HashSet;
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::frame::Renderer;
-use terramp_testkit::{camera, renderer, small_settings, synth_dataset};
+use terramp_testkit::{camera, differing_pixels, renderer, settled_colour, small_settings, synth_dataset};
 
 const IMAGE_PX: [u32; 2] = [320, 180];
 
@@ -31,14 +31,9 @@ fn pose(r: &Renderer) -> Camera {
 
 /// The settled frame of `r` at the test's pose and wind time `time_s`.
 fn frame_at(r: &mut Renderer, time_s: f64) -> image::RgbaImage {
-    r.set_wind_time_s(time_s);
+    r.set_time_s(time_s);
     let camera = pose(r);
-    r.render_resolved(&camera).unwrap();
-    r.read_colour().unwrap()
-}
-
-fn differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
-    a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
+    settled_colour(r, &camera)
 }
 
 #[test]
@@ -49,7 +44,7 @@ fn still_air_is_still_and_a_frame_number_always_shows_the_same_sway() {
     let ground = frame_at(&mut renderer(&dir, settings("", 0.0, 270.0)), 0.0);
     let still = frame_at(&mut renderer(&dir, settings(impostors, 0.0, 270.0)), 0.0);
     let still_later = frame_at(&mut renderer(&dir, settings(impostors, 0.0, 45.0)), 123.4);
-    assert_eq!(differing(&still, &still_later), 0, "still air moved something");
+    assert_eq!(differing_pixels(&still, &still_later), 0, "still air moved something");
 
     let windy = settings(impostors, 12.0, 250.0);
     let frame_7 = windy.wind.time_of_frame_s(7);
@@ -59,9 +54,9 @@ fn still_air_is_still_and_a_frame_number_always_shows_the_same_sway() {
     let a8 = frame_at(&mut a, frame_8);
     let a7_again = frame_at(&mut a, frame_7);
     let b7 = frame_at(&mut renderer(&dir, windy), frame_7);
-    assert_eq!(differing(&a7, &a7_again), 0, "frame 7 drawn again after frame 8 differs");
-    assert_eq!(differing(&a7, &b7), 0, "frame 7 differs between two renderers");
-    let (swayed, stepped) = (differing(&still, &a7), differing(&a7, &a8));
+    assert_eq!(differing_pixels(&a7, &a7_again), 0, "frame 7 drawn again after frame 8 differs");
+    assert_eq!(differing_pixels(&a7, &b7), 0, "frame 7 differs between two renderers");
+    let (swayed, stepped) = (differing_pixels(&still, &a7), differing_pixels(&a7, &a8));
     println!("the wind changed {swayed} pixels of the still frame, one frame later {stepped} changed");
     assert!(swayed > 200 && stepped > 20, "the trees hardly move: {swayed}, {stepped}");
 

@@ -321,7 +321,7 @@ fn lod_changes_cross_fade_instead_of_popping() {
         let (mut r, camera, _) =
             open_view(Dataset::open(&path).unwrap(), settings, &dir, [320, 180], pose, [40.0, -12.0]);
         // One moment of the wind throughout: only the LODs change between frames.
-        r.set_wind_time_s(6.0);
+        r.set_time_s(6.0);
         r.render(&camera).unwrap();
         r.render(&camera).unwrap();
         let mut frames = vec![r.read_colour().unwrap()];

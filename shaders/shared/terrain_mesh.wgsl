@@ -20,6 +20,8 @@ struct TerrainUniforms {
     node_cells: u32,
     has_imagery: u32,
     imagery_frame: vec4<f32>,
+    cloud_field: vec4<f32>,
+    cloud_shift: vec4<f32>,
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
     imagery_level_count: u32,
     _pad0: u32,

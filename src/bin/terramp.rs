@@ -364,8 +364,8 @@ fn fly(
     for i in 0..frames {
         let r = &renderer.settings.render;
         let camera = path.camera_at(f64::from(i) / f64::from(frames.max(2) - 1), r.fov_deg, r.near_m);
-        let wind_time_s = renderer.settings.wind.time_of_frame_s(i as usize);
-        renderer.set_wind_time_s(wind_time_s);
+        let time_s = renderer.settings.wind.time_of_frame_s(i as usize);
+        renderer.set_time_s(time_s);
         let start = Instant::now();
         let report = renderer.render(&camera)?;
         let save = save_every != 0 && i % save_every == 0;

@@ -170,6 +170,19 @@ pub struct Species {
     pub altitude_m: [f32; 2],
     /// Steepest ground it grows on, degrees (0..90).
     pub max_slope_deg: f32,
+    /// How much of the ground's colour under a seed (pass 3's sample) its foliage takes on, 0 to
+    /// 1 (Amara et al.'s colour follow-up); its bark keeps its own. Default `DEFAULT_GROUND_BLEND`.
+    pub ground_blend: f32,
+    /// How much darker a plant is low in its crown and on its side away from the sun, 0 (flat) to
+    /// 1 (black at the bottom of the shaded side): the luminosity by position inside the object.
+    pub crown_shading: f32,
+}
+
+/// `Species::ground_blend` where a table does not say.
+pub const DEFAULT_GROUND_BLEND: f32 = 0.2;
+
+fn default_ground_blend() -> f32 {
+    DEFAULT_GROUND_BLEND
 }
 
 /// A `[[species]]` as the table writes it: `Species` with its model or its variants' models.
@@ -187,6 +200,10 @@ struct SpeciesText {
     #[serde(default = "any_altitude_m")]
     altitude_m: [f32; 2],
     max_slope_deg: f32,
+    #[serde(default = "default_ground_blend")]
+    ground_blend: f32,
+    #[serde(default)]
+    crown_shading: f32,
 }
 
 impl SpeciesText {
@@ -208,6 +225,8 @@ impl SpeciesText {
             radius_per_height: self.radius_per_height,
             altitude_m: self.altitude_m,
             max_slope_deg: self.max_slope_deg,
+            ground_blend: self.ground_blend,
+            crown_shading: self.crown_shading,
         });
         Some(species.collect())
     }
@@ -422,7 +441,7 @@ impl ClassTable {
 fn check_species(s: &Species) -> Result<(), (&'static str, String, &'static str)> {
     let [h0, h1] = s.height_m;
     let [a0, a1] = s.altitude_m;
-    let checks: [(bool, &'static str, String, &'static str); 4] = [
+    let checks: [(bool, &'static str, String, &'static str); 6] = [
         (
             h0 > 0.0 && h0 <= h1 && h1.is_finite(),
             "height_m",
@@ -447,6 +466,8 @@ fn check_species(s: &Species) -> Result<(), (&'static str, String, &'static str)
             s.max_slope_deg.to_string(),
             "0 to 90 degrees",
         ),
+        ((0.0..=1.0).contains(&s.ground_blend), "ground_blend", s.ground_blend.to_string(), "0 to 1"),
+        ((0.0..=1.0).contains(&s.crown_shading), "crown_shading", s.crown_shading.to_string(), "0 to 1"),
     ];
     match checks.into_iter().find(|(ok, ..)| !ok) {
         Some((_, key, value, rule)) => Err((key, value, rule)),

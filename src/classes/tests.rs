@@ -119,6 +119,8 @@ fn species_and_rule_errors_name_table_class_and_key() {
         ("max_slope_deg = 40.0", "max_slope_deg = 91.0", "max_slope_deg"),
         ("max_slope_deg = 40.0", "max_slope_deg = -1.0", "max_slope_deg"),
         ("max_slope_deg = 40.0", "max_slope_deg = 40.0\naltitude_m = [3000.0, 100.0]", "altitude_m"),
+        ("max_slope_deg = 40.0", "max_slope_deg = 40.0\nground_blend = 1.5", "ground_blend"),
+        ("max_slope_deg = 40.0", "max_slope_deg = 40.0\ncrown_shading = -0.1", "crown_shading"),
     ] {
         let err = error(&table("", "").replace(from, to));
         assert!(err.contains("species `pine`") && err.contains(key) && err.contains("t.toml"), "{err}");
@@ -173,4 +175,14 @@ fn a_class_says_how_many_draw_lods_its_seeds_use() {
     assert!(err.contains("seed_lods") && err.contains("texcells"), "{err}");
     let dense = ClassTable::parse(&format!("{}texcells = true\n", table("", rules)), "t.toml").unwrap();
     assert!(dense.class(5).unwrap().texcells);
+}
+
+#[test]
+fn a_species_says_how_much_ground_colour_and_crown_shading_it_takes() {
+    let t = ClassTable::parse(&table("", ""), "t.toml").unwrap();
+    assert_eq!((t.species[0].ground_blend, t.species[0].crown_shading), (DEFAULT_GROUND_BLEND, 0.0));
+    let shaded = table("", "")
+        .replace("max_slope_deg = 40.0", "max_slope_deg = 40.0\nground_blend = 0.5\ncrown_shading = 0.4");
+    let t = ClassTable::parse(&shaded, "t.toml").unwrap();
+    assert_eq!((t.species[0].ground_blend, t.species[0].crown_shading), (0.5, 0.4));
 }

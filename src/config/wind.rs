@@ -17,7 +17,8 @@ pub struct WindSettings {
     pub speed_m_s: f64,
     /// Compass direction the wind blows from, degrees clockwise from north.
     pub from_deg: f64,
-    /// Frames per second of wind time along a flight (frame n is at n / this seconds).
+    /// Frames per second of the scene's time (wind, clouds) along a flight (frame n is at n / this
+    /// seconds).
     pub frame_rate_hz: f64,
 }
 

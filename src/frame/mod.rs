@@ -235,8 +235,9 @@ pub struct Renderer {
     load_maps: Option<LoadMaps>,
     last: Option<LastFrame>,
     frame: u64,
-    /// Wind time of the frames rendered from now on, seconds (`set_wind_time_s`).
-    wind_time_s: f64,
+    /// The scene's time of the frames rendered from now on (the wind's sway, the clouds' drift),
+    /// seconds (`set_time_s`).
+    time_s: f64,
     /// Pass timings of the most recent frame whose timings are in (a frame or two behind).
     last_timings: Vec<PassTiming>,
 }
@@ -295,7 +296,7 @@ impl Renderer {
             load_maps: None,
             last: None,
             frame: 0,
-            wind_time_s: 0.0,
+            time_s: 0.0,
             last_timings: Vec::new(),
         })
     }
@@ -316,16 +317,17 @@ impl Renderer {
         &self.targets.depth
     }
 
-    /// Sets the wind time of the frames rendered from now on, seconds (0 at first): a flight's
-    /// frame n is at `settings.wind.time_of_frame_s(n)`, so a frame number shows the same sway.
-    pub fn set_wind_time_s(&mut self, time_s: f64) {
-        self.wind_time_s = time_s;
+    /// Sets the scene's time of the frames rendered from now on, seconds (0 at first): a flight's
+    /// frame n is at `settings.wind.time_of_frame_s(n)`, so a frame number shows the same sway
+    /// and the same clouds.
+    pub fn set_time_s(&mut self, time_s: f64) {
+        self.time_s = time_s;
     }
 
-    /// The wind's constants for a frame from `camera` at the current wind time.
+    /// The wind's constants for a frame from `camera` at the scene's current time.
     pub fn wind_frame(&self, camera: &Camera) -> WindFrame {
         let p = camera.position_m;
-        Wind::new(&self.settings.wind).frame(self.wind_time_s, [p.x, p.y])
+        Wind::new(&self.settings.wind).frame(self.time_s, [p.x, p.y])
     }
 
     /// Renders one frame from `camera`.

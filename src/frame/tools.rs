@@ -9,6 +9,7 @@ use crate::classes::ClassTable;
 use crate::gpu::GpuError;
 use crate::gpu::gpu_types::{SeedCounters, SeedDrawArgs, SeedRecord, TerrainUniforms, TlmCell};
 use crate::gpu::readback::read_texture;
+use crate::light::CloudShadowFrame;
 use crate::passes::compact::frame::Compacted;
 use crate::passes::seed_select::frame::{SeedCellRef, SeedOutput};
 use crate::reference::oracle::OracleInputs;
@@ -142,6 +143,12 @@ impl Renderer {
             camera,
             viewport_px: [self.settings.render.width, self.settings.render.height],
         })
+    }
+
+    /// The cloud shadows the last frame was lit with (`None` before a first frame).
+    pub fn last_clouds(&self) -> Option<CloudShadowFrame> {
+        let terrain = &self.last.as_ref()?.terrain;
+        Some(CloudShadowFrame { field: terrain.cloud_field, shift: terrain.cloud_shift })
     }
 
     /// The class table the species come from (`None` without land cover).

@@ -345,16 +345,36 @@ wgsl_constants! { draw_constants:
     /// `SeedMaterial::flags`: the material's stems are widened to a pixel on a share of the seeds
     /// as they shrink below it (continuous LOD, `impostor::Detail::Stems`).
     pub const MATERIAL_STEMS: u32 = 8;
+    /// `SeedMaterial::flags`: bark (a trunk, a branch): it keeps its own colour where foliage takes
+    /// on the ground's (`Species::ground_blend`; `impostor::Material::is_bark`).
+    pub const MATERIAL_BARK: u32 = 16;
     /// Continuous LOD: the projected size, pixels, below which leaves thin out; the kept ones
     /// grow back to it, so the crown keeps its area and no drawn leaf is smaller.
     pub const DETAIL_FULL_PX: f32 = 2.0;
     /// Continuous LOD: stems narrower than this on screen, pixels, are drawn this wide on a share
     /// of the seeds (their width over this).
     pub const DETAIL_MIN_PX: f32 = 1.0;
+    /// Crown shading: the half width of a crown, per metre of the plant's height, over which its
+    /// side towards the sun turns from shaded to lit.
+    pub const CROWN_HALF_WIDTH_PER_HEIGHT: f32 = 0.3;
 }
 
 const _: () = assert!(SEED_GROUPS <= COMPACT_CHUNK, "a lane per group sums or scans a column");
 const _: () = assert!(COMPACT_CHUNK * SEED_GROUPS * 4 <= 16384, "the chunk's table fits workgroup memory");
+
+// --- Cloud shadows (`light`) ---
+wgsl_constants! { cloud_constants:
+    /// Octaves of the clouds' value noise, each twice the frequency and half the weight of the
+    /// one before.
+    pub const CLOUD_OCTAVES: u32 = 4;
+    /// The noise lattice repeats every this many cells of the largest octave (a power of two): the
+    /// CPU hands the camera's position modulo it, so f32 keeps centimetres anywhere on Earth.
+    pub const CLOUD_PERIOD_CELLS: u32 = 256;
+    /// Half the width of a cloud's edge, in noise units: the penumbra over which its shadow fades.
+    pub const CLOUD_EDGE: f32 = 0.04;
+    /// Salt of the clouds' lattice hash, apart from every seed hash.
+    pub const CLOUD_SALT: u32 = 0x7c1d_5a0b;
+}
 
 // --- Wind (`seeds::wind`) ---
 wgsl_constants! { wind_constants:
@@ -447,6 +467,7 @@ pub fn wgsl_constants() -> Vec<(&'static str, &'static str, String)> {
         draw_constants(),
         texcell_constants(),
         wind_constants(),
+        cloud_constants(),
     ]
     .concat()
 }
@@ -456,36 +477,4 @@ pub const PACKED_WORDS: &[PackedWord] =
     &[LevelRange::WORD, TileSpan::WORD, SpeciesLod::WORD, SeedJitter::WORD, TexcellSlice::WORD];
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn words_round_trip_and_mask_each_field() {
-        let s = SpeciesLod { species: 9, lod: 3, last: 1, lcc_level: 2, height_level: 11 };
-        assert_eq!(s.pack(), 9 | 3 << 8 | 1 << 11 | 2 << 12 | 11 << 16);
-        assert_eq!(SpeciesLod::unpack(s.pack()), s);
-        let wide = LevelRange { min: 0x1ff, max: 1 };
-        assert_eq!(LevelRange::unpack(wide.pack()), LevelRange { min: 0xff, max: 1 });
-        assert_eq!(TileSpan { first: 3, last: 70_000 }.pack() >> 16, 70_000 & 0xffff);
-        assert_eq!(SeedJitter::unpack(0xabcd_1234), SeedJitter { angle: 0x1234, colour: 0xabcd });
-    }
-
-    #[test]
-    fn every_constant_is_declared_once() {
-        let names: Vec<_> = wgsl_constants().into_iter().map(|(name, ..)| name).collect();
-        let mut unique = names.clone();
-        unique.sort_unstable();
-        unique.dedup();
-        assert_eq!(names.len(), unique.len(), "{names:?}");
-        assert!(names.contains(&"RADIAL_INACTIVE") && names.contains(&"COUNT_OCCLUSION"));
-    }
-
-    #[test]
-    fn page_entries_and_patterns_round_trip() {
-        assert_eq!(page_slot(PAGE_EMPTY), None);
-        assert_eq!(page_slot(page_entry(7)), Some(7));
-        assert_eq!(tlm_pattern(TLM_CULLED), None);
-        assert_eq!(tlm_pattern(tlm_visibility(5)), Some(5));
-        assert_eq!(seed_group(MAX_SPECIES - 1, SEED_LODS - 1), SEED_GROUPS - 1);
-    }
-}
+mod tests;

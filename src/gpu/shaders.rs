@@ -25,6 +25,8 @@ pub const LANDCOVER: &str = include_str!("../../shaders/shared/landcover.wgsl");
 pub const DITHER: &str = include_str!("../../shaders/shared/dither.wgsl");
 /// How pass 3 hands its survivors to compaction: the block table's entries and lane ballots.
 pub const BLOCKS: &str = include_str!("../../shaders/shared/blocks.wgsl");
+/// The cloud shadows' field (`light`), the same for everything the sun lights.
+pub const CLOUDS: &str = include_str!("../../shaders/shared/clouds.wgsl");
 /// The wind's bend of a plant (`seeds::wind`), the same for every representation that draws one.
 pub const WIND: &str = include_str!("../../shaders/shared/wind.wgsl");
 

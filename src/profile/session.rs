@@ -67,9 +67,9 @@ impl<'r> Session<'r> {
         self.renderer
     }
 
-    /// Sets the wind time of the next frames (`Renderer::set_wind_time_s`).
-    pub fn set_wind_time_s(&mut self, time_s: f64) {
-        self.renderer.set_wind_time_s(time_s);
+    /// Sets the scene's time (wind, clouds) of the next frames (`Renderer::set_time_s`).
+    pub fn set_time_s(&mut self, time_s: f64) {
+        self.renderer.set_time_s(time_s);
     }
 
     /// Whether the next frame is a warm-up frame.
@@ -151,8 +151,8 @@ pub fn fly(
     for i in 0..warmup.saturating_add(frames) {
         let t = f64::from(i.saturating_sub(warmup)) / f64::from(frames.max(2) - 1);
         let camera = path.camera_at(t, fov_deg, near_m);
-        let wind_time_s = session.renderer().settings.wind.time_of_frame_s(i as usize);
-        session.set_wind_time_s(wind_time_s);
+        let time_s = session.renderer().settings.wind.time_of_frame_s(i as usize);
+        session.set_time_s(time_s);
         let warming_up = session.warming_up();
         let start = std::time::Instant::now();
         let report = session.frame(&camera)?;

@@ -116,7 +116,7 @@ impl Flight<'_> {
                 self.popping.len()
             )));
             // The truth's flight sways frame for frame alike.
-            renderer.set_wind_time_s(renderer.settings.wind.time_of_frame_s(i));
+            renderer.set_time_s(renderer.settings.wind.time_of_frame_s(i));
             match i {
                 0 => _ = renderer.render_resolved(camera)?,
                 _ => _ = renderer.render(camera)?,
@@ -155,7 +155,7 @@ impl Flight<'_> {
                 round + 1,
                 i + 1
             )));
-            session.set_wind_time_s(settings.wind.time_of_frame_s(i));
+            session.set_time_s(settings.wind.time_of_frame_s(i));
             session.frame(&self.path.camera_at(t, fov_deg, near_m))?;
         }
         Ok(Timed { adapter, timing, timing_note, recording: session.finish()? })

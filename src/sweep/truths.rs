@@ -17,11 +17,12 @@ use crate::dataset::Dataset;
 use crate::gpu::Gpu;
 use crate::truth::{Truth, TruthOptions, TruthRenderer};
 
-/// What makes two settings grow the same seeds, in the same places, seen through the same viewport.
+/// What makes two settings grow the same seeds, in the same places, seen through the same viewport
+/// under the same sky.
 fn world_key(s: &Settings) -> String {
     let (t, seeds) = (&s.tlm, &s.seeds);
     format!(
-        "{}|{}|{}|{}|{}|{}|{}|{}x{}|{}|{}|{}",
+        "{}|{}|{}|{}|{}|{}|{}|{}x{}|{}|{}|{}|{:?}",
         t.cell_m,
         t.patterns,
         t.seed,
@@ -33,7 +34,8 @@ fn world_key(s: &Settings) -> String {
         s.render.height,
         s.render.fov_deg,
         s.wind.speed_m_s,
-        s.wind.from_deg
+        s.wind.from_deg,
+        s.clouds
     )
 }
 
@@ -71,7 +73,7 @@ impl Truths {
             for (i, camera) in flight.popping.iter().enumerate() {
                 let n = flight.popping.len();
                 progress(Progress::Step(&format!("truth: popping flight, frame {} of {n}", i + 1)));
-                renderer.set_wind_time_s(reference.wind.time_of_frame_s(i));
+                renderer.set_time_s(reference.wind.time_of_frame_s(i));
                 truths.flight.push(renderer.render(camera)?.colour);
             }
         }

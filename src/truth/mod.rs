@@ -202,9 +202,9 @@ impl TruthRenderer {
         Ok(Self { renderer, meshes: MeshDrawer::new(impostors), options: options.clone() })
     }
 
-    /// Sets the wind time of the truths rendered from now on (`Renderer::set_wind_time_s`).
-    pub fn set_wind_time_s(&mut self, time_s: f64) {
-        self.renderer.set_wind_time_s(time_s);
+    /// Sets the scene's time (wind, clouds) of the truths rendered from now on (`Renderer::set_time_s`).
+    pub fn set_time_s(&mut self, time_s: f64) {
+        self.renderer.set_time_s(time_s);
     }
 
     /// The truth of the view from `camera`.

@@ -12,6 +12,11 @@ pub fn psnr(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
     psnr_db(a, b).unwrap()
 }
 
+/// How many pixels of `a` and `b` differ at all.
+pub fn differing_pixels(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
+    a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
+}
+
 /// How far below a golden test's tolerance its control frame must fall, dB: far enough that the
 /// tolerance could not pass what the control changes, however the rasteriser rounds.
 pub const CONTROL_MARGIN_DB: f64 = 10.0;

@@ -19,6 +19,6 @@ pub mod tlm;
 
 pub use data::{TempDir, shared_data};
 pub use datasets::{synth_dataset, synth_dataset_with};
-pub use images::{Golden, psnr};
+pub use images::{Golden, differing_pixels, psnr};
 pub use impostors::nc_impostors;
-pub use setup::{gpu, renderer, small_settings};
+pub use setup::{gpu, renderer, settled_colour, small_settings};

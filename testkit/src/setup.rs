@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
@@ -24,4 +25,10 @@ pub fn small_settings(width: u32, height: u32) -> Settings {
 /// A renderer over the dataset in `dataset`.
 pub fn renderer(dataset: &Path, settings: Settings) -> Renderer {
     Renderer::new(gpu(), Dataset::open(dataset).unwrap(), settings).unwrap()
+}
+
+/// The frame `r` settles on from `camera` (every tile it asks for resident), as an sRGB image.
+pub fn settled_colour(r: &mut Renderer, camera: &Camera) -> image::RgbaImage {
+    r.render_resolved(camera).unwrap();
+    r.read_colour().unwrap()
 }

@@ -25,18 +25,18 @@ gpu_struct! {
         pub sink_fraction: f32,
         /// The outer part of each LOD band over which a seed dithers out, as a fraction of its reach.
         pub fade_fraction: f32,
-        /// How much of the ground colour the seeds take on (0 to 1).
-        pub ground_blend: f32,
+        /// The lens's focal length, pixels: what a metre one metre away covers on screen, for the
+        /// continuous LOD (`impostor::detail`); 0 turns it off (`draw_seeds.continuous_lod`).
+        pub focal_px: f32,
         /// The wind (`seeds::wind::WindFrame::wind`): downwind unit vector (xy), a top's mean lean
         /// and sway per metre of height (zw); lean 0: still air, no vertex moves.
         pub wind: [f32; 4],
         /// Wind time, seconds (x), the gusts' wavenumber per metre (y) and phase at the camera (z).
         pub wind_wave: [f32; 4],
-        /// The lens's focal length, pixels: what a metre one metre away covers on screen, for the
-        /// continuous LOD (`impostor::detail`); 0 turns it off (`draw_seeds.continuous_lod`).
-        pub focal_px: f32,
-        /// Padding to the struct's 16-byte alignment.
-        pub _pad: [u32; 3],
+        /// The terrain's cloud shadows (`TerrainUniforms::cloud_field`, `cloud_shift`).
+        pub cloud_field: [f32; 4],
+        /// See `cloud_field`.
+        pub cloud_shift: [f32; 4],
     }
 }
 
@@ -48,6 +48,11 @@ gpu_struct! {
         pub inv_model_height_m: f32,
         /// How much the wind bends it (`seeds::wind::bend_of`): 1 a plant, 0 a rock.
         pub wind_bend: f32,
+        /// How much of the ground's colour its foliage takes on (`classes::Species::ground_blend`).
+        pub ground_blend: f32,
+        /// How much darker it is low in its crown and away from the sun
+        /// (`classes::Species::crown_shading`).
+        pub crown_shading: f32,
     }
 }
 

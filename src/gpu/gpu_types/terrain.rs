@@ -28,6 +28,13 @@ gpu_struct! {
         /// Imagery: grid-space position of texel (0, 0)'s south-west corner (xy), level-0 texel edge
         /// in metres (z), level-of-detail bias in log2 texels (w).
         pub imagery_frame: [f32; 4],
+        /// The cloud shadows (`light::CloudShadowFrame::field`): where the camera's sun ray meets
+        /// the cloud layer, in noise cells modulo the period (xy), cells per metre (z), the noise
+        /// threshold of a cloud's edge (w).
+        pub cloud_field: [f32; 4],
+        /// Noise cells that meeting point moves per metre of height (xy), the share of sunlight a
+        /// cloud's core holds back (z; 0: no clouds), unused (w) (`CloudShadowFrame::shift`).
+        pub cloud_shift: [f32; 4],
         /// Imagery page table per level: first entry, tiles along x, tiles along y, 0.
         pub imagery_levels: [[u32; 4]; MAX_LEVELS as usize],
         /// Imagery levels stored, then padding.

@@ -22,7 +22,8 @@ use std::ops::Range;
 
 use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
 use crate::gpu::layout::{
-    MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_STEMS, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS,
+    MATERIAL_BARK, MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_STEMS, MATERIAL_TEXTURED, SEED_DRAWS,
+    SEED_GROUPS, SEED_LODS,
 };
 use crate::impostor::{AlphaMode, Detail, Impostor, MipChain, mip_size};
 
@@ -241,7 +242,8 @@ fn push_mesh(out: &mut SeedAssets, impostor: &Impostor, detailed: bool) -> MeshD
             layer: layer.unwrap_or(0),
             alpha_cutoff,
             lod: 0,
-            flags: layer.map_or(0, |_| MATERIAL_TEXTURED | MATERIAL_REPEAT),
+            flags: layer.map_or(0, |_| MATERIAL_TEXTURED | MATERIAL_REPEAT)
+                | if source.is_bark() { MATERIAL_BARK } else { 0 },
             last_lod: u32::from(detailed),
             detail_m,
             ..Default::default()

@@ -21,9 +21,6 @@ use super::assets::MeshDetail;
 /// bounded: pass 3 and the draw measure the same distance in f32, a few ulps apart.
 const NEAREST_MARGIN: f32 = 0.98;
 
-/// How much of the ground colour under a seed it takes on.
-pub const GROUND_BLEND: f32 = 0.2;
-
 /// Each species' impostor (index = species index of the class table), `None` where the folder has
 /// no model of that name.
 pub fn load_impostors(dir: &Path, species: &[Species]) -> Result<Vec<Option<Impostor>>, DrawSeedsError> {
@@ -45,7 +42,8 @@ pub fn load_impostors(dir: &Path, species: &[Species]) -> Result<Vec<Option<Impo
     Ok(loaded)
 }
 
-/// The frame's constants from the settings, the terrain's matrix, sun and haze, and the wind.
+/// The frame's constants from the settings, the terrain's matrix, sun, clouds and haze, and the
+/// wind.
 pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &WindFrame) -> DrawSeedsUniforms {
     DrawSeedsUniforms {
         clip_from_view_world: terrain.clip_from_view_world,
@@ -55,15 +53,15 @@ pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &Wind
         inv_reference_height_m: (1.0 / settings.seeds.reference_height_m) as f32,
         sink_fraction: settings.seeds.sink_fraction as f32,
         fade_fraction: settings.draw_seeds.fade_fraction as f32,
-        ground_blend: GROUND_BLEND,
         wind: wind.wind,
         wind_wave: wind.wave,
+        cloud_field: terrain.cloud_field,
+        cloud_shift: terrain.cloud_shift,
         focal_px: if settings.draw_seeds.continuous_lod {
             focal_px(terrain, settings.render.height)
         } else {
             0.0
         },
-        _pad: [0; 3],
     }
 }
 

@@ -14,7 +14,7 @@ use crate::gpu::gpu_types::{
     DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedShape, SeedVertex,
 };
 use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
-use crate::gpu::shaders::{DITHER, HASH, SEED_RECORD, WIND, WgslSource};
+use crate::gpu::shaders::{CLOUDS, DITHER, HASH, SEED_RECORD, WIND, WgslSource};
 use crate::gpu::struct_layout::GpuLayout;
 use crate::impostor::{Impostor, mip_size};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
@@ -30,7 +30,7 @@ pub mod multisample;
 /// Pass 4's shader.
 pub const SHADER: WgslSource = WgslSource {
     name: "draw_seeds",
-    parts: &[SEED_RECORD, DITHER, HASH, WIND, include_str!("../../../shaders/draw_seeds.wgsl")],
+    parts: &[SEED_RECORD, DITHER, HASH, CLOUDS, WIND, include_str!("../../../shaders/draw_seeds.wgsl")],
 };
 
 /// Pass 4's bindings: the frame's constants, pass 3's records through compaction's order, and the
@@ -162,6 +162,8 @@ impl DrawSeedsPass {
             .map(|(i, &inv_model_height_m)| SeedShape {
                 inv_model_height_m,
                 wind_bend: species.get(i).map_or(0.0, |s| bend_of(s.kind)),
+                ground_blend: species.get(i).map_or(0.0, |s| s.ground_blend),
+                crown_shading: species.get(i).map_or(0.0, |s| s.crown_shading),
             })
             .collect();
         Ok(Self {

@@ -2,7 +2,7 @@
 
 use crate::config::Settings;
 use crate::gpu::resources::{frame_pass, pipeline_layout};
-use crate::gpu::shaders::{IMAGERY, TERRAIN_MESH, WgslSource};
+use crate::gpu::shaders::{CLOUDS, HASH, IMAGERY, TERRAIN_MESH, WgslSource};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
@@ -10,7 +10,7 @@ use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 /// `terrain::gpu::BINDINGS`).
 pub const SHADER: WgslSource = WgslSource {
     name: "ground",
-    parts: &[TERRAIN_MESH, IMAGERY, include_str!("../../../shaders/ground.wgsl")],
+    parts: &[TERRAIN_MESH, IMAGERY, HASH, CLOUDS, include_str!("../../../shaders/ground.wgsl")],
 };
 
 /// Pass 2 on the GPU: its pipeline (depth-equal, no depth write) and imagery sampler built once in

@@ -11,6 +11,7 @@ use crate::dataset::surface::diagonal_rises;
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
 use crate::gpu::layout::MAX_LEVELS;
+use crate::light::{CloudShadowFrame, sun_dir};
 use crate::streaming::{TileCache, page_levels};
 
 use super::select::{Lods, NodeId, Selected};
@@ -59,19 +60,22 @@ impl NodeBatches {
 }
 
 /// The terrain passes' uniforms for a camera at `camera_grid_m` (grid space) with `clip` the
-/// clip-from-camera-relative-world matrix; `sky_linear` is also the haze colour.
+/// clip-from-camera-relative-world matrix, at the scene's time `time_s` (the clouds' drift);
+/// `sky_linear` is also the haze colour.
 pub fn terrain_uniforms(
     dataset: &Dataset,
     settings: &Settings,
     camera_grid_m: DVec3,
     clip: glam::Mat4,
     sky_linear: [f64; 3],
+    time_s: f64,
 ) -> TerrainUniforms {
     let r = &settings.render;
     let manifest = &dataset.manifest;
-    let (azimuth, elevation) = (r.sun_azimuth_deg.to_radians(), r.sun_elevation_deg.to_radians());
-    let sun = DVec3::new(azimuth.sin() * elevation.cos(), azimuth.cos() * elevation.cos(), elevation.sin());
+    let sun = sun_dir(r);
     let half_spacing = 0.5 * manifest.height.spacing_m;
+    let clouds =
+        CloudShadowFrame::new(&settings.clouds, sun, manifest.height.max_m as f64, camera_grid_m, time_s);
     let mut uniforms = TerrainUniforms {
         clip_from_view_world: clip.to_cols_array_2d(),
         sun_dir: sun.as_vec3().extend(0.0).to_array(),
@@ -86,6 +90,8 @@ pub fn terrain_uniforms(
         node_cells: settings.terrain.node_cells,
         has_imagery: u32::from(dataset.imagery.is_some()),
         imagery_frame: [0.0; 4],
+        cloud_field: clouds.field,
+        cloud_shift: clouds.shift,
         imagery_levels: [[0; 4]; MAX_LEVELS as usize],
         imagery_level_count: 1,
         _pad: [0; 3],

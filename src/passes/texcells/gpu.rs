@@ -10,7 +10,7 @@ use crate::dataset::surface::diagonal_rises;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::gpu_types::{TexcellRecord, TexcellUniforms};
 use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
-use crate::gpu::shaders::{DITHER, HASH, IMAGERY, LANDCOVER, TERRAIN_MESH, WgslSource};
+use crate::gpu::shaders::{CLOUDS, DITHER, HASH, IMAGERY, LANDCOVER, TERRAIN_MESH, WgslSource};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 use crate::streaming::TileCache;
@@ -24,7 +24,15 @@ pub mod probe;
 /// The texcell pass's shader: the terrain mesh and the ground's colour, then its own.
 pub const SHADER: WgslSource = WgslSource {
     name: "texcells",
-    parts: &[TERRAIN_MESH, IMAGERY, HASH, DITHER, LANDCOVER, include_str!("../../../shaders/texcells.wgsl")],
+    parts: &[
+        TERRAIN_MESH,
+        IMAGERY,
+        HASH,
+        CLOUDS,
+        DITHER,
+        LANDCOVER,
+        include_str!("../../../shaders/texcells.wgsl"),
+    ],
 };
 
 /// Group 1 of the pass (group 0 is the terrain's, `terrain::gpu::BINDINGS`).
