@@ -24,6 +24,8 @@
 //!   many empty texels between rectangles, so no mip mixes two planes. uv (0, 0) is the top-left
 //!   corner of the image's top-left texel; corner 0 of a plane (its bottom-left) sits at
 //!   (`uv_min.x`, `uv_max.y`).
+//! - `slicing_mip{M}.png`, with the manifest's optional `slicing` table: the crown's slicings
+//!   ([`Slicing`], Jakulin 2000), when baked: slices as planes, same conventions as the atlases.
 //! - `mesh.bin` ([`mesh_file`]): the real mesh, vertices ([`MeshVertex`]) then `u32` indices,
 //!   with a checksum; `material{K}_mip{M}.png`: material K's base-colour texture, same conventions
 //!   as the atlases (alpha-masked leaf textures get coverage-preserving mips too).
@@ -36,6 +38,7 @@ pub mod detail;
 pub mod manifest;
 pub mod mesh_file;
 pub mod mips;
+pub mod slicing;
 mod store;
 
 use std::path::PathBuf;
@@ -133,8 +136,31 @@ pub struct Impostor {
     pub alpha_cutoff: f32,
     /// The billboard clouds, finest first (17, 8 and 2 planes by default).
     pub lods: Vec<ImpostorLod>,
+    /// The crown's slicings (Jakulin 2000), when baked (`terramp-data bake --slicings`).
+    pub slicing: Option<Slicing>,
     /// The real mesh, for close-up drawing.
     pub mesh: Mesh,
+}
+
+/// A model's crown as slicings (Jakulin 2000): `orientations` sets of `slices` parallel slices,
+/// the sets' normals evenly spread around the vertical (orientation i at azimuth 2π i /
+/// orientations from model +X towards +Z), each set's slices equidistant across the crown, every
+/// slice as wide and tall as its set's box. The trunk and limbs (the mesh's bark materials,
+/// [`Material::is_bark`]) are not sliced: they stay the mesh's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Slicing {
+    /// Slicings, evenly spread around the vertical.
+    pub orientations: u32,
+    /// Slices per slicing.
+    pub slices: u32,
+    /// The slices as planes (orientation-major: slice j of orientation i is plane i · slices + j,
+    /// its normal the orientation) and their atlas; ε is half the distance between slices, the
+    /// farthest a primitive's centroid lies from its slice.
+    pub lod: ImpostorLod,
+    /// Triangles of the crown, drawn onto the slices.
+    pub crown_triangles: u32,
+    /// Triangles of the trunk and limbs, left to the mesh.
+    pub trunk_triangles: u32,
 }
 
 /// One level of detail: a billboard cloud.

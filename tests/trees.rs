@@ -184,6 +184,7 @@ fn continuous_lod_draws_fewer_primitives_with_distance_and_none_below_a_pixel() 
             bounding_sphere: BoundingSphere { centre_model_m: [0.0, 0.5 * top_m, 0.0], radius_m: top_m },
             alpha_cutoff: 0.5,
             lods: vec![lod; 3],
+            slicing: None,
             mesh,
         };
         let built = assets::gather(&[Some(impostor)], true).unwrap();

@@ -67,6 +67,10 @@ struct BakeArgs {
     /// Width and height of each LOD's atlas in texels (a power of two, 64 to 8192).
     #[arg(long, default_value_t = terramp::bake::BakeOptions::default().texels)]
     texels: u32,
+    /// Also slice each crown (Jakulin's slicings): ORIENTATIONSxSLICES, e.g. `6x5` (the paper's),
+    /// on an atlas of --texels; the trunk and limbs (bark materials) stay the mesh.
+    #[arg(long, value_parser = parse_slicing)]
+    slicings: Option<terramp::bake::SlicingOptions>,
     /// Skip the models already baked into --out in this build's format (resumes a bake; a folder
     /// of an older format is baked again).
     #[arg(long)]
@@ -84,7 +88,8 @@ fn bake(args: BakeArgs) -> Result<()> {
         println!("{} models already baked in {}", args.models.len() - models.len(), args.out.display());
     }
     if !models.is_empty() {
-        let options = terramp::bake::BakeOptions { planes: args.planes, texels: args.texels };
+        let options =
+            terramp::bake::BakeOptions { planes: args.planes, texels: args.texels, slicing: args.slicings };
         let reports = terramp::bake::bake_models(None, &models, &args.out, &options, true)?;
         println!(
             "baked {} models into {} in {:.1} s",
@@ -126,5 +131,15 @@ fn main() -> Result<()> {
             println!("wrote {}", dir.display());
             Ok(())
         }
+    }
+}
+
+/// `--slicings ORIENTATIONSxSLICES`, e.g. `6x5`.
+fn parse_slicing(text: &str) -> Result<terramp::bake::SlicingOptions, String> {
+    let numbers =
+        text.split_once(['x', 'X']).and_then(|(o, s)| Some((o.trim().parse().ok()?, s.trim().parse().ok()?)));
+    match numbers {
+        Some((orientations, slices)) => Ok(terramp::bake::SlicingOptions { orientations, slices }),
+        None => Err(format!("`{text}`: expected ORIENTATIONSxSLICES, e.g. 6x5")),
     }
 }

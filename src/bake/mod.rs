@@ -17,24 +17,28 @@ pub mod forest;
 mod generated;
 mod model;
 mod pack;
+mod planes;
 mod render;
 mod sheet;
+mod slicing;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::Vec3;
 use thiserror::Error;
 
 use crate::gpu::{AdapterChoice, Gpu, GpuError};
-use crate::impostor::{BoundingSphere, Impostor, ImpostorError, ImpostorLod, Mesh, Plane, build_mip_chain};
+use crate::impostor::{BoundingSphere, Impostor, ImpostorError, ImpostorLod, Mesh};
 pub use fit::FitError;
-use fit::{FitParams, FittedPlane};
+use fit::FitParams;
 pub use generated::ModelSource;
 pub use model::{ModelError, load as load_model};
+use planes::Frame;
 pub use render::RenderError;
-use render::{Baker, PlaneDraw, UploadedMesh};
+use render::{Baker, UploadedMesh};
 pub use sheet::contact_sheet;
+pub use slicing::SlicingOptions;
 
 /// Atlas texels below this alpha are not the model (the leaves' glTF cutoff).
 pub const ALPHA_CUTOFF: f32 = 0.5;
@@ -46,11 +50,16 @@ pub struct BakeOptions {
     pub planes: Vec<usize>,
     /// Width and height of each LOD's atlas in texels (a power of two, 64 to 8192).
     pub texels: u32,
+    /// The crown's slicings (Jakulin 2000), on an atlas of `texels` too; `None`: none baked.
+    pub slicing: Option<SlicingOptions>,
 }
+
+/// Most slicings, and most slices per slicing, a bake may ask for.
+pub const MAX_SLICING: u32 = 32;
 
 impl Default for BakeOptions {
     fn default() -> Self {
-        Self { planes: vec![17, 8, 2], texels: 1024 }
+        Self { planes: vec![17, 8, 2], texels: 1024, slicing: None }
     }
 }
 
@@ -62,6 +71,11 @@ impl BakeOptions {
         }
         if !self.texels.is_power_of_two() || !(64..=8192).contains(&self.texels) {
             return Err(BakeError::Texels(self.texels));
+        }
+        if let Some(s) = self.slicing
+            && !((1..=MAX_SLICING).contains(&s.orientations) && (1..=MAX_SLICING).contains(&s.slices))
+        {
+            return Err(BakeError::Slicing(s));
         }
         Ok(())
     }
@@ -89,6 +103,9 @@ pub enum BakeError {
     /// [`BakeOptions::texels`] is not a power of two from 64 to 8192; holds the value given.
     #[error("texels {0}: an atlas must be a power of two from 64 to 8192 texels wide")]
     Texels(u32),
+    /// [`BakeOptions::slicing`] asks for no slicing or slice, or more than `MAX_SLICING`.
+    #[error("slicings {0:?}: 1 to 32 slicings of 1 to 32 slices each")]
+    Slicing(SlicingOptions),
     /// A model path is not a file; holds the path.
     #[error("{0}: no such model file")]
     NoSuchModel(PathBuf),
@@ -132,7 +149,8 @@ pub enum BakeError {
     Lod {
         /// The model file.
         path: PathBuf,
-        /// The LOD's index, 0 the finest: its place in [`BakeOptions::planes`].
+        /// The LOD's index, 0 the finest: its place in [`BakeOptions::planes`]; one past the
+        /// last for the slicings.
         lod: usize,
         /// What went wrong with it.
         source: Box<LodError>,
@@ -339,107 +357,58 @@ fn bake_model(
     for (l, &count) in options.planes.iter().enumerate() {
         lods.push(bake_lod(&job, count, options.texels, l).map_err(|e| (l, e))?);
     }
-    Ok(Impostor { name, bounding_sphere, alpha_cutoff: ALPHA_CUTOFF, lods, mesh })
-}
-
-/// A fitted plane's frame and the extent of what it draws.
-struct Frame {
-    normal: Vec3,
-    offset_m: f32,
-    right: Vec3,
-    up: Vec3,
-    /// (min, max) of the drawn vertices along right, up and normal (from the plane).
-    extent_m: [[f32; 2]; 3],
-}
-
-fn frame(plane: &FittedPlane, triangles: &[[Vec3; 3]], centre: Vec3) -> Frame {
-    let (mut normal, mut offset_m) = (plane.normal.normalize(), plane.offset_m);
-    // Face out of the model, so the front shows the outermost surface (up, for a plane through it).
-    if offset_m - normal.dot(centre) < 0.0 {
-        (normal, offset_m) = (-normal, -offset_m);
-    }
-    let reference = if normal.y.abs() < 0.99 { Vec3::Y } else { Vec3::NEG_Z };
-    let up = (reference - reference.dot(normal) * normal).normalize();
-    let right = up.cross(normal);
-    let mut extent_m = [[f32::INFINITY, f32::NEG_INFINITY]; 3];
-    for &t in &plane.triangles {
-        for p in triangles[t as usize] {
-            for (k, value) in [right.dot(p), up.dot(p), normal.dot(p) - offset_m].into_iter().enumerate() {
-                extent_m[k] = [extent_m[k][0].min(value), extent_m[k][1].max(value)];
+    let slicing = match options.slicing {
+        Some(slicing_options) => {
+            let started = Instant::now();
+            let slicing = slicing::bake(&job, slicing_options, options.texels)
+                .map_err(|e| (options.planes.len(), e))?;
+            if progress {
+                match &slicing {
+                    Some(s) => eprintln!(
+                        "  {name} slicings: {} × {} slices, ε = {:.2} m; crown {} triangles, trunk and limbs {} \
+                         left to the mesh; {:.2} s",
+                        s.orientations,
+                        s.slices,
+                        s.lod.epsilon_m,
+                        s.crown_triangles,
+                        s.trunk_triangles,
+                        started.elapsed().as_secs_f64()
+                    ),
+                    None => eprintln!("  {name} slicings: none, no crown (all bark): drawn as its mesh"),
+                }
             }
+            slicing
         }
-    }
-    Frame { normal, offset_m, right, up, extent_m }
+        None => None,
+    };
+    Ok(Impostor { name, bounding_sphere, alpha_cutoff: ALPHA_CUTOFF, lods, slicing, mesh })
 }
 
 /// LOD `lod` of `job`'s model: `count` planes on an atlas of `texels`.
 fn bake_lod(job: &Job, count: usize, texels: u32, lod: usize) -> Result<ImpostorLod, LodError> {
-    let Job { gpu, baker, name, mesh, uploaded, triangles, sphere, progress } = *job;
     let started = Instant::now();
-    let fit = fit::fit_planes(triangles, count, &FitParams::default())?;
+    let fit = fit::fit_planes(job.triangles, count, &FitParams::default())?;
     if fit.planes.len() != count {
         return Err(LodError::PlaneCount { found: fit.planes.len(), wanted: count });
     }
     let fitted_s = started.elapsed().as_secs_f64();
-    let centre = Vec3::from(sphere.centre_model_m);
-    let frames: Vec<Frame> = fit.planes.iter().map(|p| frame(p, triangles, centre)).collect();
-    let sizes: Vec<[f32; 2]> =
-        frames.iter().map(|f| [0, 1].map(|k| f.extent_m[k][1] - f.extent_m[k][0])).collect();
-    let (mip_count, align) = atlas_mips(texels);
-    let packing = pack::pack(&sizes, texels, align).ok_or(LodError::Pack { planes: count, texels })?;
-    let density = packing.texels_per_m;
-    let mut planes = Vec::new();
-    let mut draws = Vec::new();
-    for ((frame, fitted), rect) in frames.iter().zip(&fit.planes).zip(&packing.rects) {
-        // The rectangle's exact extent in metres, centred on what the plane draws.
-        let [[u0, u1], [v0, v1]] = [0, 1].map(|k| {
-            let (mid, half) = (
-                0.5 * (frame.extent_m[k][0] + frame.extent_m[k][1]),
-                [rect.width, rect.height][k] as f32 / (2.0 * density),
-            );
-            [mid - half, mid + half]
-        });
-        let [w0, w1] = frame.extent_m[2];
-        let margin = 0.01 * (w1 - w0) + 1e-4;
-        let (near, far) = (w1 + margin, w0 - margin);
-        let origin = frame.offset_m * frame.normal;
-        let at = |u: f32, v: f32| (origin + u * frame.right + v * frame.up).to_array();
-        let corner = |x: u32, y: u32| [x as f32 / texels as f32, y as f32 / texels as f32];
-        planes.push(Plane {
-            corners_model_m: [at(u0, v0), at(u1, v0), at(u1, v1), at(u0, v1)],
-            normal_model: frame.normal.to_array(),
-            uv_min: corner(rect.x, rect.y),
-            uv_max: corner(rect.x + rect.width, rect.y + rect.height),
-        });
-        // Rows of the clip-from-model transform: x from right, y from up, depth 0 at the front.
-        let row = |axis: Vec3, scale: f32, shift: f32| {
-            Vec4::new(axis.x * scale, axis.y * scale, axis.z * scale, shift)
-        };
-        let depth_scale = 1.0 / (near - far);
-        let rows = [
-            row(frame.right, 2.0 / (u1 - u0), -(u1 + u0) / (u1 - u0)),
-            row(frame.up, 2.0 / (v1 - v0), -(v1 + v0) / (v1 - v0)),
-            row(-frame.normal, depth_scale, (frame.offset_m + near) * depth_scale),
-            Vec4::new(0.0, 0.0, 0.0, 1.0),
-        ];
-        let clip_from_model = Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
-        draws.push(PlaneDraw { clip_from_model, rect: *rect, triangles: fitted.triangles.clone() });
-    }
-    let texels_level0 = baker.render_atlas(gpu, mesh, uploaded, &draws, texels)?;
-    let atlas =
-        build_mip_chain(texels_level0, [texels, texels], mip_count, Some(ALPHA_CUTOFF), &packing.rects);
-    if progress {
+    let centre = Vec3::from(job.sphere.centre_model_m);
+    let frames: Vec<Frame> = fit.planes.iter().map(|p| Frame::fitted(p, job.triangles, centre)).collect();
+    let baked = planes::bake(job, &frames, texels)?;
+    if job.progress {
         eprintln!(
-            "  {name} LOD {lod}: {count} planes, ε = {:.2} m ({:.0} % of the radius), \
-             {:.1} % of the area within ε, leftovers up to {:.2} m, {density:.0} texels/m; fit {fitted_s:.2} s, total {:.2} s",
+            "  {} LOD {lod}: {count} planes, ε = {:.2} m ({:.0} % of the radius), \
+             {:.1} % of the area within ε, leftovers up to {:.2} m, {:.0} texels/m; fit {fitted_s:.2} s, total {:.2} s",
+            job.name,
             fit.epsilon_m,
-            100.0 * fit.epsilon_m / sphere.radius_m,
+            100.0 * fit.epsilon_m / job.sphere.radius_m,
             100.0 * fit.covered_fraction,
             fit.max_leftover_distance_m,
+            baked.texels_per_m,
             started.elapsed().as_secs_f64()
         );
     }
-    Ok(ImpostorLod { epsilon_m: fit.epsilon_m, planes, atlas })
+    Ok(ImpostorLod { epsilon_m: fit.epsilon_m, planes: baked.planes, atlas: baked.atlas })
 }
 
 #[cfg(test)]
@@ -449,13 +418,21 @@ mod tests {
     #[test]
     fn options_need_plane_counts_and_a_power_of_two_atlas() {
         assert!(BakeOptions::default().validate().is_ok());
-        let with = |planes: Vec<usize>, texels| BakeOptions { planes, texels }.validate();
+        let with = |planes: Vec<usize>, texels| BakeOptions { planes, texels, slicing: None }.validate();
         assert!(matches!(with(vec![], 1024), Err(BakeError::Planes(_))));
         assert!(matches!(with(vec![4, 0], 1024), Err(BakeError::Planes(_))));
         for texels in [0, 32, 1000, 16384] {
             assert!(matches!(with(vec![2], texels), Err(BakeError::Texels(t)) if t == texels));
         }
         assert!(with(vec![1], 64).is_ok() && with(vec![1], 8192).is_ok());
+        let sliced = |orientations, slices| BakeOptions {
+            slicing: Some(SlicingOptions { orientations, slices }),
+            ..BakeOptions::default()
+        };
+        assert!(sliced(6, 5).validate().is_ok());
+        for (o, s) in [(0, 5), (6, 0), (33, 5), (6, 33)] {
+            assert!(matches!(sliced(o, s).validate(), Err(BakeError::Slicing(_))), "{o} × {s}");
+        }
     }
 
     #[test]

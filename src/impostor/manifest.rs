@@ -24,6 +24,24 @@ pub struct Manifest {
     pub materials: Vec<MaterialEntry>,
     /// The billboard clouds, finest first.
     pub lods: Vec<LodEntry>,
+    /// The crown's slicings (`slicing_mip{M}.png`), when baked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slicing: Option<SlicingEntry>,
+}
+
+/// The crown's slicings: how many, the crown and trunk it split the mesh into, the slices.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SlicingEntry {
+    /// Slicings, evenly spread around the vertical.
+    pub orientations: u32,
+    /// Slices per slicing.
+    pub slices: u32,
+    /// Triangles of the crown, drawn onto the slices.
+    pub crown_triangles: u32,
+    /// Triangles of the trunk and limbs, left to the mesh.
+    pub trunk_triangles: u32,
+    /// The slices, orientation-major, and their atlas.
+    pub lod: LodEntry,
 }
 
 /// Only the version, read before the rest.

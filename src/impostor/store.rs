@@ -7,10 +7,10 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use super::manifest::{ImageEntry, LodEntry, Manifest, MaterialEntry, MeshEntry, VersionOnly};
+use super::manifest::{ImageEntry, LodEntry, Manifest, MaterialEntry, MeshEntry, SlicingEntry, VersionOnly};
 use super::{
     FORMAT_VERSION, Impostor, ImpostorError, ImpostorLod, MANIFEST_FILE, MESH_FILE, Material, Mesh, MipChain,
-    mesh_file, mip_size,
+    Slicing, mesh_file, mip_size,
 };
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ImpostorError + '_ {
@@ -66,6 +66,20 @@ fn write_all(folder: &Path, impostor: &Impostor) -> Result<(), ImpostorError> {
         let atlas = write_chain(folder, &format!("lod{l}"), &lod.atlas)?;
         lods.push(LodEntry { epsilon_m: lod.epsilon_m, atlas, planes: lod.planes.clone() });
     }
+    let slicing = match &impostor.slicing {
+        Some(s) => Some(SlicingEntry {
+            orientations: s.orientations,
+            slices: s.slices,
+            crown_triangles: s.crown_triangles,
+            trunk_triangles: s.trunk_triangles,
+            lod: LodEntry {
+                epsilon_m: s.lod.epsilon_m,
+                atlas: write_chain(folder, "slicing", &s.lod.atlas)?,
+                planes: s.lod.planes.clone(),
+            },
+        }),
+        None => None,
+    };
     let mut materials = Vec::new();
     for (k, m) in impostor.mesh.materials.iter().enumerate() {
         let texture = match &m.texture {
@@ -99,6 +113,7 @@ fn write_all(folder: &Path, impostor: &Impostor) -> Result<(), ImpostorError> {
         },
         materials,
         lods,
+        slicing,
     };
     let text = toml::to_string(&manifest).map_err(|e| ImpostorError::ManifestWrite(e.to_string()))?;
     let manifest_path = folder.join(MANIFEST_FILE);
@@ -146,6 +161,20 @@ pub fn load(dir: &Path, model: &str) -> Result<Impostor, ImpostorError> {
         let atlas = read_chain(&folder, &lod.atlas)?;
         lods.push(ImpostorLod { epsilon_m: lod.epsilon_m, planes: lod.planes.clone(), atlas });
     }
+    let slicing = match &manifest.slicing {
+        Some(s) => Some(Slicing {
+            orientations: s.orientations,
+            slices: s.slices,
+            crown_triangles: s.crown_triangles,
+            trunk_triangles: s.trunk_triangles,
+            lod: ImpostorLod {
+                epsilon_m: s.lod.epsilon_m,
+                planes: s.lod.planes.clone(),
+                atlas: read_chain(&folder, &s.lod.atlas)?,
+            },
+        }),
+        None => None,
+    };
     let mut materials = Vec::new();
     for m in &manifest.materials {
         let texture = match &m.texture {
@@ -184,6 +213,7 @@ pub fn load(dir: &Path, model: &str) -> Result<Impostor, ImpostorError> {
         bounding_sphere: manifest.bounding_sphere,
         alpha_cutoff: manifest.alpha_cutoff,
         lods,
+        slicing,
         mesh: Mesh { vertices, indices, submeshes: manifest.mesh.submeshes, materials },
     };
     check(&impostor)?;
@@ -255,14 +285,22 @@ fn check(impostor: &Impostor) -> Result<(), ImpostorError> {
                 level.len() == 4 * w as usize * h as usize
             })
     };
-    for (l, lod) in impostor.lods.iter().enumerate() {
+    let slicing = impostor.slicing.as_ref().map(|s| ("the slicing".to_string(), &s.lod));
+    let lods = impostor.lods.iter().enumerate().map(|(l, lod)| (format!("LOD {l}"), lod));
+    for (what, lod) in lods.chain(slicing) {
         if !chain_ok(&lod.atlas) {
-            return fail(format!("LOD {l}: atlas levels do not match its size"));
+            return fail(format!("{what}: atlas levels do not match its size"));
         }
         let inside = |uv: [f32; 2]| uv.iter().all(|c| (0.0..=1.0).contains(c));
         if let Some(p) = lod.planes.iter().position(|p| !inside(p.uv_min) || !inside(p.uv_max)) {
-            return fail(format!("LOD {l}: plane {p}'s atlas rectangle leaves the atlas"));
+            return fail(format!("{what}: plane {p}'s atlas rectangle leaves the atlas"));
         }
+    }
+    if let Some(s) = &impostor.slicing
+        && s.lod.planes.len() != (s.orientations * s.slices) as usize
+    {
+        let planes = s.lod.planes.len();
+        return fail(format!("the slicing has {planes} slices, not {} × {}", s.orientations, s.slices));
     }
     let mesh = &impostor.mesh;
     for m in &mesh.materials {

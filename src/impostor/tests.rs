@@ -44,6 +44,17 @@ fn sample() -> Impostor {
             planes: vec![plane(0.0), plane(1.0)],
             atlas: build_mip_chain(atlas(), [16, 8], 3, Some(0.5), &rects),
         }],
+        slicing: Some(Slicing {
+            orientations: 2,
+            slices: 1,
+            lod: ImpostorLod {
+                epsilon_m: 0.5,
+                planes: vec![plane(0.0), plane(1.0)],
+                atlas: build_mip_chain(atlas(), [16, 8], 2, Some(0.5), &rects),
+            },
+            crown_triangles: 1,
+            trunk_triangles: 0,
+        }),
         mesh: Mesh {
             vertices: vec![vertex([0.0, 0.0, 0.0]), vertex([2.0, 0.0, 0.0]), vertex([2.0, 1.0, 0.0])],
             indices: vec![0, 1, 2],
@@ -143,4 +154,27 @@ fn bounding_spheres_hold_their_points() {
     let sphere = BoundingSphere::enclosing(points);
     assert_eq!(sphere.centre_model_m[1], 4.0, "centred at mid-height");
     assert!(points.iter().all(|&p| sphere.contains(p)));
+}
+
+#[test]
+fn a_slicing_with_other_than_orientations_times_slices_planes_is_refused() {
+    let dir = temp_dir("slicing");
+    let mut impostor = sample();
+    if let Some(slicing) = impostor.slicing.as_mut() {
+        slicing.slices = 2;
+    }
+    let error = save(&dir, &impostor).unwrap_err().to_string();
+    assert!(error.contains("2 slices, not 2 × 2"), "{error}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bark_is_known_by_its_material_name() {
+    let named = |name: &str| Material { name: name.into(), ..sample().mesh.materials[0].clone() };
+    for bark in ["Bark", "Birch_Bark", "bark 0", "Trunk", "OakWood"] {
+        assert!(named(bark).is_bark(), "{bark}");
+    }
+    for foliage in ["Pine_Leaves", "Green", "Rock", "leaves", "Berry"] {
+        assert!(!named(foliage).is_bark(), "{foliage}");
+    }
 }

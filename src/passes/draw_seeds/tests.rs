@@ -58,6 +58,7 @@ fn impostor(name: &str, planes: [usize; 3], sizes: [u32; 3], with_mesh: bool) ->
                 atlas: atlas(sizes[l], 2, 10 * l as u8),
             })
             .collect(),
+        slicing: None,
         mesh: if with_mesh {
             mesh
         } else {
