@@ -53,6 +53,10 @@ struct SeedMaterial {
     detail_m: f32,
     first_leaf_vertex: u32,
     leaf_count: u32,
+    slicings: u32,
+    slicing_brightness: f32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> u: DrawSeedsUniforms;
@@ -88,6 +92,8 @@ struct VertexOut {
     @location(7) @interpolate(flat) record: u32,
     // Luminosity by position inside the plant (`crown_luminosity`).
     @location(8) luminosity: f32,
+    // The dither range a slice keeps of the slicings' blend (`slice_blend`); [0, 2) elsewhere.
+    @location(9) @interpolate(flat) blend: vec2<f32>,
 }
 
 // Model space (x, y up, z) to world (x east, y north, z up), turned by `angle` about the vertical.
@@ -114,6 +120,48 @@ fn crown_luminosity(shape: SeedShape, position_model_m: vec3<f32>, angle: f32) -
         side = clamp(dot(offset, u.sun_dir.xy / sun_across) / CROWN_HALF_WIDTH_PER_HEIGHT, -1.0, 1.0);
     }
     return 1.0 - shape.crown_shading * (0.5 * (1.0 - height) + 0.25 * (1.0 - side));
+}
+
+// Slicings (Jakulin 2000, Rust twin `impostor::slicing::view_blend`): the dither range a slice
+// of `material` keeps, by the blend of the two slicings whose orientations are nearest the eye as
+// seen from the crown's middle (the seed's mid-height), in model space. [0, α̅_p) in the primary,
+// [1 − α̅_s, 1] in the secondary: complementary, so where the corrected opacities sum past 1 a
+// pixel shows both, and no sort is needed. Empty (x ≥ y) in the other slicings. The slice's own
+// slicing is its normal's.
+fn slice_blend(material: SeedMaterial, normal_model: vec3<f32>, record: SeedRecord, angle: f32) -> vec2<f32> {
+    let tau = 6.2831853;
+    let n = max(material.slicings, 1u);
+    let step = tau / f32(n);
+    let centre_rel = record.position_rel_m + vec3<f32>(0.0, 0.0, record.height_m * (u.sink_fraction + 0.5));
+    // World to model space: undo the turn about the vertical, then model_to_world's axes.
+    let eye = -centre_rel;
+    let c = cos(angle);
+    let s = sin(angle);
+    let w = vec2<f32>(c * eye.x + s * eye.y, c * eye.y - s * eye.x);
+    let azimuth = atan2(-w.y, w.x);
+    let wrapped = azimuth - floor(azimuth / tau) * tau;
+    let nearest = round(wrapped / step);
+    let primary = u32(nearest) % n;
+    let discrepancy = wrapped - nearest * step;
+    var secondary = (primary + n - 1u) % n;
+    if discrepancy >= 0.0 {
+        secondary = (primary + 1u) % n;
+    }
+    var alpha_primary = 1.0;
+    if n > 1u {
+        alpha_primary = 1.0 - abs(discrepancy) / step;
+    }
+    let alpha_secondary = 1.0 - alpha_primary;
+    let brightness = 1.0 + material.slicing_brightness * alpha_secondary;
+    let own_azimuth = atan2(normal_model.z, normal_model.x);
+    let own = u32(round((own_azimuth - floor(own_azimuth / tau) * tau) / step)) % n;
+    if own == primary {
+        return vec2<f32>(0.0, brightness * alpha_primary);
+    }
+    if own == secondary {
+        return vec2<f32>(1.0 - brightness * alpha_secondary, 2.0);
+    }
+    return vec2<f32>(1.0, 0.0);
 }
 
 // How far the seed's foot is from the eye (its anchor was sunk by pass 3), metres.
@@ -212,6 +260,15 @@ fn vs_main(
     let angle = f32(jitter.angle) * (6.2831853 / 65536.0);
     let shape = shapes[min(species, arrayLength(&shapes) - 1u)];
     let scale = record.height_m * shape.inv_model_height_m;
+    out.blend = vec2<f32>(0.0, 2.0);
+    if (material.flags & MATERIAL_SLICE) != 0u {
+        out.blend = slice_blend(material, in.normal_model, record, angle);
+        if out.blend.x >= out.blend.y {
+            // A slicing the view does not blend: every vertex at one point outside the view.
+            out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+            return out;
+        }
+    }
     var position_model_m = in.position_model_m;
     if u.focal_px > 0.0 {
         let detailed = detail_position(in, vertex, scale, distance_m, record.jitter);
@@ -297,10 +354,14 @@ fn surface(in: VertexOut) -> Surface {
     return Surface(vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0), texel.a, fwidth(texel.a));
 }
 
-// Whether the cross-fade gives this pixel to the other of the seed's two draws.
+// Whether the cross-fade gives this pixel to the other of the seed's two draws, or the slicings'
+// blend to the other slicing (a dither of its own: the pattern transposed, not to correlate
+// with the cross-fade's).
 fn faded_out(in: VertexOut) -> bool {
-    let t = bayer4(vec2<u32>(in.clip.xy), u32(in.keep.z));
-    return t < in.keep.x || t >= in.keep.y;
+    let pixel = vec2<u32>(in.clip.xy);
+    let t = bayer4(pixel, u32(in.keep.z));
+    let b = bayer4(pixel.yx, u32(in.keep.z) ^ 9u);
+    return t < in.keep.x || t >= in.keep.y || b < in.blend.x || b >= in.blend.y;
 }
 
 // The fragment's lit, hazed colour, or discarded (alpha test, dither).

@@ -106,3 +106,75 @@ fn crowns_are_sliced_trunks_stay_meshes_and_every_crown_vertex_shows_in_a_slicin
         crown.iter().filter(|&&p| !cloud.planes.iter().any(|plane| shows(&cloud.atlas, plane, p, 2))).count();
     println!("17-plane cloud: {missing} of {} crown vertices show on none of its planes", crown.len());
 }
+
+/// A frame of the synthetic forest from 30 m up, with every seed near enough drawn as LOD 1 (no
+/// meshes), by `impostors` (or none), with slicings on or off.
+fn lod1_frame(dir: &std::path::Path, impostors: &str, slicings: bool, brightness: f64) -> image::RgbaImage {
+    let mut s = terramp_testkit::small_settings(320, 180);
+    s.draw_seeds.impostors = impostors.to_owned();
+    s.draw_seeds.reach_m = [0.0, 1000.0, 1400.0, 3000.0];
+    s.draw_seeds.slicings = slicings;
+    s.draw_seeds.slicing_brightness = brightness;
+    let mut r = terramp_testkit::renderer(dir, s);
+    let pose = terramp_testkit::camera::over_fraction(&r, [0.45, 0.35], 30.0, 20.0, -12.0);
+    terramp_testkit::settled_colour(&mut r, &pose)
+}
+
+#[test]
+fn slicings_draw_lod_1_where_the_clouds_would_with_their_trunks() {
+    let Some(sliced) = terramp_testkit::nc_sliced_impostors() else { return };
+    let sliced = sliced.to_str().unwrap();
+    let dir = terramp_testkit::synth_dataset(300, 7);
+    let bare = lod1_frame(&dir, "", false, 0.5);
+    let clouds = lod1_frame(&dir, sliced, false, 0.5);
+    let slices = lod1_frame(&dir, sliced, true, 0.5);
+    let uncorrected = lod1_frame(&dir, sliced, true, 0.0);
+    let trees = |frame: &image::RgbaImage| -> Vec<bool> {
+        frame.pixels().zip(bare.pixels()).map(|(p, q)| p != q).collect()
+    };
+    let (by_clouds, by_slices, by_uncorrected) = (trees(&clouds), trees(&slices), trees(&uncorrected));
+    let count = |mask: &[bool]| mask.iter().filter(|&&t| t).count();
+    let both = by_clouds.iter().zip(&by_slices).filter(|&(&a, &b)| a && b).count();
+    let either = by_clouds.iter().zip(&by_slices).filter(|&(&a, &b)| a || b).count();
+    println!(
+        "tree pixels: 17-plane clouds {}, slicings {} ({} without the brightness correction); both {both} of either {either}",
+        count(&by_clouds),
+        count(&by_slices),
+        count(&by_uncorrected)
+    );
+    assert!(count(&by_clouds) > 3000, "too few trees to judge");
+    // The same trees, drawn otherwise: they cover much the same pixels.
+    let ratio = count(&by_slices) as f64 / count(&by_clouds) as f64;
+    assert!((0.6..1.6).contains(&ratio), "slicings cover {ratio:.2} of the clouds' pixels");
+    assert!(both * 2 > either, "slicings and clouds share only {both} of {either} tree pixels");
+    // The correction makes up for the blend's thinning: more of each crown shows with it.
+    assert!(count(&by_slices) > count(&by_uncorrected), "the brightness correction changed nothing");
+    assert_ne!(slices, clouds);
+}
+
+#[test]
+fn the_stochastic_blend_keeps_the_sorted_blends_picture_over_its_dither() {
+    let Some(shared) = shared_data() else { return };
+    let out = TempDir::new("slicing-blend");
+    let options = BakeOptions { texels: 1024, slicing: Some(OPTIONS), ..Default::default() };
+    bake_models(None, &[shared.join("models/Tree_1.glb")], out.path(), &options, false).unwrap();
+    let tree = load(out.path(), "Tree_1").unwrap();
+    let mut errors = Vec::new();
+    for degrees in [0.0f32, 10.0, 20.0, 29.0] {
+        let a = degrees.to_radians();
+        let eye = Vec3::new(a.cos(), 0.2, a.sin());
+        let e = terramp::reference::slicing::blend_error(&tree, eye, 0.5, 0).unwrap();
+        println!(
+            "{degrees:>4}° from slicing 0: {:.2} levels of 255 per 4 × 4 block over {} blocks, coverage {:.3} of the sorted blend's",
+            e.mean_abs, e.blocks, e.coverage_ratio
+        );
+        errors.push(e);
+    }
+    // On an orientation one slicing is drawn, opaque: both blends are its nearest texels.
+    assert_eq!(errors[0].mean_abs, 0.0);
+    assert!((errors[0].coverage_ratio - 1.0).abs() < 1e-9);
+    for e in &errors[1..] {
+        assert!(e.blocks > 100 && e.mean_abs > 0.0, "{e:?}");
+        assert!(e.mean_abs < 15.0 && (0.9..1.1).contains(&e.coverage_ratio), "{e:?}");
+    }
+}

@@ -187,7 +187,11 @@ fn continuous_lod_draws_fewer_primitives_with_distance_and_none_below_a_pixel() 
             slicing: None,
             mesh,
         };
-        let built = assets::gather(&[Some(impostor)], true).unwrap();
+        let built = assets::gather(
+            &[Some(impostor)],
+            assets::LodChoices { continuous_lod: true, ..Default::default() },
+        )
+        .unwrap();
         let detail = built.details[0].clone().expect("a generated tree has continuous LOD");
         let leaves = detail.leaves.expect("its leaves are laid out for it");
         let whole = detail.whole.index_count / 3;

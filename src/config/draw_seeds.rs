@@ -27,6 +27,13 @@ pub struct DrawSeedsSettings {
     /// a pixel wide on a share of the seeds as they shrink on screen, and the thinned mesh also
     /// takes the 17-plane cloud's place (LOD 1).
     pub continuous_lod: bool,
+    /// Species whose impostor carries slicings (`terramp-data bake --slicings`) draw them in
+    /// LOD 1's place (Jakulin 2000): the mesh's trunk and limbs, and the crown's two slicings
+    /// nearest the view, blended.
+    pub slicings: bool,
+    /// The slicings' brightness correction's multiplier (the paper's m_s): both blended slicings'
+    /// opacities are raised by 1 + this × the secondary's share.
+    pub slicing_brightness: f64,
     /// Folder of baked impostors (`terramp-data bake`), one sub-folder per model; "" = seeds are
     /// selected but not drawn. Species whose model is not there are not drawn.
     pub impostors: String,
@@ -36,7 +43,13 @@ impl DrawSeedsSettings {
     pub(super) fn validate(&self, tlm: &TlmSettings) -> Result<(), SettingsError> {
         let r = self.reach_m;
         let last_band = tlm.radial_bands_m[tlm.radial_bands_m.len() - 1];
-        let checks: [RangeCheck; 4] = [
+        let checks: [RangeCheck; 5] = [
+            (
+                (0.0..=2.0).contains(&self.slicing_brightness),
+                "draw_seeds.slicing_brightness",
+                self.slicing_brightness.to_string(),
+                "0 to 2",
+            ),
             (
                 r[0] >= 0.0
                     && r[1] > 0.0

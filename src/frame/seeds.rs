@@ -20,6 +20,7 @@ use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError};
 use crate::passes::compact::frame::CompactLimits;
 use crate::passes::compact::gpu::{CompactInputs, CompactPass};
+use crate::passes::draw_seeds::LodChoices;
 use crate::passes::draw_seeds::frame::{draw_uniforms, load_impostors};
 use crate::passes::draw_seeds::gpu::{DrawSeedsInputs, DrawSeedsPass};
 use crate::passes::seed_select::frame::{SeedCellRef, SeedFrame, SeedInputs};
@@ -257,8 +258,8 @@ fn draw_pass(
     targets: &Targets,
 ) -> Result<(DrawSeedsPass, wgpu::BindGroup), RenderError> {
     let impostors = load_impostors(dir, &table.species)?;
-    let continuous = settings.draw_seeds.continuous_lod;
-    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, continuous)?;
+    let choices = LodChoices::of(&settings.draw_seeds, &table.species);
+    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, choices)?;
     if settings.draw_seeds.samples > 1 {
         draw = draw.multisampled(&gpu.device, &targets.colour, &targets.depth);
     }

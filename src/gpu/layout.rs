@@ -348,6 +348,9 @@ wgsl_constants! { draw_constants:
     /// `SeedMaterial::flags`: bark (a trunk, a branch): it keeps its own colour where foliage takes
     /// on the ground's (`Species::ground_blend`; `impostor::Material::is_bark`).
     pub const MATERIAL_BARK: u32 = 16;
+    /// `SeedMaterial::flags`: a slicing's slice (`draw_seeds.slicings`): drawn only in the two
+    /// slicings nearest the view, dithered by their blend (`impostor::slicing::view_blend`).
+    pub const MATERIAL_SLICE: u32 = 32;
     /// Continuous LOD: the projected size, pixels, below which leaves thin out; the kept ones
     /// grow back to it, so the crown keeps its area and no drawn leaf is smaller.
     pub const DETAIL_FULL_PX: f32 = 2.0;

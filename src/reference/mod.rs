@@ -5,7 +5,8 @@
 //! `accuracy` (seeds against the oracle), `image_metrics` (PSNR, SSIM of frames against the
 //! ground truth) and `frame_change` (popping: 4 × 4 block changes between consecutive frames,
 //! against the truth's along the same flight) are what the speed trade (`sweep`) reports; `worst`
-//! takes error maxima that never drop a NaN.
+//! takes error maxima that never drop a NaN; `slicing` measures the slicings' stochastic blend
+//! against the paper's sorted one.
 
 pub mod accuracy;
 pub mod compact;
@@ -14,6 +15,7 @@ pub mod frame_change;
 pub mod image_metrics;
 pub mod oracle;
 pub mod seed_select;
+pub mod slicing;
 pub mod texcells;
 pub mod tile_load_map;
 pub mod worst;

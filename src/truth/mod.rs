@@ -39,9 +39,9 @@ use crate::frame::{RenderError, Renderer};
 use crate::gpu::readback::read_texture;
 use crate::gpu::resources::buffer_init;
 use crate::gpu::{Gpu, GpuError};
-use crate::passes::draw_seeds::DrawSeedsError;
 use crate::passes::draw_seeds::frame::{draw_uniforms, load_impostors};
 use crate::passes::draw_seeds::gpu::{DrawSeedsInputs, DrawSeedsPass, SEED_ID_FORMAT};
+use crate::passes::draw_seeds::{DrawSeedsError, LodChoices};
 use crate::reference::oracle::{Culls, OracleCounts, OracleError, OracleSeed, judge_seeds};
 use scene::TruthScene;
 use visibility::samples_per_seed;
@@ -249,7 +249,8 @@ impl MeshDrawer {
                 }
                 let impostors = load_impostors(&self.dir, species)?;
                 // Every seed its whole mesh: no continuous LOD.
-                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species, false)?;
+                let draw =
+                    DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species, LodChoices::default())?;
                 let pipeline = draw.truth_pipeline(&gpu.device);
                 (draw, pipeline)
             }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use terramp::bake::{BakeOptions, bake_missing};
+use terramp::bake::{BakeOptions, SlicingOptions, bake_missing};
 use terramp::classes::ClassTable;
 
 use crate::data::{shared_data, target_tmp_dir};
@@ -14,16 +14,28 @@ use crate::data::{shared_data, target_tmp_dir};
 /// The baked folder, or `None` when the shared data is skipped (`TERRAMP_SKIP_SHARED=1`).
 pub fn nc_impostors() -> Option<&'static Path> {
     static DIR: OnceLock<Option<PathBuf>> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let models = shared_data()?.join("models");
-        let table = ClassTable::load("nc").unwrap();
-        let names: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
-        let out = target_tmp_dir().join("nc-impostors");
-        // Small atlases: enough for test views, quick to bake.
-        let options = BakeOptions { texels: 256, ..Default::default() };
-        let missing = bake_missing(&models, &names, &out, &options, false).unwrap();
-        assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
-        Some(out)
-    })
-    .as_deref()
+    // Small atlases: enough for test views, quick to bake.
+    DIR.get_or_init(|| bake_nc("nc-impostors", BakeOptions { texels: 256, ..Default::default() })).as_deref()
+}
+
+/// The same models baked with slicings too (6 × 5, `BakeOptions::slicing`), into a folder of
+/// their own.
+pub fn nc_sliced_impostors() -> Option<&'static Path> {
+    static DIR: OnceLock<Option<PathBuf>> = OnceLock::new();
+    let options = BakeOptions {
+        texels: 512,
+        slicing: Some(SlicingOptions { orientations: 6, slices: 5 }),
+        ..Default::default()
+    };
+    DIR.get_or_init(|| bake_nc("nc-impostors-sliced", options)).as_deref()
+}
+
+fn bake_nc(folder: &str, options: BakeOptions) -> Option<PathBuf> {
+    let models = shared_data()?.join("models");
+    let table = ClassTable::load("nc").unwrap();
+    let names: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
+    let out = target_tmp_dir().join(folder);
+    let missing = bake_missing(&models, &names, &out, &options, false).unwrap();
+    assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
+    Some(out)
 }

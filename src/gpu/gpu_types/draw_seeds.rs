@@ -60,7 +60,8 @@ gpu_struct! {
     /// How a seed vertex is coloured: a base colour times (when `flags` has `MATERIAL_TEXTURED`) a
     /// layer of the seed texture array, alpha-tested; the draw LODs of the geometry it belongs to
     /// (0 the mesh, 1 to 3 the billboard clouds), which tell a group's own draw from its
-    /// cross-fade; and how its primitives shed detail (`MATERIAL_LEAVES`, `MATERIAL_STEMS`).
+    /// cross-fade; how its primitives shed detail (`MATERIAL_LEAVES`, `MATERIAL_STEMS`); whether
+    /// it is bark (`MATERIAL_BARK`) or a slicing's slices (`MATERIAL_SLICE`).
     /// WGSL: `SeedMaterial` in `shaders/draw_seeds.wgsl`.
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
     pub struct SeedMaterial {
@@ -87,6 +88,13 @@ gpu_struct! {
         pub first_leaf_vertex: u32,
         /// `MATERIAL_LEAVES`: how many leaf quads it has.
         pub leaf_count: u32,
+        /// `MATERIAL_SLICE`: how many slicings its slices belong to, evenly spread around the
+        /// vertical (`impostor::slicing::orientation`); a slice's own is its normal's.
+        pub slicings: u32,
+        /// `MATERIAL_SLICE`: the brightness correction's multiplier (`draw_seeds.slicing_brightness`).
+        pub slicing_brightness: f32,
+        /// Padding to the struct's 16-byte alignment.
+        pub _pad: [u32; 2],
     }
 }
 

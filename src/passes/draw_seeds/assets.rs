@@ -12,6 +12,9 @@
 //! (at `SEED_GROUPS + group`) the next LOD's range. A model baked without a mesh draws its
 //! 17-plane cloud up close instead; a species without an impostor keeps zero-index templates.
 //!
+//! With slicings (`draw_seeds.slicings`), an impostor that carries them draws them as LOD 1: its
+//! mesh's bark submeshes, then every slice, one piece (the shader keeps two slicings per view).
+//!
 //! With continuous LOD (`draw_seeds.continuous_lod`), a mesh whose materials say how they shed
 //! detail (`impostor::Detail`, generated trees) also takes LOD 1's place: its 17-plane cloud is
 //! not uploaded, LOD 0 has no cross-fade (the same geometry goes on), and where its leaves and
@@ -20,12 +23,14 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
+use crate::classes::{Species, SpeciesKind};
+use crate::config::DrawSeedsSettings;
 use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
 use crate::gpu::layout::{
-    MATERIAL_BARK, MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_STEMS, MATERIAL_TEXTURED, SEED_DRAWS,
-    SEED_GROUPS, SEED_LODS,
+    MATERIAL_BARK, MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_SLICE, MATERIAL_STEMS, MATERIAL_TEXTURED,
+    SEED_DRAWS, SEED_GROUPS, SEED_LODS,
 };
-use crate::impostor::{AlphaMode, Detail, Impostor, MipChain, mip_size};
+use crate::impostor::{AlphaMode, Detail, Impostor, Material, Mesh, MipChain, Slicing, Submesh, mip_size};
 
 use super::DrawSeedsError;
 
@@ -113,9 +118,42 @@ impl SeedAssets {
     }
 }
 
-/// Lays out `impostors` (by species index; `None`: not drawn); with `continuous`, the meshes
-/// that say how they shed detail are laid out for continuous LOD.
-pub fn gather(impostors: &[Option<Impostor>], continuous: bool) -> Result<SeedAssets, DrawSeedsError> {
+/// What LOD 1 may be drawn with besides the 17-plane cloud (`[draw_seeds]`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LodChoices {
+    /// Meshes that say how they shed detail take LOD 1's place (`draw_seeds.continuous_lod`).
+    pub continuous_lod: bool,
+    /// Impostors with slicings draw them as LOD 1, with this brightness correction
+    /// (`draw_seeds.slicings`, `slicing_brightness`); `None`: clouds.
+    pub slicing_brightness: Option<f32>,
+    /// The species (a bit per species index) that may be drawn as slicings: plants, whose crowns
+    /// are sparse; a rock is solid, and keeps its cloud.
+    pub sliced_species: u32,
+}
+
+impl LodChoices {
+    /// The choices `settings` make for `species`.
+    pub fn of(settings: &DrawSeedsSettings, species: &[Species]) -> Self {
+        let plants = species.iter().enumerate().filter(|(_, s)| s.kind != SpeciesKind::Rock);
+        Self {
+            continuous_lod: settings.continuous_lod,
+            slicing_brightness: settings.slicings.then_some(settings.slicing_brightness as f32),
+            sliced_species: plants.filter(|(i, _)| *i < 32).fold(0, |mask, (i, _)| mask | 1 << i),
+        }
+    }
+
+    /// The slicing species `species` draws as LOD 1 with its brightness correction, if any.
+    fn slicing_of<'a>(&self, species: usize, impostor: &'a Impostor) -> Option<(f32, &'a Slicing)> {
+        let allowed = species < 32 && self.sliced_species & (1 << species) != 0;
+        let brightness = self.slicing_brightness.filter(|_| allowed)?;
+        Some((brightness, impostor.slicing.as_ref()?))
+    }
+}
+
+/// Lays out `impostors` (by species index; `None`: not drawn), LOD 1 as `choices` says: the
+/// meshes that say how they shed detail laid out for continuous LOD, or the slicings.
+pub fn gather(impostors: &[Option<Impostor>], choices: LodChoices) -> Result<SeedAssets, DrawSeedsError> {
+    let continuous = choices.continuous_lod;
     let species_max = (SEED_GROUPS / SEED_LODS) as usize;
     let present = || impostors.iter().take(species_max).flatten();
     for impostor in present() {
@@ -126,7 +164,13 @@ pub fn gather(impostors: &[Option<Impostor>], continuous: bool) -> Result<SeedAs
             });
         }
     }
-    let atlases = || present().flat_map(|i| i.lods[..CLOUD_LODS].iter().map(|l| &l.atlas));
+    let atlases = || {
+        let drawn = impostors.iter().enumerate().take(species_max);
+        drawn.filter_map(|(species, i)| i.as_ref().map(|i| (species, i))).flat_map(move |(species, i)| {
+            let slicing = choices.slicing_of(species, i).map(|(_, s)| &s.lod.atlas);
+            i.lods[..CLOUD_LODS].iter().map(|l| &l.atlas).chain(slicing)
+        })
+    };
     let textures = || present().flat_map(|i| i.mesh.materials.iter().filter_map(|m| m.texture.as_ref()));
     let size = atlases().chain(textures()).map(|a| a.size[0].max(a.size[1])).max().unwrap_or(1);
     let size = size.clamp(1, MAX_LAYER_TEXELS);
@@ -147,10 +191,11 @@ pub fn gather(impostors: &[Option<Impostor>], continuous: bool) -> Result<SeedAs
         let Some(impostor) = impostor else { continue };
         out.inv_model_height_m[species] = 1.0 / model_height_m(impostor);
         let detailed = continuous && has_detail(impostor);
+        let sliced = choices.slicing_of(species, impostor).filter(|_| !detailed);
         let mut lods = [SeedDrawArgs::default(); SEED_LODS as usize];
         for (k, level) in impostor.lods[..CLOUD_LODS].iter().enumerate() {
-            if detailed && k == 0 {
-                // The mesh takes the 17-plane cloud's place.
+            if (detailed || sliced.is_some()) && k == 0 {
+                // The mesh, or the slicings, take the 17-plane cloud's place.
                 continue;
             }
             let layer = out.layer(&level.atlas);
@@ -173,7 +218,10 @@ pub fn gather(impostors: &[Option<Impostor>], continuous: bool) -> Result<SeedAs
             });
             lods[k + 1] = out.push(vertices, &level.indices());
         }
-        if impostor.mesh.indices.is_empty() {
+        if let Some((brightness, slicing)) = sliced {
+            lods[1] = push_slicing(&mut out, impostor, slicing, brightness);
+        }
+        if impostor.mesh.indices.is_empty() && sliced.is_none() {
             lods[0] = lods[1];
         } else {
             let detail = push_mesh(&mut out, impostor, detailed);
@@ -221,52 +269,13 @@ fn push_mesh(out: &mut SeedAssets, impostor: &Impostor, detailed: bool) -> MeshD
     let mut whole_pieces = Vec::new();
     for submesh in &mesh.submeshes {
         let Some(source) = mesh.materials.get(submesh.material as usize) else { continue };
-        let layer = source.texture.as_ref().map(|chain| {
-            let first_alike = mesh.materials.iter().position(|m| m.texture.as_ref() == Some(chain));
-            *layers
-                .entry(first_alike.unwrap_or(submesh.material as usize))
-                .or_insert_with(|| out.layer(chain))
-        });
-        let alpha_cutoff = match source.alpha_mode {
-            AlphaMode::Opaque => -1.0,
-            // (The baker reads glTF's BLEND as MASK: seeds are not sorted.)
-            AlphaMode::Mask => source.alpha_cutoff,
-        };
-        let (detail_flag, detail_m) = match source.detail {
-            Some(Detail::Leaves { size_m }) => (MATERIAL_LEAVES, size_m),
-            Some(Detail::Stems { diameter_m }) => (MATERIAL_STEMS, diameter_m),
-            None => (0, 0.0),
-        };
-        let material = out.material(SeedMaterial {
-            base_colour: source.base_color_factor,
-            layer: layer.unwrap_or(0),
-            alpha_cutoff,
-            lod: 0,
-            flags: layer.map_or(0, |_| MATERIAL_TEXTURED | MATERIAL_REPEAT)
-                | if source.is_bark() { MATERIAL_BARK } else { 0 },
-            last_lod: u32::from(detailed),
-            detail_m,
-            ..Default::default()
-        });
         let (submesh_vertex, submesh_index) = (vertices.len() as u32, indices.len() as u32);
-        let mut remap: HashMap<u32, u32> = HashMap::new();
-        let range = submesh.first_index as usize..(submesh.first_index + submesh.index_count) as usize;
-        for &index in mesh.indices.get(range).unwrap_or_default() {
-            let Some(v) = mesh.vertices.get(index as usize) else { continue };
-            let local = *remap.entry(index).or_insert_with(|| {
-                vertices.push(SeedVertex {
-                    position_model_m: v.position_model_m,
-                    normal_model: v.normal_model,
-                    uv: v.uv,
-                    material,
-                    pivot_model_m: v.pivot_model_m,
-                });
-                vertices.len() as u32 - 1
-            });
-            indices.push(local);
-        }
-        // A dropped out-of-range index would shift every later triangle: keep whole triangles.
-        indices.truncate(indices.len() - indices.len() % 3);
+        let lods = [0, u32::from(detailed)];
+        let Some(material) = push_submesh(out, mesh, submesh, lods, &mut layers, &mut vertices, &mut indices)
+        else {
+            continue;
+        };
+        let (detail_flag, _) = detail_of(source);
         let run = first_index + submesh_index..first_index + indices.len() as u32;
         let m = &mut out.materials[material as usize];
         match source.detail {
@@ -294,6 +303,110 @@ fn push_mesh(out: &mut SeedAssets, impostor: &Impostor, detailed: bool) -> MeshD
     }
     let whole = out.push(vertices, &indices);
     MeshDetail { whole, leaves, stems, whole_pieces }
+}
+
+/// A mesh material's continuous-LOD flag and its detail size (leaf size or stem diameter, model
+/// metres); (0, 0) for a material drawn whole.
+fn detail_of(source: &Material) -> (u32, f32) {
+    match source.detail {
+        Some(Detail::Leaves { size_m }) => (MATERIAL_LEAVES, size_m),
+        Some(Detail::Stems { diameter_m }) => (MATERIAL_STEMS, diameter_m),
+        None => (0, 0.0),
+    }
+}
+
+/// Appends `submesh` of `mesh` to `vertices` and `indices` (its vertices repeated for it, whole
+/// triangles only) with a material of its own serving draw LODs `lods` (first, last); textures
+/// share a layer through `layers`. `None` when the submesh names no material.
+fn push_submesh(
+    out: &mut SeedAssets,
+    mesh: &Mesh,
+    submesh: &Submesh,
+    [lod, last_lod]: [u32; 2],
+    layers: &mut HashMap<usize, u32>,
+    vertices: &mut Vec<SeedVertex>,
+    indices: &mut Vec<u32>,
+) -> Option<u32> {
+    let source = mesh.materials.get(submesh.material as usize)?;
+    let layer = source.texture.as_ref().map(|chain| {
+        let first_alike = mesh.materials.iter().position(|m| m.texture.as_ref() == Some(chain));
+        *layers.entry(first_alike.unwrap_or(submesh.material as usize)).or_insert_with(|| out.layer(chain))
+    });
+    let alpha_cutoff = match source.alpha_mode {
+        AlphaMode::Opaque => -1.0,
+        // (The baker reads glTF's BLEND as MASK: seeds are not sorted.)
+        AlphaMode::Mask => source.alpha_cutoff,
+    };
+    let material = out.material(SeedMaterial {
+        base_colour: source.base_color_factor,
+        layer: layer.unwrap_or(0),
+        alpha_cutoff,
+        lod,
+        flags: layer.map_or(0, |_| MATERIAL_TEXTURED | MATERIAL_REPEAT)
+            | if source.is_bark() { MATERIAL_BARK } else { 0 },
+        last_lod,
+        detail_m: detail_of(source).1,
+        ..Default::default()
+    });
+    let mut remap: HashMap<u32, u32> = HashMap::new();
+    let range = submesh.first_index as usize..(submesh.first_index + submesh.index_count) as usize;
+    let first = indices.len();
+    for &index in mesh.indices.get(range).unwrap_or_default() {
+        let Some(v) = mesh.vertices.get(index as usize) else { continue };
+        let local = *remap.entry(index).or_insert_with(|| {
+            vertices.push(SeedVertex {
+                position_model_m: v.position_model_m,
+                normal_model: v.normal_model,
+                uv: v.uv,
+                material,
+                pivot_model_m: v.pivot_model_m,
+            });
+            vertices.len() as u32 - 1
+        });
+        indices.push(local);
+    }
+    // A dropped out-of-range index would shift every later triangle: keep whole triangles.
+    indices.truncate(indices.len() - (indices.len() - first) % 3);
+    Some(material)
+}
+
+/// LOD 1 drawn as the crown's slicings (`draw_seeds.slicings`): the mesh's bark submeshes (the
+/// trunk and limbs), then every slice, one piece. The shader keeps the two slicings nearest the
+/// view (`MATERIAL_SLICE`).
+fn push_slicing(
+    out: &mut SeedAssets,
+    impostor: &Impostor,
+    slicing: &Slicing,
+    brightness: f32,
+) -> SeedDrawArgs {
+    let mesh = &impostor.mesh;
+    let (mut layers, mut vertices, mut indices) = (HashMap::new(), Vec::new(), Vec::new());
+    let bark = |s: &&Submesh| mesh.materials.get(s.material as usize).is_some_and(Material::is_bark);
+    for submesh in mesh.submeshes.iter().filter(bark) {
+        push_submesh(out, mesh, submesh, [1, 1], &mut layers, &mut vertices, &mut indices);
+    }
+    let layer = out.layer(&slicing.lod.atlas);
+    let material = out.material(SeedMaterial {
+        base_colour: [1.0; 4],
+        layer,
+        alpha_cutoff: impostor.alpha_cutoff,
+        lod: 1,
+        flags: MATERIAL_TEXTURED | MATERIAL_SLICE,
+        last_lod: 1,
+        slicings: slicing.orientations,
+        slicing_brightness: brightness,
+        ..Default::default()
+    });
+    let base = vertices.len() as u32;
+    vertices.extend(slicing.lod.vertices().into_iter().map(|v| SeedVertex {
+        position_model_m: v.position_model_m,
+        normal_model: v.normal_model,
+        uv: v.uv_atlas,
+        material,
+        pivot_model_m: v.position_model_m,
+    }));
+    indices.extend(slicing.lod.indices().into_iter().map(|i| base + i));
+    out.push(vertices, &indices)
 }
 
 /// Whether every triangle of `indices` lies on one stem: its three vertices share a pivot (the

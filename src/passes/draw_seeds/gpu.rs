@@ -20,9 +20,9 @@ use crate::impostor::{Impostor, mip_size};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 use crate::seeds::wind::bend_of;
 
-use super::DrawSeedsError;
 use super::assets::{self, MeshDetail};
 use super::frame::detail_templates;
+use super::{DrawSeedsError, LodChoices};
 use multisample::Multisample;
 
 pub mod multisample;
@@ -95,20 +95,19 @@ pub struct DrawSeedsPass {
 }
 
 impl DrawSeedsPass {
-    /// Uploads the impostors of `species` (by species index; `None`: not drawn), the meshes that
-    /// can be drawn with continuous LOD so if `continuous` (`draw_seeds.continuous_lod`), and
-    /// builds the pipeline.
+    /// Uploads the impostors of `species` (by species index; `None`: not drawn), LOD 1 as
+    /// `choices` says (continuous LOD, slicings), and builds the pipeline.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         impostors: &[Option<Impostor>],
         species: &[Species],
-        continuous: bool,
+        choices: LodChoices,
     ) -> Result<Self, DrawSeedsError> {
         if !device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE) {
             return Err(DrawSeedsError::NoFirstInstance);
         }
-        let built = assets::gather(impostors, continuous)?;
+        let built = assets::gather(impostors, choices)?;
         let max = device.limits().max_texture_array_layers;
         let layers = built.layers.len().max(1) as u32;
         if layers > max {

@@ -32,7 +32,7 @@ use thiserror::Error;
 use crate::gpu::layout::SEED_LODS;
 use crate::impostor::ImpostorError;
 
-pub use assets::MAX_LAYER_TEXELS;
+pub use assets::{LodChoices, MAX_LAYER_TEXELS};
 
 /// Why the species' impostors could not be loaded, laid out or uploaded for the seed draw.
 #[derive(Debug, Error)]

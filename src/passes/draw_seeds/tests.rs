@@ -1,12 +1,14 @@
-use super::DrawSeedsError;
 use super::assets;
 use super::frame::load_impostors;
+use super::{DrawSeedsError, LodChoices};
+use crate::gpu::gpu_types::SeedMaterial;
 use crate::gpu::layout::{
-    MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_STEMS, MATERIAL_TEXTURED, SEED_DRAWS, SEED_GROUPS, SEED_LODS,
+    MATERIAL_BARK, MATERIAL_LEAVES, MATERIAL_REPEAT, MATERIAL_SLICE, MATERIAL_STEMS, MATERIAL_TEXTURED,
+    SEED_DRAWS, SEED_GROUPS, SEED_LODS,
 };
 use crate::impostor::{
     AlphaMode, BoundingSphere, Detail, Impostor, ImpostorLod, Material, Mesh, MeshVertex, MipChain, Plane,
-    Submesh,
+    Slicing, Submesh,
 };
 
 /// A plain atlas of `size`² texels and `mips` levels, every texel `value`.
@@ -14,6 +16,10 @@ fn atlas(size: u32, mips: u32, value: u8) -> MipChain {
     let levels = (0..mips).map(|m| vec![value; (4 * (size >> m) * (size >> m)) as usize]).collect();
     MipChain { size: [size; 2], levels }
 }
+
+/// LOD 1 drawn with continuous LOD where a mesh has it.
+const CONTINUOUS: LodChoices =
+    LodChoices { continuous_lod: true, slicing_brightness: None, sliced_species: 0 };
 
 fn impostor(name: &str, planes: [usize; 3], sizes: [u32; 3], with_mesh: bool) -> Impostor {
     let plane = Plane {
@@ -74,7 +80,7 @@ fn groups_get_their_index_ranges_materials_and_layers_and_missing_species_draw_n
         None,
         Some(impostor("C", [2, 1, 1], [8, 8, 8], false)),
     ];
-    let built = assets::gather(&impostors, false).unwrap();
+    let built = assets::gather(&impostors, LodChoices::default()).unwrap();
     // 16² leaves set the size; the atlases' 2 mips the count; 3 atlases + 1 texture + 3 atlases.
     assert_eq!((built.size, built.mips, built.layers.len()), (16, 2, 7));
     let lods = SEED_LODS as usize;
@@ -109,7 +115,7 @@ fn groups_get_their_index_ranges_materials_and_layers_and_missing_species_draw_n
     assert!(built.layers[3][1].iter().all(|&v| v == 200));
     // Nothing is drawn with continuous LOD without materials that say how.
     assert!(built.details.iter().all(Option::is_none));
-    assert_eq!(assets::gather(&impostors, true).unwrap().templates, built.templates);
+    assert_eq!(assets::gather(&impostors, CONTINUOUS).unwrap().templates, built.templates);
 }
 
 /// A generated tree's mesh in miniature: `leaves` leaf quads (leaves first, 0.1 m), then stems of
@@ -158,7 +164,7 @@ fn detailed(leaves: u32) -> Impostor {
 
 #[test]
 fn a_mesh_with_continuous_lod_stands_for_the_first_cloud_and_keeps_its_pieces() {
-    let built = assets::gather(&[Some(detailed(10))], true).unwrap();
+    let built = assets::gather(&[Some(detailed(10))], CONTINUOUS).unwrap();
     let t = &built.templates;
     let groups = SEED_GROUPS as usize;
     // Clouds of 2 and 1 planes (LODs 2, 3), then the mesh: 40 leaf vertices and 2 × 3 stems'.
@@ -190,19 +196,19 @@ fn a_mesh_with_continuous_lod_stands_for_the_first_cloud_and_keeps_its_pieces() 
     // Stems whose triangles do not share a pivot cannot be told apart: they are drawn whole.
     let mut unnamed = detailed(10);
     unnamed.mesh.vertices.iter_mut().for_each(|v| v.pivot_model_m = v.position_model_m);
-    let unnamed = assets::gather(&[Some(unnamed)], true).unwrap();
+    let unnamed = assets::gather(&[Some(unnamed)], CONTINUOUS).unwrap();
     let detail = unnamed.details[0].as_ref().unwrap();
     assert!(detail.stems.is_empty() && detail.whole_pieces == [78..81, 81..84]);
     assert!(unnamed.materials[3..].iter().all(|m| m.flags & MATERIAL_STEMS == 0));
     // Without continuous LOD the same mesh is drawn as any other.
-    let plain = assets::gather(&[Some(detailed(10))], false).unwrap();
+    let plain = assets::gather(&[Some(detailed(10))], LodChoices::default()).unwrap();
     assert!(plain.details[0].is_none() && plain.templates[1] != plain.templates[0]);
     assert!(plain.materials.iter().all(|m| m.last_lod == m.lod));
 }
 
 #[test]
 fn each_frame_narrows_lod_1_to_what_its_nearest_seed_keeps() {
-    let built = assets::gather(&[Some(detailed(100))], true).unwrap();
+    let built = assets::gather(&[Some(detailed(100))], CONTINUOUS).unwrap();
     let mut settings = crate::config::Settings::preset("balanced").unwrap();
     settings.draw_seeds.reach_m = [100.0, 200.0, 300.0, 400.0];
     settings.seeds.reference_height_m = 2.0;
@@ -242,4 +248,37 @@ fn missing_models_are_counted_not_errors() {
     assert!(loaded.iter().all(Option::is_none));
     assert!(matches!(load_impostors(&dir.join("absent"), &table.species), Err(DrawSeedsError::NoFolder(_))));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn slicings_take_lod_1_with_the_trunk_for_the_species_that_may_and_others_keep_their_cloud() {
+    let sliced = |name: &str| {
+        let mut i = impostor(name, [3, 2, 1], [8, 8, 8], true);
+        i.mesh.materials[0].name = "Bark".into();
+        let lod =
+            ImpostorLod { epsilon_m: 0.2, planes: i.lods[0].planes[..2].to_vec(), atlas: atlas(8, 2, 90) };
+        i.slicing = Some(Slicing { orientations: 2, slices: 1, lod, crown_triangles: 1, trunk_triangles: 1 });
+        i
+    };
+    let impostors = [Some(sliced("Tree")), Some(sliced("Rock"))];
+    let choices = LodChoices { continuous_lod: false, slicing_brightness: Some(0.5), sliced_species: 0b01 };
+    let built = assets::gather(&impostors, choices).unwrap();
+    let plain = assets::gather(&impostors, LodChoices::default()).unwrap();
+    let (t, lods) = (&built.templates, SEED_LODS as usize);
+    // Species 0's LOD 1: its bark triangle (3 vertices), then its 2 slices (8 vertices, 12 indices).
+    assert_eq!(t[1].index_count, 3 + 12);
+    let first = t[1].base_vertex as usize;
+    let materials: Vec<&SeedMaterial> =
+        built.vertices[first..first + 11].iter().map(|v| &built.materials[v.material as usize]).collect();
+    assert!(
+        materials[..3].iter().all(|m| (m.lod, m.last_lod, m.flags & MATERIAL_BARK) == (1, 1, MATERIAL_BARK))
+    );
+    assert!(materials[3..].iter().all(|m| {
+        (m.lod, m.flags & MATERIAL_SLICE, m.slicings, m.slicing_brightness) == (1, MATERIAL_SLICE, 2, 0.5)
+    }));
+    // The rock keeps its 3-plane cloud; the plain build draws both with clouds.
+    assert_eq!(t[lods + 1].index_count, 18);
+    assert_eq!(plain.templates[1].index_count, 18);
+    // A cross-fade from the mesh draws the slicings as LOD 1.
+    assert_eq!(t[SEED_GROUPS as usize], t[1]);
 }
