@@ -178,3 +178,37 @@ fn the_stochastic_blend_keeps_the_sorted_blends_picture_over_its_dither() {
         assert!(e.mean_abs < 15.0 && (0.9..1.1).contains(&e.coverage_ratio), "{e:?}");
     }
 }
+
+/// The figure of docs/slicings.md: Tree_1's crown seen from 0° to 60° off slicing 0 (its slices
+/// facing +X) in 10° steps, 0.2 above the horizon: the paper's sorted blend above, pass 4's
+/// stochastic one below, over grey. `cargo test --release --test slicings -- --ignored`.
+#[test]
+#[ignore = "writes docs/slicings_orbit.png"]
+fn orbit_figure() {
+    let shared = shared_data().expect("../shared/data");
+    let out = TempDir::new("slicing-orbit");
+    let options = BakeOptions { texels: 1024, slicing: Some(OPTIONS), ..Default::default() };
+    bake_models(None, &[shared.join("models/Tree_1.glb")], out.path(), &options, false).unwrap();
+    let tree = load(out.path(), "Tree_1").unwrap();
+    let px = terramp::reference::slicing::VIEW_PX as u32;
+    let steps = 7u32;
+    // The crown fills the top of the view (the bounding sphere's lower half is the trunk's).
+    let rows = px * 5 / 8;
+    let mut sheet = image::RgbaImage::from_pixel(steps * (px + 4), 2 * rows + 4, image::Rgba([255; 4]));
+    for step in 0..steps {
+        let a = (10.0 * step as f32).to_radians();
+        let views = terramp::reference::slicing::blend_views(&tree, Vec3::new(a.cos(), 0.2, a.sin()), 0.5, 0)
+            .unwrap();
+        for (row, picture) in [&views.sorted, &views.stochastic].into_iter().enumerate() {
+            for (i, p) in picture.iter().enumerate().take((rows * px) as usize) {
+                let grey = 190.0 * (1.0 - p[3]);
+                let rgb = [0, 1, 2].map(|k| (p[k] + grey).clamp(0.0, 255.0) as u8);
+                let (x, y) = (step * (px + 4) + i as u32 % px, row as u32 * (rows + 4) + i as u32 / px);
+                sheet.put_pixel(x, y, image::Rgba([rgb[0], rgb[1], rgb[2], 255]));
+            }
+        }
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/slicings_orbit.png");
+    sheet.save(&path).unwrap();
+    println!("wrote {}", path.display());
+}

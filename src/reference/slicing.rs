@@ -68,10 +68,27 @@ fn hit(impostor: &Impostor, plane: &Plane, origin: Vec3, dir: Vec3) -> Option<(f
     Some((t, [texel[0], texel[1], texel[2], texel[3]]))
 }
 
+/// The two pictures of a slicing's blend, `VIEW_PX`² each, top row first: premultiplied colour
+/// (sRGB levels, 0 to 255) and opacity (0 to 1), over nothing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlendViews {
+    /// The paper's: slices composited back to front at their slicings' opacities.
+    pub sorted: Vec<[f32; 4]>,
+    /// Pass 4's: the nearest opaque texel of a slicing the dither gives the pixel.
+    pub stochastic: Vec<[f32; 4]>,
+}
+
 /// The stochastic blend's error against the sorted one for `impostor`'s slicing seen from
 /// `eye_model` (a direction from the crown's middle, model space), with the brightness
-/// correction's multiplier `correction`; `None` without a slicing.
+/// correction's multiplier `correction` and the dither's shift `shift` (a seed's rank);
+/// `None` without a slicing.
 pub fn blend_error(impostor: &Impostor, eye_model: Vec3, correction: f32, shift: u32) -> Option<BlendError> {
+    let views = blend_views(impostor, eye_model, correction, shift)?;
+    Some(compare_blocks(&views.sorted, &views.stochastic))
+}
+
+/// Both pictures of `impostor`'s slicing seen from `eye_model`, as [`blend_error`] compares them.
+pub fn blend_views(impostor: &Impostor, eye_model: Vec3, correction: f32, shift: u32) -> Option<BlendViews> {
     let slicing = impostor.slicing.as_ref()?;
     let (n, slices) = (slicing.orientations, slicing.slices);
     let blend = view_blend(eye_model, n, correction);
@@ -124,7 +141,7 @@ pub fn blend_error(impostor: &Impostor, eye_model: Vec3, correction: f32, shift:
             }
         }
     }
-    Some(compare_blocks(&sorted, &stochastic))
+    Some(BlendViews { sorted, stochastic })
 }
 
 /// The 4 × 4 block means of two images compared: mean absolute difference per channel over the
