@@ -212,3 +212,93 @@ fn orbit_figure() {
     sheet.save(&path).unwrap();
     println!("wrote {}", path.display());
 }
+
+/// nc's table with nothing growing but white oaks (Tree_1), `per_km2` of them in its forest.
+fn lone_oaks_table(per_km2: f64) -> std::path::PathBuf {
+    let nc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/config/classes/nc.toml")).unwrap();
+    let (mut text, mut skipping) = (String::new(), false);
+    for line in nc.lines() {
+        if skipping {
+            skipping = line != "]";
+            continue;
+        }
+        if line.starts_with("seeds = [") {
+            skipping = !line.ends_with(']');
+            continue;
+        }
+        text.push_str(line);
+        text.push('\n');
+        if line == "name = \"forest\"" {
+            text.push_str(&format!("seeds = [{{ species = \"white oak\", per_km2 = {per_km2} }}]\n"));
+        }
+    }
+    let path = std::env::temp_dir().join(format!("terramp-lone-oaks-{}.toml", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The figure of docs/slicings.md: one white oak (Tree_1) of the synthetic forest as its mesh, its
+/// 17-plane cloud and its slicings (rows), from three sides (columns), 15 m away.
+/// `cargo test --release --test slicings -- --ignored`.
+#[test]
+#[ignore = "writes docs/slicings_three_ways.png"]
+fn three_ways_figure() {
+    use terramp::gpu::layout::SpeciesLod;
+    let impostors = terramp_testkit::nc_sliced_impostors().expect("../shared/data");
+    let dir = terramp_testkit::synth_dataset(300, 7);
+    let table = lone_oaks_table(60.0);
+    let settings = |reach_m: [f64; 4], slicings: bool| {
+        let mut s = terramp_testkit::small_settings(320, 240);
+        s.draw_seeds.impostors = impostors.to_str().unwrap().to_owned();
+        s.seeds.class_table = table.to_str().unwrap().to_owned();
+        s.draw_seeds.reach_m = reach_m;
+        s.draw_seeds.slicings = slicings;
+        s
+    };
+    // Find an oak from above.
+    let mut r = terramp_testkit::renderer(&dir, settings([1000.0, 1100.0, 1400.0, 3000.0], false));
+    let above = terramp_testkit::camera::over_fraction(&r, [0.45, 0.35], 80.0, 20.0, -35.0);
+    r.render_resolved(&above).unwrap();
+    let (records, _) = r.read_seeds().unwrap().unwrap();
+    let oak = records
+        .iter()
+        .filter(|s| s.height_m > 8.0)
+        .min_by(|a, b| {
+            let d = |s: &&terramp::gpu::gpu_types::SeedRecord| glam::Vec3::from(s.position_rel_m).length();
+            d(a).total_cmp(&d(b))
+        })
+        .expect("an oak in view");
+    assert_eq!(
+        SpeciesLod::unpack(oak.species_lod).species,
+        r.class_table().unwrap().species_index("white oak").unwrap() as u32
+    );
+    let foot = above.position_m
+        + glam::DVec3::new(f64::from(oak.position_rel_m[0]), f64::from(oak.position_rel_m[1]), 0.0);
+    let middle_m = f64::from(oak.ground_m) + 0.5 * f64::from(oak.height_m);
+    let rows = [
+        ([1000.0, 1100.0, 1400.0, 3000.0], false),
+        ([0.0, 1000.0, 1400.0, 3000.0], false),
+        ([0.0, 1000.0, 1400.0, 3000.0], true),
+    ];
+    let mut sheet = image::RgbaImage::from_pixel(3 * 324, 3 * 244, image::Rgba([255; 4]));
+    for (row, (reach_m, slicings)) in rows.into_iter().enumerate() {
+        let mut r = terramp_testkit::renderer(&dir, settings(reach_m, slicings));
+        for (column, yaw_deg) in [0.0f64, 120.0, 240.0].into_iter().enumerate() {
+            // Looking along `yaw_deg` at the oak from 15 m, level with its middle.
+            let (sin, cos) = yaw_deg.to_radians().sin_cos();
+            let eye = glam::DVec3::new(foot.x - 15.0 * sin, foot.y - 15.0 * cos, middle_m);
+            let camera = terramp::camera::Camera {
+                position_m: eye,
+                yaw_deg,
+                pitch_deg: 0.0,
+                fov_deg: 45.0,
+                near_m: 0.1,
+            };
+            let frame = terramp_testkit::settled_colour(&mut r, &camera);
+            image::imageops::replace(&mut sheet, &frame, (column * 324) as i64, (row * 244) as i64);
+        }
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/slicings_three_ways.png");
+    sheet.save(&path).unwrap();
+    println!("wrote {}", path.display());
+}
