@@ -124,10 +124,11 @@ fn crown_luminosity(shape: SeedShape, position_model_m: vec3<f32>, angle: f32) -
 
 // Slicings (Jakulin 2000, Rust twin `impostor::slicing::view_blend`): the dither range a slice
 // of `material` keeps, by the blend of the two slicings whose orientations are nearest the eye as
-// seen from the crown's middle (the seed's mid-height), in model space. [0, α̅_p) in the primary,
-// [1 − α̅_s, 1] in the secondary: complementary, so where the corrected opacities sum past 1 a
-// pixel shows both, and no sort is needed. Empty (x ≥ y) in the other slicings. The slice's own
-// slicing is its normal's.
+// seen from the crown's middle (the seed's mid-height), in model space. [0, α̅) in the one at the
+// lower azimuth, [1 − α̅, 1] in the other: complementary, so where the corrected opacities sum
+// past 1 a pixel shows both, and no sort is needed; and by azimuth rather than by role, so each
+// slicing keeps its pixels when the two trade roles half-way. Empty (x ≥ y) in the other
+// slicings. The slice's own slicing is its normal's.
 fn slice_blend(material: SeedMaterial, normal_model: vec3<f32>, record: SeedRecord, angle: f32) -> vec2<f32> {
     let tau = 6.2831853;
     let n = max(material.slicings, 1u);
@@ -155,13 +156,19 @@ fn slice_blend(material: SeedMaterial, normal_model: vec3<f32>, record: SeedReco
     let brightness = 1.0 + material.slicing_brightness * alpha_secondary;
     let own_azimuth = atan2(normal_model.z, normal_model.x);
     let own = u32(round((own_azimuth - floor(own_azimuth / tau) * tau) / step)) % n;
+    var alpha = 0.0;
     if own == primary {
-        return vec2<f32>(0.0, brightness * alpha_primary);
+        alpha = brightness * alpha_primary;
+    } else if own == secondary {
+        alpha = brightness * alpha_secondary;
+    } else {
+        return vec2<f32>(1.0, 0.0);
     }
-    if own == secondary {
-        return vec2<f32>(1.0 - brightness * alpha_secondary, 2.0);
+    // The lower of the two (the primary when the eye is past it) keeps the low thresholds.
+    if (own == primary) == (discrepancy >= 0.0) {
+        return vec2<f32>(0.0, alpha);
     }
-    return vec2<f32>(1.0, 0.0);
+    return vec2<f32>(1.0 - alpha, 2.0);
 }
 
 // How far the seed's foot is from the eye (its anchor was sunk by pass 3), metres.

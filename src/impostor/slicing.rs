@@ -34,6 +34,10 @@ pub struct ViewBlend {
     pub alpha_primary: f32,
     /// The secondary's, brightness correction included: from 0 up to the primary's.
     pub alpha_secondary: f32,
+    /// Whether the primary is the one of the two at the lower azimuth (the secondary the next
+    /// orientation). A stochastic blend gives the lower one the dither's low thresholds and the
+    /// other the high ones, so each slicing keeps its pixels when the two trade roles half-way.
+    pub primary_lower: bool,
 }
 
 /// The blend of `orientations` slicings for an eye along `eye_model` from the slicing centre
@@ -63,6 +67,7 @@ pub fn view_blend(eye_model: Vec3, orientations: u32, correction: f32) -> ViewBl
         secondary,
         alpha_primary: brightness * alpha_primary,
         alpha_secondary: brightness * alpha_secondary,
+        primary_lower: discrepancy >= 0.0,
     }
 }
 
@@ -126,11 +131,11 @@ mod tests {
     #[test]
     fn half_way_between_two_orientations_both_are_equal_and_brightened() {
         let b = view_blend(eye(30.0 + 1e-3), SIX, 0.5);
-        assert_eq!((b.primary, b.secondary), (1, 0));
+        assert_eq!((b.primary, b.secondary, b.primary_lower), (1, 0, false));
         // α_p = α_s = ½, each times f_c = 1 + 0.5 · ½.
         assert!((b.alpha_primary - 0.625).abs() < 1e-4 && (b.alpha_secondary - 0.625).abs() < 1e-4, "{b:?}");
         let plain = view_blend(eye(30.0 - 1e-3), SIX, 0.0);
-        assert_eq!((plain.primary, plain.secondary), (0, 1));
+        assert_eq!((plain.primary, plain.secondary, plain.primary_lower), (0, 1, true));
         assert!((plain.alpha_primary - 0.5).abs() < 1e-4 && (plain.alpha_secondary - 0.5).abs() < 1e-4);
     }
 

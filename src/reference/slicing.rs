@@ -7,8 +7,8 @@
 //!   to front in the paper's interleaved order (`interleaved_order`), each opaque texel with its
 //!   slicing's corrected opacity, over the background;
 //! - **stochastic** (what pass 4 draws): the nearest opaque texel of a slicing that keeps the
-//!   pixel by the blend's ordered dither (`bayer4` transposed, [0, α̅_p) for the primary,
-//!   [1 − α̅_s, 1) for the secondary), as depth testing leaves it, else the background.
+//!   pixel by the blend's ordered dither (`bayer4` transposed, [0, α̅) for the slicing at the
+//!   lower azimuth, [1 − α̅, 1) for the other), as depth testing leaves it, else the background.
 //!
 //! The eye integrates the dither over its 4 × 4 pattern, so both are box-filtered over 4 × 4
 //! pixels before they are compared: the mean absolute difference per channel, 0 to 255, over
@@ -127,8 +127,10 @@ pub fn blend_views(impostor: &Impostor, eye_model: Vec3, correction: f32, shift:
             sorted[pixel] = colour;
             // Stochastic: the nearest opaque texel of a slicing the dither gives the pixel.
             let b = bayer4([py as u32, px as u32], shift ^ 9);
+            // The lower of the two slicings keeps the low thresholds, the other the high ones.
             let keeps = |s: u32| {
-                if s == blend.primary { b < blend.alpha_primary } else { b >= 1.0 - blend.alpha_secondary }
+                let alpha = if s == blend.primary { blend.alpha_primary } else { blend.alpha_secondary };
+                if (s == blend.primary) == blend.primary_lower { b < alpha } else { b >= 1.0 - alpha }
             };
             let nearest = order
                 .iter()
