@@ -34,5 +34,4 @@ awk -v lods="${LODS:-2}" '
     --frames "${FRAMES:-24}" --warmup "${WARMUP:-6}" --timing-rounds 3 --samples "${SAMPLES:-3}" \
     --width "${WIDTH:-1280}" --height "${HEIGHT:-720}" --truth-supersample 4 --truth-reach-m 4000 \
     --popping-frames 12 --settings "$trees" --series --series-from balanced \
-    --knob "seeds.class_table=$sparse" \
-    2> >(grep -v XDG_RUNTIME_DIR >&2)
+    --knob "seeds.class_table=$sparse"

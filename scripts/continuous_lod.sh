@@ -34,8 +34,7 @@ for name in $(grep -o 'tree-[a-z]*-s[0-9]*-h[0-9]*' config/classes/nc_generated.
     [[ -f "$glb" ]] || "$terramp_data" tree --species "$species" --seed "${seed#s}" \
         --health "$(awk "BEGIN { print ${health#h} / 100 }")" --out "$glb" >/dev/null
     started=$(date +%s.%N)
-    "$terramp_data" bake --model "$glb" --out "$impostors" --texels 256 --missing 2>&1 >/dev/null |
-        { grep -v XDG_RUNTIME_DIR >&2 || true; }
+    "$terramp_data" bake --model "$glb" --out "$impostors" --texels 256 --missing >/dev/null
     awk -v name="$name" -v t0="$started" -v t1="$(date +%s.%N)" 'BEGIN { printf "%s\t%.1f s\n", name, t1 - t0 }' >&2
 done
 generated="$data/generated.toml"
@@ -49,8 +48,7 @@ echo "## sweep: continuous LOD off and on" >&2
     --series --series-from balanced \
     --knob "draw_seeds.continuous_lod=true" \
     --knob "draw_seeds.reach_m=[800,1400,2000,3000]" \
-    --knob "draw_seeds.continuous_lod+draw_seeds.reach_m=true+[800,1400,2000,3000]" \
-    2> >(grep -v XDG_RUNTIME_DIR >&2)
+    --knob "draw_seeds.continuous_lod+draw_seeds.reach_m=true+[800,1400,2000,3000]"
 
 [[ "${PROFILE_FRAMES:-60}" != 0 ]] || exit 0
 echo "## profile: the demo's flight, generated trees against the shared models" >&2

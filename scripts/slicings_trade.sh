@@ -36,5 +36,4 @@ printf '# Written by scripts/slicings_trade.sh: seeds with slicings baked.\n[dra
     --width "${WIDTH:-960}" --height "${HEIGHT:-540}" --truth-supersample 4 --truth-reach-m 4000 \
     --popping-frames 12 --settings "$layer" \
     --knob draw_seeds.slicings=false,true \
-    --knob "draw_seeds.reach_m=[800,1000,1400,3000],[300,1000,1400,3000]" \
-    2> >(grep -v XDG_RUNTIME_DIR >&2)
+    --knob "draw_seeds.reach_m=[800,1000,1400,3000],[300,1000,1400,3000]"

@@ -34,7 +34,7 @@ forest="$data/forest"
 if [[ ! -d "$forest/texcells/5" ]]; then
     rm -rf "$forest"
     cp -r "$impostors" "$forest"
-    "$terramp_data" bake --classes nc --models "$shared/models" --out "$forest" 2> >(grep -v XDG_RUNTIME_DIR >&2)
+    "$terramp_data" bake --classes nc --models "$shared/models" --out "$forest"
 fi
 layer="$data/forest.toml"
 printf '# Written by scripts/texcells_truth.sh: seeds and texcells.\n[draw_seeds]\nimpostors = "%s"\n' \
@@ -45,5 +45,4 @@ printf '# Written by scripts/texcells_truth.sh: seeds and texcells.\n[draw_seeds
     --knob texcells.ground_blend=0,0.7 \
     --frames "${FRAMES:-6}" --warmup 4 --timing-rounds 1 --samples "${SAMPLES:-2}" \
     --width "${WIDTH:-960}" --height "${HEIGHT:-540}" --truth-supersample "${TRUTH_SUPERSAMPLE:-4}" \
-    --truth-reach-m "${TRUTH_REACH_M:-12000}" --popping-frames 0 --settings "$layer" \
-    2> >(grep -v XDG_RUNTIME_DIR >&2)
+    --truth-reach-m "${TRUTH_REACH_M:-12000}" --popping-frames 0 --settings "$layer"

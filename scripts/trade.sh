@@ -73,7 +73,7 @@ for name in ${SWEEP-synthetic nc zion}; do
     "$terramp" sweep --dataset "$data/$name" --out "docs/trade/$name" --presets "$presets" \
         --frames "$frames" --warmup "$warmup" --timing-rounds "${ROUNDS:-3}" --samples "$samples" --width "$width" --height "$height" \
         --truth-supersample "${TRUTH_SUPERSAMPLE:-4}" --truth-reach-m "${TRUTH_REACH_M:-4000}" \
-        --popping-frames "${POPPING_FRAMES:-12}" --settings "$trees" "${front[@]}" 2> >(grep -v XDG_RUNTIME_DIR >&2)
+        --popping-frames "${POPPING_FRAMES:-12}" --settings "$trees" "${front[@]}"
 done
 
 python3 scripts/trade_page.py "$frames" "$warmup" "$((($(date +%s) - started) / 60))" >docs/TRADE.md

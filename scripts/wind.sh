@@ -34,8 +34,7 @@ cp "$trees" "$still"
 for name in still windy; do
     echo "## popping, $name" >&2
     "$terramp" sweep --dataset "$data/nc" --out "$out/sweep_$name" --presets balanced --frames 4 --warmup 2 \
-        --timing-rounds 1 --samples 1 --popping-frames "${POPPING_FRAMES:-12}" --settings "$out/$name.toml" \
-        2> >(grep -v XDG_RUNTIME_DIR >&2)
+        --timing-rounds 1 --samples 1 --popping-frames "${POPPING_FRAMES:-12}" --settings "$out/$name.toml"
 done
 python3 - "$out" "$wind" <<'PY'
 import json, sys
@@ -60,7 +59,7 @@ printf '[[key]]\nat = [%s]\nyaw_deg = %s\npitch_deg = %s\n' "${STRIP_AT:-634000,
 { cat "$windy"; printf 'frame_rate_hz = %s\n' "${STRIP_HZ:-4}"; } >"$out/strip.toml"
 rm -rf "$out/strip"
 "$terramp" fly --dataset "$data/nc" --path "$out/strip_path.toml" --frames $((settle + frames)) \
-    --width 960 --height 540 --out "$out/strip" --settings "$out/strip.toml" 2> >(grep -v XDG_RUNTIME_DIR >&2)
+    --width 960 --height 540 --out "$out/strip" --settings "$out/strip.toml"
 python3 - "$out/strip" "$settle" "$frames" "${STRIP_HZ:-4}" "$wind" <<'PY'
 import sys
 from PIL import Image

@@ -129,3 +129,24 @@ fn passes_are_timed_with_timestamps_or_on_the_cpu() {
         assert!(last.iter().any(|t| t.label == "terrain_select" && t.source == TimeSource::Cpu));
     }
 }
+
+/// A headless command opens its GPU without probing a window system: Mesa's device-select layer
+/// would connect to Wayland and X11 and print errors a user cannot act on.
+#[test]
+fn a_headless_render_prints_no_window_system_errors() {
+    let dataset = synth_dataset(300, 7);
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_terramp"))
+        .args(["render", "--dataset"])
+        .arg(&dataset)
+        .args(["--camera", "100,100,900,0,-10", "--width", "32", "--height", "32", "--out"])
+        .arg(std::env::temp_dir().join(format!("terramp-quiet-{}.png", std::process::id())))
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("DISPLAY")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(!stderr.contains("XDG_RUNTIME_DIR") && !stderr.contains("error:"), "{stderr}");
+}

@@ -120,6 +120,8 @@ fn bake(args: BakeArgs) -> Result<()> {
 }
 
 fn main() -> Result<()> {
+    // SAFETY: first thing in main, before any thread starts.
+    unsafe { terramp::gpu::skip_device_select_layer() };
     match Cli::parse().command {
         Command::Build(args) => build::run(&args),
         Command::Bake(args) => bake(args),

@@ -195,6 +195,8 @@ enum Command {
 }
 
 fn main() -> Result<()> {
+    // SAFETY: first thing in main, before any thread starts.
+    unsafe { terramp::gpu::skip_device_select_layer() };
     match Cli::parse().command {
         Command::Render { view, out } => {
             let (settings, camera) = view.load()?;

@@ -3,6 +3,12 @@
 //! (Mesa lavapipe on Linux), unless the setting or `TERRAMP_ADAPTER` forces one kind. `WGPU_BACKEND`
 //! narrows the backends as usual (CI sets `vulkan`, so a silent fallback to GL cannot hide).
 //!
+//! Mesa's device-select layer (implicit, installed with its Vulkan drivers) picks a default GPU by
+//! connecting to the Wayland and X11 servers whenever an instance enables their surface
+//! extensions, which wgpu always does; on a server that prints two lines of errors no one can act
+//! on. terramp picks its adapter itself, so its binaries turn the layer off before they start
+//! ([`skip_device_select_layer`]).
+//!
 //! With no usable adapter the error says what is missing and how to install it. wgpu's default
 //! uncaptured-error handler panics; ours records the error (and prints it once), so a validation
 //! error surfaces as a `GpuError` from `Gpu::check`, never a backtrace.
@@ -11,6 +17,22 @@ use std::sync::{Arc, Mutex};
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
+
+/// The environment variable Mesa's device-select layer reads to stay out of the way.
+const NO_DEVICE_SELECT: &str = "NODEVICE_SELECT";
+
+/// Turns off Mesa's device-select layer for this process (unless the user's environment says
+/// otherwise), so that opening a GPU does not probe a window system.
+///
+/// # Safety
+/// It sets an environment variable: call it before any other thread starts (first thing in
+/// `main`), as `std::env::set_var` requires.
+pub unsafe fn skip_device_select_layer() {
+    if std::env::var_os(NO_DEVICE_SELECT).is_none() {
+        // SAFETY: the caller guarantees no other thread is running.
+        unsafe { std::env::set_var(NO_DEVICE_SELECT, "1") };
+    }
+}
 
 /// Which kind of adapter to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
