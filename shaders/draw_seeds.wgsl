@@ -367,7 +367,7 @@ fn surface(in: VertexOut) -> Surface {
 fn faded_out(in: VertexOut) -> bool {
     let pixel = vec2<u32>(in.clip.xy);
     let t = bayer4(pixel, u32(in.keep.z));
-    let b = bayer4(pixel.yx, u32(in.keep.z) ^ 9u);
+    let b = bayer4(pixel.yx, u32(in.keep.z) ^ SLICE_DITHER_SALT);
     return t < in.keep.x || t >= in.keep.y || b < in.blend.x || b >= in.blend.y;
 }
 

@@ -21,7 +21,7 @@ use glam::DVec3;
 
 use crate::config::{CloudSettings, RenderSettings};
 use crate::gpu::layout::{CLOUD_EDGE, CLOUD_OCTAVES, CLOUD_PERIOD_CELLS, CLOUD_SALT};
-use crate::seeds::pcg;
+use crate::seeds::{pcg, unit};
 
 /// The lowest sun the shadows are cast from, as the sine of its elevation: a lower sun's shadows
 /// would slide across the land faster than the clouds, and it lights almost nothing anyway.
@@ -79,13 +79,11 @@ impl CloudShadowFrame {
     /// The share of the sun's light that reaches the point `rel_m` from the camera (metres,
     /// camera-relative world axes): the shaders' `sun_through_clouds`, step for step.
     pub fn sun_visible(&self, rel_m: [f32; 3]) -> f32 {
-        let [fx, fy, cells_per_m, threshold] = self.field;
-        let [sx, sy, depth, _] = self.shift;
+        let (threshold, depth) = (self.field[3], self.shift[2]);
         if depth <= 0.0 {
             return 1.0;
         }
-        let q = [fx + rel_m[0] * cells_per_m + rel_m[2] * sx, fy + rel_m[1] * cells_per_m + rel_m[2] * sy];
-        1.0 - depth * smoothstep(threshold - CLOUD_EDGE, threshold + CLOUD_EDGE, cloud_density(q))
+        1.0 - depth * smoothstep(threshold - CLOUD_EDGE, threshold + CLOUD_EDGE, self.density_at(rel_m))
     }
 
     /// The noise density where the point `rel_m` from the camera looks at the sun, 0 to 1: how far
@@ -119,7 +117,6 @@ pub fn threshold_of_coverage(coverage: f64) -> f32 {
     }
     let sorted = SORTED.get_or_init(|| {
         let period = CLOUD_PERIOD_CELLS as f32;
-        let unit = |h: u32| (h >> 8) as f32 / 16_777_216.0;
         let mut densities: Vec<f32> = (0..DISTRIBUTION_SAMPLES)
             .map(|i| {
                 let h = pcg(i ^ CLOUD_SALT);
@@ -163,7 +160,7 @@ fn value_noise(q: [f32; 2], octave: u32) -> f32 {
 fn lattice(x: i32, y: i32, octave: u32) -> f32 {
     let mask = (CLOUD_PERIOD_CELLS << octave) as i32 - 1;
     let (x, y) = ((x & mask) as u32, (y & mask) as u32);
-    (pcg(x ^ pcg(y ^ pcg(octave ^ CLOUD_SALT))) >> 8) as f32 / 16_777_216.0
+    unit(pcg(x ^ pcg(y ^ pcg(octave ^ CLOUD_SALT))))
 }
 
 /// WGSL's `mix`.

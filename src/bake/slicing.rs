@@ -114,7 +114,7 @@ mod tests {
     fn crown() -> Vec<[Vec3; 3]> {
         (0..200)
             .map(|i| {
-                let f = |k: u32| (crate::seeds::pcg(i * 3 + k) >> 8) as f32 / 16_777_216.0;
+                let f = |k: u32| crate::seeds::unit(crate::seeds::pcg(i * 3 + k));
                 let c = Vec3::new(4.0 * f(0) - 2.0, 6.0 * f(1), 2.0 * f(2) - 1.0);
                 [c, c + Vec3::new(0.05, 0.0, 0.0), c + Vec3::new(0.0, 0.05, 0.0)]
             })

@@ -351,6 +351,10 @@ wgsl_constants! { draw_constants:
     /// `SeedMaterial::flags`: a slicing's slice (`draw_seeds.slicings`): drawn only in the two
     /// slicings nearest the view, dithered by their blend (`impostor::slicing::view_blend`).
     pub const MATERIAL_SLICE: u32 = 32;
+    /// The slicings' blend dithers with the cross-fade's pattern transposed and its shift XORed
+    /// with this, so the two dithers do not correlate (`draw_seeds.wgsl` `faded_out`, Rust
+    /// `reference::slicing`).
+    pub const SLICE_DITHER_SALT: u32 = 9;
     /// Continuous LOD: the projected size, pixels, below which leaves thin out; the kept ones
     /// grow back to it, so the crown keeps its area and no drawn leaf is smaller.
     pub const DETAIL_FULL_PX: f32 = 2.0;

@@ -16,6 +16,7 @@
 
 use glam::Vec3;
 
+use crate::gpu::layout::SLICE_DITHER_SALT;
 use crate::impostor::slicing::{interleaved_order, view_blend};
 use crate::impostor::{Impostor, Plane};
 
@@ -126,7 +127,7 @@ pub fn blend_views(impostor: &Impostor, eye_model: Vec3, correction: f32, shift:
             }
             sorted[pixel] = colour;
             // Stochastic: the nearest opaque texel of a slicing the dither gives the pixel.
-            let b = bayer4([py as u32, px as u32], shift ^ 9);
+            let b = bayer4([py as u32, px as u32], shift ^ SLICE_DITHER_SALT);
             // The lower of the two slicings keeps the low thresholds, the other the high ones.
             let keeps = |s: u32| {
                 let alpha = if s == blend.primary { blend.alpha_primary } else { blend.alpha_secondary };
