@@ -59,7 +59,10 @@ struct SeedMaterial {
     _pad1: u32,
 }
 
-@group(0) @binding(0) var<uniform> u: DrawSeedsUniforms;
+// A storage binding, not a uniform one: Mesa lavapipe specialises a shader on the values of
+// uniforms that steer loops and branches and keeps every variant, and these change every frame
+// (a leak of about 0.35 MiB a frame with seeds drawn, caught by tests/seed_flight_memory.rs).
+@group(0) @binding(0) var<storage, read> u: DrawSeedsUniforms;
 @group(0) @binding(1) var<storage, read> records: array<SeedRecord>;
 @group(0) @binding(2) var<storage, read> order: array<u32>;
 @group(0) @binding(3) var<storage, read> shapes: array<SeedShape>;

@@ -21,6 +21,7 @@ use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::path::CameraPath;
 
 use support::build;
+use terramp_testkit::memory::{floor, memory, mib};
 use terramp_testkit::{TempDir, shared_data};
 
 /// 7,500 km from the Alps to Everest, 5.5–12 km above the datum (see the file's comments).
@@ -49,38 +50,6 @@ const MIN_EVICTIONS: usize = HEIGHT_SLOTS as usize / 4;
 /// later). Measured without a leak: 1–2 MiB. A leak of one height tile a frame (258² × 4 B =
 /// 260 KiB) would add 53 MiB; anything above ~80 KiB a frame fails.
 const MAX_ANON_GROWTH_KIB: u64 = 16 * 1024;
-
-/// Resident memory of this process, KiB, from `/proc/self/status`.
-#[derive(Debug, Clone, Copy)]
-struct Memory {
-    /// All resident pages.
-    rss: u64,
-    /// Anonymous pages: heap, stacks, and lavapipe's "GPU" memory.
-    anon: u64,
-    /// File-backed pages: mostly the memory-mapped dataset packs. They grow as the flight reads
-    /// tiles it had not read before, up to the packs' size, and are page cache the kernel can
-    /// reclaim, not memory the process holds on to; so they are reported, not bounded.
-    file: u64,
-}
-
-fn memory() -> Memory {
-    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status (Linux only)");
-    let kib = |key: &str| -> u64 {
-        let line = status.lines().find(|l| l.starts_with(key)).unwrap_or_else(|| panic!("no {key}"));
-        line.split_whitespace().nth(1).unwrap().parse().unwrap()
-    };
-    Memory { rss: kib("VmRSS:"), anon: kib("RssAnon:"), file: kib("RssFile:") }
-}
-
-/// The minimum of each figure over `samples`.
-fn floor(samples: &[Memory]) -> Memory {
-    let min = |field: fn(&Memory) -> u64| samples.iter().map(field).min().unwrap();
-    Memory { rss: min(|m| m.rss), anon: min(|m| m.anon), file: min(|m| m.file) }
-}
-
-fn mib(bytes: u64) -> f64 {
-    bytes as f64 / f64::from(1 << 20)
-}
 
 #[test]
 fn globe_flight_keeps_memory_fixed() {

@@ -385,7 +385,8 @@ fn fly(
             "saved_png": save,
             // GPU timings arrive a few frames late: these are the latest complete ones.
             "passes": renderer.last_timings(),
-            "resident_kib": resident_kib(),
+            "resident_kib": status_kib("VmRSS:"),
+            "anonymous_kib": status_kib("RssAnon:"),
         });
         serde_json::to_writer(&mut log, &record)?;
         std::io::Write::write_all(&mut log, b"\n")?;
@@ -402,10 +403,10 @@ fn fly(
     Ok(())
 }
 
-/// The process's resident memory (Linux `VmRSS`), KiB.
-fn resident_kib() -> Option<u64> {
+/// A figure of the process's memory from Linux's `/proc/self/status` (`VmRSS:`, `RssAnon:`), KiB.
+fn status_kib(key: &str) -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    let line = status.lines().find(|l| l.starts_with(key))?;
     line.split_whitespace().nth(1)?.parse().ok()
 }
 

@@ -14,6 +14,7 @@ pub mod data;
 pub mod datasets;
 pub mod images;
 pub mod impostors;
+pub mod memory;
 pub mod setup;
 pub mod tlm;
 

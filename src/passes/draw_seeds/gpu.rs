@@ -38,7 +38,8 @@ pub const SHADER: WgslSource = WgslSource {
 pub const BINDINGS: BindingTable<8> = BindingTable {
     label: "draw_seeds",
     bindings: [
-        Binding::uniform::<DrawSeedsUniforms>(0, "u", Stage::VERTEX_FRAGMENT),
+        // Storage, not uniform: see the binding's comment in the shader (lavapipe's variants).
+        Binding::storage::<DrawSeedsUniforms>(0, "u", Stage::VERTEX_FRAGMENT, Access::Read),
         Binding::storage_array::<SeedRecord>(1, "records", Stage::VERTEX, Access::Read),
         Binding::storage_array::<u32>(2, "order", Stage::VERTEX, Access::Read),
         Binding::storage_array::<SeedShape>(3, "shapes", Stage::VERTEX, Access::Read),
@@ -172,7 +173,7 @@ impl DrawSeedsPass {
                 device,
                 "draw_seeds uniforms",
                 size_of::<DrawSeedsUniforms>() as u64,
-                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             ),
             materials: buffer_of("seed materials", &materials, storage),
             species: buffer_of("seed species shapes", bytemuck::cast_slice(&shapes), storage),
