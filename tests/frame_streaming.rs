@@ -115,11 +115,11 @@ fn corrupted_copy(dataset: &Path, pack: &str, name: &str) -> PathBuf {
         std::fs::copy(entry.path(), copy.join(entry.file_name())).unwrap();
     }
     let path = copy.join(pack);
+    // Tile 0: level 0, the south-west corner.
+    let span = terramp::dataset::Pack::open(&path).unwrap().stored_span(0).unwrap();
     let mut bytes = std::fs::read(&path).unwrap();
-    // Tile 0 (level 0, the south-west corner) starts at the first 4 KiB boundary after the index.
-    let tiles = terramp::dataset::Pack::open(&path).unwrap().tile_count();
-    let data_start = ((64 + 16 * tiles) as usize).next_multiple_of(4096);
-    for b in &mut bytes[data_start + 100..data_start + 140] {
+    let middle = (span.start + span.end) as usize / 2;
+    for b in &mut bytes[middle..(middle + 40).min(span.end as usize)] {
         *b ^= 0x5a;
     }
     std::fs::write(&path, bytes).unwrap();

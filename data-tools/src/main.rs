@@ -7,6 +7,7 @@
 
 mod build;
 mod models;
+mod plan;
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -23,8 +24,21 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Build a dataset from a DEM GeoTIFF, with optional imagery and land cover.
+    /// Build a dataset from a DEM GeoTIFF, with optional imagery and land cover; or, with --plan
+    /// and --partition, one partition of a planned build.
     Build(build::BuildArgs),
+    /// Plan a partitioned build: split it into jobs that any scheduler runs (`build --plan P
+    /// --partition I`, e.g. scripts/dask_build.py), then `merge`.
+    Plan(plan::PlanArgs),
+    /// Assemble a planned build's partitions into the dataset (atomically), once all are built.
+    Merge {
+        /// The plan file (`terramp-data plan`).
+        #[arg(long)]
+        plan: PathBuf,
+        /// The output dataset folder (replaced atomically if it holds a dataset).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Synthesize a stress dataset: fractal DEM, classes, imagery; any size, tile by tile.
     Synth {
         /// DEM samples per side (imagery is 4× finer per axis: 8192 gives giga-pixel imagery).
@@ -123,7 +137,12 @@ fn main() -> Result<()> {
     // SAFETY: first thing in main, before any thread starts.
     unsafe { terramp::gpu::skip_device_select_layer() };
     match Cli::parse().command {
-        Command::Build(args) => build::run(&args),
+        Command::Build(args) => match (&args.plan, args.partition) {
+            (Some(plan), Some(part)) => plan::build_partition(plan, part),
+            _ => build::run(&args),
+        },
+        Command::Plan(args) => plan::plan(&args),
+        Command::Merge { plan, out } => plan::merge(&plan, &out),
         Command::Bake(args) => bake(args),
         Command::Tree(args) => models::tree(&args),
         Command::Preview(args) => models::preview(&args),

@@ -13,10 +13,9 @@
 use std::path::Path;
 
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 use thiserror::Error;
 
-use super::pack::{PackError, PackWriter};
+use super::pack::{Codec, PackError, PackWriter, Predictor};
 use super::pyramid::{Pyramid, Sampling, TileId};
 use super::{CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS};
 use crate::dataset::lcc::LccError;
@@ -40,9 +39,16 @@ pub trait Texel: bytemuck::Pod + Send + Sync {
     fn range(_texels: &[Self]) -> Option<[f32; 2]> {
         None
     }
+
+    /// How a pack stores tiles of these texels (losslessly, `pack::codec`).
+    fn codec() -> Codec;
 }
 
 impl Texel for f32 {
+    fn codec() -> Codec {
+        Codec::Zstd(Predictor::Delta32)
+    }
+
     fn range(texels: &[f32]) -> Option<[f32; 2]> {
         let range =
             texels.iter().fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], &v| [lo.min(v), hi.max(v)]);
@@ -58,6 +64,10 @@ impl Texel for f32 {
 }
 
 impl Texel for u8 {
+    fn codec() -> Codec {
+        Codec::Zstd(Predictor::Planes(1))
+    }
+
     fn reduce(rule: Reduce, block: [u8; 4]) -> u8 {
         match rule {
             Reduce::Decimate => block[0],
@@ -67,6 +77,10 @@ impl Texel for u8 {
 }
 
 impl Texel for [u8; 4] {
+    fn codec() -> Codec {
+        Codec::Zstd(Predictor::Planes(4))
+    }
+
     fn reduce(rule: Reduce, block: [[u8; 4]; 4]) -> [u8; 4] {
         std::array::from_fn(|c| u8::reduce(rule, block.map(|texel| texel[c])))
     }
@@ -117,6 +131,14 @@ pub enum LayerError {
     /// The land cover's LCC coding is invalid, or the source gave a code outside its palette.
     #[error(transparent)]
     Lcc(#[from] LccError),
+    /// A partitioned build's part pack is not the one its plan expects.
+    #[error("{}: {message}", path.display())]
+    Parts {
+        /// The part pack.
+        path: std::path::PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 /// What is stored for one layer.
@@ -174,31 +196,48 @@ where
 {
     let pyramid = &spec.pyramid;
     debug_assert!(pyramid.tile_extent().is_multiple_of(1 << (spec.mips - 1)), "mips must halve exactly");
-    let writer = PackWriter::create(path, spec.tile_bytes::<T>(), pyramid.tile_count())?;
+    let writer = PackWriter::create(path, spec.tile_bytes::<T>(), pyramid.tile_count(), T::codec())?;
     progress.set_length(pyramid.tile_count());
-    for level in 0..pyramid.levels {
-        let [nx, ny] = pyramid.tiles_at(level);
-        let ids: Vec<TileId> = (0..ny).flat_map(|y| (0..nx).map(move |x| TileId::new(level, x, y))).collect();
-        ids.par_iter().try_for_each(|&id| -> Result<(), LayerError> {
-            let extent = pyramid.tile_extent();
-            let [x0, y0] = pyramid.tile_origin(id);
-            // A coarse tile's range also spans the finer tiles it was reduced from, so it bounds
-            // every level-0 value beneath it, not only its own (decimated) samples.
-            let (mip0, range_below) = if level == 0 {
-                (read_replicated(spec.name, spec.pyramid.size, &source, [x0, y0], extent)?, None)
-            } else {
-                reduce_level_below(spec, &writer, id)?
-            };
-            let range = union(T::range(&mip0), range_below);
-            let payload = with_mips(spec, mip0);
-            let index = pyramid.tile_index(id).unwrap_or_default();
-            writer.write_tile(index, bytemuck::cast_slice(&payload), range)?;
-            progress.inc(1);
-            Ok(())
-        })?;
+    writer.write_ordered(&level_ids(pyramid, 0), |&id| -> Result<_, LayerError> {
+        let (origin, extent) = (pyramid.tile_origin(id), pyramid.tile_extent());
+        let mip0 = read_replicated(spec.name, pyramid.size, &source, origin, extent)?;
+        let range = T::range(&mip0);
+        let payload = with_mips(spec, mip0);
+        let index = pyramid.tile_index(id).unwrap_or_default();
+        progress.inc(1);
+        Ok((index, bytemuck::cast_slice(&payload).to_vec(), range))
+    })?;
+    for level in 1..pyramid.levels {
+        write_reduced_level::<T>(spec, &writer, level, progress)?;
     }
     writer.finish()?;
     Ok(())
+}
+
+/// Every tile of `level`, row by row: the order a pack places them in.
+pub(crate) fn level_ids(pyramid: &Pyramid, level: u32) -> Vec<TileId> {
+    let [nx, ny] = pyramid.tiles_at(level);
+    (0..ny).flat_map(|y| (0..nx).map(move |x| TileId::new(level, x, y))).collect()
+}
+
+/// Writes every tile of `level` (≥ 1) into `writer`, reduced from the level below as written
+/// there. A coarse tile's range also spans the finer tiles it was reduced from, so it bounds every
+/// level-0 value beneath it, not only its own (decimated) samples.
+pub(crate) fn write_reduced_level<T: Texel>(
+    spec: &LayerSpec,
+    writer: &PackWriter,
+    level: u32,
+    progress: &ProgressBar,
+) -> Result<(), LayerError> {
+    let pyramid = &spec.pyramid;
+    writer.write_ordered(&level_ids(pyramid, level), |&id| -> Result<_, LayerError> {
+        let mip0 = reduce_level_below(spec, writer, id)?;
+        let range = union(T::range(&mip0), range_below(pyramid, writer, id)?);
+        let payload = with_mips(spec, mip0);
+        let index = pyramid.tile_index(id).unwrap_or_default();
+        progress.inc(1);
+        Ok((index, bytemuck::cast_slice(&payload).to_vec(), range))
+    })
 }
 
 /// The `extent`² window at `origin` of a source grid of `size` texels (`layer` names it in
@@ -240,29 +279,61 @@ where
     Ok(out)
 }
 
-fn union(a: Option<[f32; 2]>, b: Option<[f32; 2]>) -> Option<[f32; 2]> {
+pub(crate) fn union(a: Option<[f32; 2]>, b: Option<[f32; 2]>) -> Option<[f32; 2]> {
     match (a, b) {
         (Some(a), Some(b)) => Some([a[0].min(b[0]), a[1].max(b[1])]),
         (a, b) => a.or(b),
     }
 }
 
-/// Mip 0 of tile `id` (level ≥ 1), reduced from the level below as written in the pack, with the
-/// union of the ranges of the tiles it read.
+/// The level-below window tile `id` (level ≥ 1) reduces from: 2 × extent texels from 2 × its
+/// origin, clamped to the level.
+fn window_below(pyramid: &Pyramid, id: TileId) -> ([i64; 2], [i64; 2]) {
+    let size_below = pyramid.size_at(id.level - 1).map(i64::from);
+    let extent = i64::from(pyramid.tile_extent());
+    let origin = pyramid.tile_origin(id);
+    let lo = origin.map(|v| (2 * v).max(0));
+    let hi = [0, 1].map(|a| (2 * origin[a] + 2 * extent - 1).min(size_below[a] - 1));
+    (lo, hi)
+}
+
+/// The tiles of the level below whose texels tile `id` (level ≥ 1) reduces from, row by row: those
+/// whose owned texels (its interior; the last tile of an axis owns the rest) meet its window.
+fn tiles_below(pyramid: &Pyramid, id: TileId) -> impl Iterator<Item = TileId> {
+    let (lo, hi) = window_below(pyramid, id);
+    let (level, tile) = (id.level - 1, i64::from(pyramid.tile));
+    let tiles = pyramid.tiles_at(level).map(i64::from);
+    let tile_of = move |v: i64, axis: usize| (v / tile).min(tiles[axis] - 1);
+    (tile_of(lo[1], 1)..=tile_of(hi[1], 1)).flat_map(move |ty| {
+        (tile_of(lo[0], 0)..=tile_of(hi[0], 0)).map(move |tx| TileId::new(level, tx as u32, ty as u32))
+    })
+}
+
+/// The union of the ranges of the tiles `id` (level ≥ 1) is reduced from, as written in `writer`.
+pub(crate) fn range_below(
+    pyramid: &Pyramid,
+    writer: &PackWriter,
+    id: TileId,
+) -> Result<Option<[f32; 2]>, LayerError> {
+    let mut range = None;
+    for below in tiles_below(pyramid, id) {
+        range = union(range, writer.tile_range(pyramid.tile_index(below).unwrap_or_default())?);
+    }
+    Ok(range)
+}
+
+/// Mip 0 of tile `id` (level ≥ 1), reduced from the level below as written in the pack.
 fn reduce_level_below<T: Texel>(
     spec: &LayerSpec,
     writer: &PackWriter,
     id: TileId,
-) -> Result<(Vec<T>, Option<[f32; 2]>), LayerError> {
+) -> Result<Vec<T>, LayerError> {
     let pyramid = &spec.pyramid;
-    let below = id.level - 1;
-    let size_below = pyramid.size_at(below).map(i64::from);
+    let size_below = pyramid.size_at(id.level - 1).map(i64::from);
     let extent = pyramid.tile_extent() as i64;
     let [x0, y0] = pyramid.tile_origin(id);
-    // The level-below window this tile reads: 2 × (extent + 1) texels from 2 × origin, clamped.
-    let lo = [2 * x0, 2 * y0].map(|v| v.max(0));
-    let hi = [0, 1].map(|a| (2 * [x0, y0][a] + 2 * extent - 1).min(size_below[a] - 1));
-    let (window, range) = read_written_window::<T>(spec, writer, below, lo, hi)?;
+    let (lo, hi) = window_below(pyramid, id);
+    let window = read_written_window::<T>(spec, writer, id, lo, hi)?;
     let width = (hi[0] - lo[0] + 1) as usize;
     let at = |x: i64, y: i64| {
         let (x, y) = (x.clamp(0, size_below[0] - 1), y.clamp(0, size_below[1] - 1));
@@ -279,51 +350,44 @@ fn reduce_level_below<T: Texel>(
             out.push(T::reduce(spec.reduce, block));
         }
     }
-    Ok((out, range))
+    Ok(out)
 }
 
-/// Texels `lo..=hi` of `level`, gathered from the interiors of the tiles already written, with the
-/// union of those tiles' ranges.
+/// Texels `lo..=hi` of the level below tile `id`, gathered from the interiors of the tiles already
+/// written there.
 fn read_written_window<T: Texel>(
     spec: &LayerSpec,
     writer: &PackWriter,
-    level: u32,
+    id: TileId,
     lo: [i64; 2],
     hi: [i64; 2],
-) -> Result<(Vec<T>, Option<[f32; 2]>), LayerError> {
+) -> Result<Vec<T>, LayerError> {
     let pyramid = &spec.pyramid;
     let (tile, border, extent) =
         (i64::from(pyramid.tile), i64::from(pyramid.border), pyramid.tile_extent() as usize);
-    let tiles = pyramid.tiles_at(level).map(i64::from);
+    let tiles = pyramid.tiles_at(id.level - 1).map(i64::from);
     let width = (hi[0] - lo[0] + 1) as usize;
     let mut window = vec![T::zeroed(); width * (hi[1] - lo[1] + 1) as usize];
-    let mut range = None;
-    let tile_of = |v: i64, axis: usize| (v / tile).min(tiles[axis] - 1);
-    for ty in tile_of(lo[1], 1)..=tile_of(hi[1], 1) {
-        for tx in tile_of(lo[0], 0)..=tile_of(hi[0], 0) {
-            let id = TileId::new(level, tx as u32, ty as u32);
-            let index = pyramid.tile_index(id).unwrap_or_default();
-            let bytes = writer.read_tile(index)?;
-            range = union(range, writer.tile_range(index)?);
-            let texels: &[T] = bytemuck::cast_slice(&bytes[..extent * extent * size_of::<T>()]);
-            // The texels this tile owns: its interior; the last tile also owns the rest of the axis.
-            let own_lo = [tx * tile, ty * tile];
-            let own_hi =
-                [0, 1].map(|a| if [tx, ty][a] == tiles[a] - 1 { hi[a] } else { own_lo[a] + tile - 1 });
-            for y in own_lo[1].max(lo[1])..=own_hi[1].min(hi[1]) {
-                let src_row = (y - own_lo[1] + border) as usize * extent;
-                for x in own_lo[0].max(lo[0])..=own_hi[0].min(hi[0]) {
-                    window[(y - lo[1]) as usize * width + (x - lo[0]) as usize] =
-                        texels[src_row + (x - own_lo[0] + border) as usize];
-                }
+    for below in tiles_below(pyramid, id) {
+        let bytes = writer.read_tile(pyramid.tile_index(below).unwrap_or_default())?;
+        let texels: &[T] = bytemuck::cast_slice(&bytes[..extent * extent * size_of::<T>()]);
+        let (tx, ty) = (i64::from(below.x), i64::from(below.y));
+        // The texels this tile owns: its interior; the last tile also owns the rest of the axis.
+        let own_lo = [tx * tile, ty * tile];
+        let own_hi = [0, 1].map(|a| if [tx, ty][a] == tiles[a] - 1 { hi[a] } else { own_lo[a] + tile - 1 });
+        for y in own_lo[1].max(lo[1])..=own_hi[1].min(hi[1]) {
+            let src_row = (y - own_lo[1] + border) as usize * extent;
+            for x in own_lo[0].max(lo[0])..=own_hi[0].min(hi[0]) {
+                window[(y - lo[1]) as usize * width + (x - lo[0]) as usize] =
+                    texels[src_row + (x - own_lo[0] + border) as usize];
             }
         }
     }
-    Ok((window, range))
+    Ok(window)
 }
 
 /// Mip 0 followed by its reductions, as stored in a tile payload.
-fn with_mips<T: Texel>(spec: &LayerSpec, mip0: Vec<T>) -> Vec<T> {
+pub(crate) fn with_mips<T: Texel>(spec: &LayerSpec, mip0: Vec<T>) -> Vec<T> {
     let mut payload = Vec::with_capacity(spec.tile_texels());
     payload.extend_from_slice(&mip0);
     let mut previous = mip0;

@@ -16,11 +16,15 @@ pub mod layer_writer;
 pub mod lcc;
 pub mod manifest;
 pub mod pack;
+pub mod partition;
 pub mod pyramid;
 pub mod staging;
 pub mod surface;
 
+use std::borrow::Cow;
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
 use serde::Deserialize;
 use thiserror::Error;
@@ -31,7 +35,7 @@ pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer
 pub use manifest::{
     CellLayer, ClassName, Crs, FORMAT_VERSION, HeightLayer, LandcoverLayer, MANIFEST_FILE, Manifest,
 };
-pub use pack::{Pack, PackError};
+pub use pack::{Codec, PACK_VERSION, Pack, PackError, Predictor};
 pub use pyramid::{Pyramid, Sampling, TileId};
 pub use staging::Staging;
 
@@ -109,6 +113,10 @@ pub enum DatasetError {
     Pack(#[from] PackError),
 }
 
+/// Decoded tiles a compressed layer keeps for the next reads: tools and twins read texel by
+/// texel, mostly from the same few tiles.
+const DECODED_TILES_KEPT: usize = 16;
+
 /// One layer's pack with the pyramid that addresses it.
 pub struct LayerPack {
     /// The tile quadtree that numbers the pack's tiles, as the manifest gives it.
@@ -116,6 +124,37 @@ pub struct LayerPack {
     /// Mips stored per tile: the imagery's count, 1 for heights, the mask and land cover.
     pub mips: u32,
     pack: Pack,
+    /// The latest decoded tiles (compressed packs only), newest last.
+    decoded: Mutex<VecDeque<(u64, Arc<[u8]>)>>,
+}
+
+/// A tile's payload: in the pack's mapping (stored raw), or decoded and shared.
+pub enum TileBytes<'a> {
+    /// Borrowed from the mapping.
+    Mapped(&'a [u8]),
+    /// Decoded from a compressed pack.
+    Decoded(Arc<[u8]>),
+}
+
+impl TileBytes<'_> {
+    /// The payload to keep: the decoded tile itself, or a copy out of the mapping.
+    pub fn into_shared(self) -> Arc<[u8]> {
+        match self {
+            Self::Mapped(bytes) => Arc::from(bytes),
+            Self::Decoded(bytes) => bytes,
+        }
+    }
+}
+
+impl std::ops::Deref for TileBytes<'_> {
+    type Target = [u8];
+
+    fn deref(&self) -> &[u8] {
+        match self {
+            Self::Mapped(bytes) => bytes,
+            Self::Decoded(bytes) => bytes,
+        }
+    }
 }
 
 impl LayerPack {
@@ -138,7 +177,12 @@ impl LayerPack {
                 expected_bytes,
             });
         }
-        Ok(Self { pyramid, mips, pack })
+        Ok(Self { pyramid, mips, pack, decoded: Mutex::default() })
+    }
+
+    /// The layer's pack: its codec and sizes.
+    pub fn pack(&self) -> &Pack {
+        &self.pack
     }
 
     /// The tile's value range from the pack index (heights: conservative min/max of every
@@ -152,14 +196,33 @@ impl LayerPack {
         self.pack.tile_range(index)
     }
 
-    /// The tile's payload (all mips), checksum verified.
-    pub fn tile_bytes(&self, id: TileId) -> Result<&[u8], PackError> {
+    /// The tile's payload (all mips), checksum verified: from the mapping, or decoded (the last
+    /// `DECODED_TILES_KEPT` decoded are kept for the next reads).
+    pub fn tile_bytes(&self, id: TileId) -> Result<TileBytes<'_>, PackError> {
         let index = self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
             path: self.pack.path().to_owned(),
             index: u64::MAX,
             count: self.pack.tile_count(),
         })?;
-        self.pack.tile(index)
+        let kept = |decoded: &VecDeque<(u64, Arc<[u8]>)>| {
+            decoded.iter().find(|(i, _)| *i == index).map(|(_, bytes)| Arc::clone(bytes))
+        };
+        if let Some(bytes) = self.decoded.lock().ok().and_then(|d| kept(&d)) {
+            return Ok(TileBytes::Decoded(bytes));
+        }
+        Ok(match self.pack.tile(index)? {
+            Cow::Borrowed(bytes) => TileBytes::Mapped(bytes),
+            Cow::Owned(bytes) => {
+                let bytes: Arc<[u8]> = bytes.into();
+                if let Ok(mut decoded) = self.decoded.lock() {
+                    if decoded.len() == DECODED_TILES_KEPT {
+                        decoded.pop_front();
+                    }
+                    decoded.push_back((index, Arc::clone(&bytes)));
+                }
+                TileBytes::Decoded(bytes)
+            }
+        })
     }
 }
 
@@ -233,10 +296,16 @@ impl Dataset {
         Ok(Self { dir: dir.to_owned(), manifest, height, valid_mask, imagery, landcover })
     }
 
-    /// The height tile's samples, `tile_extent`² f32 metres, south row first.
-    pub fn height_tile(&self, id: TileId) -> Result<&[f32], PackError> {
-        // Pack payloads start 4 KiB-aligned and are whole multiples of 4 bytes.
-        Ok(bytemuck::cast_slice(self.height.tile_bytes(id)?))
+    /// The height tile's samples, `tile_extent`² f32 metres, south row first: borrowed from the
+    /// mapping when stored raw (payloads start 16-byte aligned there), else decoded.
+    pub fn height_tile(&self, id: TileId) -> Result<Cow<'_, [f32]>, PackError> {
+        Ok(match self.height.tile_bytes(id)? {
+            TileBytes::Mapped(bytes) => match bytemuck::try_cast_slice(bytes) {
+                Ok(samples) => Cow::Borrowed(samples),
+                Err(_) => Cow::Owned(bytemuck::pod_collect_to_vec(bytes)),
+            },
+            TileBytes::Decoded(bytes) => Cow::Owned(bytemuck::pod_collect_to_vec(&bytes)),
+        })
     }
 
     /// Conservative [min, max] of every level-0 height under tile `id`, metres; O(1).

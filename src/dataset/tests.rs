@@ -40,7 +40,7 @@ fn write_heights(name: &str, size: [u32; 2]) -> (PathBuf, LayerSpec) {
 
 fn tile_f32(pack: &Pack, spec: &LayerSpec, id: TileId) -> Vec<f32> {
     let index = spec.pyramid.tile_index(id).unwrap();
-    bytemuck::cast_slice(pack.tile(index).unwrap()).to_vec()
+    bytemuck::pod_collect_to_vec(&pack.tile(index).unwrap())
 }
 
 #[test]

@@ -178,17 +178,17 @@ impl TileCache {
 
     /// Makes the `wanted` tiles (most important first) resident now, as far as the slots allow,
     /// with no budget. `read` returns a tile's payload (all mips), checksum verified.
-    pub fn load_now<'a>(
+    pub fn load_now<B: std::ops::Deref<Target = [u8]>>(
         &mut self,
         queue: &wgpu::Queue,
         wanted: &[TileId],
         frame: u64,
-        mut read: impl FnMut(TileId) -> Result<&'a [u8], PackError>,
+        mut read: impl FnMut(TileId) -> Result<B, PackError>,
     ) -> CacheStats {
         let tile_bytes = self.tile_bytes();
         for request in self.residency.set_wanted(wanted, frame) {
             match read(request.id) {
-                Ok(payload) if payload.len() == tile_bytes => self.place(queue, request.id, payload),
+                Ok(payload) if payload.len() == tile_bytes => self.place(queue, request.id, &payload),
                 Ok(payload) => {
                     let id = request.id;
                     eprintln!(

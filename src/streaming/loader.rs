@@ -322,10 +322,10 @@ fn layer(dataset: &Dataset, kind: LayerKind) -> Option<&LayerPack> {
     }
 }
 
-/// The tile's payload, checksum verified, copied out of the mapping.
+/// The tile's payload, checksum verified: copied out of the mapping, or the tile as decoded.
 pub fn read(dataset: &Dataset, kind: LayerKind, id: TileId) -> Result<Arc<[u8]>, LoaderError> {
     let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
-    Ok(Arc::from(pack.tile_bytes(id)?))
+    Ok(pack.tile_bytes(id)?.into_shared())
 }
 
 fn report_once(shared: &Shared, kind: LayerKind, id: TileId, error: &LoaderError) {

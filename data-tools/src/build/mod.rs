@@ -35,8 +35,8 @@ const GDAL_BLOCK_CACHE_BYTES: i64 = 64 << 20;
 #[derive(Debug, clap::Args)]
 pub struct BuildArgs {
     /// The DEM: heights in metres, in a projected CRS or in geographic degrees.
-    #[arg(long)]
-    pub dem: PathBuf,
+    #[arg(long, required_unless_present = "plan")]
+    pub dem: Option<PathBuf>,
     /// Imagery to drape over the terrain (any CRS; reprojected onto the DEM's extent).
     #[arg(long)]
     pub imagery: Option<PathBuf>,
@@ -50,21 +50,32 @@ pub struct BuildArgs {
     #[arg(long, requires = "landcover")]
     pub classes: Option<String>,
     /// The output dataset folder (replaced atomically if it already holds a dataset).
-    #[arg(long)]
-    pub out: PathBuf,
+    #[arg(long, required_unless_present = "plan")]
+    pub out: Option<PathBuf>,
     /// A short name for logs (default: the DEM file's stem).
     #[arg(long)]
     pub name: Option<String>,
+    /// Build one partition of this plan (`terramp-data plan`) instead: its part packs, into the
+    /// plan's parts folder.
+    #[arg(long, requires = "partition", conflicts_with_all = ["dem", "imagery", "landcover", "out", "name"])]
+    pub plan: Option<PathBuf>,
+    /// The partition to build, 0 to the plan's count − 1 (a scheduler's array index, e.g.
+    /// `$JOB_COMPLETION_INDEX` or `$SLURM_ARRAY_TASK_ID`).
+    #[arg(long, requires = "plan")]
+    pub partition: Option<u32>,
 }
 
 pub fn run(args: &BuildArgs) -> Result<()> {
+    let (Some(dem), Some(out)) = (&args.dem, &args.out) else {
+        anyhow::bail!("build needs --dem and --out (or --plan and --partition)");
+    };
     configure_gdal();
-    let inputs = Inputs::open(args)?;
-    let staging = Staging::begin(&args.out).with_context(|| format!("preparing {}", args.out.display()))?;
+    let inputs = Inputs::open(args, dem)?;
+    let staging = Staging::begin(out).with_context(|| format!("preparing {}", out.display()))?;
     let progress = MultiProgress::new();
-    let name = args.name.clone().unwrap_or_else(|| file_stem(&args.dem));
+    let name = args.name.clone().unwrap_or_else(|| file_stem(dem));
     let (manifest, scans) = write_layers(&inputs, name, &staging, &progress)?;
-    let dir = staging.commit(&manifest).with_context(|| format!("publishing {}", args.out.display()))?;
+    let dir = staging.commit(&manifest).with_context(|| format!("publishing {}", out.display()))?;
     progress.clear().ok();
     print_summary(&dir, &manifest, &inputs, &scans);
     Ok(())
@@ -80,8 +91,8 @@ struct Inputs {
 }
 
 impl Inputs {
-    fn open(args: &BuildArgs) -> Result<Self> {
-        let dem_source = SourceRaster::open(&args.dem, "DEM")?;
+    fn open(args: &BuildArgs, dem_path: &Path) -> Result<Self> {
+        let dem_source = SourceRaster::open(dem_path, "DEM")?;
         let frame = Frame::from_dem(&dem_source)?;
         let imagery = args.imagery.as_deref().map(|path| Imagery::open(path, args.bands.as_deref(), &frame));
         let landcover = match (&args.landcover, &args.classes) {
@@ -89,7 +100,7 @@ impl Inputs {
             _ => None,
         };
         let dem = GridRaster::new(dem_source, &frame.dem_grid, &frame.srs, &[1], Resampling::Bilinear, true)?;
-        let footprint = footprint(&dem, &args.dem, &frame)?;
+        let footprint = footprint(&dem, dem_path, &frame)?;
         Ok(Self { imagery: imagery.transpose()?, landcover, dem, footprint, frame })
     }
 }

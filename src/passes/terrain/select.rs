@@ -238,11 +238,11 @@ impl NodeBounds {
     }
 
     /// The node's height range; `tile` gives the samples of the node's height tile.
-    pub fn get<'a>(
+    pub fn get<S: std::ops::Deref<Target = [f32]>>(
         &mut self,
         lods: &Lods,
         node: NodeId,
-        tile: impl FnOnce(TileId) -> Option<&'a [f32]>,
+        tile: impl FnOnce(TileId) -> Option<S>,
     ) -> [f32; 2] {
         if let Some(&range) = self.known.get(&node) {
             return range;

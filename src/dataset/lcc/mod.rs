@@ -10,20 +10,22 @@
 //! (b = 2: 3 codes, the paper's coding), 16 (15 codes) or 32 (255). All levels share it, so a
 //! dataset needs one texture format. `decode` is the whole reading rule, and the shader repeats it.
 //!
-//! Writing (`write_lcc_layer`) takes a source of codes on the level-1 grid, edge-replicated beyond
-//! it: level 1 is cut from the source tile by tile, levels 0 and 2 are derived from level 1 as
-//! written in the pack. The palette must be known first: `scan_codes` counts every code.
+//! Writing (`write_lcc_layer`, `writer`) takes a source of codes on the level-1 grid,
+//! edge-replicated beyond it: level 1 is cut from the source tile by tile, levels 0 and 2 are
+//! derived from level 1 as written in the pack. The palette must be known first: `scan_codes`
+//! counts every code.
 
-use std::path::Path;
+mod writer;
 
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::layer_writer::read_replicated;
-use super::pack::PackWriter;
-use super::{CELL_TILE_TEXELS, LANDCOVER_BORDER, LayerError, Pyramid, Sampling, TileId, Window};
+pub(crate) use writer::LccTiles;
+pub use writer::write_lcc_layer;
+
+use super::{CELL_TILE_TEXELS, LANDCOVER_BORDER, LayerError, Pyramid, Sampling, Window};
 
 /// The levels of the LCC quadtree (whatever the layer's size) and the level that holds the
 /// source's texels, as the shaders read them.
@@ -252,175 +254,6 @@ where
         })
         .try_reduce(|| [0; 256], |a, b| Ok(std::array::from_fn(|c| a[c] + b[c])))?;
     Ok(CodeCounts { texels: counts })
-}
-
-/// A word type the LCC pack can store.
-trait LccWord: bytemuck::Pod + Send + Sync + Into<u32> {
-    /// `value` in this word; the caller made sure it fits.
-    fn narrow(value: u32) -> Self;
-}
-
-macro_rules! lcc_word {
-    ($($word:ty),*) => {$(
-        impl LccWord for $word {
-            fn narrow(value: u32) -> Self {
-                value as $word
-            }
-        }
-    )*};
-}
-lcc_word!(u8, u16, u32);
-
-/// Writes the 3-level LCC pack at `path` from `source`, the codes of the level-1 grid of
-/// `source_size` texels (south row first). Every code must be in `coding`'s palette. Returns the
-/// layer's pyramid.
-pub fn write_lcc_layer<S>(
-    path: &Path,
-    source_size: [u32; 2],
-    coding: &LccCoding,
-    source: S,
-    progress: &ProgressBar,
-) -> Result<Pyramid, LayerError>
-where
-    S: Fn(Window) -> Result<Vec<u8>, String> + Sync,
-{
-    coding.validate()?;
-    let writer = LccWriter { pyramid: lcc_pyramid(source_size), coding };
-    match coding.word_bits {
-        8 => writer.write::<u8, S>(path, source, progress),
-        16 => writer.write::<u16, S>(path, source, progress),
-        _ => writer.write::<u32, S>(path, source, progress),
-    }
-}
-
-struct LccWriter<'a> {
-    pyramid: Pyramid,
-    coding: &'a LccCoding,
-}
-
-impl LccWriter<'_> {
-    fn write<W: LccWord, S>(
-        &self,
-        path: &Path,
-        source: S,
-        progress: &ProgressBar,
-    ) -> Result<Pyramid, LayerError>
-    where
-        S: Fn(Window) -> Result<Vec<u8>, String> + Sync,
-    {
-        let pyramid = &self.pyramid;
-        let extent = pyramid.tile_extent();
-        let tile_bytes = (extent as usize).pow(2) * size_of::<W>();
-        let writer = PackWriter::create(path, tile_bytes as u64, pyramid.tile_count())?;
-        progress.set_length(pyramid.tile_count());
-        let mut index_of = [None; 256];
-        for (entry, &code) in self.coding.palette.iter().enumerate() {
-            index_of[usize::from(code)] = Some(entry as u32 + 1);
-        }
-        // Level 1 first, from the source; levels 0 and 2 are read back from it.
-        for level in [LCC_SOURCE_LEVEL, 0, 2] {
-            let [nx, ny] = pyramid.tiles_at(level);
-            let ids: Vec<TileId> =
-                (0..ny).flat_map(|y| (0..nx).map(move |x| TileId::new(level, x, y))).collect();
-            ids.par_iter().try_for_each(|&id| -> Result<(), LayerError> {
-                let [x0, y0] = [id.x, id.y].map(|t| t * pyramid.tile);
-                let words: Vec<u32> = match level {
-                    0 => {
-                        let fine = self.level1_block::<W>(&writer, [x0 / 2, y0 / 2], extent / 2)?;
-                        let half = (extent / 2) as usize;
-                        (0..extent as usize)
-                            .flat_map(|j| (0..extent as usize).map(move |i| (i, j)))
-                            .map(|(i, j)| fine[(j / 2) * half + i / 2])
-                            .collect()
-                    }
-                    1 => {
-                        let (origin, size) = ([x0, y0].map(i64::from), pyramid.size_at(LCC_SOURCE_LEVEL));
-                        let codes = read_replicated(LAYER_NAME, size, &source, origin, extent)?;
-                        codes
-                            .into_iter()
-                            .map(|c| index_of[usize::from(c)].ok_or(LccError::NotInPalette { code: c }))
-                            .collect::<Result<_, _>>()?
-                    }
-                    _ => self.level2_words::<W>(&writer, id)?,
-                };
-                let range = self.index_range(level, &words);
-                let payload: Vec<W> = words.into_iter().map(W::narrow).collect();
-                let index = pyramid.tile_index(id).unwrap_or_default();
-                writer.write_tile(index, bytemuck::cast_slice(&payload), range)?;
-                progress.inc(1);
-                Ok(())
-            })?;
-        }
-        writer.finish()?;
-        Ok(*pyramid)
-    }
-
-    /// The words of level-2 tile `id`, each packing the 4 level-1 texels it covers; beyond the
-    /// layer, the edge word repeats.
-    fn level2_words<W: LccWord>(&self, writer: &PackWriter, id: TileId) -> Result<Vec<u32>, LayerError> {
-        let pyramid = &self.pyramid;
-        let (extent, size) = (pyramid.tile_extent(), pyramid.size_at(2));
-        let [x0, y0] = [id.x, id.y].map(|t| t * pyramid.tile);
-        let fine = self.level1_block::<W>(writer, [2 * x0, 2 * y0], 2 * extent)?;
-        let fine_extent = 2 * extent as usize;
-        let mut words = Vec::with_capacity((extent as usize).pow(2));
-        for j in 0..extent {
-            let y = (y0 + j).min(size[1] - 1) - y0;
-            for i in 0..extent {
-                let x = (x0 + i).min(size[0] - 1) - x0;
-                let child =
-                    |dx: u32, dy: u32| fine[(2 * y + dy) as usize * fine_extent + (2 * x + dx) as usize];
-                words.push(self.coding.pack([child(0, 0), child(1, 0), child(0, 1), child(1, 1)]));
-            }
-        }
-        Ok(words)
-    }
-
-    /// Level-1 indices of the `extent`² block at `origin`, clamped to the layer, gathered from the
-    /// level-1 tiles already written.
-    fn level1_block<W: LccWord>(
-        &self,
-        writer: &PackWriter,
-        origin: [u32; 2],
-        extent: u32,
-    ) -> Result<Vec<u32>, LayerError> {
-        let pyramid = &self.pyramid;
-        let (size, tile) = (pyramid.size_at(LCC_SOURCE_LEVEL), pyramid.tile);
-        let clamp = |v: u32, axis: usize| v.min(size[axis] - 1);
-        let first = [0, 1].map(|a| clamp(origin[a], a) / tile);
-        let last = [0, 1].map(|a| clamp(origin[a] + extent - 1, a) / tile);
-        let mut tiles = Vec::new();
-        for ty in first[1]..=last[1] {
-            for tx in first[0]..=last[0] {
-                let index = pyramid.tile_index(TileId::new(LCC_SOURCE_LEVEL, tx, ty)).unwrap_or_default();
-                let words: Vec<W> = bytemuck::pod_collect_to_vec(&writer.read_tile(index)?);
-                tiles.push(words);
-            }
-        }
-        let across = (last[0] - first[0] + 1) as usize;
-        let mut block = Vec::with_capacity((extent as usize).pow(2));
-        for j in 0..extent {
-            let y = clamp(origin[1] + j, 1);
-            for i in 0..extent {
-                let x = clamp(origin[0] + i, 0);
-                let (tx, ty) = ((x / tile - first[0]) as usize, (y / tile - first[1]) as usize);
-                // Land-cover tiles have no border: a tile's words are its `tile`² texels.
-                let local = ((y % tile) * tile + x % tile) as usize;
-                block.push(tiles[ty * across + tx][local].into());
-            }
-        }
-        Ok(block)
-    }
-
-    /// The pack index range of a tile: min and max palette index under it.
-    fn index_range(&self, level: u32, words: &[u32]) -> Option<[f32; 2]> {
-        let sub_codes = if level < 2 { 1 } else { 4 };
-        let indices = words.iter().flat_map(|&w| (0..sub_codes).map(move |k| (w, [k & 1, k >> 1])));
-        let [lo, hi] = indices
-            .map(|(word, q)| self.coding.decode(level, word, q))
-            .fold([u32::MAX, 0], |[lo, hi], v| [lo.min(v), hi.max(v)]);
-        (lo <= hi).then_some([lo as f32, hi as f32])
-    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,192 @@
+//! Partitioned builds (`terramp-data plan`, `build --plan --partition`, `merge`) equal the
+//! single-process build byte for byte: run as separate jobs, on Dask's `LocalCluster`, and after a
+//! job killed with SIGKILL in the middle of its partition.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use terramp_testkit::data::TempDir;
+
+const SIZE: &str = "600";
+const SEED: &str = "5";
+
+fn terramp_data(args: &[&str]) -> Output {
+    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
+    assert!(
+        output.status.success(),
+        "terramp-data {}: {}{}",
+        args.join(" "),
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
+fn stdout(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The single-process build the partitioned ones must equal.
+fn single(dir: &Path, size: &str) -> PathBuf {
+    let out = dir.join("single");
+    terramp_data(&["synth", "--size", size, "--seed", SEED, "--out", path(&out)]);
+    out
+}
+
+fn plan(dir: &Path, size: &str, partitions: u32) -> PathBuf {
+    let plan = dir.join("plan.toml");
+    let partitions = partitions.to_string();
+    terramp_data(&[
+        "plan",
+        "--synth-size",
+        size,
+        "--seed",
+        SEED,
+        "--partitions",
+        &partitions,
+        "--out",
+        path(&plan),
+    ]);
+    plan
+}
+
+/// Every file of dataset `a` equals `b`'s, byte for byte, and neither has others.
+fn assert_same_dataset(a: &Path, b: &Path) {
+    let names = |dir: &Path| {
+        let mut names: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        names.sort();
+        names
+    };
+    assert_eq!(names(a), names(b), "{} and {} hold other files", a.display(), b.display());
+    for name in names(a) {
+        let same = std::fs::read(a.join(&name)).unwrap() == std::fs::read(b.join(&name)).unwrap();
+        assert!(same, "{} differs from the single-process build's", b.join(&name).display());
+    }
+}
+
+#[test]
+fn jobs_run_one_by_one_merge_into_the_single_process_build() {
+    let dir = TempDir::new("partitioned-jobs");
+    let single = single(dir.path(), SIZE);
+    let plan = plan(dir.path(), SIZE, 3);
+    for part in ["0", "1", "2"] {
+        let built = stdout(&terramp_data(&["build", "--plan", path(&plan), "--partition", part]));
+        assert!(built.contains("built in"), "{built}");
+    }
+    let merged = dir.path().join("merged");
+    terramp_data(&["merge", "--plan", path(&plan), "--out", path(&merged)]);
+    assert_same_dataset(&single, &merged);
+    // Idempotent: a partition built for this plan is not built again.
+    let again = stdout(&terramp_data(&["build", "--plan", path(&plan), "--partition", "1"]));
+    assert!(again.contains("already built"), "{again}");
+}
+
+#[test]
+fn a_merge_names_the_partitions_not_built_and_writes_nothing() {
+    let dir = TempDir::new("partitioned-missing");
+    let plan = plan(dir.path(), "300", 3);
+    terramp_data(&["build", "--plan", path(&plan), "--partition", "1"]);
+    let out = dir.path().join("merged");
+    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data"))
+        .args(["merge", "--plan", path(&plan), "--out", path(&out)])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("not built for this plan: 0, 2"), "{stderr}");
+    assert!(!out.exists());
+    // A plan edited by hand is refused rather than built half one way, half another.
+    let text = std::fs::read_to_string(&plan).unwrap().replace("seed = 5", "seed = 6");
+    std::fs::write(&plan, text).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data"))
+        .args(["build", "--plan", path(&plan), "--partition", "0"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && stderr.contains("edited"), "{stderr}");
+}
+
+/// The Python of the virtual environment `.ci/run` makes with Dask, if it is there.
+fn dask_python() -> Option<PathBuf> {
+    let python = Path::new(env!("CARGO_MANIFEST_DIR")).join("../.venv-dask/bin/python");
+    if python.is_file() {
+        return Some(python);
+    }
+    assert!(
+        std::env::var("CI").is_err(),
+        "{} is missing: .ci/run makes it (python3 -m venv .venv-dask; pip install -r scripts/requirements-dask.txt)",
+        python.display()
+    );
+    eprintln!("skipped: no Dask ({} is missing)", python.display());
+    None
+}
+
+fn dask_build(python: &Path, plan: &Path, out: &Path) -> String {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/dask_build.py");
+    let output = Command::new(python)
+        .arg(script)
+        .args(["--plan", path(plan), "--out", path(out), "--local", "2"])
+        .args(["--terramp-data", env!("CARGO_BIN_EXE_terramp-data")])
+        .output()
+        .unwrap();
+    let text = format!("{}{}", stdout(&output), String::from_utf8_lossy(&output.stderr));
+    assert!(output.status.success(), "dask_build.py: {text}");
+    text
+}
+
+#[test]
+fn a_dask_local_cluster_builds_the_single_process_dataset() {
+    let Some(python) = dask_python() else { return };
+    let dir = TempDir::new("partitioned-dask");
+    let single = single(dir.path(), SIZE);
+    let plan = plan(dir.path(), SIZE, 4);
+    let merged = dir.path().join("merged");
+    let log = dask_build(&python, &plan, &merged);
+    assert!(log.contains("[4/4]") && log.contains("ETA") && log.contains("merged 4 partitions"), "{log}");
+    assert_same_dataset(&single, &merged);
+}
+
+#[test]
+fn a_job_killed_mid_partition_is_rebuilt_and_only_it() {
+    let Some(python) = dask_python() else { return };
+    let dir = TempDir::new("partitioned-kill");
+    let size = "1200";
+    let single = single(dir.path(), size);
+    let plan = plan(dir.path(), size, 3);
+    for part in ["1", "2"] {
+        terramp_data(&["build", "--plan", path(&plan), "--partition", part]);
+    }
+    // Partition 0, killed once its part packs are being written.
+    let mut job = Command::new(env!("CARGO_BIN_EXE_terramp-data"))
+        .args(["build", "--plan", path(&plan), "--partition", "0"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let parts = dir.path().join("plan.parts");
+    let started = Instant::now();
+    let writing = || {
+        std::fs::read_dir(&parts).into_iter().flatten().flatten().any(|e| {
+            let partial = e.file_name().to_string_lossy().starts_with(".part-00000.partial-");
+            partial && std::fs::read_dir(e.path()).is_ok_and(|mut d| d.next().is_some())
+        })
+    };
+    while !writing() {
+        assert!(job.try_wait().unwrap().is_none(), "partition 0 finished before it could be killed");
+        assert!(started.elapsed() < Duration::from_secs(300), "partition 0 never started writing");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    job.kill().unwrap();
+    job.wait().unwrap();
+    assert!(!parts.join("part-00000").exists(), "a killed partition was taken for a finished one");
+    let merged = dir.path().join("merged");
+    let log = dask_build(&python, &plan, &merged);
+    assert_eq!(log.matches("already built").count(), 2, "{log}");
+    assert_eq!(log.matches("built in").count(), 1, "{log}");
+    assert_same_dataset(&single, &merged);
+}

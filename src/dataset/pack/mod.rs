@@ -1,0 +1,340 @@
+//! How it works: a pack is one file holding every tile of one layer, memory-mapped at run time.
+//!
+//! Every tile of a layer has the same payload (its texels, all mips), stored as the pack's codec
+//! says (`codec`: as it is, or losslessly compressed by zstd after a predictor). An index after
+//! the header gives each tile's place and stored length, so finding a tile is O(1), and its CRC-32
+//! over the *stored* bytes, checked before they are decoded; the decoded payload must have the
+//! pack's tile size. Readers verify the header, the file length and the index checksum at open, so
+//! a truncated or bit-flipped pack is an error that names the file and the tile, never garbage on
+//! screen.
+//!
+//! Each index entry also carries the tile's value range (two f32, NaN when the layer has none):
+//! for heights, a conservative min/max of every level-0 sample under the tile, so culling can bound
+//! a tile's relief in O(1) without reading it. The index is checksummed in the header.
+//!
+//! Layout (little-endian): 64-byte header (magic, version, codec, tile bytes, tile count, index
+//! checksum, data bytes, header checksum) | `tile_count` × 32-byte index entries (offset, stored
+//! length, crc, state, range) | padding to 4 KiB | the stored tiles, each at a 16-byte boundary,
+//! in the order they were written. Version 2 packs (raw tiles at fixed places, 16-byte entries)
+//! are still read.
+
+use std::borrow::Cow;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use memmap2::Mmap;
+use thiserror::Error;
+
+mod codec;
+mod writer;
+
+pub use codec::{Codec, Predictor};
+pub use writer::PackWriter;
+
+const MAGIC: &[u8; 8] = b"TRMPPACK";
+/// Version of the pack layout written; `Pack::open` reads it and `LEGACY_VERSION`, and refuses any
+/// other, so an old pack is rebuilt, never misread.
+pub const PACK_VERSION: u32 = 3;
+/// The layout before codecs: raw tiles at fixed places.
+const LEGACY_VERSION: u32 = 2;
+const HEADER_BYTES: u64 = 64;
+const DATA_ALIGN: u64 = 4096;
+/// Stored tiles start at multiples of this (raw `f32` payloads stay aligned in the mapping).
+const TILE_ALIGN: u64 = 16;
+/// Index entry state of a tile that the builder wrote.
+const TILE_PRESENT: u32 = 1;
+
+/// Why a pack could not be written or opened, or could not hand out a tile.
+#[derive(Debug, Error)]
+pub enum PackError {
+    /// Creating, sizing, mapping, reading or writing the pack file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The pack file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The file is too short for a header, or its magic or header checksum is wrong: not a pack,
+    /// or one whose header is damaged.
+    #[error("{path}: not a terramp pack (bad magic or header checksum)")]
+    NotAPack {
+        /// The file opened as a pack.
+        path: PathBuf,
+    },
+    /// The header's layout version is not `PACK_VERSION`: the dataset must be rebuilt.
+    #[error(
+        "{path}: pack format version {found}, this build reads versions {LEGACY_VERSION} and {PACK_VERSION}; rebuild the dataset"
+    )]
+    Version {
+        /// The pack file.
+        path: PathBuf,
+        /// The version the header declares.
+        found: u32,
+    },
+    /// At open, the file is shorter than its header's tile count and tile size imply (a build or
+    /// a copy cut short).
+    #[error("{path}: truncated: {actual} bytes, the header promises {expected}")]
+    Truncated {
+        /// The pack file.
+        path: PathBuf,
+        /// File length the header implies, bytes.
+        expected: u64,
+        /// File length on disk, bytes.
+        actual: u64,
+    },
+    /// At open, the tile index fails the checksum stored in the header.
+    #[error("{path}: the tile index is corrupt (checksum mismatch)")]
+    CorruptIndex {
+        /// The pack file.
+        path: PathBuf,
+    },
+    /// A tile's stored bytes fail their CRC-32, lie outside the data, or do not decode to the
+    /// pack's tile size: that tile alone is unusable.
+    #[error("{path}: tile {index} is corrupt (checksum mismatch, or it does not decode)")]
+    Corrupt {
+        /// The pack file.
+        path: PathBuf,
+        /// The tile's position in the pack (`Pyramid::tile_index`).
+        index: u64,
+    },
+    /// A tile the builder never wrote is read, from a pack or back through `PackWriter::read_tile`.
+    #[error("{path}: tile {index} was never written")]
+    Missing {
+        /// The pack file.
+        path: PathBuf,
+        /// The tile's position in the pack (`Pyramid::tile_index`).
+        index: u64,
+    },
+    /// A tile past the pack's tile count is asked for, or a `TileId` outside the layer's pyramid.
+    #[error("{path}: tile {index} is out of range (the pack holds {count})")]
+    OutOfRange {
+        /// The pack file.
+        path: PathBuf,
+        /// The position asked for; `u64::MAX` for a `TileId` outside the pyramid.
+        index: u64,
+        /// Tiles the pack holds.
+        count: u64,
+    },
+    /// A payload given to `PackWriter::write_tile` is not the pack's tile size.
+    #[error("{path}: tile payload is {actual} bytes, the pack stores {expected}")]
+    PayloadSize {
+        /// The pack file.
+        path: PathBuf,
+        /// Bytes per tile the pack stores.
+        expected: u64,
+        /// Bytes of the payload given.
+        actual: u64,
+    },
+    /// A tile of a layer the dataset does not have is asked for (land cover in a dataset without).
+    #[error("{path}: the dataset has no {layer} layer")]
+    NoLayer {
+        /// The dataset folder.
+        path: PathBuf,
+        /// The missing layer's name for the message, e.g. "land-cover".
+        layer: &'static str,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Header {
+    version: u32,
+    codec: Codec,
+    tile_bytes: u64,
+    tile_count: u64,
+    index_crc: u32,
+    /// Bytes of the stored tiles (version 3; implied by the tile size in version 2).
+    data_bytes: u64,
+}
+
+impl Header {
+    fn entry_bytes(&self) -> u64 {
+        if self.version == LEGACY_VERSION { 16 } else { 32 }
+    }
+
+    fn index_range(&self) -> std::ops::Range<usize> {
+        HEADER_BYTES as usize..(HEADER_BYTES + self.tile_count * self.entry_bytes()) as usize
+    }
+
+    fn data_offset(&self) -> u64 {
+        (HEADER_BYTES + self.tile_count * self.entry_bytes()).next_multiple_of(DATA_ALIGN)
+    }
+
+    fn file_bytes(&self) -> u64 {
+        self.data_offset() + self.data_bytes
+    }
+
+    fn encode(&self) -> [u8; HEADER_BYTES as usize] {
+        let mut bytes = [0u8; HEADER_BYTES as usize];
+        bytes[0..8].copy_from_slice(MAGIC);
+        bytes[8..12].copy_from_slice(&self.version.to_le_bytes());
+        bytes[12..16].copy_from_slice(&self.codec.word().to_le_bytes());
+        bytes[16..24].copy_from_slice(&self.tile_bytes.to_le_bytes());
+        bytes[24..32].copy_from_slice(&self.tile_count.to_le_bytes());
+        bytes[32..36].copy_from_slice(&self.index_crc.to_le_bytes());
+        bytes[40..48].copy_from_slice(&self.data_bytes.to_le_bytes());
+        let crc = crc32fast::hash(&bytes[0..60]);
+        bytes[60..64].copy_from_slice(&crc.to_le_bytes());
+        bytes
+    }
+
+    fn decode(bytes: &[u8], path: &Path) -> Result<Header, PackError> {
+        let not_a_pack = || PackError::NotAPack { path: path.to_owned() };
+        if bytes.len() < HEADER_BYTES as usize || &bytes[0..8] != MAGIC {
+            return Err(not_a_pack());
+        }
+        let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap_or([0; 4]));
+        let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap_or([0; 8]));
+        if crc32fast::hash(&bytes[0..60]) != u32_at(60) {
+            return Err(not_a_pack());
+        }
+        let version = u32_at(8);
+        let (tile_bytes, tile_count) = (u64_at(16), u64_at(24));
+        let (codec, data_bytes) = match version {
+            PACK_VERSION => (Codec::from_word(u32_at(12)), u64_at(40)),
+            LEGACY_VERSION => (Some(Codec::Raw), tile_count.saturating_mul(tile_bytes)),
+            found => return Err(PackError::Version { path: path.to_owned(), found }),
+        };
+        // A codec this build does not know is a newer pack's: as good as another version.
+        let codec = codec.ok_or(PackError::Version { path: path.to_owned(), found: version })?;
+        Ok(Header { version, codec, tile_bytes, tile_count, index_crc: u32_at(32), data_bytes })
+    }
+}
+
+/// A tile's value range from its two f32 bit patterns (`max << 32 | min`); NaN: none.
+fn unpack_range(bits: u64) -> Option<[f32; 2]> {
+    let range = [f32::from_bits(bits as u32), f32::from_bits((bits >> 32) as u32)];
+    (!range[0].is_nan()).then_some(range)
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> PackError + '_ {
+    move |source| PackError::Io { path: path.to_owned(), source }
+}
+
+/// A memory-mapped pack, read-only.
+pub struct Pack {
+    map: Mmap,
+    path: PathBuf,
+    header: Header,
+}
+
+/// One tile's index entry, decoded.
+struct Entry {
+    /// Where its stored bytes start, from the start of the data.
+    offset: u64,
+    stored_bytes: u64,
+    crc: u32,
+    state: u32,
+    range: u64,
+}
+
+impl Pack {
+    /// Maps the pack at `path` read-only and checks its header, version, length and index checksum;
+    /// tiles are checked when read.
+    pub fn open(path: &Path) -> Result<Self, PackError> {
+        let file = File::open(path).map_err(io(path))?;
+        // SAFETY: packs are written once by the builder and never modified in place; a dataset is
+        // replaced by an atomic rename, which leaves this mapping's inode intact.
+        let map = unsafe { Mmap::map(&file) }.map_err(io(path))?;
+        let header = Header::decode(&map, path)?;
+        let actual = map.len() as u64;
+        let expected = header.tile_count.checked_mul(header.entry_bytes()).map(|_| header.file_bytes());
+        if expected.is_none_or(|e| actual < e) {
+            return Err(PackError::Truncated {
+                path: path.to_owned(),
+                expected: expected.unwrap_or(u64::MAX),
+                actual,
+            });
+        }
+        if crc32fast::hash(&map[header.index_range()]) != header.index_crc {
+            return Err(PackError::CorruptIndex { path: path.to_owned() });
+        }
+        Ok(Self { map, path: path.to_owned(), header })
+    }
+
+    /// The mapped pack file, for messages.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Payload bytes of every tile, all mips included (as decoded, whatever the codec).
+    pub fn tile_bytes(&self) -> u64 {
+        self.header.tile_bytes
+    }
+
+    /// Tiles the pack holds, all levels together.
+    pub fn tile_count(&self) -> u64 {
+        self.header.tile_count
+    }
+
+    /// How the tiles are stored.
+    pub fn codec(&self) -> Codec {
+        self.header.codec
+    }
+
+    /// Tile `index`'s index entry, or the error for a tile the pack does not hold.
+    fn entry(&self, index: u64) -> Result<Entry, PackError> {
+        let h = &self.header;
+        if index >= h.tile_count {
+            return Err(PackError::OutOfRange { path: self.path.clone(), index, count: h.tile_count });
+        }
+        let at = (HEADER_BYTES + index * h.entry_bytes()) as usize;
+        let e = &self.map[at..at + h.entry_bytes() as usize];
+        let u32_at = |i: usize| u32::from_le_bytes(e[i..i + 4].try_into().unwrap_or([0; 4]));
+        let u64_at = |i: usize| u64::from_le_bytes(e[i..i + 8].try_into().unwrap_or([0xff; 8]));
+        Ok(if h.version == LEGACY_VERSION {
+            let (offset, stored_bytes) = (index * h.tile_bytes, h.tile_bytes);
+            Entry { offset, stored_bytes, crc: u32_at(0), state: u32_at(4), range: u64_at(8) }
+        } else {
+            let (offset, stored_bytes) = (u64_at(0), u64::from(u32_at(8)));
+            Entry { offset, stored_bytes, crc: u32_at(12), state: u32_at(16), range: u64_at(24) }
+        })
+    }
+
+    /// Where tile `index`'s stored bytes lie in the file (for tools that inspect or damage packs).
+    pub fn stored_span(&self, index: u64) -> Result<std::ops::Range<u64>, PackError> {
+        let entry = self.entry(index)?;
+        let start = self.header.data_offset() + entry.offset;
+        Ok(start..start + entry.stored_bytes)
+    }
+
+    /// The tile's value range (heights: conservative min/max of the level-0 samples under it), or
+    /// `None` for layers without one. Verified with the index at `open`; no payload is read.
+    pub fn tile_range(&self, index: u64) -> Result<Option<[f32; 2]>, PackError> {
+        Ok(unpack_range(self.entry(index)?.range))
+    }
+
+    /// The tile's stored bytes (as its codec wrote them), after checking that it was written and
+    /// that they hold their checksum.
+    pub fn stored(&self, index: u64) -> Result<&[u8], PackError> {
+        let entry = self.entry(index)?;
+        if entry.state != TILE_PRESENT {
+            return Err(PackError::Missing { path: self.path.clone(), index });
+        }
+        let corrupt = || PackError::Corrupt { path: self.path.clone(), index };
+        let end = entry.offset.checked_add(entry.stored_bytes).filter(|&end| end <= self.header.data_bytes);
+        let end = end.ok_or_else(corrupt)?;
+        let base = self.header.data_offset();
+        let stored = &self.map[(base + entry.offset) as usize..(base + end) as usize];
+        if crc32fast::hash(stored) != entry.crc {
+            return Err(corrupt());
+        }
+        Ok(stored)
+    }
+
+    /// The tile's payload, after checking that it was written and that its stored bytes hold
+    /// their checksum: borrowed from the mapping when stored raw, else decoded.
+    pub fn tile(&self, index: u64) -> Result<Cow<'_, [u8]>, PackError> {
+        let stored = self.stored(index)?;
+        match self.header.codec {
+            Codec::Raw if stored.len() as u64 == self.header.tile_bytes => Ok(Cow::Borrowed(stored)),
+            codec => codec
+                .decode(stored, self.header.tile_bytes as usize)
+                .map(Cow::Owned)
+                .ok_or_else(|| PackError::Corrupt { path: self.path.clone(), index }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
