@@ -16,6 +16,7 @@ use crate::gpu::AdapterChoice;
 
 mod clouds;
 mod draw_seeds;
+pub mod knobs;
 mod seeds;
 mod texcells;
 mod tlm;
@@ -262,7 +263,9 @@ impl Settings {
         Ok(settings)
     }
 
-    fn validate(&self) -> Result<(), SettingsError> {
+    /// Range-checks every value, naming the first key out of range (as loading does; for
+    /// settings changed after loading, such as a turned knob).
+    pub fn validate(&self) -> Result<(), SettingsError> {
         let r = &self.render;
         let t = &self.terrain;
         let c = &self.cache;

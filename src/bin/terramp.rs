@@ -24,6 +24,9 @@ use terramp::profile::{Meta, Summary};
 mod sweep;
 #[path = "terramp/truth.rs"]
 mod truth;
+#[cfg(feature = "viewer")]
+#[path = "terramp/view/mod.rs"]
+mod view;
 
 #[derive(Parser)]
 #[command(
@@ -68,6 +71,10 @@ struct ViewArgs {
     width: Option<u32>,
     #[arg(long)]
     height: Option<u32>,
+    /// The scene's time, seconds: where the wind's sway and the clouds are (`terramp view`'s
+    /// screenshots give theirs).
+    #[arg(long, default_value_t = 0.0)]
+    time_s: f64,
     #[command(flatten)]
     settings: SettingsArgs,
 }
@@ -87,6 +94,12 @@ impl ViewArgs {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Fly over a dataset in a window, with a live per-pass profiler and the speed knobs (without
+    /// --dataset: the embedded default). Controls: mouse drag to look, WASD/arrows to move, E/Q
+    /// or Space/Ctrl up/down, scroll or +/- for speed, Shift to boost, R overview, Tab next
+    /// view, F12 screenshot, P record the path, H overlay, Esc quit.
+    #[cfg(feature = "viewer")]
+    View(view::ViewArgs),
     /// Render one frame of a dataset to a PNG.
     Render {
         #[command(flatten)]
@@ -200,7 +213,7 @@ fn main() -> Result<()> {
     match Cli::parse().command {
         Command::Render { view, out } => {
             let (settings, camera) = view.load()?;
-            render_one(&view.dataset, settings, &camera, &out)
+            render_one(&view.dataset, settings, &camera, view.time_s, &out)
         }
         Command::Demo { dataset, out, frames, warmup, impostors, models, settings } => {
             demo::run(&demo::DemoArgs {
@@ -224,6 +237,8 @@ fn main() -> Result<()> {
             let outputs = ProfileOutputs { json, trace, log };
             profile(&dataset, path.as_deref(), frames, warmup, (width, height), &settings, &outputs)
         }
+        #[cfg(feature = "viewer")]
+        Command::View(args) => view::run(args),
         Command::Sweep(args) => args.run(),
         Command::Truth(args) => args.run(),
         Command::Info { dataset } => info(&dataset),
@@ -311,8 +326,15 @@ fn open_renderer(dataset_dir: &Path, settings: Settings) -> Result<Renderer> {
     Ok(renderer)
 }
 
-fn render_one(dataset_dir: &Path, settings: Settings, camera: &Camera, out: &Path) -> Result<()> {
+fn render_one(
+    dataset_dir: &Path,
+    settings: Settings,
+    camera: &Camera,
+    time_s: f64,
+    out: &Path,
+) -> Result<()> {
     let mut renderer = open_renderer(dataset_dir, settings)?;
+    renderer.set_time_s(time_s);
     let start = Instant::now();
     // One finished picture: keep rendering while tiles stream in.
     let (report, frames) = renderer.render_resolved(camera)?;

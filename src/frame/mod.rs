@@ -245,8 +245,8 @@ pub struct Renderer {
 impl Renderer {
     /// Makes the targets, caches (pinned tiles loaded now), loader threads and passes for
     /// `dataset`; fails when the viewport, the caches or the seeds do not fit this adapter.
-    pub fn new(gpu: Gpu, dataset: Dataset, settings: Settings) -> Result<Self, RenderError> {
-        let dataset = Arc::new(dataset);
+    pub fn new(gpu: Gpu, dataset: impl Into<Arc<Dataset>>, settings: Settings) -> Result<Self, RenderError> {
+        let dataset = dataset.into();
         let targets = Targets::new(&gpu.device, &settings)?;
         let device = &gpu.device;
         let terrain = TerrainPass::new(device, &settings);
@@ -298,6 +298,25 @@ impl Renderer {
             frame: 0,
             time_s: 0.0,
             last_timings: Vec::new(),
+        })
+    }
+
+    /// Makes this renderer again with `settings`, on the same device and dataset (a new viewport,
+    /// other cache sizes or seed tables): its streaming starts over from the pinned tiles, the
+    /// scene's time carries on. If the new one cannot be made, this one is left as it was.
+    pub fn remake(&mut self, settings: Settings) -> Result<(), RenderError> {
+        let mut fresh = Self::new(self.gpu.clone(), Arc::clone(&self.dataset), settings)?;
+        fresh.time_s = self.time_s;
+        *self = fresh;
+        Ok(())
+    }
+
+    /// A view of the last frame's colour as plain `Rgba8Unorm` (the sRGB-encoded bytes, not
+    /// decoded when sampled): what a window shows them through, byte for byte.
+    pub fn colour_bytes_view(&self) -> wgpu::TextureView {
+        self.targets.colour.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(crate::passes::COLOUR_FORMAT.remove_srgb_suffix()),
+            ..Default::default()
         })
     }
 

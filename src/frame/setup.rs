@@ -30,7 +30,7 @@ impl Targets {
         if width.max(height) > max {
             return Err(RenderError::ViewportTooLarge { width, height, max });
         }
-        let target = |label, format| {
+        let target = |label, format, view_formats: &[wgpu::TextureFormat]| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -41,11 +41,12 @@ impl Targets {
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING
                     | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
+                view_formats,
             })
         };
-        let colour = target("colour", COLOUR_FORMAT);
-        let depth = target("depth", DEPTH_FORMAT);
+        // A window samples the colour's bytes as they are (`Renderer::colour_bytes_view`).
+        let colour = target("colour", COLOUR_FORMAT, &[COLOUR_FORMAT.remove_srgb_suffix()]);
+        let depth = target("depth", DEPTH_FORMAT, &[]);
         let colour_view = colour.create_view(&Default::default());
         let depth_view = depth.create_view(&Default::default());
         Ok(Self { colour, depth, colour_view, depth_view })

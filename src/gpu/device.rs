@@ -9,6 +9,10 @@
 //! on. terramp picks its adapter itself, so its binaries turn the layer off before they start
 //! ([`skip_device_select_layer`]).
 //!
+//! A window (`terramp view`) opens its GPU the other way round: the instance knows the display,
+//! the window's surface is made first, and only adapters that can present to it are candidates
+//! ([`Gpu::for_surface`]); the policy among them is the same.
+//!
 //! With no usable adapter the error says what is missing and how to install it. wgpu's default
 //! uncaptured-error handler panics; ours records the error (and prints it once), so a validation
 //! error surfaces as a `GpuError` from `Gpu::check`, never a backtrace.
@@ -99,6 +103,9 @@ pub enum GpuError {
         /// wgpu's reason.
         source: wgpu::RequestDeviceError,
     },
+    /// The window's surface could not be made (no display, or a handle wgpu cannot use).
+    #[error("cannot draw into the window: {0}")]
+    Surface(#[from] wgpu::CreateSurfaceError),
     /// wgpu raised errors (validation, out of memory) since the last `Gpu::check`, joined with
     /// `; `; also a readback that failed or never arrived.
     #[error("GPU error: {0}")]
@@ -111,7 +118,9 @@ pub enum GpuError {
     Map(#[from] wgpu::BufferAsyncError),
 }
 
-/// The device terramp renders with, and what it can do.
+/// The device terramp renders with, and what it can do. Clones share the device (wgpu's handles
+/// are reference-counted), so a renderer can be remade on the same device.
+#[derive(Clone)]
 pub struct Gpu {
     /// The logical device every pass creates its buffers, textures and pipelines on.
     pub device: wgpu::Device,
@@ -119,6 +128,8 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// The chosen adapter: name, backend, device type and driver (`describe` prints them).
     pub info: wgpu::AdapterInfo,
+    /// The adapter itself: what a window's surface can be configured with is asked of it.
+    pub adapter: wgpu::Adapter,
     /// GPU timestamps can be written inside encoders (else the profiler times on the CPU).
     pub has_timestamps: bool,
     errors: Arc<Mutex<Vec<String>>>,
@@ -128,34 +139,27 @@ impl Gpu {
     /// Picks an adapter by `choice` (`TERRAMP_ADAPTER` overrides it; hardware first, Vulkan before
     /// other backends) and opens a headless device on it whose GPU errors `check` reports.
     pub fn new(choice: AdapterChoice) -> Result<Self, GpuError> {
-        let choice = choice.with_env()?;
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
-        let adapters = pollster::block_on(instance.enumerate_adapters(backends));
-        let seen: Vec<String> =
-            adapters.iter().map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend)).collect();
-        // Hardware first, then by backend preference (Vulkan before GL): the order is the policy.
-        let rank = |info: &wgpu::AdapterInfo| {
-            let kind = match info.device_type {
-                wgpu::DeviceType::DiscreteGpu => 0,
-                wgpu::DeviceType::IntegratedGpu => 1,
-                wgpu::DeviceType::VirtualGpu | wgpu::DeviceType::Other => 2,
-                wgpu::DeviceType::Cpu => 3,
-            };
-            (kind, info.backend != wgpu::Backend::Vulkan)
-        };
-        let adapter = adapters
-            .into_iter()
-            .filter(|a| choice.accepts(a.get_info().device_type))
-            .min_by_key(|a| rank(&a.get_info()))
-            .ok_or_else(|| GpuError::NoAdapter {
-                wanted: match choice {
-                    AdapterChoice::Auto => "usable",
-                    AdapterChoice::Hardware => "hardware",
-                    AdapterChoice::Software => "software",
-                },
-                seen: if seen.is_empty() { "none".into() } else { seen.join(", ") },
-            })?;
+        Self::open(pick_adapter(&instance, choice, None)?)
+    }
+
+    /// Opens a device that can present to a window: `display` is the window system's connection
+    /// (winit's `OwnedDisplayHandle`), `window` the window. Among the adapters that can present
+    /// to its surface, `choice` picks as in `new`.
+    pub fn for_surface(
+        choice: AdapterChoice,
+        display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
+        window: impl Into<wgpu::SurfaceTarget<'static>>,
+    ) -> Result<(Self, wgpu::Surface<'static>), GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(display));
+        let surface = instance.create_surface(window)?;
+        let gpu = Self::open(pick_adapter(&instance, choice, Some(&surface))?)?;
+        Ok((gpu, surface))
+    }
+
+    /// A device on `adapter` with terramp's features and limits, as far as the adapter has them.
+    fn open(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
         let info = adapter.get_info();
         let wanted = wgpu_profiler::GpuProfiler::ALL_WGPU_TIMER_FEATURES
             | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
@@ -190,7 +194,7 @@ impl Gpu {
                 errors.push(text);
             }
         }));
-        Ok(Self { device, queue, info, has_timestamps, errors })
+        Ok(Self { device, queue, info, adapter, has_timestamps, errors })
     }
 
     /// One line naming the adapter, for logs.
@@ -217,4 +221,41 @@ impl Gpu {
         errors.clear();
         Err(GpuError::Validation(joined))
     }
+}
+
+/// The adapter `choice` picks among those `instance` sees (those that present to `surface`, when
+/// given): hardware first, then by backend preference (Vulkan before GL). The order is the policy.
+fn pick_adapter(
+    instance: &wgpu::Instance,
+    choice: AdapterChoice,
+    surface: Option<&wgpu::Surface<'_>>,
+) -> Result<wgpu::Adapter, GpuError> {
+    let choice = choice.with_env()?;
+    let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+    let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+    let seen: Vec<String> =
+        adapters.iter().map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend)).collect();
+    let rank = |info: &wgpu::AdapterInfo| {
+        let kind = match info.device_type {
+            wgpu::DeviceType::DiscreteGpu => 0,
+            wgpu::DeviceType::IntegratedGpu => 1,
+            wgpu::DeviceType::VirtualGpu | wgpu::DeviceType::Other => 2,
+            wgpu::DeviceType::Cpu => 3,
+        };
+        (kind, info.backend != wgpu::Backend::Vulkan)
+    };
+    adapters
+        .into_iter()
+        .filter(|a| choice.accepts(a.get_info().device_type))
+        .filter(|a| surface.is_none_or(|s| a.is_surface_supported(s)))
+        .min_by_key(|a| rank(&a.get_info()))
+        .ok_or_else(|| GpuError::NoAdapter {
+            wanted: match (choice, surface.is_some()) {
+                (AdapterChoice::Auto, false) => "usable",
+                (AdapterChoice::Auto, true) => "window-presenting",
+                (AdapterChoice::Hardware, _) => "hardware",
+                (AdapterChoice::Software, _) => "software",
+            },
+            seen: if seen.is_empty() { "none".into() } else { seen.join(", ") },
+        })
 }

@@ -38,20 +38,13 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let mut settings = Settings::load(&args.preset, args.settings_file.as_deref())?;
-    ensure_dataset(&args.dataset)?;
-    let dataset = Dataset::open(&args.dataset)?;
-    let scheme = dataset.manifest.landcover.as_ref().map(|l| l.scheme.as_str());
-    if let (true, Some(table)) =
-        (settings.seeds.class_table.is_empty(), scheme.and_then(ClassTable::generated_for))
-    {
-        eprintln!("terramp: seeds grow from the class table {table} (generated trees)");
-        settings.seeds.class_table = table.to_string();
-    }
-    if settings.draw_seeds.impostors.is_empty() {
-        let baked = ensure_impostors(&dataset, &settings, &args.impostors, &args.models)?;
-        settings.draw_seeds.impostors = baked.map(|d| d.display().to_string()).unwrap_or_default();
-    }
+    let (settings, dataset) = prepare(&Prepare {
+        dataset: &args.dataset,
+        impostors: &args.impostors,
+        models: &args.models,
+        preset: &args.preset,
+        settings_file: args.settings_file.as_deref(),
+    })?;
     let gpu = Gpu::new(settings.gpu.adapter)?;
     let adapter = gpu.describe();
     eprintln!("terramp: adapter {adapter}");
@@ -112,6 +105,36 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         frame_ms[frame_ms.len() / 2]
     );
     Ok(())
+}
+
+/// Where the embedded default lives and is baked from, and the settings asked for.
+pub struct Prepare<'a> {
+    pub dataset: &'a Path,
+    pub impostors: &'a Path,
+    pub models: &'a Path,
+    pub preset: &'a str,
+    pub settings_file: Option<&'a Path>,
+}
+
+/// The embedded default ready to fly: the dataset (synthesized if missing), and the settings with
+/// its generated trees' class table and the impostor folder (baked if missing), unless the
+/// settings name others.
+pub fn prepare(p: &Prepare) -> Result<(Settings, Dataset)> {
+    let mut settings = Settings::load(p.preset, p.settings_file)?;
+    ensure_dataset(p.dataset)?;
+    let dataset = Dataset::open(p.dataset)?;
+    let scheme = dataset.manifest.landcover.as_ref().map(|l| l.scheme.as_str());
+    if let (true, Some(table)) =
+        (settings.seeds.class_table.is_empty(), scheme.and_then(ClassTable::generated_for))
+    {
+        eprintln!("terramp: seeds grow from the class table {table} (generated trees)");
+        settings.seeds.class_table = table.to_string();
+    }
+    if settings.draw_seeds.impostors.is_empty() {
+        let baked = ensure_impostors(&dataset, &settings, p.impostors, p.models)?;
+        settings.draw_seeds.impostors = baked.map(|d| d.display().to_string()).unwrap_or_default();
+    }
+    Ok((settings, dataset))
 }
 
 /// The default dataset is ours to make: synthesized when missing, or when made by a build whose
