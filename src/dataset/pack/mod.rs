@@ -214,6 +214,8 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> PackError + '_ {
 /// A memory-mapped pack, read-only.
 pub struct Pack {
     map: Mmap,
+    /// The mapped file, for reads that bypass the mapping (`read_stored`).
+    file: File,
     path: PathBuf,
     header: Header,
 }
@@ -249,7 +251,7 @@ impl Pack {
         if crc32fast::hash(&map[header.index_range()]) != header.index_crc {
             return Err(PackError::CorruptIndex { path: path.to_owned() });
         }
-        Ok(Self { map, path: path.to_owned(), header })
+        Ok(Self { map, file, path: path.to_owned(), header })
     }
 
     /// The mapped pack file, for messages.
@@ -304,20 +306,39 @@ impl Pack {
         Ok(unpack_range(self.entry(index)?.range))
     }
 
-    /// The tile's stored bytes (as its codec wrote them), after checking that it was written and
-    /// that they hold their checksum.
-    pub fn stored(&self, index: u64) -> Result<&[u8], PackError> {
+    /// Where tile `index`'s stored bytes lie (from the file's start) and their checksum, after
+    /// checking that it was written and that they lie within the data.
+    fn stored_place(&self, index: u64) -> Result<(std::ops::Range<usize>, u32), PackError> {
         let entry = self.entry(index)?;
         if entry.state != TILE_PRESENT {
             return Err(PackError::Missing { path: self.path.clone(), index });
         }
-        let corrupt = || PackError::Corrupt { path: self.path.clone(), index };
         let end = entry.offset.checked_add(entry.stored_bytes).filter(|&end| end <= self.header.data_bytes);
-        let end = end.ok_or_else(corrupt)?;
+        let end = end.ok_or_else(|| PackError::Corrupt { path: self.path.clone(), index })?;
         let base = self.header.data_offset();
-        let stored = &self.map[(base + entry.offset) as usize..(base + end) as usize];
-        if crc32fast::hash(stored) != entry.crc {
-            return Err(corrupt());
+        Ok(((base + entry.offset) as usize..(base + end) as usize, entry.crc))
+    }
+
+    /// The tile's stored bytes (as its codec wrote them), from the mapping, after checking that
+    /// it was written and that they hold their checksum.
+    pub fn stored(&self, index: u64) -> Result<&[u8], PackError> {
+        let (place, crc) = self.stored_place(index)?;
+        let stored = &self.map[place];
+        if crc32fast::hash(stored) != crc {
+            return Err(PackError::Corrupt { path: self.path.clone(), index });
+        }
+        Ok(stored)
+    }
+
+    /// As `stored`, but read from the file rather than the mapping: a tool copying a whole pack
+    /// (the partitioned build's merge) keeps its resident memory flat.
+    pub fn read_stored(&self, index: u64) -> Result<Vec<u8>, PackError> {
+        use std::os::unix::fs::FileExt;
+        let (place, crc) = self.stored_place(index)?;
+        let mut stored = vec![0; place.len()];
+        self.file.read_exact_at(&mut stored, place.start as u64).map_err(io(&self.path))?;
+        if crc32fast::hash(&stored) != crc {
+            return Err(PackError::Corrupt { path: self.path.clone(), index });
         }
         Ok(stored)
     }

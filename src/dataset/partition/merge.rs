@@ -74,8 +74,9 @@ impl Parts {
                 path: pack.path().to_owned(),
                 message: format!("does not hold tile {id:?}"),
             })?;
-            let stored = pack.stored(slot)?;
-            writer.place_stored(global, stored, range(id, pack.tile_range(slot)?)?)?;
+            // Read, not mapped: the merge copies whole packs and must not hold them resident.
+            let stored = pack.read_stored(slot)?;
+            writer.place_stored(global, &stored, range(id, pack.tile_range(slot)?)?)?;
             progress.inc(1);
         }
         Ok(())
