@@ -15,7 +15,7 @@ use std::path::Path;
 use indicatif::ProgressBar;
 use thiserror::Error;
 
-use super::pack::{Codec, PackError, PackWriter, Predictor};
+use super::pack::{Codec, MadeTile, PackError, PackWriter, Predictor};
 use super::pyramid::{Pyramid, Sampling, TileId};
 use super::{CELL_TILE_TEXELS, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_MIPS};
 use crate::dataset::lcc::LccError;
@@ -201,11 +201,8 @@ where
     writer.write_ordered(&level_ids(pyramid, 0), |&id| -> Result<_, LayerError> {
         let (origin, extent) = (pyramid.tile_origin(id), pyramid.tile_extent());
         let mip0 = read_replicated(spec.name, pyramid.size, &source, origin, extent)?;
-        let range = T::range(&mip0);
-        let payload = with_mips(spec, mip0);
-        let index = pyramid.tile_index(id).unwrap_or_default();
         progress.inc(1);
-        Ok((index, bytemuck::cast_slice(&payload).to_vec(), range))
+        Ok(made_tile(spec, pyramid.tile_index(id).unwrap_or_default(), mip0, None))
     })?;
     for level in 1..pyramid.levels {
         write_reduced_level::<T>(spec, &writer, level, progress)?;
@@ -231,12 +228,10 @@ pub(crate) fn write_reduced_level<T: Texel>(
 ) -> Result<(), LayerError> {
     let pyramid = &spec.pyramid;
     writer.write_ordered(&level_ids(pyramid, level), |&id| -> Result<_, LayerError> {
-        let mip0 = reduce_level_below(spec, writer, id)?;
-        let range = union(T::range(&mip0), range_below(pyramid, writer, id)?);
-        let payload = with_mips(spec, mip0);
-        let index = pyramid.tile_index(id).unwrap_or_default();
+        let mip0 = reduce_level_below::<T>(spec, writer, id)?;
+        let below = range_below(pyramid, writer, id)?;
         progress.inc(1);
-        Ok((index, bytemuck::cast_slice(&payload).to_vec(), range))
+        Ok(made_tile(spec, pyramid.tile_index(id).unwrap_or_default(), mip0, below))
     })
 }
 
@@ -386,8 +381,21 @@ fn read_written_window<T: Texel>(
     Ok(window)
 }
 
+/// The tile to place at `index` from its mip 0: the payload with its mips, and as range its own
+/// texels' with `below`, the ranges of the tiles it was reduced from.
+pub(crate) fn made_tile<T: Texel>(
+    spec: &LayerSpec,
+    index: u64,
+    mip0: Vec<T>,
+    below: Option<[f32; 2]>,
+) -> MadeTile {
+    let range = union(T::range(&mip0), below);
+    let payload = with_mips(spec, mip0);
+    (index, bytemuck::cast_slice(&payload).to_vec(), range)
+}
+
 /// Mip 0 followed by its reductions, as stored in a tile payload.
-pub(crate) fn with_mips<T: Texel>(spec: &LayerSpec, mip0: Vec<T>) -> Vec<T> {
+fn with_mips<T: Texel>(spec: &LayerSpec, mip0: Vec<T>) -> Vec<T> {
     let mut payload = Vec::with_capacity(spec.tile_texels());
     payload.extend_from_slice(&mip0);
     let mut previous = mip0;

@@ -29,7 +29,7 @@ mod codec;
 mod writer;
 
 pub use codec::{Codec, Predictor};
-pub use writer::PackWriter;
+pub use writer::{MadeTile, PackWriter};
 
 const MAGIC: &[u8; 8] = b"TRMPPACK";
 /// Version of the pack layout written; `Pack::open` reads it and `LEGACY_VERSION`, and refuses any

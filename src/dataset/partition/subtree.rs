@@ -12,7 +12,7 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 
 use super::{PartSlots, Split};
-use crate::dataset::layer_writer::with_mips;
+use crate::dataset::layer_writer::made_tile;
 use crate::dataset::lcc::{LccCoding, LccTiles, lcc_pyramid};
 use crate::dataset::pack::PackWriter;
 use crate::dataset::{LayerError, LayerSpec, Pyramid, Texel, TileId, Window};
@@ -171,12 +171,10 @@ where
                 image = reduce_image(spec, &image, level, rects[level as usize]);
             }
             writer.write_ordered(&split.subtree_at(root, level), |&id| -> Result<_, LayerError> {
-                let mip0 = cut_tile(pyramid, &image, id);
-                let range = T::range(&mip0);
-                let payload = with_mips(spec, mip0);
+                // The tile's own range: those of the tiles it was reduced from join at the merge.
                 let slot = pyramid.tile_index(id).and_then(|global| slots.slot(global));
                 progress.inc(1);
-                Ok((slot.unwrap_or(u64::MAX), bytemuck::cast_slice(&payload).to_vec(), range))
+                Ok(made_tile(spec, slot.unwrap_or(u64::MAX), cut_tile(pyramid, &image, id), None))
             })?;
         }
     }
