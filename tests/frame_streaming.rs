@@ -11,7 +11,7 @@ use terramp::config::Settings;
 use terramp::frame::{FrameReport, Renderer};
 
 use terramp_testkit::camera::over_fraction;
-use terramp_testkit::{psnr, renderer, small_settings, synth_dataset};
+use terramp_testkit::{ground_settings, psnr, renderer, synth_dataset};
 
 /// The view the convergence test looks at: low over the dataset's south-west quarter, looking
 /// north-east across it, so near tiles want fine imagery and far ones coarse.
@@ -21,7 +21,7 @@ fn view(r: &Renderer) -> Camera {
 
 /// Settings that make streaming visible: a few uploads per frame, one loader thread.
 fn trickle(width: u32, height: u32) -> Settings {
-    let mut settings = small_settings(width, height);
+    let mut settings = ground_settings(width, height);
     settings.cache.upload_tiles_per_frame = 2;
     settings.cache.loader_threads = 1;
     settings
@@ -42,7 +42,7 @@ fn a_fixed_view_converges_to_the_all_resident_picture() {
     let settled = streamed.render(&camera).unwrap();
     assert_eq!(settled.height.uploaded + settled.imagery.uploaded, 0, "{settled:?}");
 
-    let mut all = small_settings(192, 108);
+    let mut all = ground_settings(192, 108);
     all.cache.imagery_slots = 160;
     all.cache.landcover_slots = 160;
     let mut reference = renderer(&dataset, all);
@@ -131,7 +131,7 @@ fn a_corrupt_tile_is_reported_and_the_frame_still_renders() {
     let dataset = synth_dataset(1200, 11);
     for pack in ["imagery.pack", "height.pack"] {
         let copy = corrupted_copy(&dataset, pack, &format!("corrupt-{}", pack.replace('.', "-")));
-        let mut r = renderer(&copy, small_settings(128, 72));
+        let mut r = renderer(&copy, ground_settings(128, 72));
         // Low over the corrupted south-west corner, looking into the dataset.
         let m = r.dataset.manifest.clone();
         let camera = Camera {

@@ -1,8 +1,10 @@
-//! `terramp sweep` on a small synthetic dataset, two presets and a knob, a few frames at 160 × 90,
-//! trees drawn (the shared models baked): it writes trade.csv, trade.json and trade.png; the CSV
-//! and the JSON hold the same figures; every point has positive times and sensible errors against
-//! the ground truth, whole and per distance band; `fast`, which grows half the density, misses
-//! about half the truth's visible seeds, `accurate` nearly none.
+//! `terramp sweep` on a small synthetic dataset, two presets with a knob set, a few frames at
+//! 160 × 90, trees drawn (the shared models baked): it writes trade.csv, trade.json and trade.png;
+//! the CSV and the JSON hold the same figures; every point has positive times and sensible errors
+//! against the ground truth, whole and per distance band; `fast`, which grows half the density,
+//! misses about half the truth's visible seeds, `accurate` nearly none. (The product of presets
+//! and knob values is `sweep::knobs`' unit test: each point here costs the software adapter a
+//! minute.)
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::path::PathBuf;
@@ -22,7 +24,7 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
     let output = Command::new(env!("CARGO_BIN_EXE_terramp"))
         .args(["sweep", "--presets", "fast,accurate", "--frames", "4", "--warmup", "2", "--samples", "2"])
         .args(["--timing-rounds", "2"])
-        .args(["--width", "160", "--height", "90", "--knob", "seeds.frustum_epsilon=0,0.05"])
+        .args(["--width", "160", "--height", "90", "--knob", "seeds.frustum_epsilon=0.05"])
         .args(["--truth-supersample", "2", "--truth-reach-m", "1500"])
         .args(["--popping-frames", "4", "--popping-step-m", "3"])
         .arg("--settings")
@@ -50,15 +52,7 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
     assert_eq!(json["resolution"], serde_json::json!([160, 90]));
     let points = json["points"].as_array().unwrap();
     let labels: Vec<&str> = points.iter().map(|p| p["label"].as_str().unwrap()).collect();
-    assert_eq!(
-        labels,
-        [
-            "fast seeds.frustum_epsilon=0",
-            "fast seeds.frustum_epsilon=0.05",
-            "accurate seeds.frustum_epsilon=0",
-            "accurate seeds.frustum_epsilon=0.05",
-        ]
-    );
+    assert_eq!(labels, ["fast seeds.frustum_epsilon=0.05", "accurate seeds.frustum_epsilon=0.05"]);
     for label in &labels {
         assert!(stdout.contains(label), "the table lacks {label}:\n{stdout}");
     }
@@ -162,7 +156,7 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
     // part showing, still misses some (seeds whose summit hides but whose crown shows).
     let recall = |p: &Value| p["any_part"]["recall_pct"].as_f64().unwrap();
     let pixel_recall = |p: &Value| p["any_part"]["pixel_weighted_recall_pct"].as_f64().unwrap();
-    let (fast, accurate) = (&points[0], &points[2]);
+    let (fast, accurate) = (&points[0], &points[1]);
     println!(
         "recall: fast {:.2} %, accurate {:.2} %; pixel-weighted: fast {:.2} %, accurate {:.2} %",
         recall(fast),
