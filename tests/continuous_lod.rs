@@ -15,7 +15,7 @@ use terramp::bake::{BakeOptions, bake_missing};
 use terramp::config::Settings;
 use terramp::frame::Renderer;
 use terramp_testkit::data::target_tmp_dir;
-use terramp_testkit::{camera, renderer, small_settings, synth_dataset};
+use terramp_testkit::{camera, ground_settings, renderer, small_settings, synth_dataset};
 
 const IMAGE_PX: [u32; 2] = [480, 270];
 const MODEL: &str = "tree-pine-s1-h100";
@@ -72,11 +72,9 @@ fn thinned_trees_cover_what_whole_ones_do_and_the_frame_is_deterministic() {
     let (table, impostors) = table_and_impostors();
     let (table, impostors) = (table.to_str().unwrap(), impostors.to_str().unwrap());
     let dir = synth_dataset(1024, 7);
-    // The ground alone: no seeds grown, none selected (selecting them without drawing costs the
-    // software adapter seconds a frame here, and draws nothing).
-    let mut bare = settings(table, "", false);
-    bare.seeds.density_scale = 0.0;
-    let ground = frame(&mut renderer(&dir, bare));
+    // The ground alone: no seeds grown (selecting them without drawing costs the software adapter
+    // seconds a frame here, and draws nothing).
+    let ground = frame(&mut renderer(&dir, ground_settings(IMAGE_PX[0], IMAGE_PX[1])));
     let whole = frame(&mut renderer(&dir, settings(table, impostors, false)));
     let mut on = renderer(&dir, settings(table, impostors, true));
     let thinned = frame(&mut on);
