@@ -249,6 +249,21 @@ fn geographic_srtm_alone_builds_without_voids_left() {
     let heights = height_image(&dataset, 0);
     assert!(heights.iter().all(|h| (lo..=hi).contains(h)));
     assert_eq!(number_before(&stdout, " voids in the source"), 0, "{stdout}");
+
+    // An integer DEM's warp is stored on quarter metres by default: each height within an eighth
+    // of a metre of the exact build's, in a smaller pack.
+    assert_eq!(dataset.manifest.height.step_m, Some(0.25), "{stdout}");
+    assert!(heights.iter().all(|h| (h * 4.0).fract() == 0.0));
+    let (exact, _) =
+        build(&tmp.path().join("srtm-exact"), &["--dem", dem.to_str().unwrap(), "--height-step-m", "0"]);
+    assert_eq!(exact.manifest.height.step_m, None);
+    let exact_heights = height_image(&exact, 0);
+    let worst = heights.iter().zip(&exact_heights).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+    assert!(worst <= 0.125, "rounded {worst} m away");
+    assert!(exact_heights.iter().any(|h| (h * 4.0).fract() != 0.0), "the exact warp has finer fractions");
+    let pack_bytes = |dir: &str| std::fs::metadata(tmp.path().join(dir).join("height.pack")).unwrap().len();
+    let (rounded_bytes, exact_bytes) = (pack_bytes("srtm"), pack_bytes("srtm-exact"));
+    assert!(rounded_bytes * 3 < exact_bytes * 2, "{rounded_bytes} against {exact_bytes} bytes");
 }
 
 #[test]

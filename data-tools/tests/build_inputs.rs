@@ -71,6 +71,10 @@ fn bad_inputs_fail_naming_the_file() {
         "no-such-table",
         "class table",
     );
+    for step in ["0.3", "-0.25", "512", "NaN"] {
+        let arg = format!("--height-step-m={step}");
+        assert_fails(&["--dem", dem, &arg], &out, "--height-step-m", "power of two");
+    }
 }
 
 /// A sloping DEM of 700 × 600 samples with voids: one sample, a 150-sample square across the

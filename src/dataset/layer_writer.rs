@@ -46,7 +46,7 @@ pub trait Texel: bytemuck::Pod + Send + Sync {
 
 impl Texel for f32 {
     fn codec() -> Codec {
-        Codec::Zstd(Predictor::Delta32)
+        Codec::Zstd(Predictor::Grid32)
     }
 
     fn range(texels: &[f32]) -> Option<[f32; 2]> {

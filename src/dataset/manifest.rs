@@ -62,6 +62,11 @@ pub struct HeightLayer {
     pub min_m: f32,
     /// Highest height sample of the dataset, metres: the bound of a tile whose own range is unknown.
     pub max_m: f32,
+    /// The step every height was rounded to when the dataset was built, metres (a power of two:
+    /// each is exactly a multiple of it, within half a step of the source's warped value); absent
+    /// when the heights are stored exactly as the source gave them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_m: Option<f32>,
     /// Samples with no source value that were filled: voids and nodata in the source, and, for a
     /// reprojected DEM, the grid's corners beyond the source's edge. Equals the zeros of the mask.
     pub filled_samples: u64,

@@ -230,6 +230,7 @@ fn manifest_for(spec: &LayerSpec) -> Manifest {
             pyramid: spec.pyramid,
             min_m: 0.0,
             max_m: 20_000.0,
+            step_m: None,
             filled_samples: 0,
             valid_mask_pack: None,
         },

@@ -126,6 +126,7 @@ impl Layers {
                 pyramid: self.height.pyramid,
                 min_m,
                 max_m,
+                step_m: None,
                 filled_samples: 0,
                 valid_mask_pack: None,
             },

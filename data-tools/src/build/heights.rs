@@ -2,23 +2,75 @@
 //! tile, so memory stays flat. The scan reads the whole grid once for what tiles cannot know
 //! alone: the range of the valid heights, the voids (and, for a warped DEM, which of them lie
 //! beyond the source's edge rather than in it), and the coarse summary the void fill falls back
-//! on. The tile pass writes the height pack, filling each window's voids (`fill`). When there were
-//! voids, a last pass writes the validity mask pack, reading again only the windows with voids.
+//! on. The tile pass writes the height pack, filling each window's voids (`fill`) and rounding
+//! every height to the dataset's step (`HeightStep`), so that the pack's codec stores integer
+//! counts of steps instead of the warp's fractions. When there were voids, a last pass writes the
+//! validity mask pack, reading again only the windows with voids.
 
 use std::collections::HashSet;
 use std::sync::Mutex;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, bail, ensure};
 use indicatif::ProgressBar;
+use rayon::prelude::*;
 use terramp::dataset::{HeightLayer, LayerSpec, Staging, Window, write_layer};
 
 use super::fill::{CoarseBuilder, VoidFill};
-use super::raster::GridRaster;
+use super::raster::{GridRaster, SourceRaster};
+use super::spill::SpilledGrid;
 
 /// Samples per side of the blocks the scan reads.
 const SCAN_BLOCK: u32 = 1024;
+/// Blocks each thread warps before the scan takes them (bounds the scan's memory: 4 MiB a block).
+const SCAN_BLOCKS_PER_THREAD: usize = 2;
 pub const HEIGHT_PACK: &str = "height.pack";
 pub const VALID_MASK_PACK: &str = "height_valid.pack";
+
+/// The finest and coarsest steps heights may be rounded to, as powers of two (1/65536 m, 256 m).
+const STEP_EXPONENTS: std::ops::RangeInclusive<i32> = -16..=8;
+/// Steps per unit of an integer DEM by default: its values are whole units, and a bilinear warp
+/// between them is worth a quarter unit more, not the f32 fraction's 24 bits (`docs/building.md`).
+const DEFAULT_STEPS_PER_UNIT: f64 = 4.0;
+
+/// What every height is rounded to before it is stored: a power of two of metres, or nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeightStep {
+    /// Metres; 0 keeps heights exactly as read.
+    step_m: f64,
+}
+
+impl HeightStep {
+    /// The step the user asked for: 0 (exact) or a power of two from 1/65536 to 256 m.
+    pub fn new(step_m: f64) -> Result<Self> {
+        let exponent = step_m.log2().round() as i32;
+        ensure!(
+            step_m == 0.0 || (STEP_EXPONENTS.contains(&exponent) && 2f64.powi(exponent) == step_m),
+            "--height-step-m {step_m}: give 0 (heights exactly as read) or a power of two of metres from \
+             1/65536 to 256 (… 0.125, 0.25, 0.5, 1, 2 …), so that every rounded height is exact in f32"
+        );
+        Ok(Self { step_m })
+    }
+
+    /// The default for `dem`: a quarter of its unit when its heights are integers (a warp's
+    /// fractions of a unit are not data), exact when they are floating point.
+    pub fn default_for(dem: &SourceRaster) -> Result<Self> {
+        let integer = dem.band(1)?.band_type().is_integer();
+        Self::new(if integer { 1.0 / DEFAULT_STEPS_PER_UNIT } else { 0.0 })
+    }
+
+    /// `height_m` rounded to the step (NaN stays NaN; never `-0.0`, which the codec cannot count).
+    pub fn round(self, height_m: f32) -> f32 {
+        if self.step_m == 0.0 {
+            return height_m;
+        }
+        ((f64::from(height_m) / self.step_m).round() * self.step_m) as f32 + 0.0
+    }
+
+    /// The step for the manifest: `None` when heights are exact.
+    pub fn step_m(self) -> Option<f32> {
+        (self.step_m > 0.0).then_some(self.step_m as f32)
+    }
+}
 
 /// What the scan learns about the DEM on the dataset grid.
 pub struct HeightScan {
@@ -29,6 +81,20 @@ pub struct HeightScan {
     pub beyond_edge: u64,
     /// The fill, when there is anything to fill.
     pub fill: Option<VoidFill>,
+    /// The warped DEM as the scan read it, which the tile passes read instead of warping again
+    /// (`None` for a DEM on its own grid, read as it is). Dropping it frees its disk.
+    pub spill: Option<SpilledGrid>,
+}
+
+impl HeightScan {
+    /// The DEM's samples of `window` (`NaN` for voids and past the grid): the spill's when there
+    /// is one, else the source's.
+    fn read(&self, dem: &GridRaster, window: Window) -> Result<Vec<f32>, String> {
+        match &self.spill {
+            Some(spill) => spill.read(window),
+            None => dem.read_f32(window),
+        }
+    }
 }
 
 /// Where the scan learns whether a void lies in the source or beyond its edge.
@@ -41,43 +107,62 @@ pub enum Footprint {
     Coverage(GridRaster),
 }
 
-/// Reads the whole DEM grid once, block by block.
-pub fn scan(dem: &GridRaster, footprint: &Footprint, progress: &ProgressBar) -> Result<HeightScan> {
+/// Reads the whole DEM grid once, block by block, a few blocks per thread side by side (each
+/// warped through its thread's reader) and taken in order, so the result does not depend on the
+/// threads. Into `spill`, when given, goes every sample read, for the tile passes.
+pub fn scan(
+    dem: &GridRaster,
+    footprint: &Footprint,
+    spill: Option<SpilledGrid>,
+    progress: &ProgressBar,
+) -> Result<HeightScan> {
     let size = dem.grid.size;
     let blocks = size.map(|n| n.div_ceil(SCAN_BLOCK));
     progress.set_length(u64::from(blocks[0] * blocks[1]));
+    let windows: Vec<Window> = (0..blocks[1])
+        .flat_map(|by| (0..blocks[0]).map(move |bx| (bx * SCAN_BLOCK, by * SCAN_BLOCK)))
+        .map(|(x0, y0)| Window {
+            x0,
+            y0,
+            width: SCAN_BLOCK.min(size[0] - x0),
+            height: SCAN_BLOCK.min(size[1] - y0),
+        })
+        .collect();
+    let read = |window: Window| -> Result<(Vec<f32>, u64, u64)> {
+        let heights = dem
+            .read_f32(window)
+            .map_err(anyhow::Error::msg)
+            .with_context(|| format!("scanning the DEM {}", dem.path.display()))?;
+        if let Some(spill) = &spill {
+            spill.write(window, &heights)?;
+        }
+        let voids: Vec<usize> = (0..heights.len()).filter(|&k| heights[k].is_nan()).collect();
+        let in_source = count_in_source(&voids, window, footprint)?;
+        progress.inc(1);
+        Ok((heights, in_source, voids.len() as u64 - in_source))
+    };
     let mut coarse = CoarseBuilder::new(size);
     let (mut range_m, mut source_voids, mut beyond_edge) = ([f32::INFINITY, f32::NEG_INFINITY], 0, 0);
-    for by in 0..blocks[1] {
-        for bx in 0..blocks[0] {
-            let (x0, y0) = (bx * SCAN_BLOCK, by * SCAN_BLOCK);
-            let window =
-                Window { x0, y0, width: SCAN_BLOCK.min(size[0] - x0), height: SCAN_BLOCK.min(size[1] - y0) };
-            let heights = dem
-                .read_f32(window)
-                .map_err(anyhow::Error::msg)
-                .with_context(|| format!("scanning the DEM {}", dem.path.display()))?;
-            let mut voids = Vec::new();
+    for chunk in windows.chunks(SCAN_BLOCKS_PER_THREAD * rayon::current_num_threads().max(1)) {
+        let blocks: Vec<_> = chunk.par_iter().map(|&window| read(window)).collect();
+        for (window, block) in chunk.iter().zip(blocks) {
+            let (heights, in_source, beyond) = block?;
             for (k, &height_m) in heights.iter().enumerate() {
-                let (x, y) = (x0 + k as u32 % window.width, y0 + k as u32 / window.width);
-                if height_m.is_nan() {
-                    voids.push(k);
-                } else {
+                if !height_m.is_nan() {
+                    let (x, y) = (window.x0 + k as u32 % window.width, window.y0 + k as u32 / window.width);
                     coarse.add(x, y, height_m);
                     range_m = [range_m[0].min(height_m), range_m[1].max(height_m)];
                 }
             }
-            let in_source = count_in_source(&voids, window, footprint)?;
             source_voids += in_source;
-            beyond_edge += voids.len() as u64 - in_source;
-            progress.inc(1);
+            beyond_edge += beyond;
         }
     }
     let Some(coarse) = coarse.finish() else {
         bail!("{}: the DEM holds no valid height at all", dem.path.display());
     };
     let fill = (source_voids + beyond_edge > 0).then(|| VoidFill::new(size, coarse, range_m));
-    Ok(HeightScan { range_m, source_voids, beyond_edge, fill })
+    Ok(HeightScan { range_m, source_voids, beyond_edge, fill, spill })
 }
 
 /// How many of the `voids` (indices into `window`) lie inside the source's footprint.
@@ -100,6 +185,7 @@ fn count_in_source(voids: &[usize], window: Window, footprint: &Footprint) -> Re
 pub fn write(
     dem: &GridRaster,
     scan: &HeightScan,
+    step: HeightStep,
     spacing_m: f64,
     staging: &Staging,
     bars: [&ProgressBar; 2],
@@ -109,16 +195,17 @@ pub fn write(
     // windows) writes ones there without reading, and so warps only the windows with voids again.
     let void_free = Mutex::new(HashSet::new());
     let heights = |window: Window| -> Result<Vec<f32>, String> {
-        let heights = dem.read_f32(window)?;
-        match &scan.fill {
+        let heights = scan.read(dem, window)?;
+        let heights = match &scan.fill {
             Some(fill) if heights.iter().any(|h| h.is_nan()) => {
-                Ok(fill.fill(window, &dem.read_f32(fill.padded(window))?))
+                fill.fill(window, &scan.read(dem, fill.padded(window))?)
             }
             _ => {
                 void_free.lock().map_err(|_| "a height thread panicked")?.insert(window);
-                Ok(heights)
+                heights
             }
-        }
+        };
+        Ok(heights.into_iter().map(|h| step.round(h)).collect())
     };
     write_layer(&staging.path(HEIGHT_PACK), &spec, heights, bars[0]).context("writing the height pack")?;
     let valid_mask_pack = if scan.fill.is_some() {
@@ -128,7 +215,7 @@ pub fn write(
             if void_free.lock().map_err(|_| "a mask thread panicked")?.contains(&window) {
                 return Ok(vec![1; (window.width * window.height) as usize]);
             }
-            Ok(dem.read_f32(window)?.iter().map(|h| u8::from(!h.is_nan())).collect())
+            Ok(scan.read(dem, window)?.iter().map(|h| u8::from(!h.is_nan())).collect())
         };
         write_layer(&staging.path(VALID_MASK_PACK), &mask_spec, valid, bars[1])
             .context("writing the validity mask pack")?;
@@ -141,8 +228,10 @@ pub fn write(
         pack: HEIGHT_PACK.to_owned(),
         spacing_m,
         pyramid: spec.pyramid,
-        min_m: scan.range_m[0],
-        max_m: scan.range_m[1],
+        // Rounding keeps order, so the rounded extremes bound every rounded height.
+        min_m: step.round(scan.range_m[0]),
+        max_m: step.round(scan.range_m[1]),
+        step_m: step.step_m(),
         // Every sample the mask marks 0: the source's voids and the grid beyond its edge alike.
         filled_samples: scan.source_voids + scan.beyond_edge,
         valid_mask_pack,

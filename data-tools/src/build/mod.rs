@@ -16,6 +16,7 @@ mod heights;
 mod imagery;
 mod landcover;
 mod raster;
+mod spill;
 
 use std::path::{Path, PathBuf};
 
@@ -24,10 +25,11 @@ use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use terramp::dataset::{FORMAT_VERSION, Manifest, Staging};
 
 use frame::{Frame, Grid};
-use heights::{Footprint, HeightScan};
+use heights::{Footprint, HeightScan, HeightStep};
 use imagery::Imagery;
 use landcover::{Landcover, LandcoverScan};
 use raster::{Access, GridRaster, Resampling, SourceRaster};
+use spill::SpilledGrid;
 
 /// GDAL's raster block cache: enough for a few rows of tiles, and a bound on resident memory.
 const GDAL_BLOCK_CACHE_BYTES: i64 = 64 << 20;
@@ -52,12 +54,17 @@ pub struct BuildArgs {
     /// The output dataset folder (replaced atomically if it already holds a dataset).
     #[arg(long, required_unless_present = "plan")]
     pub out: Option<PathBuf>,
+    /// Store heights rounded to this step, metres: 0 keeps them exactly as read, else a power of
+    /// two (0.25, 0.5, 1, …). Default: 0.25 of an integer DEM's unit (its warp's finer fractions
+    /// are not data, and cost the packs most of their bytes), 0 for a floating-point DEM.
+    #[arg(long)]
+    pub height_step_m: Option<f64>,
     /// A short name for logs (default: the DEM file's stem).
     #[arg(long)]
     pub name: Option<String>,
     /// Build one partition of this plan (`terramp-data plan`) instead: its part packs, into the
     /// plan's parts folder.
-    #[arg(long, requires = "partition", conflicts_with_all = ["dem", "imagery", "landcover", "out", "name"])]
+    #[arg(long, requires = "partition", conflicts_with_all = ["dem", "imagery", "landcover", "out", "name", "height_step_m"])]
     pub plan: Option<PathBuf>,
     /// The partition to build, 0 to the plan's count − 1 (a scheduler's array index, e.g.
     /// `$JOB_COMPLETION_INDEX` or `$SLURM_ARRAY_TASK_ID`).
@@ -85,6 +92,7 @@ pub fn run(args: &BuildArgs) -> Result<()> {
 struct Inputs {
     frame: Frame,
     dem: GridRaster,
+    height_step: HeightStep,
     footprint: Footprint,
     imagery: Option<Imagery>,
     landcover: Option<Landcover>,
@@ -93,6 +101,10 @@ struct Inputs {
 impl Inputs {
     fn open(args: &BuildArgs, dem_path: &Path) -> Result<Self> {
         let dem_source = SourceRaster::open(dem_path, "DEM")?;
+        let height_step = match args.height_step_m {
+            Some(step_m) => HeightStep::new(step_m)?,
+            None => HeightStep::default_for(&dem_source)?,
+        };
         let frame = Frame::from_dem(&dem_source)?;
         let imagery = args.imagery.as_deref().map(|path| Imagery::open(path, args.bands.as_deref(), &frame));
         let landcover = match (&args.landcover, &args.classes) {
@@ -101,7 +113,7 @@ impl Inputs {
         };
         let dem = GridRaster::new(dem_source, &frame.dem_grid, &frame.srs, &[1], Resampling::Bilinear, true)?;
         let footprint = footprint(&dem, dem_path, &frame)?;
-        Ok(Self { imagery: imagery.transpose()?, landcover, dem, footprint, frame })
+        Ok(Self { imagery: imagery.transpose()?, landcover, dem, height_step, footprint, frame })
     }
 }
 
@@ -118,9 +130,17 @@ fn write_layers(
     staging: &Staging,
     progress: &MultiProgress,
 ) -> Result<(Manifest, Scans)> {
-    let scan = heights::scan(&inputs.dem, &inputs.footprint, &bar(progress, "scan DEM", "blocks"))?;
+    // A warp is read by every height pass: the scan keeps it for the others.
+    let spill = match inputs.dem.access {
+        Access::Warped => Some(SpilledGrid::create(&staging.path(".dem-warped.f32"), inputs.dem.grid.size)?),
+        Access::Direct => None,
+    };
+    let mut scan =
+        heights::scan(&inputs.dem, &inputs.footprint, spill, &bar(progress, "scan DEM", "blocks"))?;
     let height_bars = [&bar(progress, "heights", "tiles"), &bar(progress, "valid mask", "tiles")];
-    let height = heights::write(&inputs.dem, &scan, inputs.frame.dem_grid.pixel_m, staging, height_bars)?;
+    let spacing_m = inputs.frame.dem_grid.pixel_m;
+    let height = heights::write(&inputs.dem, &scan, inputs.height_step, spacing_m, staging, height_bars)?;
+    scan.spill = None;
     let imagery = inputs.imagery.as_ref().map(|i| i.write(staging, &bar(progress, "imagery", "tiles")));
     let landcover = match &inputs.landcover {
         Some(l) => {
@@ -191,13 +211,14 @@ fn print_summary(dir: &Path, manifest: &Manifest, inputs: &Inputs, scans: &Scans
     println!("wrote {} ({})", dir.display(), manifest.name);
     println!("  frame: {}", manifest.crs.note);
     println!(
-        "  heights: {} × {} samples {} m apart, {} .. {} m, {}",
+        "  heights: {} × {} samples {} m apart, {} .. {} m, {}, {}",
         height.pyramid.size[0],
         height.pyramid.size[1],
         height.spacing_m,
         height.min_m,
         height.max_m,
-        describe_access(inputs.dem.access)
+        describe_access(inputs.dem.access),
+        height.step_m.map_or_else(|| "stored exactly".to_owned(), |s| format!("rounded to {s} m")),
     );
     println!(
         "  filled {} samples: {} voids in the source, {} beyond its edge",

@@ -49,6 +49,7 @@ fn dem(name: &str, size: u32, spacing_m: f64, height: impl Fn(u32, u32) -> f32 +
             pyramid: spec.pyramid,
             min_m: -1000.0,
             max_m: 1000.0,
+            step_m: None,
             filled_samples: 0,
             valid_mask_pack: None,
         },
