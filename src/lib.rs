@@ -21,6 +21,7 @@ pub mod light;
 pub mod passes;
 pub mod path;
 pub mod profile;
+pub mod publish;
 pub mod reference;
 pub mod seeds;
 pub mod streaming;

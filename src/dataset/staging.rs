@@ -1,8 +1,10 @@
-//! How it works: a dataset is built in a hidden sibling folder (`.NAME.partial-PID`) and renamed
-//! onto its final name only once every pack and the manifest are written and synced. A build that
-//! fails or is dropped removes its staging folder; one that is killed leaves only that hidden
-//! folder, which the next build in the same place sweeps away. `DIR` is therefore either absent,
-//! the previous complete dataset, or the new complete one: never half of anything.
+//! How it works: a dataset is built in a hidden sibling folder (`.NAME.partial-PID`) and put in
+//! place (`crate::publish`: exchanged with the previous dataset in one step) only once every pack
+//! and the manifest are written and synced. A build that fails or is dropped removes its staging
+//! folder; one that is killed leaves only that hidden folder (or, killed just after the exchange,
+//! the previous dataset under that name), which the next build in the same place sweeps away.
+//! `DIR` is therefore either absent, the previous complete dataset, or the new complete one: never
+//! half of anything (`data-tools/tests/kill9.rs` kills builds anywhere and checks it).
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -62,13 +64,9 @@ impl Staging {
         let manifest_path = self.staging.join(MANIFEST_FILE);
         fs::write(&manifest_path, text).map_err(io(&manifest_path))?;
         fs::File::open(&manifest_path).and_then(|f| f.sync_all()).map_err(io(&manifest_path))?;
-        let old = PathBuf::from(format!("{}-old", self.staging.display()));
-        if self.out.exists() {
-            fs::rename(&self.out, &old).map_err(io(&self.out))?;
-        }
-        fs::rename(&self.staging, &self.out).map_err(io(&self.out))?;
+        let old = crate::publish::swap_into_place(&self.staging, &self.out).map_err(io(&self.out))?;
         self.committed = true;
-        if old.exists() {
+        if let Some(old) = old {
             fs::remove_dir_all(&old).map_err(io(&old))?;
         }
         Ok(self.out.clone())

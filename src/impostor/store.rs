@@ -30,8 +30,9 @@ pub fn save(dir: &Path, impostor: &Impostor) -> Result<PathBuf, ImpostorError> {
 }
 
 /// Makes `out` the folder `fill` writes, atomically: `fill` writes into a hidden folder beside it
-/// (`.NAME.partial-PID`, removed if `fill` fails), which is then renamed into place, the old
-/// `out` moved aside first and removed last, so `out` is always whole. `io` names a failing path.
+/// (`.NAME.partial-PID`, removed if `fill` fails), which then takes the place of the old `out` in
+/// one step (`crate::publish`), the old one removed last, so `out` is always whole. Hidden folders
+/// that killed runs left beside `out` are swept first. `io` names a failing path.
 pub fn replace_folder<E>(
     out: &Path,
     fill: impl FnOnce(&Path) -> Result<(), E>,
@@ -40,21 +41,20 @@ pub fn replace_folder<E>(
     let parent = out.parent().unwrap_or(Path::new("."));
     let name = out.file_name().map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
     fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
-    let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
-    if staging.exists() {
-        fs::remove_dir_all(&staging).map_err(|e| io(&staging, e))?;
+    let prefix = format!(".{name}.partial-");
+    for entry in fs::read_dir(parent).map_err(|e| io(parent, e))?.flatten() {
+        if entry.file_name().to_string_lossy().starts_with(&prefix) {
+            // A killed earlier run's: nothing else writes there.
+            let _ = fs::remove_dir_all(entry.path());
+        }
     }
+    let staging = parent.join(format!("{prefix}{}", std::process::id()));
     fs::create_dir_all(&staging).map_err(|e| io(&staging, e))?;
     if let Err(e) = fill(&staging) {
         let _ = fs::remove_dir_all(&staging);
         return Err(e);
     }
-    let old = parent.join(format!(".{name}.old-{}", std::process::id()));
-    if out.exists() {
-        fs::rename(out, &old).map_err(|e| io(out, e))?;
-    }
-    fs::rename(&staging, out).map_err(|e| io(out, e))?;
-    if old.exists() {
+    if let Some(old) = crate::publish::swap_into_place(&staging, out).map_err(|e| io(out, e))? {
         fs::remove_dir_all(&old).map_err(|e| io(&old, e))?;
     }
     Ok(())
