@@ -114,6 +114,18 @@ pub enum RenderError {
         /// Frames rendered.
         frames: u32,
     },
+    /// A `cache.*_slots` asks for more tiles than this adapter's texture arrays hold.
+    #[error(
+        "cache.{key} = {slots} slots is more than this adapter's texture arrays hold (at most {max} layers)"
+    )]
+    CacheTooLarge {
+        /// The setting: `height_slots`, `imagery_slots` or `landcover_slots`.
+        key: &'static str,
+        /// Slots asked for.
+        slots: u32,
+        /// The device's `max_texture_array_layers`.
+        max: u32,
+    },
     /// `render.width` or `render.height` exceeds the adapter's largest 2D texture.
     #[error("a {width}×{height} viewport is larger than this adapter's {max}-pixel targets")]
     ViewportTooLarge {

@@ -58,6 +58,17 @@ impl Caches {
     pub(super) fn new(gpu: &Gpu, dataset: &Dataset, settings: &Settings) -> Result<Self, RenderError> {
         let device = &gpu.device;
         let slots = &settings.cache;
+        // Each cache is one texture array, a slot a layer: past the limit, wgpu would only report
+        // an invalid texture, at every use.
+        let max = device.limits().max_texture_array_layers;
+        let asked = [
+            ("height_slots", slots.height_slots, true),
+            ("imagery_slots", slots.imagery_slots, dataset.imagery.is_some()),
+            ("landcover_slots", slots.landcover_slots, dataset.landcover.is_some()),
+        ];
+        if let Some(&(key, slots, _)) = asked.iter().find(|&&(_, n, used)| used && n > max) {
+            return Err(RenderError::CacheTooLarge { key, slots, max });
+        }
         let mut heights = TileCache::new(
             device,
             "height cache",

@@ -21,6 +21,13 @@ fn viewports_of_no_area_or_too_large_are_errors() {
         assert!(matches!(open(w, h), Err(RenderError::Camera(CameraError::Viewport(..)))), "{w}×{h}");
     }
     assert!(matches!(open(1 << 20, 8), Err(RenderError::ViewportTooLarge { .. })));
+    // A cache of more slots than a texture array holds is named, not a GPU validation error.
+    let mut settings = small_settings(64, 64);
+    settings.cache.imagery_slots = terramp_testkit::gpu().device.limits().max_texture_array_layers + 1;
+    let error =
+        Renderer::new(terramp_testkit::gpu(), Dataset::open(&dataset).unwrap(), settings).err().unwrap();
+    assert!(matches!(error, RenderError::CacheTooLarge { key: "imagery_slots", .. }), "{error}");
+    assert!(error.to_string().starts_with("cache.imagery_slots = "), "{error}");
     // One pixel is a viewport.
     let mut r = open(1, 1).unwrap();
     let dem = Dem::load(&r.dataset);
