@@ -8,7 +8,7 @@
 #   ROUNDS=3 STEPS="0.25 0 0.5 1" scripts/globe_vs_gdal.sh [OUT_DIR]
 #
 # Needs a release build (cargo build --release -p terramp-data-tools), gdalwarp (apt-get install
-# gdal-bin), GNU time at /usr/bin/time, and ../shared/data.
+# gdal-bin), GNU time at /usr/bin/time, bc, and ../shared/data.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 dem="$root/../shared/data/globe/globe_g_30arcsec.tif"
