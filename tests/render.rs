@@ -4,8 +4,8 @@
 
 use glam::DVec3;
 use terramp::camera::Camera;
-use terramp::frame::Renderer;
-use terramp::gpu::TimeSource;
+use terramp::frame::{RenderError, Renderer};
+use terramp::gpu::{GpuError, TimeSource};
 
 use terramp_testkit::camera::over_fraction;
 use terramp_testkit::{renderer, small_settings, synth_dataset};
@@ -149,4 +149,22 @@ fn a_headless_render_prints_no_window_system_errors() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
     assert!(!stderr.contains("XDG_RUNTIME_DIR") && !stderr.contains("error:"), "{stderr}");
+}
+
+#[test]
+fn a_lost_device_is_an_error_not_a_panic() {
+    let dataset = synth_dataset(300, 3);
+    let mut r = renderer(&dataset, small_settings(96, 54));
+    let camera = over_fraction(&r, [0.5, 0.5], 200.0, 30.0, -20.0);
+    r.render(&camera).unwrap();
+    // What a driver reset or a removed GPU does to wgpu's device, on demand.
+    r.gpu.device.destroy();
+    let errors: Vec<RenderError> = (0..6).map(|_| r.render(&camera).unwrap_err()).collect();
+    let lost =
+        |e: &RenderError| matches!(e, RenderError::Gpu(GpuError::DeviceLost(why)) if why == "Destroyed");
+    let first = errors.iter().position(lost).unwrap_or_else(|| panic!("never told of the loss: {errors:?}"));
+    assert_eq!(first, 0, "the first frame after the loss must say so: {errors:?}");
+    assert!(errors[first..].iter().all(lost), "once lost, always lost: {errors:?}");
+    let said = errors[first].to_string();
+    assert!(said.starts_with("the GPU device was lost (Destroyed); nothing more can be drawn"), "{said}");
 }

@@ -391,7 +391,15 @@ fn fly(
         let time_s = renderer.settings.wind.time_of_frame_s(i as usize);
         renderer.set_time_s(time_s);
         let start = Instant::now();
-        let report = renderer.render(&camera)?;
+        let report = match renderer.render(&camera) {
+            Ok(report) => report,
+            Err(error) => {
+                // A failed frame (a lost device, say) stops the flight with what it logged kept.
+                std::io::Write::flush(&mut log)?;
+                let logged = format!("{i} frames logged in {}", log_path.display());
+                return Err(anyhow::Error::new(error).context(format!("frame {i} of the flight ({logged})")));
+            }
+        };
         let save = save_every != 0 && i % save_every == 0;
         if save {
             save_png(&renderer.read_colour()?, &out.join(format!("frame_{i:04}.png")))?;

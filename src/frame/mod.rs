@@ -363,14 +363,26 @@ impl Renderer {
 
     /// Renders one frame from `camera`.
     pub fn render(&mut self, camera: &Camera) -> Result<FrameReport, RenderError> {
+        if let Some(why) = self.gpu.lost() {
+            return Err(GpuError::DeviceLost(why).into());
+        }
         camera.validate()?;
         let (camera, camera_lifted_m) = self.above_ground(camera);
         let mut report = FrameReport { frame: self.frame, camera_lifted_m, ..Default::default() };
-        let plan = self.prepare(&camera, &mut report)?;
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        self.encode(&mut encoder, &plan.nodes, &plan.tlm)?;
-        self.submit(encoder, plan, &mut report)?;
-        Ok(report)
+        let frame = self.prepare(&camera, &mut report).and_then(|plan| {
+            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, &plan.nodes, &plan.tlm)?;
+            self.submit(encoder, plan, &mut report)
+        });
+        // A lost device fails whatever step comes next, each in its own words: say the cause.
+        // wgpu tells of a loss once the queue has drained, so a frame the GPU failed waits for it.
+        if matches!(frame, Err(RenderError::Gpu(_))) && self.gpu.lost().is_none() {
+            let _ = self.gpu.wait();
+        }
+        match (frame, self.gpu.lost()) {
+            (_, Some(why)) => Err(GpuError::DeviceLost(why).into()),
+            (frame, None) => frame.map(|()| report),
+        }
     }
 
     /// Records the frame's passes, in the paper's order.

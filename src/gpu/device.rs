@@ -110,6 +110,10 @@ pub enum GpuError {
     /// `; `; also a readback that failed or never arrived.
     #[error("GPU error: {0}")]
     Validation(String),
+    /// The device is gone (a driver reset, a GPU removed or switched, or `destroy`): nothing more
+    /// can be drawn with it. Every later call says so, before the errors that follow from it.
+    #[error("the GPU device was lost ({0}); nothing more can be drawn with it: restart terramp")]
+    DeviceLost(String),
     /// Waiting for the device, or polling it, failed.
     #[error("waiting for the GPU: {0}")]
     Poll(#[from] wgpu::PollError),
@@ -133,6 +137,8 @@ pub struct Gpu {
     /// GPU timestamps can be written inside encoders (else the profiler times on the CPU).
     pub has_timestamps: bool,
     errors: Arc<Mutex<Vec<String>>>,
+    /// Why the device was lost, once it is.
+    lost: Arc<Mutex<Option<String>>>,
 }
 
 impl Gpu {
@@ -186,15 +192,28 @@ impl Gpu {
         }))
         .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
         let errors = Arc::new(Mutex::new(Vec::new()));
-        let sink = Arc::clone(&errors);
+        let lost = Arc::new(Mutex::new(None));
+        let (sink, lost_sink, was_lost) = (Arc::clone(&errors), Arc::clone(&lost), Arc::clone(&lost));
+        device.set_device_lost_callback(move |reason, message| {
+            let why =
+                if message.is_empty() { format!("{reason:?}") } else { format!("{reason:?}: {message}") };
+            eprintln!("terramp: the GPU device was lost ({why})");
+            if let Ok(mut lost) = lost_sink.lock() {
+                *lost = Some(why);
+            }
+        });
         device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            // After a loss every call fails on invalid objects: the loss is the one error to tell.
+            if was_lost.lock().is_ok_and(|lost| lost.is_some()) {
+                return;
+            }
             let text = error.to_string();
             eprintln!("terramp: GPU error: {text}");
             if let Ok(mut errors) = sink.lock() {
                 errors.push(text);
             }
         }));
-        Ok(Self { device, queue, info, adapter, has_timestamps, errors })
+        Ok(Self { device, queue, info, adapter, has_timestamps, errors, lost })
     }
 
     /// One line naming the adapter, for logs.
@@ -211,8 +230,16 @@ impl Gpu {
         Ok(())
     }
 
-    /// The GPU errors raised since the last check, as one error.
+    /// Why the device was lost, if it was.
+    pub fn lost(&self) -> Option<String> {
+        self.lost.lock().ok().and_then(|lost| lost.clone())
+    }
+
+    /// The GPU errors raised since the last check, as one error; a lost device first.
     pub fn check(&self) -> Result<(), GpuError> {
+        if let Some(why) = self.lost() {
+            return Err(GpuError::DeviceLost(why));
+        }
         let mut errors = self.errors.lock().map_err(|_| GpuError::Validation("error log poisoned".into()))?;
         if errors.is_empty() {
             return Ok(());
