@@ -288,3 +288,29 @@ pub(super) fn seed_inputs<'a>(
         active_ranks,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A device whose storage bindings hold at most `max_bytes`, as a smaller adapter's would.
+    fn device_binding_at_most(max_bytes: u64) -> wgpu::Device {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&Default::default())).unwrap();
+        let required_limits =
+            wgpu::Limits { max_storage_buffer_binding_size: max_bytes, ..Default::default() };
+        let descriptor = wgpu::DeviceDescriptor { required_limits, ..Default::default() };
+        pollster::block_on(adapter.request_device(&descriptor)).unwrap().0
+    }
+
+    #[test]
+    fn a_seed_capacity_beyond_one_binding_is_a_named_error() {
+        let device = device_binding_at_most(1 << 20);
+        let fits = (1u32 << 20) / size_of::<SeedRecord>() as u32;
+        check_capacity(&device, fits).unwrap();
+        let error = check_capacity(&device, fits + 1).unwrap_err();
+        assert!(matches!(error, RenderError::SeedCapacity { max, .. } if max == fits), "{error}");
+        let said = error.to_string();
+        assert!(said.starts_with(&format!("seeds.capacity = {} records does not fit", fits + 1)), "{said}");
+    }
+}
