@@ -1,6 +1,6 @@
 //! How it works: everything the tools publish (a dataset, an impostor, a forest sample) is a
-//! folder written under a hidden name beside its final place and then put in place by
-//! `swap_into_place`. Where a folder already stands there, the two are exchanged by one
+//! folder written under a hidden name beside its final place (`begin_staging`) and then put in
+//! place by `swap_into_place`. Where a folder already stands there, the two are exchanged by one
 //! `renameat2(RENAME_EXCHANGE)`: at every instant the final name holds either the old complete
 //! folder or the new complete one, so a process killed anywhere (even between the steps of
 //! publishing) never leaves the name empty or half-written; the old folder, now under the hidden
@@ -8,14 +8,40 @@
 //! exchange is not available (not Linux, or a file system without it) the old folder is renamed
 //! aside first, and a kill between the two renames leaves the name empty (never half-written).
 
+use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
+
+/// A new, empty hidden folder beside `out` (`.NAME.partial-PID`) for this process to write what
+/// will take `out`'s place; the ones killed runs left there are swept first (nothing else writes
+/// under that name). On failure, the path that failed with the error.
+pub fn begin_staging(out: &Path) -> Result<PathBuf, (PathBuf, io::Error)> {
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => PathBuf::from("."),
+    };
+    let name = out.file_name().map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
+    let at = |path: &Path| {
+        let path = path.to_owned();
+        move |e| (path, e)
+    };
+    fs::create_dir_all(&parent).map_err(at(&parent))?;
+    let prefix = format!(".{name}.partial-");
+    for entry in fs::read_dir(&parent).map_err(at(&parent))?.flatten() {
+        if entry.file_name().to_string_lossy().starts_with(&prefix) {
+            let _ = fs::remove_dir_all(entry.path());
+        }
+    }
+    let staging = parent.join(format!("{prefix}{}", std::process::id()));
+    fs::create_dir_all(&staging).map_err(at(&staging))?;
+    Ok(staging)
+}
 
 /// Puts the folder `staging` at `out`. Returns where the folder `out` held before now is (to be
 /// removed by the caller), `None` when `out` was empty.
 pub fn swap_into_place(staging: &Path, out: &Path) -> io::Result<Option<PathBuf>> {
     if !out.exists() {
-        std::fs::rename(staging, out)?;
+        fs::rename(staging, out)?;
         return Ok(None);
     }
     match exchange(staging, out) {
@@ -26,8 +52,8 @@ pub fn swap_into_place(staging: &Path, out: &Path) -> io::Result<Option<PathBuf>
     let mut aside = staging.as_os_str().to_owned();
     aside.push("-old");
     let aside = PathBuf::from(aside);
-    std::fs::rename(out, &aside)?;
-    std::fs::rename(staging, out)?;
+    fs::rename(out, &aside)?;
+    fs::rename(staging, out)?;
     Ok(Some(aside))
 }
 

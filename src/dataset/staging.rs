@@ -27,28 +27,15 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> DatasetError + '_ {
 impl Staging {
     /// Starts a build whose result will be `out`. An existing `out` is replaced only on commit.
     pub fn begin(out: &Path) -> Result<Self, DatasetError> {
-        let name = out
-            .file_name()
-            .and_then(|n| n.to_str())
-            .ok_or_else(|| DatasetError::BadOutput { path: out.to_owned() })?;
-        let parent = match out.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-            _ => PathBuf::from("."),
-        };
-        fs::create_dir_all(&parent).map_err(io(&parent))?;
+        if out.file_name().and_then(|n| n.to_str()).is_none() {
+            return Err(DatasetError::BadOutput { path: out.to_owned() });
+        }
         if out.exists() && !out.join(MANIFEST_FILE).exists() {
             // Refuse to replace something that is not a dataset: it may be the user's folder.
             return Err(DatasetError::NotADataset { path: out.to_owned() });
         }
-        let prefix = format!(".{name}.partial-");
-        for entry in fs::read_dir(&parent).map_err(io(&parent))?.flatten() {
-            if entry.file_name().to_string_lossy().starts_with(&prefix) {
-                // A killed earlier build: nothing else ever writes there.
-                let _ = fs::remove_dir_all(entry.path());
-            }
-        }
-        let staging = parent.join(format!("{prefix}{}", std::process::id()));
-        fs::create_dir_all(&staging).map_err(io(&staging))?;
+        let staging =
+            crate::publish::begin_staging(out).map_err(|(path, source)| DatasetError::Io { path, source })?;
         Ok(Self { out: out.to_owned(), staging, committed: false })
     }
 

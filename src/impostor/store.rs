@@ -38,18 +38,7 @@ pub fn replace_folder<E>(
     fill: impl FnOnce(&Path) -> Result<(), E>,
     io: impl Fn(&Path, std::io::Error) -> E,
 ) -> Result<(), E> {
-    let parent = out.parent().unwrap_or(Path::new("."));
-    let name = out.file_name().map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
-    fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
-    let prefix = format!(".{name}.partial-");
-    for entry in fs::read_dir(parent).map_err(|e| io(parent, e))?.flatten() {
-        if entry.file_name().to_string_lossy().starts_with(&prefix) {
-            // A killed earlier run's: nothing else writes there.
-            let _ = fs::remove_dir_all(entry.path());
-        }
-    }
-    let staging = parent.join(format!("{prefix}{}", std::process::id()));
-    fs::create_dir_all(&staging).map_err(|e| io(&staging, e))?;
+    let staging = crate::publish::begin_staging(out).map_err(|(path, e)| io(&path, e))?;
     if let Err(e) = fill(&staging) {
         let _ = fs::remove_dir_all(&staging);
         return Err(e);

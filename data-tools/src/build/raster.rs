@@ -164,13 +164,11 @@ impl GridRaster {
         honour_nodata: bool,
     ) -> Result<Self> {
         let path = source.path.clone();
-        for &band in bands {
-            source.band(band)?;
-        }
+        // Reading each band's nodata checks that the band exists, before any work.
+        let nodata = bands.iter().map(|&b| source.nodata(b)).collect::<Result<Vec<_>>>()?;
         let threads = rayon::current_num_threads().max(1);
         let mut handles = (1..threads).map(|_| source.reopen()).collect::<Result<Vec<_>>>()?;
         if honour_nodata && let Some(offset) = aligned_offset(&source, grid, grid_srs) {
-            let nodata = bands.iter().map(|&b| source.nodata(b)).collect::<Result<_>>()?;
             let size = source.size.map(|n| n as i64);
             handles.insert(0, source.dataset);
             let readers = handles.into_iter().map(|source| Mutex::new(Reader { warped: None, source }));
@@ -185,11 +183,8 @@ impl GridRaster {
                 size,
             });
         }
-        let mut has_nodata = false;
-        for &band in bands {
-            has_nodata |= source.nodata(band)?.is_some();
-        }
-        let args = warp_args(grid, grid_srs, resampling, honour_nodata && has_nodata)?;
+        let source_nodata = honour_nodata && nodata.iter().any(Option::is_some);
+        let args = warp_args(grid, grid_srs, resampling, source_nodata)?;
         handles.insert(0, source.dataset);
         let readers = handles
             .into_iter()

@@ -127,12 +127,13 @@ fn grid32(payload: &[u8]) -> Vec<u8> {
         out.extend(planes(&delta32(payload), 4));
         return out;
     };
-    let mut residues = steps.clone();
-    let row = row_words(steps.len());
-    for (i, residue) in residues.iter_mut().enumerate() {
-        let r = steps[i].wrapping_sub(predict(&steps, i, row)) as i32;
-        *residue = ((r << 1) ^ (r >> 31)) as u32;
-    }
+    let residues: Vec<u32> = residues(&steps)
+        .into_iter()
+        .map(|r| {
+            let r = r as i32;
+            ((r << 1) ^ (r >> 31)) as u32
+        })
+        .collect();
     let mut out = vec![GRID_ON];
     out.extend(exponent.to_le_bytes());
     out.extend(planes(bytemuck::cast_slice(&residues), 4));
@@ -157,10 +158,7 @@ fn ungrid32(bytes: &[u8], tile_bytes: usize) -> Option<Vec<u8>> {
                     ((z >> 1) as i32 ^ -((z & 1) as i32)) as u32
                 })
                 .collect();
-            let row = row_words(steps.len());
-            for i in 0..steps.len() {
-                steps[i] = steps[i].wrapping_add(predict(&steps, i, row));
-            }
+            add_predictions(&mut steps);
             Some(steps.iter().flat_map(|&k| ((f64::from(k as i32) * step) as f32).to_le_bytes()).collect())
         }
         _ => None,
@@ -260,24 +258,32 @@ fn predict(words: &[u32], i: usize, row: usize) -> u32 {
 }
 
 /// Little-endian 32-bit words, each minus its plane prediction (wrapping); a tail stays as it is.
+/// Each word minus its plane prediction (wrapping).
+fn residues(words: &[u32]) -> Vec<u32> {
+    let row = row_words(words.len());
+    (0..words.len()).map(|i| words[i].wrapping_sub(predict(words, i, row))).collect()
+}
+
+/// Undoes `residues` in place, in the order the predictions need.
+fn add_predictions(words: &mut [u32]) {
+    let row = row_words(words.len());
+    for i in 0..words.len() {
+        words[i] = words[i].wrapping_add(predict(words, i, row));
+    }
+}
+
 fn delta32(bytes: &[u8]) -> Vec<u8> {
     let words: Vec<u32> =
         bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
-    let row = row_words(words.len());
-    let mut out = bytes.to_vec();
-    for (i, chunk) in out.chunks_exact_mut(4).enumerate() {
-        chunk.copy_from_slice(&words[i].wrapping_sub(predict(&words, i, row)).to_le_bytes());
-    }
+    let mut out: Vec<u8> = residues(&words).iter().flat_map(|w| w.to_le_bytes()).collect();
+    out.extend_from_slice(&bytes[out.len()..]);
     out
 }
 
 fn undelta32(bytes: &[u8]) -> Vec<u8> {
     let mut words: Vec<u32> =
         bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
-    let row = row_words(words.len());
-    for i in 0..words.len() {
-        words[i] = words[i].wrapping_add(predict(&words, i, row));
-    }
+    add_predictions(&mut words);
     let mut out: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     out.extend_from_slice(&bytes[out.len()..]);
     out
