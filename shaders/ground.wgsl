@@ -9,7 +9,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
     let height_m = in.rel_m.z + u.camera_grid_m.z;
     var albedo = tint(height_m, normal);
-    if u.has_imagery != 0u {
+    if u.imagery_texels != IMAGERY_NONE {
         // Where the imagery has no data (or no tile is resident yet), the relief tint shows.
         let imagery = imagery_albedo(in.grid_m);
         albedo = mix(albedo, imagery.rgb, imagery.a);

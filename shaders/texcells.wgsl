@@ -223,7 +223,7 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
 // camera, seen along `view` at `distance_m`, over ground of imagery colour `ground`.
 fn shade(albedo: vec3<f32>, ground: vec4<f32>, rel_m: vec3<f32>, view: vec3<f32>, distance_m: f32, opacity: f32) -> vec4<f32> {
     var tinted = albedo;
-    if u.has_imagery != 0u {
+    if u.imagery_texels != IMAGERY_NONE {
         tinted = mix(albedo, ground.rgb, ground.a * tu.ground_blend);
     }
     // Lit as the seeds are, on average: the leaves the eye sees face it (the seeds turn every

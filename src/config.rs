@@ -184,6 +184,20 @@ pub struct ImagerySettings {
     pub lod_bias: f64,
     /// Anisotropic filtering, 1 (off) to 16, or 0 for automatic (see `anisotropy_on`).
     pub anisotropy: u16,
+    /// How block-compressed imagery is held in the cache (see `decode_blocks_on`).
+    pub blocks: ImageryBlocks,
+}
+
+/// How block-compressed imagery (BC1, BC7) is held in the imagery cache.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ImageryBlocks {
+    /// Sampled as stored on a hardware GPU, decoded on load on a software rasteriser.
+    Auto,
+    /// Sampled as stored (where the adapter can).
+    Sample,
+    /// Decoded to RGBA8 as each tile loads.
+    Decode,
 }
 
 impl ImagerySettings {
@@ -195,6 +209,16 @@ impl ImagerySettings {
             (n, _) => n,
         }
     }
+
+    /// Whether block-compressed imagery is decoded on load on an adapter (`software`: a CPU
+    /// rasteriser, which decodes blocks at every fetch), resolving `Auto`.
+    pub fn decode_blocks_on(&self, software: bool) -> bool {
+        match self.blocks {
+            ImageryBlocks::Auto => software,
+            ImageryBlocks::Sample => false,
+            ImageryBlocks::Decode => true,
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -204,7 +228,8 @@ impl ImagerySettings {
 pub struct CacheSettings {
     /// Height tile slots on the GPU (259² × 4 bytes, 262 KiB each).
     pub height_slots: u32,
-    /// Imagery tile slots on the GPU (528² × 4 bytes with mips, 1.45 MiB each).
+    /// Imagery tile slots on the GPU (528² × 4 bytes with mips, 1.45 MiB each; a quarter of that
+    /// in BC7 blocks, an eighth in BC1).
     pub imagery_slots: u32,
     /// Land-cover tile slots on the GPU (512² bytes, 256 KiB each), read by seeds near the camera.
     pub landcover_slots: u32,

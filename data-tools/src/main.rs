@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use terramp::dataset::ImageryFormat;
 
 #[derive(Parser)]
 #[command(name = "terramp-data", version, about)]
@@ -50,6 +51,9 @@ enum Command {
         /// Random seed: the same seed gives the same dataset, bit for bit.
         #[arg(long, default_value_t = terramp::synth::SynthParams::default().seed)]
         seed: u64,
+        /// How the imagery is stored: rgba8, or bc7 / bc1 blocks (4× / 8× smaller, lossy).
+        #[arg(long, default_value = "rgba8", value_parser = parse_imagery_format)]
+        imagery_format: ImageryFormat,
     },
     /// Bake impostors (billboard clouds at 3 LODs, atlases with mips, the mesh) from glTF models,
     /// and with --classes the forest samples (texcells) of a class table's dense classes.
@@ -146,13 +150,21 @@ fn main() -> Result<()> {
         Command::Bake(args) => bake(args),
         Command::Tree(args) => models::tree(&args),
         Command::Preview(args) => models::preview(&args),
-        Command::Synth { size, out, seed } => {
-            let params = terramp::synth::SynthParams { size, seed, ..Default::default() };
+        Command::Synth { size, out, seed, imagery_format } => {
+            let params = terramp::synth::SynthParams { size, seed, imagery_format, ..Default::default() };
             let dir = terramp::synth::synthesize(&out, &params, true)?;
             println!("wrote {}", dir.display());
             Ok(())
         }
     }
+}
+
+/// `--imagery-format`: `rgba8`, `bc1` or `bc7`.
+pub(crate) fn parse_imagery_format(text: &str) -> Result<ImageryFormat, String> {
+    ImageryFormat::ALL.into_iter().find(|f| f.short_name() == text).ok_or_else(|| {
+        let names: Vec<&str> = ImageryFormat::ALL.iter().map(|f| f.short_name()).collect();
+        format!("`{text}`: expected one of {}", names.join(", "))
+    })
 }
 
 /// `--slicings ORIENTATIONSxSLICES`, e.g. `6x5`.

@@ -14,8 +14,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail, ensure};
 use serde::{Deserialize, Serialize};
-use terramp::dataset::PACK_VERSION;
 use terramp::dataset::lcc::{LCC_SOURCE_LEVEL, LccCoding};
+use terramp::dataset::{ImageryFormat, PACK_VERSION};
 use terramp::synth::{SynthParams, SynthParts};
 
 /// The plan file's format; a job refuses a plan of another.
@@ -37,6 +37,10 @@ pub struct PlanArgs {
     /// The plan file to write.
     #[arg(long)]
     out: PathBuf,
+    /// How the merged dataset stores its imagery (`build --imagery-format`): the partitions write
+    /// plain texels, which the merge turns into blocks once every level is made.
+    #[arg(long, default_value = "rgba8", value_parser = crate::parse_imagery_format)]
+    imagery_format: ImageryFormat,
     /// The folder the jobs write their parts into, shared by every node (default: beside the plan,
     /// `<plan>.parts`); relative paths are from the plan's folder.
     #[arg(long)]
@@ -80,8 +84,16 @@ struct Plan {
     partitions: u32,
     parts: PathBuf,
     source: Source,
+    /// The merged dataset's imagery format (short name); the parts do not depend on it, so it is
+    /// not hashed.
+    #[serde(default = "plain_imagery")]
+    imagery_format: String,
     coding: LccCoding,
     layers: Vec<LayerPlan>,
+}
+
+fn plain_imagery() -> String {
+    ImageryFormat::Rgba8.short_name().to_owned()
 }
 
 /// A finished partition's receipt.
@@ -153,7 +165,9 @@ impl Plan {
     }
 
     fn build(&self) -> Result<SynthParts> {
-        Ok(SynthParts::new(&self.source.params(), self.partitions, self.coding.clone())?)
+        let imagery_format = crate::parse_imagery_format(&self.imagery_format).map_err(anyhow::Error::msg)?;
+        let params = SynthParams { imagery_format, ..self.source.params() };
+        Ok(SynthParts::new(&params, self.partitions, self.coding.clone())?)
     }
 }
 
@@ -199,6 +213,7 @@ pub fn plan(args: &PlanArgs) -> Result<()> {
         partitions: args.partitions,
         parts: args.parts.clone().unwrap_or_else(|| PathBuf::from(format!("{stem}.parts"))),
         source,
+        imagery_format: args.imagery_format.short_name().to_owned(),
         coding: parts.coding.clone(),
         layers,
     };

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
 use support::{build, gdal_band, height_image, level_image, mask_image, north_first, number_before};
-use terramp::dataset::{Dataset, DatasetError, PackError, TileId};
+use terramp::dataset::{Dataset, DatasetError, ImageryFormat, PackError, TileId};
 use terramp_testkit::{TempDir, shared_data};
 
 /// Truth from `gdallocationinfo -valonly nc/elev_ned_30m.tif COL ROW`: (row, col, metres).
@@ -111,6 +111,49 @@ fn nc_trio_is_copied_exactly_and_tiles_agree() {
         (40.0..200.0).contains(&mean_grey),
         "stretched imagery should be mid-grey on average: {mean_grey}"
     );
+}
+
+/// nc's Landsat scene, which leaves a corner of the DEM uncovered, stored in BC7 and BC1 blocks:
+/// each decodes close to the plain build, with its holes where the plain one has them.
+#[test]
+fn nc_imagery_in_blocks_keeps_its_holes() {
+    let Some(data) = shared_data() else { return };
+    let tmp = TempDir::new("nc-blocks");
+    let nc = |file: &str| data.join("nc").join(file).to_str().unwrap().to_owned();
+    let (dem, imagery) = (nc("elev_ned_30m.tif"), nc("landsat_multiband.tif"));
+    let build_as = |format: &str| {
+        let args = ["--dem", &dem, "--imagery", &imagery, "--bands", "3,2,1", "--imagery-format", format];
+        build(&tmp.path().join(format), &args).0
+    };
+    let level0 = |dataset: &Dataset| {
+        let layer = dataset.imagery.as_ref().unwrap();
+        let extent = layer.pyramid.tile_extent() as usize;
+        level_image(&layer.pyramid, 0, |id| {
+            let texels = layer.tile_texels(id).unwrap();
+            texels[..extent * extent * 4].chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect()
+        })
+    };
+    let plain = level0(&build_as("rgba8"));
+    for (format, floor_db, alpha_error) in [(ImageryFormat::Bc7, 33.5, 8), (ImageryFormat::Bc1, 27.5, 0)] {
+        let dataset = build_as(format.short_name());
+        let layer = dataset.imagery.as_ref().unwrap();
+        assert_eq!(
+            (dataset.manifest.imagery.as_ref().unwrap().format.as_str(), layer.block_format),
+            (format.name(), Some(format))
+        );
+        assert_eq!(layer.pack().tile_bytes(), format.tile_bytes(&layer.pyramid, layer.mips));
+        let texels = level0(&dataset);
+        let (mut squared, mut covered) = (0.0, 0usize);
+        for (k, (b, p)) in texels.iter().zip(&plain).enumerate() {
+            assert!(b[3].abs_diff(p[3]) <= alpha_error, "{format} texel {k}: alpha {} for {}", b[3], p[3]);
+            if p[3] == 255 {
+                squared += (0..3).map(|c| (f64::from(b[c]) - f64::from(p[c])).powi(2)).sum::<f64>();
+                covered += 3;
+            }
+        }
+        let db = 10.0 * (255.0f64.powi(2) * covered as f64 / squared).log10();
+        assert!(db >= floor_db, "{format}: {db:.1} dB over the covered texels");
+    }
 }
 
 #[test]

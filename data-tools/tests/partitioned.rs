@@ -85,6 +85,23 @@ fn jobs_run_one_by_one_merge_into_the_single_process_build() {
     // Idempotent: a partition built for this plan is not built again.
     let again = stdout(&terramp_data(&["build", "--plan", path(&plan), "--partition", "1"]));
     assert!(again.contains("already built"), "{again}");
+
+    // The imagery's format is the merge's alone: a plan for BC7 over the same parts builds nothing
+    // again, and merges into the single-process BC7 build.
+    let bc7_plan = dir.path().join("plan-bc7.toml");
+    let parts = dir.path().join("plan.parts");
+    let args = ["--synth-size", SIZE, "--seed", SEED, "--partitions", "3", "--imagery-format", "bc7"];
+    terramp_data(&[&["plan"], &args[..], &["--parts", path(&parts), "--out", path(&bc7_plan)]].concat());
+    for part in ["0", "1", "2"] {
+        let again = stdout(&terramp_data(&["build", "--plan", path(&bc7_plan), "--partition", part]));
+        assert!(again.contains("already built"), "{again}");
+    }
+    let (single_bc7, merged_bc7) = (dir.path().join("single-bc7"), dir.path().join("merged-bc7"));
+    let synth =
+        ["synth", "--size", SIZE, "--seed", SEED, "--imagery-format", "bc7", "--out", path(&single_bc7)];
+    terramp_data(&synth);
+    terramp_data(&["merge", "--plan", path(&bc7_plan), "--out", path(&merged_bc7)]);
+    assert_same_dataset(&single_bc7, &merged_bc7);
 }
 
 #[test]

@@ -50,5 +50,9 @@ fn imagery_albedo(grid_m: vec2<f32>) -> vec4<f32> {
     // The cache is an sRGB texture: filtering happens on linear values, as it should.
     let colour = textureSampleGrad(imagery_tiles, imagery_sampler, uv, page_layer(slot),
                                    ddx0 * scale / extent, ddy0 * scale / extent);
+    if u.imagery_texels == IMAGERY_PUNCHED && colour.a > 0.0 {
+        // Transparent black texels added nothing but weight: the covered ones' mean colour.
+        return vec4<f32>(colour.rgb / colour.a, colour.a);
+    }
     return colour;
 }

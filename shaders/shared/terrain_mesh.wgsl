@@ -18,7 +18,7 @@ struct TerrainUniforms {
     camera_grid_m: vec4<f32>,
     height_range_m: vec2<f32>,
     node_cells: u32,
-    has_imagery: u32,
+    imagery_texels: u32,
     imagery_frame: vec4<f32>,
     cloud_field: vec4<f32>,
     cloud_shift: vec4<f32>,

@@ -469,8 +469,8 @@ fn info(dataset_dir: &Path) -> Result<()> {
     );
     if let Some(i) = &m.imagery {
         println!(
-            "  imagery: {}×{} texels at {} m, {} levels",
-            i.pyramid.size[0], i.pyramid.size[1], i.texel_m, i.pyramid.levels
+            "  imagery: {}×{} texels at {} m, {} levels, {}",
+            i.pyramid.size[0], i.pyramid.size[1], i.texel_m, i.pyramid.levels, i.format
         );
     }
     if let Some(l) = &m.landcover {

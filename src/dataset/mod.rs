@@ -12,6 +12,9 @@
 //! tile by tile; `lcc::write_lcc_layer` for land cover), shared by `terramp-data build` and the
 //! synthetic generator.
 
+#[cfg(feature = "bc-encode")]
+pub mod block_encode;
+pub mod imagery_format;
 pub mod layer_writer;
 pub mod lcc;
 pub mod manifest;
@@ -31,6 +34,7 @@ use thiserror::Error;
 
 use lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
 
+pub use imagery_format::{ImageryFormat, MipLayout};
 pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer};
 pub use manifest::{
     CellLayer, ClassName, Crs, FORMAT_VERSION, HeightLayer, LandcoverLayer, MANIFEST_FILE, Manifest,
@@ -123,9 +127,33 @@ pub struct LayerPack {
     pub pyramid: Pyramid,
     /// Mips stored per tile: the imagery's count, 1 for heights, the mask and land cover.
     pub mips: u32,
+    /// How the texels are stored when in blocks (block-compressed imagery); `None` when plain.
+    pub block_format: Option<ImageryFormat>,
     pack: Pack,
-    /// The latest decoded tiles (compressed packs only), newest last.
-    decoded: Mutex<VecDeque<(u64, Arc<[u8]>)>>,
+    /// The latest tiles decompressed from the pack (compressed packs only).
+    decoded: RecentTiles,
+    /// The latest tiles decoded from blocks into plain texels (block formats only).
+    plain: RecentTiles,
+}
+
+/// The latest few tiles made by decoding, newest last, by pack index.
+#[derive(Default)]
+struct RecentTiles(Mutex<VecDeque<(u64, Arc<[u8]>)>>);
+
+impl RecentTiles {
+    fn get(&self, index: u64) -> Option<Arc<[u8]>> {
+        let tiles = self.0.lock().ok()?;
+        tiles.iter().find(|(i, _)| *i == index).map(|(_, bytes)| Arc::clone(bytes))
+    }
+
+    fn keep(&self, index: u64, bytes: &Arc<[u8]>) {
+        if let Ok(mut tiles) = self.0.lock() {
+            if tiles.len() == DECODED_TILES_KEPT {
+                tiles.pop_front();
+            }
+            tiles.push_back((index, Arc::clone(bytes)));
+        }
+    }
 }
 
 /// A tile's payload: in the pack's mapping (stored raw), or decoded and shared.
@@ -158,26 +186,45 @@ impl std::ops::Deref for TileBytes<'_> {
 }
 
 impl LayerPack {
+    /// The pack `file` in `dir`, checked to hold a tile of `tile_bytes` for every tile of `pyramid`.
     fn open(
+        dir: &Path,
+        file: &str,
+        pyramid: Pyramid,
+        mips: u32,
+        tile_bytes: u64,
+        block_format: Option<ImageryFormat>,
+    ) -> Result<Self, DatasetError> {
+        let pack = Pack::open(&dir.join(file))?;
+        if pack.tile_count() != pyramid.tile_count() || pack.tile_bytes() != tile_bytes {
+            return Err(DatasetError::PackShape {
+                path: pack.path().to_owned(),
+                found: pack.tile_count(),
+                found_bytes: pack.tile_bytes(),
+                expected: pyramid.tile_count(),
+                expected_bytes: tile_bytes,
+            });
+        }
+        Ok(Self {
+            pyramid,
+            mips,
+            block_format,
+            pack,
+            decoded: RecentTiles::default(),
+            plain: RecentTiles::default(),
+        })
+    }
+
+    /// A pack of plain texels of `texel_bytes` each, `mips` mips a tile.
+    fn open_plain(
         dir: &Path,
         file: &str,
         pyramid: Pyramid,
         mips: u32,
         texel_bytes: usize,
     ) -> Result<Self, DatasetError> {
-        let pack = Pack::open(&dir.join(file))?;
         let spec = LayerSpec { name: "", pyramid, mips, reduce: Reduce::Decimate };
-        let expected_bytes = (spec.tile_texels() * texel_bytes) as u64;
-        if pack.tile_count() != pyramid.tile_count() || pack.tile_bytes() != expected_bytes {
-            return Err(DatasetError::PackShape {
-                path: pack.path().to_owned(),
-                found: pack.tile_count(),
-                found_bytes: pack.tile_bytes(),
-                expected: pyramid.tile_count(),
-                expected_bytes,
-            });
-        }
-        Ok(Self { pyramid, mips, pack, decoded: Mutex::default() })
+        Self::open(dir, file, pyramid, mips, (spec.tile_texels() * texel_bytes) as u64, None)
     }
 
     /// The layer's pack: its codec and sizes.
@@ -196,33 +243,42 @@ impl LayerPack {
         self.pack.tile_range(index)
     }
 
-    /// The tile's payload (all mips), checksum verified: from the mapping, or decoded (the last
-    /// `DECODED_TILES_KEPT` decoded are kept for the next reads).
-    pub fn tile_bytes(&self, id: TileId) -> Result<TileBytes<'_>, PackError> {
-        let index = self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
+    fn index_of(&self, id: TileId) -> Result<u64, PackError> {
+        self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
             path: self.pack.path().to_owned(),
             index: u64::MAX,
             count: self.pack.tile_count(),
-        })?;
-        let kept = |decoded: &VecDeque<(u64, Arc<[u8]>)>| {
-            decoded.iter().find(|(i, _)| *i == index).map(|(_, bytes)| Arc::clone(bytes))
-        };
-        if let Some(bytes) = self.decoded.lock().ok().and_then(|d| kept(&d)) {
+        })
+    }
+
+    /// The tile's payload (all mips) as stored, checksum verified: from the mapping, or
+    /// decompressed (the last `DECODED_TILES_KEPT` are kept for the next reads).
+    pub fn tile_bytes(&self, id: TileId) -> Result<TileBytes<'_>, PackError> {
+        let index = self.index_of(id)?;
+        if let Some(bytes) = self.decoded.get(index) {
             return Ok(TileBytes::Decoded(bytes));
         }
         Ok(match self.pack.tile(index)? {
             Cow::Borrowed(bytes) => TileBytes::Mapped(bytes),
             Cow::Owned(bytes) => {
                 let bytes: Arc<[u8]> = bytes.into();
-                if let Ok(mut decoded) = self.decoded.lock() {
-                    if decoded.len() == DECODED_TILES_KEPT {
-                        decoded.pop_front();
-                    }
-                    decoded.push_back((index, Arc::clone(&bytes)));
-                }
+                self.decoded.keep(index, &bytes);
                 TileBytes::Decoded(bytes)
             }
         })
+    }
+
+    /// The tile's texels (all mips, each `mip_extent`² texels): the payload itself when stored
+    /// plain, else decoded from its blocks into RGBA8 (the last few are kept for the next reads).
+    pub fn tile_texels(&self, id: TileId) -> Result<TileBytes<'_>, PackError> {
+        let Some(format) = self.block_format else { return self.tile_bytes(id) };
+        let index = self.index_of(id)?;
+        if let Some(texels) = self.plain.get(index) {
+            return Ok(TileBytes::Decoded(texels));
+        }
+        let texels: Arc<[u8]> = format.decode_tile(&self.pyramid, self.mips, &self.tile_bytes(id)?).into();
+        self.plain.keep(index, &texels);
+        Ok(TileBytes::Decoded(texels))
     }
 }
 
@@ -236,7 +292,8 @@ pub struct Dataset {
     pub height: LayerPack,
     /// 1 where the DEM had a value, 0 where it was filled; absent when nothing was filled.
     pub valid_mask: Option<LayerPack>,
-    /// The aerial imagery, RGBA8 sRGB texels with their mips; absent when the dataset has none.
+    /// The aerial imagery, RGBA8 sRGB texels with their mips, plain or in BC1/BC7 blocks
+    /// (`LayerPack::block_format`); absent when the dataset has none.
     pub imagery: Option<LayerPack>,
     /// The land cover's LCC quadtree of palette-index words (read through `lcc_coding`); absent
     /// when the dataset has none.
@@ -265,18 +322,25 @@ impl Dataset {
         }
         let manifest: Manifest = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
         let height =
-            LayerPack::open(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?;
+            LayerPack::open_plain(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?;
         let valid_mask = manifest
             .height
             .valid_mask_pack
             .as_ref()
-            .map(|pack| LayerPack::open(dir, pack, manifest.height.pyramid, 1, 1))
+            .map(|pack| LayerPack::open_plain(dir, pack, manifest.height.pyramid, 1, 1))
             .transpose()?;
-        let imagery = manifest
-            .imagery
-            .as_ref()
-            .map(|l| LayerPack::open(dir, &l.pack, l.pyramid, l.mips, 4))
-            .transpose()?;
+        let imagery = match &manifest.imagery {
+            Some(l) => {
+                let format = ImageryFormat::from_name(&l.format).ok_or_else(|| {
+                    let known: Vec<&str> = ImageryFormat::ALL.iter().map(|f| f.name()).collect();
+                    bad(format!("imagery: format {:?} is none of {}", l.format, known.join(", ")))
+                })?;
+                let bytes = format.tile_bytes(&l.pyramid, l.mips);
+                let blocks = format.is_block_compressed().then_some(format);
+                Some(LayerPack::open(dir, &l.pack, l.pyramid, l.mips, bytes, blocks)?)
+            }
+            None => None,
+        };
         let landcover = match &manifest.landcover {
             Some(l) => {
                 l.coding.validate().map_err(|e| bad(format!("land cover: {e}")))?;
@@ -289,7 +353,7 @@ impl Dataset {
                     );
                     return Err(bad(message));
                 }
-                Some(LayerPack::open(dir, &l.layer.pack, *p, 1, l.coding.word_bytes())?)
+                Some(LayerPack::open_plain(dir, &l.layer.pack, *p, 1, l.coding.word_bytes())?)
             }
             None => None,
         };

@@ -332,3 +332,34 @@ fn stored_tiles_have_the_extents_the_shaders_read() {
         assert_eq!(LayerSpec::imagery(size).pyramid.tile_extent(), IMAGERY_TILE_EXTENT);
     }
 }
+
+#[test]
+fn an_imagery_format_unknown_or_unlike_its_pack_is_refused() {
+    let (path, spec) = write_heights("imagery-format", [37, 21]);
+    let dir = path.parent().unwrap();
+    let imagery = LayerSpec::imagery([40, 24]);
+    let colour = |x: u32, y: u32| [x as u8, y as u8, 0, 255];
+    write_layer(&dir.join("imagery.pack"), &imagery, source_of(colour), &ProgressBar::hidden()).unwrap();
+    let with_format = |format: &str| {
+        let layer = CellLayer {
+            pack: "imagery.pack".into(),
+            texel_m: 28.5,
+            pyramid: imagery.pyramid,
+            mips: imagery.mips,
+            format: format.into(),
+            source: "test".into(),
+        };
+        let text = toml::to_string_pretty(&Manifest { imagery: Some(layer), ..manifest_for(&spec) }).unwrap();
+        std::fs::write(dir.join(MANIFEST_FILE), text).unwrap();
+        Dataset::open(dir)
+    };
+    assert!(with_format("rgba8 srgb").is_ok());
+    let err = with_format("bc3 srgb").err().expect("an unknown format");
+    assert!(
+        matches!(err, DatasetError::Manifest { .. }) && err.to_string().contains("\"bc3 srgb\""),
+        "{err}"
+    );
+    // An RGBA8 pack under a BC7 manifest: its tiles are 4 times the size the format says.
+    let err = with_format("bc7 srgb").err().expect("a pack of another format");
+    assert!(matches!(err, DatasetError::PackShape { .. }), "{err}");
+}

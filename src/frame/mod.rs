@@ -28,7 +28,7 @@ use crate::passes::tile_load_map::frame::{TlmFrame, height_tile_ranges};
 use crate::passes::tile_load_map::gpu::{TileLoadMapPass, TlmBindings};
 use crate::passes::tile_load_map::layout::TlmLayout;
 use crate::seeds::wind::{Wind, WindFrame};
-use crate::streaming::{CacheStats, Loader, LoaderError, TileCache};
+use crate::streaming::{CacheStats, Delivery, Loader, LoaderError, TileCache};
 
 mod clearance;
 mod prepare;
@@ -197,6 +197,8 @@ struct LastFrame {
 struct Caches {
     heights: TileCache,
     imagery: TileCache,
+    /// How the loader hands the imagery cache its tiles: as stored, or decoded from blocks.
+    imagery_delivery: Delivery,
     /// `None` without land cover.
     landcover: Option<TileCache>,
     /// The coarsest tiles of each layer, resident from the first frame on and never evicted (all
@@ -265,7 +267,11 @@ impl Renderer {
         let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
         let ground = GroundPass::new(device, &settings, software, &terrain);
         let caches = Caches::new(&gpu, &dataset, &settings)?;
-        let loader = Loader::new(Arc::clone(&dataset), settings.cache.loader_threads as usize)?;
+        let loader = Loader::new(
+            Arc::clone(&dataset),
+            settings.cache.loader_threads as usize,
+            caches.imagery_delivery,
+        )?;
         let depth_pyramid = DepthPyramid::new(device, settings.render.width, settings.render.height);
         let tlm = TileLoadMapPass::new(device, &settings);
         let tlm_bindings = tlm.bind_group(device, &height_tile_ranges(&dataset), &depth_pyramid);

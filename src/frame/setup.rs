@@ -1,15 +1,17 @@
 //! How it works: what a renderer makes once, before its first frame: the render targets (checked
 //! against the adapter's limits, so a bad viewport is an error here rather than a GPU error
 //! later) and the three tile caches, whose coarsest levels load now, synchronously, because every
-//! later frame falls back on them.
+//! later frame falls back on them. Block-compressed imagery goes to a cache of its own format
+//! where the adapter samples it, else to an RGBA8 cache that the loader feeds decoded tiles.
 
 use crate::config::Settings;
-use crate::dataset::{Dataset, IMAGERY_MIPS, LayerSpec};
+use crate::dataset::{Dataset, IMAGERY_MIPS, LayerPack, LayerSpec};
 use crate::gpu::Gpu;
 use crate::gpu::layout::MAX_LEVELS;
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
+use crate::streaming::loader::imagery_tile;
 use crate::streaming::wants::pinned_tiles;
-use crate::streaming::{LayerKind, TileCache};
+use crate::streaming::{Delivery, LayerKind, TileCache};
 
 use super::{Caches, RenderError, Targets};
 use crate::camera::CameraError;
@@ -78,6 +80,10 @@ impl Caches {
             wgpu::TextureFormat::R32Float,
             slots.height_slots,
         );
+        let imagery_delivery = dataset.imagery.as_ref().map_or(Delivery::Stored, |layer| {
+            let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
+            imagery_delivery(layer, device.features(), settings.imagery.decode_blocks_on(software))
+        });
         let mut imagery = match &dataset.imagery {
             Some(layer) if layer.pyramid.levels > MAX_LEVELS => {
                 return Err(RenderError::TooManyLevels { levels: layer.pyramid.levels });
@@ -88,7 +94,10 @@ impl Caches {
                 LayerKind::Imagery,
                 layer.pyramid,
                 layer.mips,
-                wgpu::TextureFormat::Rgba8UnormSrgb,
+                match (imagery_delivery, layer.block_format) {
+                    (Delivery::Stored, Some(format)) => format.texture_format(),
+                    _ => wgpu::TextureFormat::Rgba8UnormSrgb,
+                },
                 slots.imagery_slots,
             ),
             // The shader reads imagery through the same bindings either way; a one-slot cache
@@ -110,7 +119,7 @@ impl Caches {
         let pinned_imagery = match &dataset.imagery {
             Some(layer) => {
                 let pinned = pin(&imagery);
-                imagery.load_now(&gpu.queue, &pinned, 0, |id| layer.tile_bytes(id));
+                imagery.load_now(&gpu.queue, &pinned, 0, |id| imagery_tile(layer, id, imagery_delivery));
                 pinned
             }
             None => Vec::new(),
@@ -127,6 +136,29 @@ impl Caches {
             )),
             _ => None,
         };
-        Ok(Self { heights, imagery, landcover, pinned_heights, pinned_imagery, pinned_landcover: Vec::new() })
+        Ok(Self {
+            heights,
+            imagery,
+            imagery_delivery,
+            landcover,
+            pinned_heights,
+            pinned_imagery,
+            pinned_landcover: Vec::new(),
+        })
     }
+}
+
+/// How the imagery cache takes `layer`'s tiles on a device with `features`: as stored, unless
+/// they are blocks the device cannot sample (said once, here) or `decode` asks for plain texels.
+fn imagery_delivery(layer: &LayerPack, features: wgpu::Features, decode: bool) -> Delivery {
+    let Some(format) = layer.block_format else { return Delivery::Stored };
+    if !features.contains(wgpu::Features::TEXTURE_COMPRESSION_BC) {
+        eprintln!(
+            "terramp: this adapter cannot sample {format} blocks: the imagery is decoded to RGBA8 as it \
+             loads ({}× the GPU memory and uploads of a slot)",
+            4 * 16 / format.texture_format().block_copy_size(None).unwrap_or(16)
+        );
+        return Delivery::ImageryDecoded;
+    }
+    if decode { Delivery::ImageryDecoded } else { Delivery::Stored }
 }

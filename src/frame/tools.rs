@@ -16,6 +16,7 @@ use crate::reference::oracle::OracleInputs;
 use crate::reference::seed_select::{SeedSnapshot, seed_select, seed_select_blocks, snapshot_caches};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
+use crate::streaming::loader::imagery_tile;
 use crate::streaming::wants::pinned_tiles;
 use crate::streaming::{CacheStats, TileCache};
 
@@ -57,7 +58,8 @@ impl Renderer {
         c.heights.load_now(queue, &c.pinned_heights, frame, |id| self.dataset.height.tile_bytes(id));
         if let Some(layer) = &self.dataset.imagery {
             c.pinned_imagery = everything(&c.imagery, "imagery")?;
-            c.imagery.load_now(queue, &c.pinned_imagery, frame, |id| layer.tile_bytes(id));
+            let delivery = c.imagery_delivery;
+            c.imagery.load_now(queue, &c.pinned_imagery, frame, |id| imagery_tile(layer, id, delivery));
         }
         if let (Some(layer), Some(cache)) = (&self.dataset.landcover, c.landcover.as_mut()) {
             c.pinned_landcover = everything(cache, "land-cover")?;
@@ -102,6 +104,11 @@ impl Renderer {
             self.loader.wait_for_progress(LOADER_WAIT);
         }
         Err(RenderError::Unresolved { frames: RESOLVE_GUARD_FRAMES })
+    }
+
+    /// The imagery cache: its texture format (the dataset's blocks, or RGBA8) and slots.
+    pub fn imagery_cache(&self) -> &TileCache {
+        &self.caches.imagery
     }
 
     /// The last frame's colour, as an sRGB image.

@@ -169,6 +169,8 @@ impl Gpu {
         let info = adapter.get_info();
         let wanted = wgpu_profiler::GpuProfiler::ALL_WGPU_TIMER_FEATURES
             | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            // Imagery sampled as the dataset stores it, in BC1/BC7 blocks (else decoded on load).
+            | wgpu::Features::TEXTURE_COMPRESSION_BC
             // The seed draws start at compaction's slots (`first_instance` of indirect draws).
             | wgpu::Features::INDIRECT_FIRST_INSTANCE;
         let features = adapter.features() & wanted;

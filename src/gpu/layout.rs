@@ -158,6 +158,14 @@ wgsl_constants! { dataset_constants:
     /// A page-table entry of a tile that is not resident; otherwise the entry is its slot + 1
     /// (`PageEntry`).
     pub const PAGE_EMPTY: u32 = 0;
+    /// `TerrainUniforms::imagery_texels`: the dataset has no imagery (the relief tint shows).
+    pub const IMAGERY_NONE: u32 = 0;
+    /// Imagery texels hold their colour as it is, alpha the coverage (RGBA8, BC7: a texel
+    /// without data keeps a colour, the valid texels' mean).
+    pub const IMAGERY_STRAIGHT: u32 = 1;
+    /// Imagery texels without data are transparent black (BC1's punch-through): a filtered texel
+    /// is the covered texels' colour times their coverage, so the shader divides by alpha.
+    pub const IMAGERY_PUNCHED: u32 = 2;
 }
 
 /// A page-table entry: the tile's cache slot (texture-array layer) + 1, or `PAGE_EMPTY`.

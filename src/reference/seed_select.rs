@@ -130,8 +130,9 @@ pub fn snapshot_caches(
     let landcover = TwinCache::of(landcover, |id| dataset.landcover_words(id))?;
     let extent = imagery.pyramid().tile_extent() as usize;
     let imagery = match &dataset.imagery {
+        // Mip 0's texels as the GPU samples them: decoded from blocks by the format's rules.
         Some(layer) => TwinCache::of(imagery, |id| {
-            let bytes = layer.tile_bytes(id)?;
+            let bytes = layer.tile_texels(id)?;
             Ok(bytes[..extent * extent * 4].chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
         })?,
         None => TwinCache {

@@ -16,7 +16,7 @@
 
 use super::loader::{LayerKind, Loaded};
 use super::residency::{CacheStats, Placement, Residency, UploadBudget};
-use crate::dataset::{PackError, Pyramid, TileId};
+use crate::dataset::{MipLayout, PackError, Pyramid, TileId};
 use crate::gpu::layout::{PAGE_EMPTY, page_entry};
 
 /// One layer's GPU tile cache: a texture array with a tile in each of its fixed number of slots,
@@ -25,7 +25,6 @@ pub struct TileCache {
     label: &'static str,
     pyramid: Pyramid,
     mips: u32,
-    texel_bytes: u32,
     format: wgpu::TextureFormat,
     texture: wgpu::Texture,
     /// A 2D-array view of every slot, all mips: what the passes bind to read tiles.
@@ -73,12 +72,10 @@ impl TileCache {
             // Zeroed by wgpu: every tile starts absent.
             mapped_at_creation: false,
         });
-        let texel_bytes = format.block_copy_size(None).unwrap_or(4);
         Self {
             label,
             pyramid,
             mips,
-            texel_bytes,
             format,
             texture,
             view,
@@ -141,10 +138,14 @@ impl TileCache {
         self.residency.stats()
     }
 
-    /// Bytes of one tile, all mips: what the loader must deliver.
+    /// Bytes of one tile, all mips (in whole blocks for a block-compressed format): what the
+    /// loader must deliver, and what a slot holds on the GPU.
     pub fn tile_bytes(&self) -> usize {
-        let texel_bytes = self.texel_bytes as usize;
-        (0..self.mips).map(|mip| (self.pyramid.mip_extent(mip) as usize).pow(2) * texel_bytes).sum()
+        (0..self.mips).map(|mip| self.mip_layout(mip).bytes()).sum()
+    }
+
+    fn mip_layout(&self, mip: u32) -> MipLayout {
+        MipLayout::of(self.format, self.pyramid.mip_extent(mip))
     }
 
     /// Starts a frame: records the tiles it needs (most important first: coarse levels first,
@@ -246,8 +247,7 @@ impl TileCache {
     fn write_tile(&self, queue: &wgpu::Queue, slot: u32, payload: &[u8]) {
         let mut offset = 0usize;
         for mip in 0..self.mips {
-            let extent = self.pyramid.mip_extent(mip);
-            let bytes = (extent * extent * self.texel_bytes) as usize;
+            let layout = self.mip_layout(mip);
             queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &self.texture,
@@ -255,15 +255,20 @@ impl TileCache {
                     origin: wgpu::Origin3d { x: 0, y: 0, z: slot },
                     aspect: wgpu::TextureAspect::All,
                 },
-                &payload[offset..offset + bytes],
+                &payload[offset..offset + layout.bytes()],
                 wgpu::TexelCopyBufferLayout {
                     offset: 0,
-                    bytes_per_row: Some(extent * self.texel_bytes),
-                    rows_per_image: Some(extent),
+                    bytes_per_row: Some(layout.bytes_per_row),
+                    rows_per_image: Some(layout.blocks_y),
                 },
-                wgpu::Extent3d { width: extent, height: extent, depth_or_array_layers: 1 },
+                // Whole blocks: a mip of 66 texels is copied as the 68 its blocks cover.
+                wgpu::Extent3d {
+                    width: layout.copy_extent,
+                    height: layout.copy_extent,
+                    depth_or_array_layers: 1,
+                },
             );
-            offset += bytes;
+            offset += layout.bytes();
         }
     }
 }

@@ -13,6 +13,10 @@
 //! comes back as an error so the cache can remember it and let the tile's ancestor stand in.
 //! Dropping the `Loader` discards the queue and joins the workers (each finishes at most the tile
 //! it is reading).
+//!
+//! A cache whose texture cannot take a layer's stored blocks (BC imagery on an adapter without BC
+//! sampling) is fed plain texels: the loader made with `Delivery::ImageryDecoded` decodes each
+//! imagery tile on its worker thread, so the render thread only ever uploads.
 
 use std::cmp::{Ordering, Reverse};
 use std::collections::{BinaryHeap, HashMap, HashSet};
@@ -23,7 +27,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 use thiserror::Error;
 
-use crate::dataset::{Dataset, LayerPack, PackError, TileId};
+use crate::dataset::{Dataset, LayerPack, PackError, TileBytes, TileId};
 
 /// Which of the dataset's tile layers a request reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
@@ -51,6 +55,17 @@ impl std::fmt::Display for LayerKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// What the loader delivers of each tile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Delivery {
+    /// Every payload as the pack stores it (what caches of the packs' own formats take).
+    #[default]
+    Stored,
+    /// Imagery decoded from its blocks to plain RGBA8 texels (`LayerPack::tile_texels`), every
+    /// other layer as stored: for an imagery cache of RGBA8 over a block-compressed pack.
+    ImageryDecoded,
 }
 
 /// Why the loader could not start, or why a tile could not be read.
@@ -161,8 +176,9 @@ pub struct Loader {
 }
 
 impl Loader {
-    /// Starts `threads` workers (at least one) reading from `dataset`.
-    pub fn new(dataset: Arc<Dataset>, threads: usize) -> Result<Self, LoaderError> {
+    /// Starts `threads` workers (at least one) reading from `dataset`, delivering tiles as
+    /// `delivery` says.
+    pub fn new(dataset: Arc<Dataset>, threads: usize, delivery: Delivery) -> Result<Self, LoaderError> {
         let shared = Arc::new(Shared {
             queue: Mutex::new(Queue::default()),
             wake: Condvar::new(),
@@ -175,7 +191,7 @@ impl Loader {
             let (shared, dataset, sender) = (loader.shared.clone(), dataset.clone(), sender.clone());
             let worker = std::thread::Builder::new()
                 .name(format!("terramp-loader-{index}"))
-                .spawn(move || work(&shared, &dataset, &sender))
+                .spawn(move || work(&shared, &dataset, delivery, &sender))
                 // Dropping `loader` here joins the workers already started.
                 .map_err(|source| LoaderError::Spawn { index, source })?;
             loader.workers.push(worker);
@@ -287,7 +303,7 @@ impl Drop for Loader {
     }
 }
 
-fn work(shared: &Shared, dataset: &Dataset, results: &Sender<Loaded>) {
+fn work(shared: &Shared, dataset: &Dataset, delivery: Delivery, results: &Sender<Loaded>) {
     loop {
         let request = {
             let mut queue = shared.queue();
@@ -303,7 +319,7 @@ fn work(shared: &Shared, dataset: &Dataset, results: &Sender<Loaded>) {
                 queue = shared.wake.wait(queue).unwrap_or_else(PoisonError::into_inner);
             }
         };
-        let result = read(dataset, request.layer, request.id);
+        let result = read(dataset, request.layer, request.id, delivery);
         if let Err(error) = &result {
             report_once(shared, request.layer, request.id, error);
         }
@@ -322,10 +338,28 @@ fn layer(dataset: &Dataset, kind: LayerKind) -> Option<&LayerPack> {
     }
 }
 
-/// The tile's payload, checksum verified: copied out of the mapping, or the tile as decoded.
-pub fn read(dataset: &Dataset, kind: LayerKind, id: TileId) -> Result<Arc<[u8]>, LoaderError> {
+/// The tile's payload as `delivery` wants it, checksum verified: copied out of the mapping, or
+/// the tile as decoded.
+pub fn read(
+    dataset: &Dataset,
+    kind: LayerKind,
+    id: TileId,
+    delivery: Delivery,
+) -> Result<Arc<[u8]>, LoaderError> {
     let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
-    Ok(pack.tile_bytes(id)?.into_shared())
+    let bytes = match kind {
+        LayerKind::Imagery => imagery_tile(pack, id, delivery)?,
+        _ => pack.tile_bytes(id)?,
+    };
+    Ok(bytes.into_shared())
+}
+
+/// The imagery tile as `delivery` wants it: as stored, or decoded from its blocks.
+pub fn imagery_tile(imagery: &LayerPack, id: TileId, delivery: Delivery) -> Result<TileBytes<'_>, PackError> {
+    match delivery {
+        Delivery::Stored => imagery.tile_bytes(id),
+        Delivery::ImageryDecoded => imagery.tile_texels(id),
+    }
 }
 
 fn report_once(shared: &Shared, kind: LayerKind, id: TileId, error: &LoaderError) {

@@ -11,6 +11,6 @@ mod residency;
 pub mod wants;
 
 pub use cache::{TileCache, page_levels};
-pub use loader::{LayerKind, Loaded, Loader, LoaderError, TileRequest};
+pub use loader::{Delivery, LayerKind, Loaded, Loader, LoaderError, TileRequest};
 pub use residency::{CacheStats, UploadBudget};
 pub use wants::{AreaWant, tiles_over};

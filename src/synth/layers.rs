@@ -38,6 +38,11 @@ pub struct Layers {
 }
 
 impl Layers {
+    /// The parameters the layers were made from.
+    pub fn params(&self) -> &SynthParams {
+        &self.params
+    }
+
     /// The layers `params` describe, after checking them.
     pub fn new(params: &SynthParams) -> Result<Self, SynthError> {
         let &SynthParams { size, spacing_m, origin_m, water_level_m, .. } = params;
@@ -101,7 +106,7 @@ impl Layers {
     /// The manifest of these layers, the land cover coded by `coding`.
     pub fn manifest(&self, [min_m, max_m]: [f32; 2], coding: LccCoding) -> Result<Manifest, SynthError> {
         let table = ClassTable::load(CLASS_SCHEME)?;
-        let SynthParams { size, seed, spacing_m, origin_m, water_level_m } = self.params;
+        let SynthParams { size, seed, spacing_m, origin_m, water_level_m, .. } = self.params;
         let cell_layer = |pack: &str, texel_m: f64, spec: &LayerSpec, format: &str| CellLayer {
             pack: pack.into(),
             texel_m,

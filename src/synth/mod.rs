@@ -25,8 +25,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use thiserror::Error;
 
 use crate::classes::ClassTableError;
+use crate::dataset::block_encode::encode_staged_imagery;
 use crate::dataset::lcc::{LccError, write_lcc_layer};
-use crate::dataset::{DatasetError, LayerError, PackError, Staging, Window, write_layer};
+use crate::dataset::{
+    DatasetError, ImageryFormat, LayerError, Manifest, PackError, Staging, Window, write_layer,
+};
 
 pub use colour::Painter;
 pub use layers::{HEIGHT_PACK, IMAGERY_PACK, LANDCOVER_PACK};
@@ -60,11 +63,20 @@ pub struct SynthParams {
     pub origin_m: [f64; 2],
     /// Height of lakes' surface, metres; the relief is built around it.
     pub water_level_m: f64,
+    /// How the imagery is stored: plain RGBA8, or BC1/BC7 blocks made from it.
+    pub imagery_format: ImageryFormat,
 }
 
 impl Default for SynthParams {
     fn default() -> Self {
-        Self { size: 1024, seed: 1, spacing_m: 10.0, origin_m: [0.0, 0.0], water_level_m: 100.0 }
+        Self {
+            size: 1024,
+            seed: 1,
+            spacing_m: 10.0,
+            origin_m: [0.0, 0.0],
+            water_level_m: 100.0,
+            imagery_format: ImageryFormat::Rgba8,
+        }
     }
 }
 
@@ -124,7 +136,23 @@ pub fn synthesize(out: &Path, params: &SynthParams, progress: bool) -> Result<Pa
     write_lcc_layer(&staging.path(LANDCOVER_PACK), layers.class_texels, &coding, classify, &bar)?;
     bar.finish();
     let range = layers.height_range(&staging.path(HEIGHT_PACK))?;
-    Ok(staging.commit(&layers.manifest(range, coding)?)?)
+    commit(staging, layers.manifest(range, coding)?, params.imagery_format, progress)
+}
+
+/// Stores the staged imagery in `imagery_format` (made from the plain pack written first), and
+/// puts the dataset of `manifest` in place.
+fn commit(
+    staging: Staging,
+    mut manifest: Manifest,
+    imagery_format: ImageryFormat,
+    progress: bool,
+) -> Result<PathBuf, SynthError> {
+    if let Some(imagery) = manifest.imagery.as_mut().filter(|_| imagery_format.is_block_compressed()) {
+        let bar = progress_bar(progress, imagery_format.short_name());
+        encode_staged_imagery(&staging, imagery, imagery_format, &bar)?;
+        bar.finish();
+    }
+    Ok(staging.commit(&manifest)?)
 }
 
 fn progress_bar(progress: bool, layer: &str) -> ProgressBar {

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use indicatif::ProgressBar;
 
 use super::layers::{HEIGHT_PACK, IMAGERY_PACK, LANDCOVER_PACK, Layers};
-use super::{SynthError, SynthParams, progress_bar};
+use super::{SynthError, SynthParams, commit, progress_bar};
 use crate::dataset::lcc::{LccCoding, lcc_pyramid};
 use crate::dataset::partition::{Split, merge_layer, merge_lcc, write_layer_part, write_lcc_part};
 use crate::dataset::{Staging, Window};
@@ -85,6 +85,7 @@ impl SynthParts {
         merge_lcc(&path, layers.class_texels, &self.coding, landcover, &packs(LANDCOVER_PACK), &bar)?;
         bar.finish();
         let range = layers.height_range(&staging.path(HEIGHT_PACK))?;
-        Ok(staging.commit(&layers.manifest(range, self.coding.clone())?)?)
+        let manifest = layers.manifest(range, self.coding.clone())?;
+        commit(staging, manifest, layers.params().imagery_format, progress)
     }
 }

@@ -113,7 +113,7 @@ impl<'a> ImageryTexels<'a> {
     fn texel(&self, t: [u32; 2]) -> Result<[f64; 4], PackError> {
         let Some(layer) = &self.dataset.imagery else { return Ok([0.0; 4]) };
         let tile = t.map(|v| v / IMAGERY_TILE_TEXELS);
-        let bytes = layer.tile_bytes(TileId { level: 0, x: tile[0], y: tile[1] })?;
+        let bytes = layer.tile_texels(TileId { level: 0, x: tile[0], y: tile[1] })?;
         let local = [0, 1].map(|a| t[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
         let at = 4 * (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize;
         let rgba = bytes.get(at..at + 4).unwrap_or(&[0; 4]);

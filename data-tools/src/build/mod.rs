@@ -22,7 +22,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
-use terramp::dataset::{FORMAT_VERSION, Manifest, Staging};
+use terramp::dataset::block_encode::encode_staged_imagery;
+use terramp::dataset::{FORMAT_VERSION, ImageryFormat, Manifest, Staging};
 
 use frame::{Frame, Grid};
 use heights::{Footprint, HeightScan, HeightStep};
@@ -59,6 +60,10 @@ pub struct BuildArgs {
     /// are not data, and cost the packs most of their bytes), 0 for a floating-point DEM.
     #[arg(long)]
     pub height_step_m: Option<f64>,
+    /// How the imagery is stored: rgba8 (lossless), or blocks the GPU samples as they are, bc7
+    /// (4× smaller, keeps coverage) or bc1 (8× smaller, imagery without holes only).
+    #[arg(long, default_value = "rgba8", value_parser = crate::parse_imagery_format, requires = "imagery")]
+    pub imagery_format: ImageryFormat,
     /// A short name for logs (default: the DEM file's stem).
     #[arg(long)]
     pub name: Option<String>,
@@ -95,6 +100,7 @@ struct Inputs {
     height_step: HeightStep,
     footprint: Footprint,
     imagery: Option<Imagery>,
+    imagery_format: ImageryFormat,
     landcover: Option<Landcover>,
 }
 
@@ -113,7 +119,16 @@ impl Inputs {
         };
         let dem = GridRaster::new(dem_source, &frame.dem_grid, &frame.srs, &[1], Resampling::Bilinear, true)?;
         let footprint = footprint(&dem, dem_path, &frame)?;
-        Ok(Self { imagery: imagery.transpose()?, landcover, dem, height_step, footprint, frame })
+        let imagery_format = args.imagery_format;
+        Ok(Self {
+            imagery: imagery.transpose()?,
+            imagery_format,
+            landcover,
+            dem,
+            height_step,
+            footprint,
+            frame,
+        })
     }
 }
 
@@ -141,7 +156,16 @@ fn write_layers(
     let spacing_m = inputs.frame.dem_grid.pixel_m;
     let height = heights::write(&inputs.dem, &scan, inputs.height_step, spacing_m, staging, height_bars)?;
     scan.spill = None;
-    let imagery = inputs.imagery.as_ref().map(|i| i.write(staging, &bar(progress, "imagery", "tiles")));
+    let imagery = match &inputs.imagery {
+        Some(source) => {
+            let mut layer = source.write(staging, &bar(progress, "imagery", "tiles"))?;
+            let blocks = bar(progress, inputs.imagery_format.short_name(), "tiles");
+            encode_staged_imagery(staging, &mut layer, inputs.imagery_format, &blocks)
+                .context("encoding the imagery's blocks")?;
+            Some(layer)
+        }
+        None => None,
+    };
     let landcover = match &inputs.landcover {
         Some(l) => {
             let scan = l.scan(&bar(progress, "scan codes", "windows"))?;
@@ -156,7 +180,7 @@ fn write_layers(
         crs: inputs.frame.crs.clone(),
         origin_m: inputs.frame.origin_m(),
         height,
-        imagery: imagery.transpose()?,
+        imagery,
         landcover,
     };
     Ok((manifest, Scans { height: scan, landcover: landcover_scan }))
@@ -226,7 +250,12 @@ fn print_summary(dir: &Path, manifest: &Manifest, inputs: &Inputs, scans: &Scans
     );
     if let Some(imagery) = &inputs.imagery {
         let bands: Vec<String> = imagery.bands.iter().map(usize::to_string).collect();
-        println!("  imagery: {}, bands {}", describe_grid(imagery.grid(), imagery.access()), bands.join(","));
+        println!(
+            "  imagery: {}, bands {}, stored as {}",
+            describe_grid(imagery.grid(), imagery.access()),
+            bands.join(","),
+            inputs.imagery_format.name()
+        );
     }
     if let (Some(landcover), Some(lcc)) = (&inputs.landcover, &scans.landcover) {
         let table = landcover.table();

@@ -23,8 +23,9 @@ gpu_struct! {
         /// Grid cells along a node's edge, the same at every LOD: a node draws (node_cells + 3)²
         /// vertices, its skirt ring included.
         pub node_cells: u32,
-        /// 1 when the dataset has imagery, which the ground pass blends over its relief tint; else 0.
-        pub has_imagery: u32,
+        /// How the dataset's imagery texels carry coverage: `IMAGERY_NONE` (no imagery: the relief
+        /// tint shows), `IMAGERY_STRAIGHT` or `IMAGERY_PUNCHED`.
+        pub imagery_texels: u32,
         /// Imagery: grid-space position of texel (0, 0)'s south-west corner (xy), level-0 texel edge
         /// in metres (z), level-of-detail bias in log2 texels (w).
         pub imagery_frame: [f32; 4],

@@ -8,9 +8,9 @@ use glam::DVec3;
 
 use crate::config::Settings;
 use crate::dataset::surface::diagonal_rises;
-use crate::dataset::{Dataset, TileId};
+use crate::dataset::{Dataset, ImageryFormat, TileId};
 use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
-use crate::gpu::layout::MAX_LEVELS;
+use crate::gpu::layout::{IMAGERY_NONE, IMAGERY_PUNCHED, IMAGERY_STRAIGHT, MAX_LEVELS};
 use crate::light::{CloudShadowFrame, sun_dir};
 use crate::streaming::{TileCache, page_levels};
 
@@ -88,7 +88,13 @@ pub fn terrain_uniforms(
         camera_grid_m: camera_grid_m.as_vec3().extend(0.0).to_array(),
         height_range_m: [manifest.height.min_m, manifest.height.max_m],
         node_cells: settings.terrain.node_cells,
-        has_imagery: u32::from(dataset.imagery.is_some()),
+        imagery_texels: match &dataset.imagery {
+            None => IMAGERY_NONE,
+            Some(layer) if layer.block_format.is_some_and(ImageryFormat::holes_are_transparent) => {
+                IMAGERY_PUNCHED
+            }
+            Some(_) => IMAGERY_STRAIGHT,
+        },
         imagery_frame: [0.0; 4],
         cloud_field: clouds.field,
         cloud_shift: clouds.shift,
