@@ -16,6 +16,7 @@ use crate::gpu::AdapterChoice;
 
 mod clouds;
 mod draw_seeds;
+mod faults;
 pub mod knobs;
 mod seeds;
 mod texcells;
@@ -24,6 +25,7 @@ mod wind;
 
 pub use clouds::CloudSettings;
 pub use draw_seeds::DrawSeedsSettings;
+pub use faults::FaultSettings;
 pub use seeds::{OcclusionTolerance, SeedSettings};
 pub use texcells::TexcellSettings;
 pub use tlm::TlmSettings;
@@ -131,6 +133,8 @@ pub struct Settings {
     pub wind: WindSettings,
     /// `[clouds]`: the shadows of clouds drifting over the land.
     pub clouds: CloudSettings,
+    /// `[faults]`: faults injected into tile streaming (tests and soak runs; none by default).
+    pub faults: FaultSettings,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -362,6 +366,7 @@ impl Settings {
         self.texcells.validate(&self.draw_seeds)?;
         self.wind.validate()?;
         self.clouds.validate()?;
+        self.faults.validate()?;
         first_out_of_range(checks)
     }
 }

@@ -12,7 +12,7 @@ use terramp::dataset::pack::{Pack, PackWriter};
 use terramp::dataset::{Dataset, IMAGERY_MIPS, Manifest, Pyramid, TileId};
 use terramp::gpu::Gpu;
 use terramp::streaming::{
-    AreaWant, CacheStats, Delivery, LayerKind, Loaded, Loader, LoaderError, TileCache, TileRequest,
+    AreaWant, CacheStats, LayerKind, Loaded, Loader, LoaderError, LoaderOptions, TileCache, TileRequest,
     UploadBudget, tiles_over,
 };
 
@@ -119,7 +119,7 @@ fn rewrite_without(path: &Path, index: u64) {
 fn loader_serves_most_important_first_and_never_blocks() {
     let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     let pyramid = dataset.imagery.as_ref().unwrap().pyramid;
-    let loader = Loader::new(dataset.clone(), 1, Delivery::Stored).unwrap();
+    let loader = Loader::new(dataset.clone(), LoaderOptions { threads: 1, ..Default::default() }).unwrap();
     // Priorities in a scrambled order; one worker must return them sorted.
     let tiles: Vec<TileId> = pyramid.tiles().collect();
     let requests: Vec<TileRequest> = (0..tiles.len())
@@ -168,7 +168,7 @@ fn loader_reports_missing_tiles_and_shuts_down_cleanly() {
     let index = manifest.height.pyramid.tile_index(unwritten).unwrap();
     rewrite_without(&dir.join(&manifest.height.pack), index);
 
-    let loader = Loader::new(open(&dir), 2, Delivery::Stored).unwrap();
+    let loader = Loader::new(open(&dir), LoaderOptions { threads: 2, ..Default::default() }).unwrap();
     let ask = |layer, id| TileRequest { layer, id, priority: 0 };
     let outside = TileId::new(0, 99, 99);
     loader.submit(&[
@@ -199,7 +199,7 @@ fn loader_reports_missing_tiles_and_shuts_down_cleanly() {
     // at most the tile each is reading: most of the queue is still there to discard (to empty half
     // of it, two workers would have to copy and checksum some 30 MB between these two lines).
     let pyramid = manifest.imagery.as_ref().unwrap().pyramid;
-    let busy = Loader::new(open(&dir), 2, Delivery::Stored).unwrap();
+    let busy = Loader::new(open(&dir), LoaderOptions { threads: 2, ..Default::default() }).unwrap();
     let all: Vec<TileRequest> = pyramid.tiles().map(|id| ask(LayerKind::Imagery, id)).collect();
     busy.submit(&all);
     let discarded = busy.close();
@@ -210,7 +210,7 @@ fn loader_reports_missing_tiles_and_shuts_down_cleanly() {
 fn budget_and_eviction_rules_hold_over_a_moving_view() {
     let gpu = terramp_testkit::gpu();
     let dataset = open(&terramp_testkit::synth_dataset(600, 11));
-    let loader = Loader::new(dataset.clone(), 2, Delivery::Stored).unwrap();
+    let loader = Loader::new(dataset.clone(), LoaderOptions { threads: 2, ..Default::default() }).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 12);
     let mut heights = cache(&gpu, &dataset, LayerKind::Height, 6);
     // Imagery is held back by its tile count, heights by their bytes (262 KiB a tile).
@@ -265,7 +265,7 @@ fn budget_and_eviction_rules_hold_over_a_moving_view() {
 fn fixed_view_converges_then_uploads_nothing() {
     let gpu = terramp_testkit::gpu();
     let dataset = open(&terramp_testkit::synth_dataset(600, 11));
-    let loader = Loader::new(dataset.clone(), 2, Delivery::Stored).unwrap();
+    let loader = Loader::new(dataset.clone(), LoaderOptions { threads: 2, ..Default::default() }).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 24);
     let wanted: Vec<TileId> = wants(imagery.pyramid(), [1.0, 3.0], 0).into_iter().take(20).collect();
     let budget = UploadBudget { tiles: 4, bytes: 32 << 20 };
@@ -296,7 +296,7 @@ fn coarse_and_near_tiles_arrive_first() {
     let gpu = terramp_testkit::gpu();
     let dataset = open(&terramp_testkit::synth_dataset(600, 11));
     // One worker serves in strict priority order; one tile a frame makes the order visible.
-    let loader = Loader::new(dataset.clone(), 1, Delivery::Stored).unwrap();
+    let loader = Loader::new(dataset.clone(), LoaderOptions { threads: 1, ..Default::default() }).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 48);
     let wanted = wants(imagery.pyramid(), [4.5, 0.5], 0);
     let budget = UploadBudget { tiles: 1, bytes: 1 };
@@ -328,7 +328,7 @@ fn corrupt_tiles_fail_once_and_their_ancestor_stands_in() {
     let mut heights = cache(&gpu, &clean, LayerKind::Height, 16);
     corrupt_tile(&dir, "imagery.pack", &ip, bad);
     corrupt_tile(&dir, "height.pack", &hp, bad);
-    let loader = Loader::new(open(&dir), 2, Delivery::Stored).unwrap();
+    let loader = Loader::new(open(&dir), LoaderOptions { threads: 2, ..Default::default() }).unwrap();
     let (want_imagery, want_heights) = (wants(&ip, [1.5, 1.5], 0), wants(&hp, [1.5, 1.5], 0));
     let mut errors = Vec::new();
     let mut failed = [0, 0];
@@ -366,7 +366,7 @@ fn corrupt_tiles_fail_once_and_their_ancestor_stands_in() {
 fn camera_jump_converges_within_the_budget() {
     let gpu = terramp_testkit::gpu();
     let dataset = open(&terramp_testkit::synth_dataset(600, 11));
-    let loader = Loader::new(dataset.clone(), 2, Delivery::Stored).unwrap();
+    let loader = Loader::new(dataset.clone(), LoaderOptions { threads: 2, ..Default::default() }).unwrap();
     let mut imagery = cache(&gpu, &dataset, LayerKind::Imagery, 16);
     let texel_m = dataset.manifest.imagery.as_ref().unwrap().texel_m;
     let view = |min: f64, max: f64| {

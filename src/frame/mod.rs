@@ -28,7 +28,7 @@ use crate::passes::tile_load_map::frame::{TlmFrame, height_tile_ranges};
 use crate::passes::tile_load_map::gpu::{TileLoadMapPass, TlmBindings};
 use crate::passes::tile_load_map::layout::TlmLayout;
 use crate::seeds::wind::{Wind, WindFrame};
-use crate::streaming::{CacheStats, Delivery, Loader, LoaderError, TileCache};
+use crate::streaming::{CacheStats, Delivery, Faults, Loader, LoaderError, LoaderOptions, TileCache};
 
 mod clearance;
 mod prepare;
@@ -269,8 +269,11 @@ impl Renderer {
         let caches = Caches::new(&gpu, &dataset, &settings)?;
         let loader = Loader::new(
             Arc::clone(&dataset),
-            settings.cache.loader_threads as usize,
-            caches.imagery_delivery,
+            LoaderOptions {
+                threads: settings.cache.loader_threads as usize,
+                delivery: caches.imagery_delivery,
+                faults: Faults::new(&settings.faults),
+            },
         )?;
         let depth_pyramid = DepthPyramid::new(device, settings.render.width, settings.render.height);
         let tlm = TileLoadMapPass::new(device, &settings);

@@ -111,6 +111,12 @@ impl Renderer {
         &self.caches.imagery
     }
 
+    /// Every tile cache: heights, imagery, then land cover when the dataset has it.
+    pub fn tile_caches(&self) -> Vec<&TileCache> {
+        let c = &self.caches;
+        [&c.heights, &c.imagery].into_iter().chain(c.landcover.as_ref()).collect()
+    }
+
     /// The last frame's colour, as an sRGB image.
     pub fn read_colour(&self) -> Result<image::RgbaImage, RenderError> {
         let colour = &self.targets.colour;

@@ -14,6 +14,9 @@
 //! Dropping the `Loader` discards the queue and joins the workers (each finishes at most the tile
 //! it is reading).
 //!
+//! Faults can be injected into the reads (`faults`, off by default): a failed or corrupt read
+//! comes back as the error a real one would, a slow one late.
+//!
 //! A cache whose texture cannot take a layer's stored blocks (BC imagery on an adapter without BC
 //! sampling) is fed plain texels: the loader made with `Delivery::ImageryDecoded` decodes each
 //! imagery tile on its worker thread, so the render thread only ever uploads.
@@ -27,6 +30,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 use thiserror::Error;
 
+use super::faults::{Fate, Faults};
 use crate::dataset::{Dataset, LayerPack, PackError, TileBytes, TileId};
 
 /// Which of the dataset's tile layers a request reads.
@@ -68,6 +72,17 @@ pub enum Delivery {
     ImageryDecoded,
 }
 
+/// How a loader reads.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LoaderOptions {
+    /// Worker threads (at least one is started).
+    pub threads: usize,
+    /// What it delivers of block-compressed imagery.
+    pub delivery: Delivery,
+    /// The faults injected into its reads (none by default).
+    pub faults: Faults,
+}
+
 /// Why the loader could not start, or why a tile could not be read.
 #[derive(Debug, Error)]
 pub enum LoaderError {
@@ -85,6 +100,9 @@ pub enum LoaderError {
     /// The layer's pack could not give the tile: missing, corrupt or out of range.
     #[error(transparent)]
     Pack(#[from] PackError),
+    /// A read failed by fault injection (`faults.fail`).
+    #[error("injected read failure (faults.fail)")]
+    Injected,
 }
 
 /// One tile the render thread wants read.
@@ -176,9 +194,8 @@ pub struct Loader {
 }
 
 impl Loader {
-    /// Starts `threads` workers (at least one) reading from `dataset`, delivering tiles as
-    /// `delivery` says.
-    pub fn new(dataset: Arc<Dataset>, threads: usize, delivery: Delivery) -> Result<Self, LoaderError> {
+    /// Starts `options.threads` workers (at least one) reading from `dataset`.
+    pub fn new(dataset: Arc<Dataset>, options: LoaderOptions) -> Result<Self, LoaderError> {
         let shared = Arc::new(Shared {
             queue: Mutex::new(Queue::default()),
             wake: Condvar::new(),
@@ -187,11 +204,11 @@ impl Loader {
         });
         let (sender, results) = crossbeam_channel::unbounded();
         let mut loader = Self { shared, results, workers: Vec::new() };
-        for index in 0..threads.max(1) {
+        for index in 0..options.threads.max(1) {
             let (shared, dataset, sender) = (loader.shared.clone(), dataset.clone(), sender.clone());
             let worker = std::thread::Builder::new()
                 .name(format!("terramp-loader-{index}"))
-                .spawn(move || work(&shared, &dataset, delivery, &sender))
+                .spawn(move || work(&shared, &dataset, options, &sender))
                 // Dropping `loader` here joins the workers already started.
                 .map_err(|source| LoaderError::Spawn { index, source })?;
             loader.workers.push(worker);
@@ -303,7 +320,7 @@ impl Drop for Loader {
     }
 }
 
-fn work(shared: &Shared, dataset: &Dataset, delivery: Delivery, results: &Sender<Loaded>) {
+fn work(shared: &Shared, dataset: &Dataset, options: LoaderOptions, results: &Sender<Loaded>) {
     loop {
         let request = {
             let mut queue = shared.queue();
@@ -319,7 +336,11 @@ fn work(shared: &Shared, dataset: &Dataset, delivery: Delivery, results: &Sender
                 queue = shared.wake.wait(queue).unwrap_or_else(PoisonError::into_inner);
             }
         };
-        let result = read(dataset, request.layer, request.id, delivery);
+        let result = if options.faults.any() {
+            read_with_faults(dataset, request.layer, request.id, options)
+        } else {
+            read(dataset, request.layer, request.id, options.delivery)
+        };
         if let Err(error) = &result {
             report_once(shared, request.layer, request.id, error);
         }
@@ -352,6 +373,26 @@ pub fn read(
         _ => pack.tile_bytes(id)?,
     };
     Ok(bytes.into_shared())
+}
+
+/// As `read`, with the read's fate and wait from `options.faults`.
+fn read_with_faults(
+    dataset: &Dataset,
+    kind: LayerKind,
+    id: TileId,
+    options: LoaderOptions,
+) -> Result<Arc<[u8]>, LoaderError> {
+    let (fate, wait) = options.faults.fate(kind, id);
+    std::thread::sleep(wait);
+    match fate {
+        Fate::Read => read(dataset, kind, id, options.delivery),
+        Fate::Fail => Err(LoaderError::Injected),
+        Fate::Corrupt { at } => {
+            let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
+            let index = pack.pyramid.tile_index(id).unwrap_or(u64::MAX);
+            Ok(pack.pack().tile_damaged(index, at)?.into_owned().into())
+        }
+    }
 }
 
 /// The imagery tile as `delivery` wants it: as stored, or decoded from its blocks.

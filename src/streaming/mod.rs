@@ -6,11 +6,13 @@
 //! `TileCache::set_wanted`. Nothing here knows the passes: they tell it what they want.
 
 pub mod cache;
+pub mod faults;
 pub mod loader;
 mod residency;
 pub mod wants;
 
 pub use cache::{TileCache, page_levels};
-pub use loader::{Delivery, LayerKind, Loaded, Loader, LoaderError, TileRequest};
+pub use faults::Faults;
+pub use loader::{Delivery, LayerKind, Loaded, Loader, LoaderError, LoaderOptions, TileRequest};
 pub use residency::{CacheStats, UploadBudget};
 pub use wants::{AreaWant, tiles_over};

@@ -346,7 +346,27 @@ impl Pack {
     /// The tile's payload, after checking that it was written and that its stored bytes hold
     /// their checksum: borrowed from the mapping when stored raw, else decoded.
     pub fn tile(&self, index: u64) -> Result<Cow<'_, [u8]>, PackError> {
-        let stored = self.stored(index)?;
+        self.payload(index, self.stored(index)?)
+    }
+
+    /// The tile as `tile` would give it had byte `at` (modulo their length) of its stored bytes
+    /// been flipped on the way from the disk, through the same checks (fault injection's corrupt
+    /// read: the checksum catches it).
+    pub fn tile_damaged(&self, index: u64, at: usize) -> Result<Cow<'_, [u8]>, PackError> {
+        let (place, crc) = self.stored_place(index)?;
+        let mut stored = self.map[place].to_vec();
+        let len = stored.len().max(1);
+        if let Some(byte) = stored.get_mut(at % len) {
+            *byte ^= 0xa5;
+        }
+        if crc32fast::hash(&stored) != crc {
+            return Err(PackError::Corrupt { path: self.path.clone(), index });
+        }
+        Ok(Cow::Owned(self.payload(index, &stored)?.into_owned()))
+    }
+
+    /// A tile's payload from its checked stored bytes.
+    fn payload<'a>(&self, index: u64, stored: &'a [u8]) -> Result<Cow<'a, [u8]>, PackError> {
         match self.header.codec {
             Codec::Raw if stored.len() as u64 == self.header.tile_bytes => Ok(Cow::Borrowed(stored)),
             codec => codec

@@ -1,0 +1,97 @@
+//! How it works: fault injection into the loader's reads (`[faults]`, off by default), so that
+//! tests and soak runs can show what failed, corrupt and slow reads do to a flight. Each tile's
+//! fate is a hash of the faults' seed and the tile, so a run is repeatable: its read fails (an
+//! injected I/O error), or its stored bytes arrive with one byte flipped and go through the
+//! pack's own checks (`Pack::tile_damaged`: the checksum catches it), or it is read as usual; and
+//! every read first waits its own share of `delay_ms`. With no fault set, `fate` is never asked.
+
+use std::time::Duration;
+
+use super::loader::LayerKind;
+use crate::config::FaultSettings;
+use crate::dataset::TileId;
+
+/// The faults a loader injects.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Faults {
+    fail: f64,
+    corrupt: f64,
+    delay_ms: u32,
+    seed: u32,
+}
+
+/// What happens to one read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fate {
+    /// Read as usual.
+    Read,
+    /// Fails with an injected I/O error.
+    Fail,
+    /// Its stored bytes arrive with byte `at` (modulo their length) flipped.
+    Corrupt {
+        /// Which stored byte is flipped.
+        at: usize,
+    },
+}
+
+impl Faults {
+    /// The faults `settings` ask for.
+    pub fn new(settings: &FaultSettings) -> Self {
+        let FaultSettings { fail, corrupt, delay_ms, seed } = *settings;
+        Self { fail, corrupt, delay_ms, seed }
+    }
+
+    /// Whether any fault is injected.
+    pub fn any(&self) -> bool {
+        self.fail > 0.0 || self.corrupt > 0.0 || self.delay_ms > 0
+    }
+
+    /// What happens to the read of `id` in `layer`, and how long it waits first.
+    pub fn fate(&self, layer: LayerKind, id: TileId) -> (Fate, Duration) {
+        let key = u64::from(self.seed) << 32
+            ^ (layer as u64) << 28
+            ^ u64::from(id.level) << 24
+            ^ u64::from(id.x) << 12
+            ^ u64::from(id.y);
+        let unit = |salt: u64| (mix(key ^ salt) >> 11) as f64 / (1u64 << 53) as f64;
+        let wait = Duration::from_secs_f64(unit(3) * f64::from(self.delay_ms) / 1000.0);
+        let fate = if unit(1) < self.fail {
+            Fate::Fail
+        } else if unit(2) < self.corrupt {
+            Fate::Corrupt { at: mix(key ^ 4) as usize }
+        } else {
+            Fate::Read
+        };
+        (fate, wait)
+    }
+}
+
+/// SplitMix64's finaliser: every bit of `v` moves every bit of the result.
+fn mix(mut v: u64) -> u64 {
+    v = (v ^ (v >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    v = (v ^ (v >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    v ^ (v >> 31)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shares_of_tiles_fail_and_are_corrupt_as_asked_and_the_same_every_time() {
+        let faults = Faults::new(&FaultSettings { fail: 0.2, corrupt: 0.1, delay_ms: 40, seed: 7 });
+        let tiles: Vec<TileId> =
+            (0..100).flat_map(|x| (0..100).map(move |y| TileId::new(x % 4, x, y))).collect();
+        let fates: Vec<(Fate, Duration)> =
+            tiles.iter().map(|&id| faults.fate(LayerKind::Imagery, id)).collect();
+        let share = |f: fn(&Fate) -> bool| fates.iter().filter(|(fate, _)| f(fate)).count() as f64 / 1e4;
+        assert!((share(|f| *f == Fate::Fail) - 0.2).abs() < 0.02);
+        // Corrupt among those that do not fail: 0.8 × 0.1.
+        assert!((share(|f| matches!(f, Fate::Corrupt { .. })) - 0.08).abs() < 0.015);
+        assert!(fates.iter().all(|(_, wait)| *wait <= Duration::from_millis(40)));
+        assert!(fates.iter().any(|(_, wait)| *wait > Duration::from_millis(30)));
+        let again: Vec<_> = tiles.iter().map(|&id| faults.fate(LayerKind::Imagery, id)).collect();
+        assert_eq!(fates, again);
+        assert!(!Faults::default().any());
+    }
+}
