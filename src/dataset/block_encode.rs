@@ -25,6 +25,16 @@ use super::pack::{Codec, Pack, PackError, PackWriter, Predictor};
 use super::pyramid::Pyramid;
 use super::staging::Staging;
 
+// intel_tex_2's prebuilt kernels carry C++ (its ASTC encoder, linked in with the rest) but do not
+// name the C++ runtime: without this, a binary that links nothing else of C++ (`terramp-data` built
+// alone) fails to link.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[link(name = "stdc++")]
+unsafe extern "C" {}
+#[cfg(target_os = "macos")]
+#[link(name = "c++")]
+unsafe extern "C" {}
+
 /// How a block pack stores its tiles: zstd with no predictor (blocks look like noise to a
 /// predictor; zstd still finds the repeated endpoints of flat ground).
 const BLOCK_CODEC: Codec = Codec::Zstd(Predictor::None);
