@@ -13,10 +13,12 @@
 // which no compiler can fuse into an FMA. Large coordinates never reach f32: each cell's corner
 // comes as an integer texel plus a remainder in every layer's own grid.
 //
-// Output: a workgroup numbers its survivors by a ballot (rank order, every run), claims room with
-// one global atomic (where it lands varies), writes them with their draw-group keys, and notes
-// where in its fixed block-table entry: read in table order, records come in the twin's order
-// (compaction keeps it). Records beyond `capacity` are not written and are counted as overflow.
+// Output (`seed_select_blocks.wgsl`): a workgroup numbers its survivors by a ballot (rank order,
+// every run), claims room with one global atomic (where it lands varies), writes them with their
+// draw-group keys, and notes where in its fixed block-table entry: read in table order, records
+// come in the twin's order (compaction keeps it). When the records overflow `capacity`, `settle`
+// renumbers the table in table order and the blocks that keep anything select again into their
+// new places, so the first `capacity` records in the twin's order are kept, on every run.
 
 struct SeedUniforms {
     clip_from_view_world: mat4x4<f32>,
@@ -52,7 +54,7 @@ struct SeedUniforms {
     refine_max_steps: u32,
     active_ranks: u32,
     wind_reach_per_height: f32,
-    _pad: u32,
+    cell_count: u32,
     height_levels: array<vec4<u32>, MAX_LEVELS>,
     lcc_levels: array<vec4<u32>, 4>,
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
@@ -113,10 +115,6 @@ struct SeedCounters {
 @group(0) @binding(13) var<storage, read_write> counters: SeedCounters;
 @group(0) @binding(14) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(15) var<storage, read_write> blocks: array<SeedBlock>;
-
-var<workgroup> wg_count: array<atomic<u32>, SEED_COUNTERS>;
-var<workgroup> wg_kept: array<atomic<u32>, BALLOT_WORDS>;
-var<workgroup> wg_base: u32;
 
 // a · b, correctly rounded and never fused into a following add.
 fn mul(a: f32, b: f32) -> f32 {
@@ -424,59 +422,4 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
         ground.height_m,
     );
     return out;
-}
-
-@compute @workgroup_size(SEED_WORKGROUP)
-fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>,
-        @builtin(local_invocation_index) lane: u32) {
-    if lane < SEED_COUNTERS {
-        atomicStore(&wg_count[lane], 0u);
-    }
-    if lane < BALLOT_WORDS {
-        atomicStore(&wg_kept[lane], 0u);
-    }
-    workgroupBarrier();
-    let rank = group.x * SEED_WORKGROUP + lane;
-    var outcome: Outcome;
-    if rank < u.active_ranks {
-        outcome = select_seed(cells[group.y], rank);
-        if outcome.count == COUNT_SELECTED {
-            atomicOr(&wg_kept[lane / 32u], 1u << (lane % 32u));
-        } else {
-            atomicAdd(&wg_count[outcome.count], 1u);
-        }
-    }
-    workgroupBarrier();
-    var kept_mask: array<u32, BALLOT_WORDS>;
-    for (var w = 0u; w < BALLOT_WORDS; w += 1u) {
-        kept_mask[w] = atomicLoad(&wg_kept[w]);
-    }
-    if lane == 0u {
-        let kept = ballot_count(kept_mask);
-        var block = SeedBlock(0u, 0u);
-        if kept != 0u {
-            let base = atomicAdd(&counters.count[COUNT_SELECTED], kept);
-            block.count = min(kept, select(0u, u.capacity - base, base < u.capacity));
-            block.offset = select(0u, base, block.count != 0u);
-            if block.count != kept {
-                atomicAdd(&counters.count[COUNT_OVERFLOW], kept - block.count);
-            }
-            wg_base = base;
-        }
-        blocks[group.y * groups.x + group.x] = block;
-        let checked = min(SEED_WORKGROUP, u.active_ranks - group.x * SEED_WORKGROUP);
-        atomicAdd(&counters.count[COUNT_CHECKED], checked);
-        for (var c = COUNT_CHECKED + 1u; c < SEED_COUNTERS; c += 1u) {
-            let n = atomicLoad(&wg_count[c]);
-            if n != 0u {
-                atomicAdd(&counters.count[c], n);
-            }
-        }
-    }
-    let base = workgroupUniformLoad(&wg_base);
-    let index = base + ballot_below(kept_mask, lane);
-    if rank < u.active_ranks && outcome.count == COUNT_SELECTED && index < u.capacity {
-        records[index] = outcome.record;
-        keys[index] = outcome.key;
-    }
 }

@@ -234,8 +234,10 @@ fn seeds_are_the_same_in_every_run_and_after_any_path() {
     assert_eq!(direct, seeds_after(&[a, b, end]), "a path through other views changes the seeds");
 }
 
+/// Under overflow the records kept are the first `capacity` in the twin's order (cell by cell, rank
+/// by rank), in the same places on every run, whatever order the workgroups claimed room in.
 #[test]
-fn overflow_is_flagged_counted_and_keeps_valid_records() {
+fn overflow_is_counted_and_keeps_the_first_records_in_table_order_on_every_run() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     let mut settings = terramp_testkit::small_settings(320, 180);
     let mut full = terramp_testkit::renderer(&dataset, settings.clone());
@@ -245,7 +247,7 @@ fn overflow_is_flagged_counted_and_keeps_valid_records() {
     drop(full);
     let capacity = (all.len() / 3).max(1) as u32;
     settings.seeds.capacity = capacity;
-    let mut small = terramp_testkit::renderer(&dataset, settings);
+    let mut small = terramp_testkit::renderer(&dataset, settings.clone());
     small.render_resolved(&camera).unwrap();
     let (kept, counters) = small.read_seeds().unwrap().unwrap();
     assert_eq!(counters.selected, all_counters.selected);
@@ -256,11 +258,31 @@ fn overflow_is_flagged_counted_and_keeps_valid_records() {
     assert_eq!(diff.common, kept.len());
     let (_, twin_counters) = small.seed_twin().unwrap().unwrap();
     assert_eq!(twin_counters, counters);
-    // Compaction draws exactly what was kept, as its twin does over the same block table.
+    // The whole output is the twin's: the block table, the seeds in place (each record of the
+    // buffer is the twin's seed, equal as the twin test holds them: positions to the bit, colours
+    // within one sRGB step) and their keys. Compaction draws exactly what was kept.
     let output = small.read_seed_output().unwrap().unwrap();
+    let (twin_output, _) = small.compact_twin().unwrap().unwrap();
+    assert_eq!(output.blocks, twin_output.blocks);
+    let identity = |records: &[SeedRecord]| records.iter().map(|r| (r.address, r.rank)).collect::<Vec<_>>();
+    assert!(identity(&output.records) == identity(&twin_output.records), "records out of the twin's places");
+    let diff = SeedComparison::of(&output.records, &twin_output.records);
+    assert!(
+        diff.mismatched.is_empty() && diff.max_length_error_m == 0.0 && diff.max_colour_error <= 1,
+        "{diff:?}"
+    );
+    assert_eq!(output.keys, twin_output.keys);
     let compacted = small.read_compacted().unwrap().unwrap();
     assert_eq!(compacted.drawn(), capacity as usize);
     assert_eq!(compacted, terramp::reference::compact::compact(&output.keys, &output.blocks, &[]).unwrap());
+    // Frame after frame, and in a renderer of its own.
+    for run in 0..2 {
+        let mut again = terramp_testkit::renderer(&dataset, settings.clone());
+        again.render_resolved(&camera).unwrap();
+        again.render_resolved(&camera).unwrap();
+        let repeated = again.read_seed_output().unwrap().unwrap();
+        assert!(repeated.records == output.records && repeated.blocks == output.blocks, "run {run} differs");
+    }
 }
 
 #[test]

@@ -101,9 +101,15 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     },
     PipelineBindings {
         shader: &seed_select::gpu::SHADER,
-        entry_points: &["main"],
+        entry_points: &["main", "settle"],
         group: 0,
         bindings: &seed_select::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &seed_select::gpu::SHADER,
+        entry_points: &["settle"],
+        group: 1,
+        bindings: &seed_select::gpu::SETTLE_BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &compact::gpu::SHADER,

@@ -5,7 +5,8 @@
 //! never fuses them unasked). It returns the kept records in a canonical order (cell by cell,
 //! rank by rank) and the same counters, and (`seed_select_blocks`) the block table the GPU writes,
 //! as if every workgroup's block had landed in order: the GPU's blocks land in a varying order,
-//! but read in table order (`SeedOutput::in_block_order`) its records equal the twin's list.
+//! but read in table order (`SeedOutput::in_block_order`) its records equal the twin's list; when
+//! the records overflow, the GPU settles its table to exactly the twin's, records in place.
 
 use std::collections::HashMap;
 

@@ -7,8 +7,10 @@ use crate::gpu::struct_layout::gpu_struct;
 gpu_struct! {
     /// Where one pass-3 workgroup put its survivors. WGSL: `SeedBlock`. Entry `cell × workgroups per
     /// cell + workgroup` of the block table, so its index is fixed while `offset` (where its one
-    /// atomic landed in the record buffer) varies; `count` records follow it, in rank order (0 for a
-    /// workgroup that kept nothing or found the buffer full; `offset` is then 0).
+    /// atomic landed in the record buffer) varies, unless the records overflowed: then every
+    /// offset is the survivors of the blocks before it in the table (`seed_select_blocks.wgsl`).
+    /// `count` records follow it, in rank order (0 for a workgroup that kept nothing or found the
+    /// buffer full; `offset` is then 0).
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default)]
     pub struct SeedBlock {
         /// Index in the record buffer of the workgroup's first survivor.

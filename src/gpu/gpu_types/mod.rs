@@ -13,7 +13,7 @@ mod tile_load_map;
 
 pub use compact::{CompactParams, SeedBlock, SeedDrawArgs};
 pub use draw_seeds::{DrawSeedsUniforms, SeedMaterial, SeedShape, SeedVertex};
-pub use seed_select::{SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms};
+pub use seed_select::{SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSettle, SeedSpecies, SeedUniforms};
 pub use terrain::{TerrainNode, TerrainUniforms};
 pub use texcells::{TexcellRecord, TexcellUniforms};
 pub use tile_load_map::{TlmCell, TlmRing, TlmSpan, TlmUniforms};
@@ -35,6 +35,7 @@ pub fn layouts() -> Vec<StructLayout> {
         SeedClass::layout(),
         SeedRecord::layout(),
         SeedCounters::layout(),
+        SeedSettle::layout(),
         SeedBlock::layout(),
         SeedDrawArgs::layout(),
         CompactParams::layout(),

@@ -85,8 +85,8 @@ gpu_struct! {
         /// (`seeds::wind::Wind::reach_per_height`): plants' spheres grow by it, and their summits
         /// rise and come nearer by it, so a swaying crown is never culled; 0 in still air.
         pub wind_reach_per_height: f32,
-        /// Padding to the WGSL struct's alignment (always 0).
-        pub _pad: u32,
+        /// Cells of the frame (`SeedFrame::cells`): rows of the dispatch grid.
+        pub cell_count: u32,
         /// Page tables per level (first entry, tiles along x, tiles along y, 0).
         pub height_levels: [[u32; 4]; MAX_LEVELS as usize],
         /// The land-cover page table per LCC level, laid out as `height_levels` (0 without land
@@ -220,5 +220,21 @@ gpu_struct! {
         pub frustum: u32,
         /// Culled: the summit lies more than the occlusion tolerance behind the terrain's depth.
         pub occlusion: u32,
+    }
+}
+
+gpu_struct! {
+    /// Pass 3's second round (`shaders/seed_select_blocks.wgsl`): the indirect dispatch its
+    /// `settle` writes, wgpu's `DispatchIndirectArgs`: no workgroups when nothing overflowed, else
+    /// the first round's grid in two layers along z (which tells the round apart). WGSL:
+    /// `SeedSettle`.
+    #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Eq, Default)]
+    pub struct SeedSettle {
+        /// Workgroups along x: per cell.
+        pub groups_x: u32,
+        /// Workgroups along y: the cells.
+        pub groups_y: u32,
+        /// 2: layer 0 returns at once, layer 1 selects again into the settled blocks.
+        pub groups_z: u32,
     }
 }

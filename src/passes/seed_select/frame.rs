@@ -69,7 +69,7 @@ pub struct SeedOutput {
 
 impl SeedOutput {
     /// The records block by block in table order: cell by cell, rank by rank, as the twin lists
-    /// them (when nothing overflowed), whatever order the blocks landed in.
+    /// them, whatever order the blocks landed in.
     pub fn in_block_order(&self) -> Vec<SeedRecord> {
         self.blocks
             .iter()
@@ -139,7 +139,7 @@ impl SeedFrame {
             refine_max_steps: seeds.occlusion_refine_steps,
             active_ranks: inputs.active_ranks.min(seeds.seeds_per_pattern),
             wind_reach_per_height: Wind::new(&s.wind).reach_per_height() as f32,
-            _pad: 0,
+            cell_count: 0,
             height_levels: page_levels(&dataset.height.pyramid),
             lcc_levels: [[0; 4]; 4],
             imagery_levels: [[0; 4]; MAX_LEVELS as usize],
@@ -199,7 +199,8 @@ impl SeedFrame {
                     _pad: [0; 2],
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        u.cell_count = cells.len() as u32;
         Ok(Self { uniforms: u, cells, cells_dropped: inputs.cells.len() - kept })
     }
 

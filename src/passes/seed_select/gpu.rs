@@ -1,6 +1,7 @@
-//! Pass 3's GPU half: the pipeline and binding table (built once), the patterns and species
-//! tables uploaded once, the frame's upload and the recorded dispatch, and blocking readbacks for
-//! tests.
+//! Pass 3's GPU half: the pipelines and binding table (built once), the patterns and species
+//! tables uploaded once, the frame's upload and the recorded dispatches (the selection, `settle`,
+//! and the selection again, indirectly, which runs only when the records overflowed: see
+//! `shaders/seed_select_blocks.wgsl`), and blocking readbacks for tests.
 
 use wgpu::{ShaderStages as Stage, TextureSampleType as Sample, TextureViewDimension as Dim};
 
@@ -8,7 +9,7 @@ use crate::camera::CameraError;
 use crate::config::Settings;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::gpu_types::{
-    SeedBlock, SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSpecies, SeedUniforms,
+    SeedBlock, SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSettle, SeedSpecies, SeedUniforms,
 };
 use crate::gpu::readback::read_values;
 use crate::gpu::resources::{buffer, buffer_init, compute_pipeline, pipeline_layout};
@@ -30,6 +31,7 @@ pub const SHADER: WgslSource = WgslSource {
         TERRAIN_SURFACE,
         LANDCOVER,
         include_str!("../../../shaders/seed_select.wgsl"),
+        include_str!("../../../shaders/seed_select_blocks.wgsl"),
     ],
 };
 
@@ -70,10 +72,19 @@ pub const BINDINGS: BindingTable<16> = BindingTable {
     ],
 };
 
+/// `settle`'s group 1: the second round's indirect dispatch, which it writes. Not in `BINDINGS`:
+/// bound for that round, it could not also be its indirect argument.
+pub const SETTLE_BINDINGS: BindingTable<1> = BindingTable {
+    label: "seed select settle",
+    bindings: [Binding::storage::<SeedSettle>(0, "settled", Stage::COMPUTE, Access::ReadWrite)],
+};
+
 /// Pass 3 on the GPU: pipeline, binding table, patterns, species tables and output buffers built once
 /// in `new`; each frame `prepare` uploads the uniforms and cells and `encode` records the dispatch.
 pub struct SeedSelectPass {
     pipeline: wgpu::ComputePipeline,
+    settle: wgpu::ComputePipeline,
+    settle_group: wgpu::BindGroup,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     cells: wgpu::Buffer,
@@ -84,6 +95,7 @@ pub struct SeedSelectPass {
     counters: wgpu::Buffer,
     keys: wgpu::Buffer,
     blocks: wgpu::Buffer,
+    settled: wgpu::Buffer,
     capacity: u32,
     block_capacity: u32,
 }
@@ -110,9 +122,15 @@ impl SeedSelectPass {
     ) -> Self {
         let module = SHADER.module(device);
         let layout = BINDINGS.layout(device);
-        let pipeline_layout = pipeline_layout(device, "seed select", &[&layout]);
-        let pipeline = compute_pipeline(device, "seed select", &pipeline_layout, &module, "main");
+        let main_layout = pipeline_layout(device, "seed select", &[&layout]);
+        let pipeline = compute_pipeline(device, "seed select", &main_layout, &module, "main");
+        // `settle` sees the pass's bindings and, in group 1, the second round's dispatch.
+        let settle_layout = SETTLE_BINDINGS.layout(device);
+        let both = pipeline_layout(device, "seed select settle", &[&layout, &settle_layout]);
+        let settle = compute_pipeline(device, "seed select settle", &both, &module, "settle");
         use wgpu::BufferUsages as U;
+        let settled = buffer(device, "seed settle", size_of::<SeedSettle>() as u64, U::STORAGE | U::INDIRECT);
+        let settle_group = SETTLE_BINDINGS.bind_group(device, &settle_layout, [settled.as_entire_binding()]);
         let empty = |label, size: u64, usage| buffer(device, label, size, usage);
         let init = |label, contents: &[u8]| buffer_init(device, label, contents, U::STORAGE);
         let capacity = settings.seeds.capacity;
@@ -127,6 +145,8 @@ impl SeedSelectPass {
         let blocks_bytes = u64::from(block_capacity) * size_of::<SeedBlock>() as u64;
         Self {
             pipeline,
+            settle,
+            settle_group,
             layout,
             uniforms: empty("seed uniforms", size_of::<SeedUniforms>() as u64, U::STORAGE | U::COPY_DST),
             cells: empty("seed cells", cells_bytes, U::STORAGE | U::COPY_DST),
@@ -137,6 +157,7 @@ impl SeedSelectPass {
             counters: empty("seed counters", size_of::<SeedCounters>() as u64, output | U::COPY_DST),
             keys: empty("seed keys", u64::from(capacity.max(1)) * 4, output),
             blocks: empty("seed blocks", blocks_bytes, output),
+            settled,
             capacity,
             block_capacity,
         }
@@ -179,7 +200,8 @@ impl SeedSelectPass {
         Ok(frame)
     }
 
-    /// Records the pass: counters cleared, then one invocation per seed of every cell.
+    /// Records the pass: counters cleared, one invocation per seed of every cell, `settle`, and the
+    /// second round (dispatched by `settle`: no workgroups unless the records overflowed).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -201,6 +223,11 @@ impl SeedSelectPass {
             frame.cells.len() as u32,
             1,
         );
+        pass.set_pipeline(&self.settle);
+        pass.set_bind_group(1, &self.settle_group, &[]);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(&self.pipeline);
+        pass.dispatch_workgroups_indirect(&self.settled, 0);
     }
 
     /// The record buffer (`capacity` records; a frame fills `min(selected, capacity)`).
