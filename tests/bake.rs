@@ -140,6 +140,22 @@ fn baking_every_model_gives_three_lods_with_their_planes_and_non_empty_atlases()
     assert_eq!(terramp::impostor::models(out.path()).unwrap(), names);
 }
 
+/// Found by `fuzz/`'s `gltf_model`: a primitive whose POSITION names an accessor past the file's
+/// made the glTF crate's validation panic.
+#[test]
+fn a_position_accessor_the_file_lacks_is_refused_not_a_panic() {
+    let dir = TempDir::new("bake-accessor");
+    let model = dir.path().join("Ghost.gltf");
+    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}}]}]}"#;
+    std::fs::write(&model, json).unwrap();
+    let message = terramp::bake::load_model(&model).unwrap_err().to_string();
+    assert!(message.contains("POSITION from accessor 1") && message.contains("0 accessors"), "{message}");
+    let err = bake_models(None, std::slice::from_ref(&model), dir.path(), &BakeOptions::default(), false)
+        .unwrap_err();
+    assert!(err.to_string().contains("Ghost.gltf"), "{err}");
+}
+
 #[test]
 fn missing_corrupt_and_same_named_models_are_named() {
     let dir = TempDir::new("bake-errors");

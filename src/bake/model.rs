@@ -27,6 +27,21 @@ pub enum ModelError {
     /// The file does not parse as glTF (JSON `.gltf` or binary `.glb`).
     #[error("not a valid glTF model: {0}")]
     NotGltf(#[source] gltf::Error),
+    /// A primitive takes its positions from an accessor the file does not have.
+    #[error(
+        "not a valid glTF model: mesh {mesh}, primitive {primitive} takes its POSITION from accessor \
+         {accessor}, and the file has {accessors} accessors"
+    )]
+    NoSuchAccessor {
+        /// The mesh, counted from 0.
+        mesh: usize,
+        /// The primitive in it, counted from 0.
+        primitive: usize,
+        /// The accessor it names.
+        accessor: usize,
+        /// Accessors in the file.
+        accessors: usize,
+    },
     /// A buffer or image is embedded as a `data:` URI, which the baker does not decode.
     #[error("unusable glTF model: embedded data URIs are not supported: use a .glb")]
     DataUri,
@@ -106,8 +121,29 @@ pub enum ModelError {
 /// The mesh of the model at `path`.
 pub fn load(path: &Path) -> Result<Mesh, ModelError> {
     let bytes = std::fs::read(path).map_err(ModelError::Read)?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(ModelError::NotGltf)?;
+    let gltf = parse(&bytes)?;
     read(&gltf, path)
+}
+
+/// Parses and validates a model's bytes. gltf-json 1.4's validation reads a primitive's POSITION
+/// accessor before it checks that the accessor exists, and panics when it does not (found by
+/// `fuzz/`'s `gltf_model`): those indices are checked here first, then the crate validates the rest.
+fn parse(bytes: &[u8]) -> Result<gltf::Gltf, ModelError> {
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::Checked;
+    let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(ModelError::NotGltf)?;
+    let json = unchecked.document.into_json();
+    let accessors = json.accessors.len();
+    for (mesh, m) in json.meshes.iter().enumerate() {
+        for (primitive, p) in m.primitives.iter().enumerate() {
+            let position = p.attributes.get(&Checked::Valid(Semantic::Positions));
+            if let Some(accessor) = position.map(|a| a.value()).filter(|&a| a >= accessors) {
+                return Err(ModelError::NoSuchAccessor { mesh, primitive, accessor, accessors });
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(ModelError::NotGltf)?;
+    Ok(gltf::Gltf { document, blob: unchecked.blob })
 }
 
 fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
