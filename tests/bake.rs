@@ -140,20 +140,49 @@ fn baking_every_model_gives_three_lods_with_their_planes_and_non_empty_atlases()
     assert_eq!(terramp::impostor::models(out.path()).unwrap(), names);
 }
 
-/// Found by `fuzz/`'s `gltf_model`: a primitive whose POSITION names an accessor past the file's
-/// made the glTF crate's validation panic.
+/// Models that made the glTF crate panic, found by `fuzz/`'s `gltf_model`, are refused with an
+/// error naming what is wrong: a POSITION naming an accessor past the file's (its validation
+/// indexed it), indices stored as floats (its reader's `unreachable!`); and a node that is its own
+/// child (a walk of the scene that never ends).
 #[test]
-fn a_position_accessor_the_file_lacks_is_refused_not_a_panic() {
-    let dir = TempDir::new("bake-accessor");
-    let model = dir.path().join("Ghost.gltf");
-    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}}]}]}"#;
-    std::fs::write(&model, json).unwrap();
-    let message = terramp::bake::load_model(&model).unwrap_err().to_string();
-    assert!(message.contains("POSITION from accessor 1") && message.contains("0 accessors"), "{message}");
-    let err = bake_models(None, std::slice::from_ref(&model), dir.path(), &BakeOptions::default(), false)
-        .unwrap_err();
-    assert!(err.to_string().contains("Ghost.gltf"), "{err}");
+fn malformed_models_found_by_fuzzing_are_refused_not_a_panic() {
+    let dir = TempDir::new("bake-fuzzed");
+    // One triangle: positions (3 float VEC3s), then its 3 indices (read as u32 or, damaged, f32).
+    let positions = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let mut bin: Vec<u8> = positions.iter().flat_map(|v| v.to_le_bytes()).collect();
+    bin.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.path().join("tri.bin"), &bin).unwrap();
+    let triangle = |nodes: &str, indices_type: u32, position: u32| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}], "nodes": {nodes},
+            "buffers": [{{"uri": "tri.bin", "byteLength": 48}}],
+            "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 12}}],
+            "accessors": [
+                {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+                {{"bufferView": 1, "componentType": {indices_type}, "count": 3, "type": "SCALAR"}}],
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": {position}}}, "indices": 1}}]}}]}}"#
+        )
+    };
+    let tree = r#"[{"mesh": 0}]"#;
+    let cases = [
+        ("Sound", triangle(tree, 5125, 0), None),
+        (
+            "Ghost",
+            triangle(tree, 5125, 2),
+            Some("takes its POSITION from accessor 2, and the file has 2 accessors"),
+        ),
+        ("Floats", triangle(tree, 5126, 0), Some("indices accessor 1: (F32, Scalar) elements")),
+        ("Loop", triangle(r#"[{"mesh": 0, "children": [0]}]"#, 5125, 0), Some("node 0 is reached twice")),
+    ];
+    for (name, json, expected) in cases {
+        let model = dir.path().join(format!("{name}.gltf"));
+        std::fs::write(&model, json).unwrap();
+        match (terramp::bake::load_model(&model), expected) {
+            (Ok(mesh), None) => assert_eq!(mesh.indices.len(), 3, "{name}"),
+            (Err(e), Some(expected)) => assert!(e.to_string().contains(expected), "{name}: {e}"),
+            (result, _) => panic!("{name}: {:?}", result.map(|m| m.indices)),
+        }
+    }
 }
 
 #[test]

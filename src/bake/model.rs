@@ -11,6 +11,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Vec3};
+use gltf::Semantic;
+use gltf::accessor::DataType::{self, F32, U8, U16, U32};
+use gltf::accessor::Dimensions::{self, Scalar, Vec2};
 use thiserror::Error;
 
 use crate::impostor::detail::DETAIL_EXTRAS;
@@ -91,6 +94,25 @@ pub enum ModelError {
         /// The glTF index of the mesh holding the primitive.
         mesh: usize,
     },
+    /// An accessor the baker reads is of another type, sparse, empty, or lies outside its buffer
+    /// view (the glTF crate's reader assumes all this, and would panic).
+    #[error("unusable glTF model: mesh {mesh}: {what} accessor {accessor}: {problem}")]
+    BadAccessor {
+        /// The glTF index of the mesh holding the primitive.
+        mesh: usize,
+        /// What the accessor holds (positions, normals, texture coordinates, indices).
+        what: &'static str,
+        /// The accessor's glTF index.
+        accessor: usize,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A node is reached twice from the scene: the node hierarchy is not a tree.
+    #[error("unusable glTF model: node {node} is reached twice from the scene (the nodes must form a tree)")]
+    NodeCycle {
+        /// The node's glTF index.
+        node: usize,
+    },
     /// A primitive's index count is not a multiple of 3, or an index points past its vertices.
     #[error("unusable glTF model: mesh {mesh}: bad triangle indices")]
     BadIndices {
@@ -157,6 +179,8 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
     let mut buffers = Vec::new();
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
+            // Only the first buffer may be the binary chunk (glTF 2.0 § 4.4.3.3): each would copy it.
+            gltf::buffer::Source::Bin if buffer.index() > 0 => return Err(ModelError::NoBinaryChunk),
             gltf::buffer::Source::Bin => gltf.blob.clone().ok_or(ModelError::NoBinaryChunk)?,
             gltf::buffer::Source::Uri(uri) => beside(uri)?,
         };
@@ -207,7 +231,11 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
     let mut by_material: Vec<Vec<u32>> = vec![Vec::new(); materials.len() + 1];
     let scene = gltf.default_scene().or_else(|| gltf.scenes().next()).ok_or(ModelError::NoScene)?;
     let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+    let mut reached = vec![false; gltf.nodes().len()];
     while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut reached[node.index()], true) {
+            return Err(ModelError::NodeCycle { node: node.index() });
+        }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         stack.extend(node.children().map(|c| (c, world)));
         let Some(mesh) = node.mesh() else { continue };
@@ -221,6 +249,20 @@ fn read(gltf: &gltf::Gltf, path: &Path) -> Result<Mesh, ModelError> {
             let material = primitive.material().index().unwrap_or(default_material);
             let set = tex_coords.get(material).copied().unwrap_or(0);
             let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+            let checked = |what, accessor: Option<gltf::Accessor>, formats: &[(DataType, Dimensions)]| {
+                let Some(a) = accessor else { return Ok(()) };
+                check_accessor(&a, formats).map_err(|problem| ModelError::BadAccessor {
+                    mesh: mesh.index(),
+                    what,
+                    accessor: a.index(),
+                    problem,
+                })
+            };
+            checked("positions", primitive.get(&Semantic::Positions), &[(F32, Dimensions::Vec3)])?;
+            checked("normals", primitive.get(&Semantic::Normals), &[(F32, Dimensions::Vec3)])?;
+            checked("indices", primitive.indices(), &[(U8, Scalar), (U16, Scalar), (U32, Scalar)])?;
+            let uv_formats = [(F32, Vec2), (U8, Vec2), (U16, Vec2)];
+            checked("texture coordinates", primitive.get(&Semantic::TexCoords(set)), &uv_formats)?;
             let positions: Vec<Vec3> = reader
                 .read_positions()
                 .ok_or(ModelError::NoPositions { mesh: mesh.index() })?
@@ -324,6 +366,36 @@ fn read_pivots<'a, 's>(
     (points.len() == count).then_some(points)
 }
 
+/// Whether the glTF crate's reader can read `accessor` without a panic: one of `formats`, not
+/// sparse, not empty, with a stride of at least its elements' size, and all inside its view.
+fn check_accessor(accessor: &gltf::Accessor, formats: &[(DataType, Dimensions)]) -> Result<(), String> {
+    let format = (accessor.data_type(), accessor.dimensions());
+    if !formats.contains(&format) {
+        return Err(format!("{format:?} elements, where the baker reads {formats:?}"));
+    }
+    if accessor.sparse().is_some() {
+        return Err("sparse accessors are not supported".into());
+    }
+    let (count, size) = (accessor.count(), accessor.size());
+    if count == 0 {
+        return Err("no elements".into());
+    }
+    let Some(view) = accessor.view() else { return Ok(()) };
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        return Err(format!("a stride of {stride} bytes under its {size}-byte elements"));
+    }
+    let end = stride
+        .checked_mul(count - 1)
+        .and_then(|n| n.checked_add(accessor.offset()))
+        .and_then(|n| n.checked_add(size));
+    let view_end = view.offset().checked_add(view.length());
+    if end.is_none_or(|end| end > view.length()) || view_end.is_none() {
+        return Err(format!("{count} elements from byte {} run past its buffer view", accessor.offset()));
+    }
+    Ok(())
+}
+
 /// Area-weighted vertex normals of a triangle list.
 fn face_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; positions.len()];
@@ -349,10 +421,11 @@ fn decode_image(
     let bytes = match image.source() {
         gltf::image::Source::View { view, .. } => {
             let buffer = buffers.get(view.buffer().index()).ok_or_else(|| view_error("no such buffer"))?;
-            buffer
-                .get(view.offset()..view.offset() + view.length())
-                .ok_or_else(|| view_error("view outside its buffer"))?
-                .to_vec()
+            let end = view
+                .offset()
+                .checked_add(view.length())
+                .ok_or_else(|| view_error("view outside its buffer"))?;
+            buffer.get(view.offset()..end).ok_or_else(|| view_error("view outside its buffer"))?.to_vec()
         }
         gltf::image::Source::Uri { uri, .. } => beside(uri)?,
     };
