@@ -3,16 +3,22 @@
 total resident memory over the 100 frames before; the rise of the anonymous floor from the first
 window after the warm-up to the last (bound 16 MiB); and a plot of both into OUT.PNG.
 
+The warm-up is WARM_UP frames (environment; 300 by default). Memory rises with the heaviest
+frame drawn so far, until the flight has shown its heaviest view: soak.sh flies its path there
+and back several times and passes the first leg as the warm-up, so that what is judged is
+growth over views already seen.
+
     scripts/soak_plot.py OUT.PNG LOG.JSONL...
 """
 import json
+import os
 import sys
 from pathlib import Path
 
 from PIL import Image, ImageDraw
 
 WINDOW = 100
-WARM_UP = 300
+WARM_UP = int(os.environ.get("WARM_UP", "300"))
 BOUND_MIB = 16.0
 
 
