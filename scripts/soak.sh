@@ -9,7 +9,7 @@
 # Each flight is `terramp fly --save-every 0` along the dataset's path, with wind and cloud shadows
 # on (they change uniforms every frame), into out/soak/<name>/log.jsonl; `scripts/soak_plot.py`
 # then prints the anonymous and total resident memory every 100 frames, the rise of the floor after
-# the warm-up (bound: 16 MiB), and draws docs/soak.png.
+# the warm-up (bound: 16 MiB), and draws docs/soak_<name>.png.
 #
 # The path is flown LEGS times, there and back, and the first leg is the warm-up: memory rises with
 # the heaviest frame drawn so far, until the flight has shown its heaviest view (a one-way nc
@@ -73,5 +73,6 @@ PY
   /usr/bin/time -v "$bin/terramp" fly --dataset "$dataset" --path "$path" --frames "$FRAMES" --save-every 0 \
     --width "$WIDTH" --height "$HEIGHT" --settings "$weather" --out "out/soak/$name" 2> "out/soak/$name/time.txt" \
     || { tail -5 "out/soak/$name/time.txt"; exit 1; }
+  WARM_UP=$((FRAMES / LEGS)) python3 scripts/soak_plot.py "docs/soak_$name.png" "out/soak/$name/log.jsonl" || failed=1
 done
-WARM_UP=$((FRAMES / LEGS)) python3 scripts/soak_plot.py docs/soak.png $(for n in $SOAKS; do echo "out/soak/$n/log.jsonl"; done)
+exit "${failed:-0}"
