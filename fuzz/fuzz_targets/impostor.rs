@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
-use terramp::texcell::pyramid::{self, Layer};
-use terramp::texcell::{Chain, ForestSample, SampleTree, VolumeLevel};
+use terramp::texcell::pyramid::Layer;
+use terramp::texcell::{ForestSample, SampleTree};
 
 struct Template {
     /// The folder the inputs change.
@@ -36,25 +36,12 @@ fn small_sample() -> ForestSample {
     let finest: Vec<Layer> = (0..4)
         .map(|k| Layer {
             side: 8,
-            texels: (0..64).map(|i| if (i + k) % 5 == 0 { [0.1, 0.3, 0.05, 0.6] } else { [0.0; 4] }).collect(),
+            texels: (0..64)
+                .map(|i| if (i + k) % 5 == 0 { [0.1, 0.3, 0.05, 0.6] } else { [0.0; 4] })
+                .collect(),
         })
         .collect();
-    let slices = pyramid::slice_pyramid(finest.clone())
-        .into_iter()
-        .map(|level| {
-            level
-                .into_iter()
-                .map(|l| Chain {
-                    side: l.side,
-                    levels: pyramid::mip_chain(l).iter().map(|m| pyramid::encode(&m.texels)).collect(),
-                })
-                .collect()
-        })
-        .collect();
-    let volume = pyramid::volume_chain(&finest)
-        .into_iter()
-        .map(|v| VolumeLevel { side: v.side, depth: v.depth, bytes: pyramid::encode(&v.texels) })
-        .collect();
+    let (slices, volume) = terramp::texcell::sample_images(finest);
     let tree = SampleTree { model: "Pine_1".into(), position_m: [3.0, 4.0], height_m: 12.5, angle_deg: 30.0 };
     ForestSample {
         class_code: CLASS,

@@ -123,6 +123,24 @@ pub struct ForestSample {
     pub volume: Vec<VolumeLevel>,
 }
 
+/// The images a sample stores, made from its finest slices (bottom first): the slice pyramid, each
+/// slice with its mip chain, and the 3D texture's chain, encoded as stored (`pyramid::encode`).
+pub fn sample_images(finest: Vec<pyramid::Layer>) -> (Vec<Vec<Chain>>, Vec<VolumeLevel>) {
+    let volume = pyramid::volume_chain(&finest)
+        .into_iter()
+        .map(|v| VolumeLevel { side: v.side, depth: v.depth, bytes: pyramid::encode(&v.texels) })
+        .collect();
+    let chain = |layer: pyramid::Layer| {
+        let side = layer.side;
+        Chain { side, levels: pyramid::mip_chain(layer).iter().map(|l| pyramid::encode(&l.texels)).collect() }
+    };
+    let slices = pyramid::slice_pyramid(finest)
+        .into_iter()
+        .map(|level| level.into_iter().map(chain).collect())
+        .collect();
+    (slices, volume)
+}
+
 impl ForestSample {
     /// Slices of the finest level (2^N).
     pub fn slice_count(&self) -> u32 {

@@ -250,7 +250,7 @@ fn check_shape(s: &ForestSample) -> Result<(), String> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::pyramid::{self, Layer};
+    use super::super::pyramid::Layer;
     use super::*;
 
     /// A small sample built by the pyramid from 4 slices of 8 texels.
@@ -263,22 +263,7 @@ mod tests {
                     .collect(),
             })
             .collect();
-        let slices = pyramid::slice_pyramid(finest.clone())
-            .into_iter()
-            .map(|level| {
-                level
-                    .into_iter()
-                    .map(|l| Chain {
-                        side: l.side,
-                        levels: pyramid::mip_chain(l).iter().map(|m| pyramid::encode(&m.texels)).collect(),
-                    })
-                    .collect()
-            })
-            .collect();
-        let volume = pyramid::volume_chain(&finest)
-            .into_iter()
-            .map(|v| VolumeLevel { side: v.side, depth: v.depth, bytes: pyramid::encode(&v.texels) })
-            .collect();
+        let (slices, volume) = super::super::sample_images(finest);
         let tree =
             SampleTree { model: "Pine_1".into(), position_m: [3.0, 4.0], height_m: 12.5, angle_deg: 30.0 };
         ForestSample {

@@ -26,7 +26,7 @@ use crate::gpu::Gpu;
 use crate::impostor::{Mesh, TexelRect};
 use crate::texcell::pyramid::{self, Layer};
 use crate::texcell::tiling::REFERENCE_CELLS;
-use crate::texcell::{Chain, ForestSample, SampleTree, VolumeLevel};
+use crate::texcell::{ForestSample, SampleTree};
 pub use place::{Grown, place};
 
 /// How a forest sample is baked.
@@ -127,14 +127,7 @@ pub fn bake_forest(
     }
     let finest = render_slices(gpu, &baker, &models_read, &trees, height_m, options)
         .map_err(|e| bad(format!("rendering the slices: {e}")))?;
-    let slices: Vec<Vec<Chain>> = pyramid::slice_pyramid(finest.clone())
-        .into_iter()
-        .map(|level| level.into_iter().map(chain).collect())
-        .collect();
-    let volume = pyramid::volume_chain(&finest)
-        .into_iter()
-        .map(|v| VolumeLevel { side: v.side, depth: v.depth, bytes: pyramid::encode(&v.texels) })
-        .collect();
+    let (slices, volume) = crate::texcell::sample_images(finest);
     Ok(ForestSample {
         class_code: class.code,
         class_name: class.name.clone(),
@@ -196,11 +189,6 @@ pub fn bake_forests(
         reports.push(report);
     }
     Ok(reports)
-}
-
-fn chain(layer: Layer) -> Chain {
-    let side = layer.side;
-    Chain { side, levels: pyramid::mip_chain(layer).iter().map(|l| pyramid::encode(&l.texels)).collect() }
 }
 
 /// The finest slices, bottom first, premultiplied.
