@@ -36,7 +36,7 @@ struct Flight {
 fn fly(faults: &FaultSettings) -> Flight {
     let dataset = synth_dataset(2048, 9);
     let mut settings = ground_settings(320, 180);
-    settings.faults = faults.clone();
+    settings.faults = *faults;
     let mut r = renderer(&dataset, settings);
     let [w, h] = r.dataset.manifest.extent_m();
     let (mut failed, mut worst_queue, mut no_ground_px) = (0usize, 0usize, Vec::new());

@@ -355,10 +355,9 @@ fn read_pivots<'a, 's>(
     count: usize,
     buffer_data: impl Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
 ) -> Option<Vec<Vec3>> {
-    use gltf::accessor::{DataType, Dimensions};
-    let float_vec3 = accessor.data_type() == DataType::F32 && accessor.dimensions() == Dimensions::Vec3;
-    // (The reader computes the data's end from the count: a count of 0 must not reach it.)
-    if !float_vec3 || accessor.count() != count || count == 0 {
+    // What the reader assumes (`check_accessor`: float VEC3s, not sparse, not empty, inside its
+    // view), and one point per vertex.
+    if check_accessor(&accessor, &[(F32, Dimensions::Vec3)]).is_err() || accessor.count() != count {
         return None;
     }
     let points: Vec<Vec3> =
@@ -389,9 +388,15 @@ fn check_accessor(accessor: &gltf::Accessor, formats: &[(DataType, Dimensions)])
         .checked_mul(count - 1)
         .and_then(|n| n.checked_add(accessor.offset()))
         .and_then(|n| n.checked_add(size));
-    let view_end = view.offset().checked_add(view.length());
-    if end.is_none_or(|end| end > view.length()) || view_end.is_none() {
+    if end.is_none_or(|end| end > view.length()) {
         return Err(format!("{count} elements from byte {} run past its buffer view", accessor.offset()));
+    }
+    if view.offset().checked_add(view.length()).is_none() {
+        return Err(format!(
+            "its buffer view's end, {} + {} bytes, is past any buffer",
+            view.offset(),
+            view.length()
+        ));
     }
     Ok(())
 }

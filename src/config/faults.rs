@@ -7,7 +7,7 @@ use serde::Deserialize;
 use super::{RangeCheck, SettingsError, first_out_of_range};
 
 /// Faults injected into the loader's tile reads, see `config/default.toml` `[faults]`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FaultSettings {
     /// Share of tiles whose read fails (an I/O error), 0 to 1.
@@ -21,11 +21,6 @@ pub struct FaultSettings {
 }
 
 impl FaultSettings {
-    /// Whether any fault is injected.
-    pub fn any(&self) -> bool {
-        self.fail > 0.0 || self.corrupt > 0.0 || self.delay_ms > 0
-    }
-
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
         let checks: [RangeCheck; 3] = [
             ((0.0..=1.0).contains(&self.fail), "faults.fail", self.fail.to_string(), "0 to 1"),

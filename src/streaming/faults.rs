@@ -13,12 +13,7 @@ use crate::dataset::TileId;
 
 /// The faults a loader injects.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Faults {
-    fail: f64,
-    corrupt: f64,
-    delay_ms: u32,
-    seed: u32,
-}
+pub struct Faults(FaultSettings);
 
 /// What happens to one read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,27 +32,28 @@ pub enum Fate {
 impl Faults {
     /// The faults `settings` ask for.
     pub fn new(settings: &FaultSettings) -> Self {
-        let FaultSettings { fail, corrupt, delay_ms, seed } = *settings;
-        Self { fail, corrupt, delay_ms, seed }
+        Self(*settings)
     }
 
     /// Whether any fault is injected.
     pub fn any(&self) -> bool {
-        self.fail > 0.0 || self.corrupt > 0.0 || self.delay_ms > 0
+        let FaultSettings { fail, corrupt, delay_ms, .. } = self.0;
+        fail > 0.0 || corrupt > 0.0 || delay_ms > 0
     }
 
     /// What happens to the read of `id` in `layer`, and how long it waits first.
     pub fn fate(&self, layer: LayerKind, id: TileId) -> (Fate, Duration) {
-        let key = u64::from(self.seed) << 32
+        let FaultSettings { fail, corrupt, delay_ms, seed } = self.0;
+        let key = u64::from(seed) << 32
             ^ (layer as u64) << 28
             ^ u64::from(id.level) << 24
             ^ u64::from(id.x) << 12
             ^ u64::from(id.y);
         let unit = |salt: u64| (mix(key ^ salt) >> 11) as f64 / (1u64 << 53) as f64;
-        let wait = Duration::from_secs_f64(unit(3) * f64::from(self.delay_ms) / 1000.0);
-        let fate = if unit(1) < self.fail {
+        let wait = Duration::from_secs_f64(unit(3) * f64::from(delay_ms) / 1000.0);
+        let fate = if unit(1) < fail {
             Fate::Fail
-        } else if unit(2) < self.corrupt {
+        } else if unit(2) < corrupt {
             Fate::Corrupt { at: mix(key ^ 4) as usize }
         } else {
             Fate::Read
