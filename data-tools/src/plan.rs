@@ -1,6 +1,7 @@
 //! How it works: a partitioned build in three commands any scheduler can run. `plan` fixes
-//! everything the jobs must agree on (the source, each layer's split, the land cover's palette)
-//! in a TOML file with a hash of all of it, and lists each partition's subtrees and input window.
+//! everything the jobs must agree on (the source, each layer's split, the land cover's palette;
+//! for GeoTIFF inputs also the DEM's scan and the imagery's stretch, `build::parts`) in a TOML
+//! file with a hash of all of it, and lists each partition's subtrees and input window.
 //! `build --plan P --partition i` writes partition `i`'s part packs into a hidden folder beside
 //! the others and renames it into place with a receipt (the plan's hash, time, peak memory) only
 //! when complete: a killed job leaves nothing that counts, and a partition whose receipt carries
@@ -15,8 +16,12 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail, ensure};
 use serde::{Deserialize, Serialize};
 use terramp::dataset::lcc::{LCC_SOURCE_LEVEL, LccCoding};
+use terramp::dataset::partition::Split;
 use terramp::dataset::{ImageryFormat, PACK_VERSION};
 use terramp::synth::{SynthParams, SynthParts};
+
+use crate::build::InputArgs;
+use crate::build::parts::{GeotiffParts, GeotiffSource};
 
 /// The plan file's format; a job refuses a plan of another.
 const PLAN_FORMAT: u32 = 1;
@@ -24,12 +29,16 @@ const PLAN_FORMAT: u32 = 1;
 const RECEIPT_FILE: &str = "done.toml";
 
 #[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("what").required(true).args(["synth_size", "dem"])))]
 pub struct PlanArgs {
-    /// Plan the synthetic dataset of this many DEM samples per side (`synth --size`).
-    #[arg(long)]
-    synth_size: u32,
+    /// Plan the build of these GeoTIFF inputs (`build`'s arguments).
+    #[command(flatten)]
+    inputs: InputArgs,
+    /// Plan the synthetic dataset of this many DEM samples per side (`synth --size`) instead.
+    #[arg(long, conflicts_with = "dem")]
+    synth_size: Option<u32>,
     /// The synthetic dataset's seed (`synth --seed`).
-    #[arg(long, default_value_t = SynthParams::default().seed)]
+    #[arg(long, default_value_t = SynthParams::default().seed, requires = "synth_size")]
     seed: u64,
     /// How many jobs to cut the build into.
     #[arg(long)]
@@ -53,6 +62,8 @@ pub struct PlanArgs {
 enum Source {
     /// `terramp-data synth`'s dataset.
     Synth { size: u32, seed: u64 },
+    /// `terramp-data build`'s dataset from GeoTIFF inputs.
+    Geotiff(Box<GeotiffSource>),
 }
 
 /// One layer's cut, for people and schedulers to read (the jobs recompute it and check).
@@ -88,7 +99,9 @@ struct Plan {
     /// not hashed.
     #[serde(default = "plain_imagery")]
     imagery_format: String,
-    coding: LccCoding,
+    /// The land cover's palette (absent without land cover).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    coding: Option<LccCoding>,
     layers: Vec<LayerPlan>,
 }
 
@@ -105,22 +118,45 @@ struct Receipt {
     peak_rss_mib: f64,
 }
 
-impl Source {
-    fn params(&self) -> SynthParams {
-        match *self {
-            Source::Synth { size, seed } => SynthParams { size, seed, ..SynthParams::default() },
+/// A plan's source, opened for its jobs and merge.
+enum Parts {
+    Synth(Box<SynthParts>),
+    Geotiff(Box<GeotiffParts>),
+}
+
+impl Parts {
+    /// Each layer's pack name, split and source level.
+    fn splits(&self) -> Vec<(&'static str, Split, u32)> {
+        match self {
+            Parts::Synth(parts) => {
+                let names = ["height", "imagery", "landcover"];
+                names
+                    .into_iter()
+                    .zip(parts.splits)
+                    .zip([0, 0, LCC_SOURCE_LEVEL])
+                    .map(|((n, s), l)| (n, s, l))
+                    .collect()
+            }
+            Parts::Geotiff(parts) => parts.splits.clone(),
+        }
+    }
+
+    fn write_part(&self, dir: &Path, part: u32, progress: bool) -> Result<()> {
+        match self {
+            Parts::Synth(parts) => Ok(parts.write_part(dir, part, progress)?),
+            Parts::Geotiff(parts) => parts.write_part(dir, part, progress),
         }
     }
 }
 
 impl Plan {
-    fn hash_of(source: &Source, partitions: u32, coding: &LccCoding) -> Result<String> {
+    fn hash_of(source: &Source, partitions: u32, coding: Option<&LccCoding>) -> Result<String> {
         /// Everything a job's output depends on.
         #[derive(Serialize)]
         struct Hashed<'a> {
             source: &'a Source,
             partitions: u32,
-            coding: &'a LccCoding,
+            coding: Option<&'a LccCoding>,
             pack_version: u32,
             builder: String,
         }
@@ -150,7 +186,7 @@ impl Plan {
             plan.builder,
             builder()
         );
-        let hash = Self::hash_of(&plan.source, plan.partitions, &plan.coding)?;
+        let hash = Self::hash_of(&plan.source, plan.partitions, plan.coding.as_ref())?;
         ensure!(
             hash == plan.hash,
             "{}: the plan was edited after it was made (hash {hash}, recorded {})",
@@ -164,10 +200,26 @@ impl Plan {
         plan_path.parent().unwrap_or(Path::new(".")).join(&self.parts)
     }
 
-    fn build(&self) -> Result<SynthParts> {
+    /// The source opened for jobs and merges; `plan_path` is where the plan lies.
+    fn open(&self, plan_path: &Path) -> Result<Parts> {
         let imagery_format = crate::parse_imagery_format(&self.imagery_format).map_err(anyhow::Error::msg)?;
-        let params = SynthParams { imagery_format, ..self.source.params() };
-        Ok(SynthParts::new(&params, self.partitions, self.coding.clone())?)
+        Ok(match &self.source {
+            &Source::Synth { size, seed } => {
+                let params = SynthParams { size, seed, imagery_format, ..SynthParams::default() };
+                let coding =
+                    self.coding.clone().context("a synthetic plan without its land cover's coding")?;
+                Parts::Synth(Box::new(SynthParts::new(&params, self.partitions, coding)?))
+            }
+            Source::Geotiff(source) => {
+                let dir = plan_path.parent().unwrap_or(Path::new("."));
+                Parts::Geotiff(Box::new(GeotiffParts::open(
+                    source,
+                    self.coding.clone(),
+                    self.partitions,
+                    dir,
+                )?))
+            }
+        })
     }
 }
 
@@ -187,15 +239,31 @@ fn receipt(plan: &Plan, parts: &Path, part: u32) -> Option<Receipt> {
 
 pub fn plan(args: &PlanArgs) -> Result<()> {
     ensure!(args.partitions >= 1, "--partitions must be at least 1");
-    let source = Source::Synth { size: args.synth_size, seed: args.seed };
-    let parts = SynthParts::plan(&source.params(), args.partitions, std::io::stderr().is_terminal())?;
-    let names = ["height", "imagery", "landcover"];
-    let layers = names
-        .iter()
-        .zip(&parts.splits)
-        .zip([0, 0, LCC_SOURCE_LEVEL])
-        .map(|((name, split), source_level)| LayerPlan {
-            name: (*name).to_owned(),
+    let stem = args.out.file_stem().map_or_else(|| "plan".into(), |s| s.to_string_lossy().into_owned());
+    let (source, parts, coding) = match args.synth_size {
+        Some(size) => {
+            let params = SynthParams { size, seed: args.seed, ..SynthParams::default() };
+            let parts = SynthParts::plan(&params, args.partitions, std::io::stderr().is_terminal())?;
+            let coding = parts.coding.clone();
+            (Source::Synth { size, seed: args.seed }, Parts::Synth(Box::new(parts)), Some(coding))
+        }
+        None => {
+            // The void fill's coarse surface, beside the plan (recorded by its file name).
+            let coarse = args.out.with_file_name(format!("{stem}.coarse.bin"));
+            let (mut source, coding) = GeotiffSource::plan(&args.inputs, &coarse)?;
+            if let Some(file) = &mut source.heights.coarse {
+                file.path = coarse.file_name().map(PathBuf::from).unwrap_or_default();
+            }
+            let dir = args.out.parent().unwrap_or(Path::new("."));
+            let parts = GeotiffParts::open(&source, coding.clone(), args.partitions, dir)?;
+            (Source::Geotiff(Box::new(source)), Parts::Geotiff(Box::new(parts)), coding)
+        }
+    };
+    let layers = parts
+        .splits()
+        .into_iter()
+        .map(|(name, split, source_level)| LayerPlan {
+            name: name.trim_end_matches(".pack").to_owned(),
             split_level: split.level,
             partitions: (0..split.partitions)
                 .map(|p| PartPlan {
@@ -205,16 +273,15 @@ pub fn plan(args: &PlanArgs) -> Result<()> {
                 .collect(),
         })
         .collect();
-    let stem = args.out.file_stem().map_or_else(|| "plan".into(), |s| s.to_string_lossy().into_owned());
     let plan = Plan {
         format: PLAN_FORMAT,
-        hash: Plan::hash_of(&source, args.partitions, &parts.coding)?,
+        hash: Plan::hash_of(&source, args.partitions, coding.as_ref())?,
         builder: builder(),
         partitions: args.partitions,
         parts: args.parts.clone().unwrap_or_else(|| PathBuf::from(format!("{stem}.parts"))),
         source,
         imagery_format: args.imagery_format.short_name().to_owned(),
-        coding: parts.coding.clone(),
+        coding,
         layers,
     };
     write_atomically(&args.out, toml::to_string_pretty(&plan)?.as_bytes())?;
@@ -254,7 +321,7 @@ pub fn build_partition(plan_path: &Path, part: u32) -> Result<()> {
     }
     let staging = parts.join(format!("{prefix}{}", std::process::id()));
     fs::create_dir_all(&staging).with_context(|| format!("creating {}", staging.display()))?;
-    plan.build()?.write_part(&staging, part, std::io::stderr().is_terminal())?;
+    plan.open(plan_path)?.write_part(&staging, part, std::io::stderr().is_terminal())?;
     let receipt = Receipt {
         hash: plan.hash.clone(),
         partition: part,
@@ -296,7 +363,15 @@ pub fn merge(plan_path: &Path, out: &Path) -> Result<()> {
         );
     }
     let dirs: Vec<PathBuf> = (0..plan.partitions).map(|p| part_dir(&parts, p)).collect();
-    let dir = plan.build()?.merge(&dirs, out, std::io::stderr().is_terminal())?;
+    let progress = std::io::stderr().is_terminal();
+    let dir = match plan.open(plan_path)? {
+        Parts::Synth(parts) => parts.merge(&dirs, out, progress)?,
+        Parts::Geotiff(parts) => {
+            let imagery_format =
+                crate::parse_imagery_format(&plan.imagery_format).map_err(anyhow::Error::msg)?;
+            parts.merge(&dirs, out, imagery_format, progress)?
+        }
+    };
     println!(
         "merged {} partitions into {} in {:.1} s, peak RSS {:.0} MiB",
         plan.partitions,
@@ -308,7 +383,7 @@ pub fn merge(plan_path: &Path, out: &Path) -> Result<()> {
 }
 
 /// Writes `bytes` to `path` through a sibling temporary file and a rename.
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_extension(format!("partial-{}", std::process::id()));
     fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display()))?;
     fs::File::open(&tmp).and_then(|f| f.sync_all())?;

@@ -1,13 +1,15 @@
 //! Partitioned builds (`terramp-data plan`, `build --plan --partition`, `merge`) equal the
 //! single-process build byte for byte: run as separate jobs, on Dask's `LocalCluster`, and after a
-//! job killed with SIGKILL in the middle of its partition.
+//! job killed with SIGKILL in the middle of its partition; of the synthetic dataset and of GeoTIFF
+//! inputs (a DEM as it is, with voids, or reprojected from degrees; imagery and land cover
+//! reprojected or not).
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use terramp_testkit::data::TempDir;
+use terramp_testkit::data::{TempDir, shared_data};
 
 const SIZE: &str = "600";
 const SEED: &str = "5";
@@ -206,4 +208,109 @@ fn a_job_killed_mid_partition_is_rebuilt_and_only_it() {
     assert_eq!(log.matches("already built").count(), 2, "{log}");
     assert_eq!(log.matches("built in").count(), 1, "{log}");
     assert_same_dataset(&single, &merged);
+}
+
+/// Runs `terramp-data ARGS`, expecting it to fail; returns its stderr.
+fn terramp_data_fails(args: &[&str]) -> String {
+    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
+    assert!(!output.status.success(), "terramp-data {} succeeded", args.join(" "));
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Builds `inputs` (`build`'s arguments) in one process and as `partitions` jobs, in `dir`, and
+/// checks that they are the same dataset; returns the plan's text.
+fn geotiff_both_ways(dir: &Path, inputs: &[&str], partitions: u32) -> String {
+    let single = dir.join("single");
+    terramp_data(&[&["build"], inputs, &["--out", path(&single)]].concat());
+    let plan = dir.join("plan.toml");
+    let count = partitions.to_string();
+    terramp_data(&[&["plan"], inputs, &["--partitions", &count, "--out", path(&plan)]].concat());
+    for part in 0..partitions {
+        terramp_data(&["build", "--plan", path(&plan), "--partition", &part.to_string()]);
+    }
+    let merged = dir.join("merged");
+    terramp_data(&["merge", "--plan", path(&plan), "--out", path(&merged)]);
+    assert_same_dataset(&single, &merged);
+    std::fs::read_to_string(&plan).unwrap()
+}
+
+#[test]
+fn geotiff_plans_merge_into_the_single_process_build() {
+    let shared = std::path::absolute(shared_data().expect("../shared/data")).unwrap();
+    let file = |f: &str| shared.join(f).to_str().unwrap().to_owned();
+    let (nc_dem, landsat, landuse) =
+        (file("nc/elev_ned_30m.tif"), file("nc/landsat_multiband.tif"), file("nc/landuse_r.tif"));
+    let (zion_dem, nlcd, srtm) =
+        (file("zion/dem_utm12n_30m.tif"), file("zion/nlcd2011.tif"), file("zion/srtm.tif"));
+
+    // nc: all three layers on their own grids, the imagery stretched from 2 % to 98 %.
+    let dir = TempDir::new("partitioned-nc");
+    let args = [
+        "--dem",
+        &nc_dem,
+        "--imagery",
+        &landsat,
+        "--bands",
+        "3,2,1",
+        "--landcover",
+        &landuse,
+        "--classes",
+        "nc",
+    ];
+    let plan = geotiff_both_ways(dir.path(), &args, 3);
+    assert!(plan.contains("kind = \"geotiff\"") && plan.contains("tone = \"stretch\""), "{plan}");
+
+    // Zion: a DEM with 73,270 voids (the fill's coarse surface travels beside the plan, and the
+    // validity mask is a fourth layer), the NLCD and a grey SRTM reprojected, imagery in BC7.
+    let dir = TempDir::new("partitioned-zion");
+    let args = [
+        "--dem",
+        &zion_dem,
+        "--imagery",
+        &srtm,
+        "--landcover",
+        &nlcd,
+        "--classes",
+        "nlcd",
+        "--imagery-format",
+        "bc7",
+    ];
+    let plan = geotiff_both_ways(dir.path(), &args, 4);
+    assert!(
+        plan.contains("name = \"height_valid\"") && dir.path().join("plan.coarse.bin").is_file(),
+        "{plan}"
+    );
+
+    // SRTM in degrees: the DEM itself warped onto a local metric frame, voids beyond its edge.
+    let dir = TempDir::new("partitioned-srtm");
+    let args = ["--dem", &srtm, "--landcover", &nlcd, "--classes", "nlcd"];
+    let plan = geotiff_both_ways(dir.path(), &args, 5);
+    assert!(plan.contains("beyond_edge = 1111"), "{plan}");
+}
+
+#[test]
+fn a_geotiff_job_refuses_inputs_changed_since_its_plan() {
+    let shared = shared_data().expect("../shared/data");
+    let dir = TempDir::new("partitioned-changed");
+    let dem = dir.path().join("dem.tif");
+    std::fs::copy(shared.join("zion/dem_utm12n_30m.tif"), &dem).unwrap();
+    let plan = dir.path().join("plan.toml");
+    terramp_data(&["plan", "--dem", path(&dem), "--partitions", "2", "--out", path(&plan)]);
+
+    // The fill's coarse surface replaced: refused, nothing built.
+    let coarse = dir.path().join("plan.coarse.bin");
+    let good = std::fs::read(&coarse).unwrap();
+    let mut bad = good.clone();
+    *bad.last_mut().unwrap() ^= 1;
+    std::fs::write(&coarse, &bad).unwrap();
+    let stderr = terramp_data_fails(&["build", "--plan", path(&plan), "--partition", "0"]);
+    assert!(stderr.contains("not the coarse surface the plan was made with"), "{stderr}");
+    std::fs::write(&coarse, &good).unwrap();
+    terramp_data(&["build", "--plan", path(&plan), "--partition", "0"]);
+
+    // The DEM replaced by another file: the next job refuses it, naming it.
+    std::fs::copy(shared.join("zion/srtm.tif"), &dem).unwrap();
+    let stderr = terramp_data_fails(&["build", "--plan", path(&plan), "--partition", "1"]);
+    assert!(stderr.contains("dem.tif") && stderr.contains("the input changed since"), "{stderr}");
+    assert!(!dir.path().join("plan.parts/part-00001").exists());
 }

@@ -21,6 +21,8 @@ use terramp::dataset::Window;
 
 /// Voids take their values from valid samples at most this many samples away.
 pub const FILL_RADIUS: u32 = 32;
+/// What a coarse grid's bytes begin with (`CoarseGrid::to_bytes`).
+const COARSE_TAG: &[u8; 8] = b"TRCOARS1";
 /// The coarse fallback has at most this many cells per axis (its cells grow with the DEM).
 const COARSE_MAX_CELLS: u32 = 512;
 /// Relaxation rounds that turn the coarse cells grown into wide voids into a smooth surface.
@@ -108,6 +110,7 @@ impl CoarseBuilder {
 }
 
 /// A gap-free, coarse version of the DEM: the fallback for the middle of wide voids.
+#[derive(Debug, PartialEq)]
 pub struct CoarseGrid {
     step: u32,
     cells: [usize; 2],
@@ -115,6 +118,30 @@ pub struct CoarseGrid {
 }
 
 impl CoarseGrid {
+    /// The grid as bytes (a tag, the step, the cells, each height's f64 bits, all little-endian),
+    /// for a partitioned build's plan to hand every job the scan's grid exactly.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut bytes = COARSE_TAG.to_vec();
+        bytes.extend(self.step.to_le_bytes());
+        bytes.extend(self.cells.iter().flat_map(|&n| (n as u32).to_le_bytes()));
+        bytes.extend(self.heights.iter().flat_map(|h| h.to_le_bytes()));
+        bytes
+    }
+
+    /// The grid `to_bytes` wrote; `None` for anything else.
+    pub fn from_bytes(bytes: &[u8]) -> Option<Self> {
+        let rest = bytes.strip_prefix(COARSE_TAG)?;
+        let word = |i: usize| Some(u32::from_le_bytes(rest.get(4 * i..4 * i + 4)?.try_into().ok()?));
+        let (step, cells) = (word(0)?, [word(1)? as usize, word(2)? as usize]);
+        let heights: Vec<f64> = rest[12..]
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap_or_default()))
+            .collect();
+        let whole =
+            rest.len() == 12 + 8 * heights.len() && heights.len() == cells[0].checked_mul(cells[1])?;
+        (whole && step > 0 && heights.iter().all(|h| h.is_finite())).then_some(Self { step, cells, heights })
+    }
+
     /// Bilinear height at sample (`x`, `y`) between coarse cell centres.
     fn at(&self, x: u32, y: u32) -> f64 {
         let step = f64::from(self.step);
@@ -150,6 +177,11 @@ pub struct VoidFill {
 impl VoidFill {
     pub fn new(size: [u32; 2], coarse: CoarseGrid, range_m: [f32; 2]) -> Self {
         Self { size, coarse, range_m }
+    }
+
+    /// The coarse surface the fill falls back on.
+    pub fn coarse(&self) -> &CoarseGrid {
+        &self.coarse
     }
 
     /// The window whose samples `fill` needs: `window` grown by the radius (and the one sample
@@ -347,5 +379,15 @@ mod tests {
             let step = at(x + 1, 125) - at(x, 125);
             assert!((-1.0..2.0).contains(&step), "step of {step} m at x = {x}");
         }
+    }
+
+    #[test]
+    fn the_coarse_grid_survives_its_bytes_and_refuses_others() {
+        let fill = filler(&field());
+        let bytes = fill.coarse().to_bytes();
+        assert_eq!(CoarseGrid::from_bytes(&bytes).as_ref(), Some(fill.coarse()));
+        assert_eq!(CoarseGrid::from_bytes(&bytes[..bytes.len() - 1]), None, "a truncated grid");
+        assert_eq!(CoarseGrid::from_bytes(&bytes[..10]), None, "a header cut short");
+        assert_eq!(CoarseGrid::from_bytes(b"something else entirely"), None);
     }
 }

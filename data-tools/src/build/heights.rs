@@ -13,7 +13,7 @@ use std::sync::Mutex;
 use anyhow::{Context, Result, bail, ensure};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
-use terramp::dataset::{HeightLayer, LayerSpec, Staging, Window, write_layer};
+use terramp::dataset::{HeightLayer, LayerSpec, Pyramid, Staging, Window, write_layer};
 
 use super::fill::{CoarseBuilder, VoidFill};
 use super::raster::{GridRaster, SourceRaster};
@@ -66,6 +66,11 @@ impl HeightStep {
         ((f64::from(height_m) / self.step_m).round() * self.step_m) as f32 + 0.0
     }
 
+    /// Metres; 0 when heights are kept exactly as read.
+    pub fn metres(self) -> f64 {
+        self.step_m
+    }
+
     /// The step for the manifest: `None` when heights are exact.
     pub fn step_m(self) -> Option<f32> {
         (self.step_m > 0.0).then_some(self.step_m as f32)
@@ -87,13 +92,47 @@ pub struct HeightScan {
 }
 
 impl HeightScan {
-    /// The DEM's samples of `window` (`NaN` for voids and past the grid): the spill's when there
-    /// is one, else the source's.
-    fn read(&self, dem: &GridRaster, window: Window) -> Result<Vec<f32>, String> {
-        match &self.spill {
+    /// What the tile passes read: the scan's spill when there is one, voids filled, `step` kept.
+    pub fn source<'a>(&'a self, dem: &'a GridRaster, step: HeightStep) -> HeightSource<'a> {
+        HeightSource { dem, spill: self.spill.as_ref(), fill: self.fill.as_ref(), step }
+    }
+}
+
+/// The heights as the dataset stores them, window by window: the DEM's samples (from the scan's
+/// spill, or read again), voids filled, every height rounded to the step. Any window gives a
+/// sample the same value, so a partition's windows agree with the single build's tiles.
+pub struct HeightSource<'a> {
+    pub dem: &'a GridRaster,
+    /// The warped DEM as the scan kept it, read instead of warping again.
+    pub spill: Option<&'a SpilledGrid>,
+    /// The fill, when the DEM has voids.
+    pub fill: Option<&'a VoidFill>,
+    pub step: HeightStep,
+}
+
+impl HeightSource<'_> {
+    /// The DEM's samples of `window` (`NaN` for voids and past the grid).
+    fn samples(&self, window: Window) -> Result<Vec<f32>, String> {
+        match self.spill {
             Some(spill) => spill.read(window),
-            None => dem.read_f32(window),
+            None => self.dem.read_f32(window),
         }
+    }
+
+    /// The stored heights of `window`, and whether it had no void.
+    pub fn heights(&self, window: Window) -> Result<(Vec<f32>, bool), String> {
+        let samples = self.samples(window)?;
+        let void_free = !samples.iter().any(|h| h.is_nan());
+        let heights = match self.fill {
+            Some(fill) if !void_free => fill.fill(window, &self.samples(fill.padded(window))?),
+            _ => samples,
+        };
+        Ok((heights.into_iter().map(|h| self.step.round(h)).collect(), void_free))
+    }
+
+    /// The validity mask of `window`: 1 where the DEM has a sample, 0 for its voids.
+    pub fn valid(&self, window: Window) -> Result<Vec<u8>, String> {
+        Ok(self.samples(window)?.iter().map(|h| u8::from(!h.is_nan())).collect())
     }
 }
 
@@ -191,21 +230,16 @@ pub fn write(
     bars: [&ProgressBar; 2],
 ) -> Result<HeightLayer> {
     let spec = LayerSpec::heights(dem.grid.size);
+    let source = scan.source(dem, step);
     // The windows the height pass found void-free: the mask pass (same pyramid, so the same
     // windows) writes ones there without reading, and so warps only the windows with voids again.
     let void_free = Mutex::new(HashSet::new());
     let heights = |window: Window| -> Result<Vec<f32>, String> {
-        let heights = scan.read(dem, window)?;
-        let heights = match &scan.fill {
-            Some(fill) if heights.iter().any(|h| h.is_nan()) => {
-                fill.fill(window, &scan.read(dem, fill.padded(window))?)
-            }
-            _ => {
-                void_free.lock().map_err(|_| "a height thread panicked")?.insert(window);
-                heights
-            }
-        };
-        Ok(heights.into_iter().map(|h| step.round(h)).collect())
+        let (heights, whole) = source.heights(window)?;
+        if whole {
+            void_free.lock().map_err(|_| "a height thread panicked")?.insert(window);
+        }
+        Ok(heights)
     };
     write_layer(&staging.path(HEIGHT_PACK), &spec, heights, bars[0]).context("writing the height pack")?;
     let valid_mask_pack = if scan.fill.is_some() {
@@ -215,25 +249,38 @@ pub fn write(
             if void_free.lock().map_err(|_| "a mask thread panicked")?.contains(&window) {
                 return Ok(vec![1; (window.width * window.height) as usize]);
             }
-            Ok(scan.read(dem, window)?.iter().map(|h| u8::from(!h.is_nan())).collect())
+            source.valid(window)
         };
         write_layer(&staging.path(VALID_MASK_PACK), &mask_spec, valid, bars[1])
             .context("writing the validity mask pack")?;
-        Some(VALID_MASK_PACK.to_owned())
+        true
     } else {
         bars[1].finish_and_clear();
-        None
+        false
     };
-    Ok(HeightLayer {
+    let filled = scan.source_voids + scan.beyond_edge;
+    Ok(height_layer(spec.pyramid, spacing_m, scan.range_m, step, filled, valid_mask_pack))
+}
+
+/// The manifest's height layer: `range_m` of the valid heights as read, `filled` samples (the
+/// source's voids and the grid beyond its edge alike, which the mask, when written, marks 0).
+pub fn height_layer(
+    pyramid: Pyramid,
+    spacing_m: f64,
+    range_m: [f32; 2],
+    step: HeightStep,
+    filled: u64,
+    valid_mask_pack: bool,
+) -> HeightLayer {
+    HeightLayer {
         pack: HEIGHT_PACK.to_owned(),
         spacing_m,
-        pyramid: spec.pyramid,
+        pyramid,
         // Rounding keeps order, so the rounded extremes bound every rounded height.
-        min_m: step.round(scan.range_m[0]),
-        max_m: step.round(scan.range_m[1]),
+        min_m: step.round(range_m[0]),
+        max_m: step.round(range_m[1]),
         step_m: step.step_m(),
-        // Every sample the mask marks 0: the source's voids and the grid beyond its edge alike.
-        filled_samples: scan.source_voids + scan.beyond_edge,
-        valid_mask_pack,
-    })
+        filled_samples: filled,
+        valid_mask_pack: valid_mask_pack.then(|| VALID_MASK_PACK.to_owned()),
+    }
 }

@@ -15,6 +15,7 @@ use std::path::Path;
 use anyhow::{Context, Result, ensure};
 use gdal::raster::{ColorInterpretation, GdalDataType};
 use indicatif::ProgressBar;
+use serde::{Deserialize, Serialize};
 use terramp::dataset::{CellLayer, IMAGERY_MIPS, LayerSpec, Staging, Window, write_layer};
 
 use super::frame::{Frame, Grid};
@@ -26,8 +27,9 @@ const SAMPLE_SIDE: usize = 1024;
 const STRETCH_PERCENTILES: [f64; 2] = [0.02, 0.98];
 
 /// How one band's values become 0..=255.
-#[derive(Debug, Clone, Copy)]
-enum Tone {
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "tone", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Tone {
     Identity,
     Stretch { low: f64, high: f64 },
 }
@@ -67,6 +69,17 @@ impl Colour {
     }
 }
 
+/// What the imagery's colours depend on beyond each texel, measured over the whole source: a
+/// partitioned build measures it once, in the plan, for every job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageryLook {
+    /// Per band read; empty for a palette, whose colours are the file's own.
+    pub tones: Vec<Tone>,
+    /// The colour of texels without data.
+    pub fill_rgb: [u8; 3],
+}
+
 /// An imagery input, ready to be tiled.
 pub struct Imagery {
     raster: GridRaster,
@@ -77,18 +90,40 @@ pub struct Imagery {
 }
 
 impl Imagery {
-    pub fn open(path: &Path, bands: Option<&[usize]>, frame: &Frame) -> Result<Self> {
+    /// Opens the imagery at `path` on `frame`'s extent; its look measured from the source, or
+    /// `look` (a plan's) when given.
+    pub fn open(
+        path: &Path,
+        bands: Option<&[usize]>,
+        frame: &Frame,
+        look: Option<&ImageryLook>,
+    ) -> Result<Self> {
         let source = SourceRaster::open(path, "imagery")?;
         let bands = choose_bands(&source, bands).with_context(|| format!("imagery {}", path.display()))?;
         let grid = frame.cell_grid(&source)?;
-        let colour = colour_of(&source, &bands)?;
-        let fill_rgb = mean_colour(&source, &bands, &colour)?;
+        let (colour, fill_rgb) = match look {
+            Some(look) => (colour_planned(&source, &bands, look)?, look.fill_rgb),
+            None => {
+                let colour = colour_of(&source, &bands)?;
+                let fill_rgb = mean_colour(&source, &bands, &colour)?;
+                (colour, fill_rgb)
+            }
+        };
         let resampling = match colour {
             Colour::Palette(_) => Resampling::Nearest,
             Colour::Bands(_) => Resampling::Bilinear,
         };
         let raster = GridRaster::new(source, &grid, &frame.srs, &bands, resampling, true)?;
         Ok(Self { raster, colour, fill_rgb, bands })
+    }
+
+    /// The look this imagery's colours were made with.
+    pub fn look(&self) -> ImageryLook {
+        let tones = match &self.colour {
+            Colour::Bands(tones) => tones.clone(),
+            Colour::Palette(_) => Vec::new(),
+        };
+        ImageryLook { tones, fill_rgb: self.fill_rgb }
     }
 
     pub fn grid(&self) -> &Grid {
@@ -99,31 +134,41 @@ impl Imagery {
         self.raster.access
     }
 
-    pub fn write(&self, staging: &Staging, bar: &ProgressBar) -> Result<CellLayer> {
-        let grid = self.grid();
-        let spec = LayerSpec::imagery(grid.size);
-        let texels = |window: Window| -> Result<Vec<[u8; 4]>, String> {
-            let bands = self.raster.read(window)?;
-            let mut values = vec![0.0; bands.len()];
-            Ok((0..(window.width * window.height) as usize)
-                .map(|k| {
-                    values.iter_mut().zip(&bands).for_each(|(v, band)| *v = band[k]);
-                    match self.colour.rgb(&values) {
-                        Some([r, g, b]) => [r, g, b, 255],
-                        None => [self.fill_rgb[0], self.fill_rgb[1], self.fill_rgb[2], 0],
-                    }
-                })
-                .collect())
-        };
-        write_layer(&staging.path(IMAGERY_PACK), &spec, texels, bar).context("writing the imagery pack")?;
-        Ok(CellLayer {
+    pub fn spec(&self) -> LayerSpec {
+        LayerSpec::imagery(self.grid().size)
+    }
+
+    /// The texels of `window`, sRGB with alpha 0 where the source has no data.
+    pub fn texels(&self, window: Window) -> Result<Vec<[u8; 4]>, String> {
+        let bands = self.raster.read(window)?;
+        let mut values = vec![0.0; bands.len()];
+        Ok((0..(window.width * window.height) as usize)
+            .map(|k| {
+                values.iter_mut().zip(&bands).for_each(|(v, band)| *v = band[k]);
+                match self.colour.rgb(&values) {
+                    Some([r, g, b]) => [r, g, b, 255],
+                    None => [self.fill_rgb[0], self.fill_rgb[1], self.fill_rgb[2], 0],
+                }
+            })
+            .collect())
+    }
+
+    /// The manifest's imagery layer, as written in plain texels.
+    pub fn layer(&self) -> CellLayer {
+        CellLayer {
             pack: IMAGERY_PACK.to_owned(),
-            texel_m: grid.pixel_m,
-            pyramid: spec.pyramid,
+            texel_m: self.grid().pixel_m,
+            pyramid: self.spec().pyramid,
             mips: IMAGERY_MIPS,
             format: "rgba8 srgb".to_owned(),
             source: self.raster.path.display().to_string(),
-        })
+        }
+    }
+
+    pub fn write(&self, staging: &Staging, bar: &ProgressBar) -> Result<CellLayer> {
+        write_layer(&staging.path(IMAGERY_PACK), &self.spec(), |w| self.texels(w), bar)
+            .context("writing the imagery pack")?;
+        Ok(self.layer())
     }
 }
 
@@ -165,6 +210,24 @@ fn colour_of(source: &SourceRaster, bands: &[usize]) -> Result<Colour> {
         })
         .collect::<Result<_>>()?;
     Ok(Colour::Bands(tones))
+}
+
+/// The colour of a plan's `look`: its tones, or the band's palette when the look has none.
+fn colour_planned(source: &SourceRaster, bands: &[usize], look: &ImageryLook) -> Result<Colour> {
+    if look.tones.is_empty()
+        && let [band] = bands
+        && let Some(palette) = palette(source, *band)?
+    {
+        return Ok(Colour::Palette(palette));
+    }
+    ensure!(
+        look.tones.len() == bands.len(),
+        "imagery {}: the plan has {} tones for {} bands (was the file replaced since the plan?)",
+        source.path.display(),
+        look.tones.len(),
+        bands.len()
+    );
+    Ok(Colour::Bands(look.tones.clone()))
 }
 
 /// The band's palette, unless it has none or it is a plain grey ramp (entry i = grey i).

@@ -13,7 +13,7 @@ use anyhow::{Context, Result};
 use indicatif::ProgressBar;
 use terramp::classes::ClassTable;
 use terramp::dataset::lcc::{CodeCounts, LccCoding, scan_codes, write_lcc_layer};
-use terramp::dataset::{CellLayer, LandcoverLayer, Staging, Window};
+use terramp::dataset::{CellLayer, LandcoverLayer, Pyramid, Staging, Window};
 
 use super::frame::{Frame, Grid};
 use super::raster::{Access, GridRaster, Resampling, SourceRaster};
@@ -65,7 +65,7 @@ impl Landcover {
     }
 
     /// The source's codes in `window` of the grid, south row first.
-    fn codes(&self, window: Window) -> Result<Vec<u8>, String> {
+    pub fn codes(&self, window: Window) -> Result<Vec<u8>, String> {
         let nodata_code = self.table.nodata_code;
         Ok(self.raster.read(window)?[0].iter().map(|&v| code_of(v, nodata_code)).collect())
     }
@@ -86,16 +86,20 @@ impl Landcover {
         staging: &Staging,
         bar: &ProgressBar,
     ) -> Result<LandcoverLayer> {
-        let grid = self.grid();
-        let coding = scan.coding.clone();
+        let coding = &scan.coding;
         let pyramid =
-            write_lcc_layer(&staging.path(LANDCOVER_PACK), grid.size, &coding, |w| self.codes(w), bar)
+            write_lcc_layer(&staging.path(LANDCOVER_PACK), self.grid().size, coding, |w| self.codes(w), bar)
                 .context("writing the land-cover pack")?;
-        Ok(LandcoverLayer {
+        Ok(self.layer(pyramid, coding.clone()))
+    }
+
+    /// The manifest's land-cover layer, its LCC quadtree `pyramid` coded by `coding`.
+    pub fn layer(&self, pyramid: Pyramid, coding: LccCoding) -> LandcoverLayer {
+        LandcoverLayer {
             layer: CellLayer {
                 pack: LANDCOVER_PACK.to_owned(),
                 // Level 0 repeats each source texel on its 2 × 2 children.
-                texel_m: 0.5 * grid.pixel_m,
+                texel_m: 0.5 * self.grid().pixel_m,
                 pyramid,
                 mips: 1,
                 format: coding.format_name(),
@@ -105,7 +109,7 @@ impl Landcover {
             scheme: self.table.scheme.clone(),
             classes: self.table.names(),
             nodata_code: self.table.nodata_code,
-        })
+        }
     }
 }
 

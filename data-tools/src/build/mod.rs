@@ -15,6 +15,7 @@ mod gdal_ffi;
 mod heights;
 mod imagery;
 mod landcover;
+pub mod parts;
 mod raster;
 mod spill;
 
@@ -27,7 +28,7 @@ use terramp::dataset::{FORMAT_VERSION, ImageryFormat, Manifest, Staging};
 
 use frame::{Frame, Grid};
 use heights::{Footprint, HeightScan, HeightStep};
-use imagery::Imagery;
+use imagery::{Imagery, ImageryLook};
 use landcover::{Landcover, LandcoverScan};
 use raster::{Access, GridRaster, Resampling, SourceRaster};
 use spill::SpilledGrid;
@@ -35,10 +36,11 @@ use spill::SpilledGrid;
 /// GDAL's raster block cache: enough for a few rows of tiles, and a bound on resident memory.
 const GDAL_BLOCK_CACHE_BYTES: i64 = 64 << 20;
 
-#[derive(Debug, clap::Args)]
-pub struct BuildArgs {
+/// What a dataset is built from, for `build` and `plan` alike.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct InputArgs {
     /// The DEM: heights in metres, in a projected CRS or in geographic degrees.
-    #[arg(long, required_unless_present = "plan")]
+    #[arg(long)]
     pub dem: Option<PathBuf>,
     /// Imagery to drape over the terrain (any CRS; reprojected onto the DEM's extent).
     #[arg(long)]
@@ -52,21 +54,28 @@ pub struct BuildArgs {
     /// The land cover's class table: a built-in one (`nc`, `nlcd`) or a TOML file.
     #[arg(long, requires = "landcover")]
     pub classes: Option<String>,
-    /// The output dataset folder (replaced atomically if it already holds a dataset).
-    #[arg(long, required_unless_present = "plan")]
-    pub out: Option<PathBuf>,
     /// Store heights rounded to this step, metres: 0 keeps them exactly as read, else a power of
     /// two (0.25, 0.5, 1, …). Default: 0.25 of an integer DEM's unit (its warp's finer fractions
     /// are not data, and cost the packs most of their bytes), 0 for a floating-point DEM.
-    #[arg(long)]
+    #[arg(long, requires = "dem")]
     pub height_step_m: Option<f64>,
+    /// A short name for logs (default: the DEM file's stem).
+    #[arg(long, requires = "dem")]
+    pub name: Option<String>,
+}
+
+#[derive(Debug, clap::Args)]
+#[command(group(clap::ArgGroup::new("what").required(true).args(["dem", "plan"])))]
+pub struct BuildArgs {
+    #[command(flatten)]
+    pub inputs: InputArgs,
+    /// The output dataset folder (replaced atomically if it already holds a dataset).
+    #[arg(long, requires = "dem")]
+    pub out: Option<PathBuf>,
     /// How the imagery is stored: rgba8 (lossless), or blocks the GPU samples as they are, bc7
     /// (4× smaller, keeps coverage) or bc1 (8× smaller, imagery without holes only).
     #[arg(long, default_value = "rgba8", value_parser = crate::parse_imagery_format, requires = "imagery")]
     pub imagery_format: ImageryFormat,
-    /// A short name for logs (default: the DEM file's stem).
-    #[arg(long)]
-    pub name: Option<String>,
     /// Build one partition of this plan (`terramp-data plan`) instead: its part packs, into the
     /// plan's parts folder.
     #[arg(long, requires = "partition", conflicts_with_all = ["dem", "imagery", "landcover", "out", "name", "height_step_m"])]
@@ -78,15 +87,14 @@ pub struct BuildArgs {
 }
 
 pub fn run(args: &BuildArgs) -> Result<()> {
-    let (Some(dem), Some(out)) = (&args.dem, &args.out) else {
+    let (Some(dem), Some(out)) = (&args.inputs.dem, &args.out) else {
         anyhow::bail!("build needs --dem and --out (or --plan and --partition)");
     };
     configure_gdal();
-    let inputs = Inputs::open(args, dem)?;
+    let inputs = Inputs::open(&args.inputs, dem, args.imagery_format, None)?;
     let staging = Staging::begin(out).with_context(|| format!("preparing {}", out.display()))?;
     let progress = MultiProgress::new();
-    let name = args.name.clone().unwrap_or_else(|| file_stem(dem));
-    let (manifest, scans) = write_layers(&inputs, name, &staging, &progress)?;
+    let (manifest, scans) = write_layers(&inputs, inputs.name.clone(), &staging, &progress)?;
     let dir = staging.commit(&manifest).with_context(|| format!("publishing {}", out.display()))?;
     progress.clear().ok();
     print_summary(&dir, &manifest, &inputs, &scans);
@@ -95,6 +103,7 @@ pub fn run(args: &BuildArgs) -> Result<()> {
 
 /// Every input, opened and checked before anything is written.
 struct Inputs {
+    name: String,
     frame: Frame,
     dem: GridRaster,
     height_step: HeightStep,
@@ -105,22 +114,29 @@ struct Inputs {
 }
 
 impl Inputs {
-    fn open(args: &BuildArgs, dem_path: &Path) -> Result<Self> {
+    /// Opens `args`' inputs (`dem_path` is its DEM); the imagery's look measured, or `look`.
+    fn open(
+        args: &InputArgs,
+        dem_path: &Path,
+        imagery_format: ImageryFormat,
+        look: Option<&ImageryLook>,
+    ) -> Result<Self> {
         let dem_source = SourceRaster::open(dem_path, "DEM")?;
         let height_step = match args.height_step_m {
             Some(step_m) => HeightStep::new(step_m)?,
             None => HeightStep::default_for(&dem_source)?,
         };
         let frame = Frame::from_dem(&dem_source)?;
-        let imagery = args.imagery.as_deref().map(|path| Imagery::open(path, args.bands.as_deref(), &frame));
+        let imagery =
+            args.imagery.as_deref().map(|path| Imagery::open(path, args.bands.as_deref(), &frame, look));
         let landcover = match (&args.landcover, &args.classes) {
             (Some(path), Some(classes)) => Some(Landcover::open(path, classes, &frame)?),
             _ => None,
         };
         let dem = GridRaster::new(dem_source, &frame.dem_grid, &frame.srs, &[1], Resampling::Bilinear, true)?;
         let footprint = footprint(&dem, dem_path, &frame)?;
-        let imagery_format = args.imagery_format;
         Ok(Self {
+            name: args.name.clone().unwrap_or_else(|| file_stem(dem_path)),
             imagery: imagery.transpose()?,
             imagery_format,
             landcover,
