@@ -146,6 +146,9 @@ pub struct GpuSettings {
     /// Time passes with GPU timestamp queries where the adapter has them; false times them on the
     /// CPU (submit and wait), which serialises the frame.
     pub timestamps: bool,
+    /// Count the foliage passes' fragments shaded and pixels covered, every frame (`profile`'s
+    /// overdraw); reads each frame back, which serialises the frames.
+    pub count_fragments: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]

@@ -22,6 +22,7 @@ use thiserror::Error;
 
 use crate::frame::{RenderError, SeedReport};
 use crate::gpu::GpuError;
+use crate::gpu::fragments::PassFragments;
 use crate::gpu::profiler::ScopeTiming;
 
 pub mod session;
@@ -111,6 +112,8 @@ pub struct Recording {
     pub scopes: BTreeMap<u64, Vec<ScopeTiming>>,
     /// Seed counters by the frame they count.
     pub seeds: BTreeMap<u64, SeedSample>,
+    /// The foliage passes' fragments and pixels by frame (with `gpu.count_fragments`).
+    pub fragments: BTreeMap<u64, Vec<PassFragments>>,
 }
 
 impl Recording {
@@ -137,6 +140,7 @@ impl Recording {
             self.frames.last().map(|f| f.frame),
             self.scopes.keys().next_back().copied(),
             self.seeds.keys().next_back().copied(),
+            self.fragments.keys().next_back().copied(),
         ];
         let offset = last.into_iter().flatten().max().map_or(0, |f| f + 1);
         self.frames.extend(other.frames.into_iter().map(|f| FrameSample { frame: f.frame + offset, ..f }));
@@ -147,6 +151,12 @@ impl Recording {
                 .into_iter()
                 .map(|(frame, s)| (frame + offset, SeedSample { frame: frame + offset, ..s })),
         );
+        self.fragments.extend(other.fragments.into_iter().map(|(frame, f)| (frame + offset, f)));
+    }
+
+    /// The fragment counts of the profiled frames.
+    pub fn profiled_fragments(&self) -> impl Iterator<Item = &[PassFragments]> {
+        self.fragments.iter().filter(|(frame, _)| self.is_profiled(**frame)).map(|(_, f)| f.as_slice())
     }
 }
 

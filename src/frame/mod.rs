@@ -14,6 +14,7 @@ use thiserror::Error;
 use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::{Dataset, PackError, TileId};
+use crate::gpu::fragments::{CountedPass, FragmentCounter, PassFragments};
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::layout::MAX_LEVELS;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
@@ -89,6 +90,9 @@ pub enum RenderError {
     /// of LODs, or an adapter without the features it needs.
     #[error(transparent)]
     DrawSeeds(#[from] crate::passes::draw_seeds::DrawSeedsError),
+    /// `gpu.count_fragments` is on, and the adapter has no pipeline-statistics queries.
+    #[error("gpu.count_fragments: this adapter cannot count fragments (no pipeline-statistics queries)")]
+    NoFragmentCounts,
     /// `seeds.capacity` asks for a record buffer larger than this adapter can bind at once.
     #[error("seeds.capacity = {capacity} records does not fit one GPU buffer binding here (at most {max})")]
     SeedCapacity {
@@ -176,6 +180,8 @@ pub struct FrameReport {
     pub camera_lifted_m: f64,
     /// The far forest's patches and slices (all zero without texcells).
     pub texcells: TexcellReport,
+    /// Per foliage pass, fragments shaded and pixels covered (only with `gpu.count_fragments`).
+    pub fragments: Vec<PassFragments>,
 }
 
 /// What a frame's Tile Load Map is read against when it comes back: the frame, its rings and
@@ -254,6 +260,8 @@ pub struct Renderer {
     time_s: f64,
     /// Pass timings of the most recent frame whose timings are in (a frame or two behind).
     last_timings: Vec<PassTiming>,
+    /// Counts the foliage passes' fragments, with `gpu.count_fragments`.
+    fragments: Option<FragmentCounter>,
 }
 
 impl Renderer {
@@ -295,6 +303,16 @@ impl Renderer {
         let h = &dataset.manifest.height;
         let bounds = NodeBounds::new([h.min_m, h.max_m]);
         let profiler = Profiler::new(&gpu, settings.gpu.timestamps);
+        let counted = [("texcells", texcells.is_some()), ("draw_seeds", seeds.is_some())];
+        let labels: Vec<_> =
+            counted.into_iter().filter_map(|(label, drawn)| drawn.then_some(label)).collect();
+        let fragments = match settings.gpu.count_fragments {
+            true => Some(
+                FragmentCounter::new(&gpu, &labels, &targets.colour, 4)
+                    .ok_or(RenderError::NoFragmentCounts)?,
+            ),
+            false => None,
+        };
         Ok(Self {
             gpu,
             dataset,
@@ -319,6 +337,7 @@ impl Renderer {
             frame: 0,
             time_s: 0.0,
             last_timings: Vec::new(),
+            fragments,
         })
     }
 
@@ -402,6 +421,11 @@ impl Renderer {
         tlm: &TlmFrame,
     ) -> Result<(), RenderError> {
         let (gpu, p, t) = (&self.gpu, &mut self.profiler, &self.targets);
+        // With `gpu.count_fragments`, the foliage passes count their fragments and pixels.
+        let (targets, counter) = ((&t.colour_view, &t.depth_view), self.fragments.as_ref());
+        let counted = |label, e: &mut _, record: &dyn Fn(&mut _, Option<CountedPass<'_>>)| {
+            FragmentCounter::around(counter, label, e, &t.colour, record)
+        };
         let mesh = MeshDraw { terrain: &self.terrain, bind_group: &self.terrain_bindings, nodes };
         // 0. Terrain and depth: the ground every later pass stands on and is occluded by.
         p.pass(gpu, encoder, "terrain", |e| {
@@ -417,7 +441,8 @@ impl Renderer {
         })?;
         if let Some(stage) = &self.texcells {
             // The far forest: slices of the dense classes' samples over the ground beyond the seeds.
-            p.pass(gpu, encoder, "texcells", |e| stage.encode(e, mesh, &t.colour_view, &t.depth_view))?;
+            let draw = |e: &mut _, count: Option<CountedPass<'_>>| stage.encode(e, mesh, targets, count);
+            p.pass(gpu, encoder, "texcells", |e| counted("texcells", e, &draw))?;
         }
         if let Some(stage) = &self.seeds {
             // 3. Seed selection: the seeds of the cells the latest TLM found near and visible.
@@ -425,7 +450,8 @@ impl Renderer {
             // 4a. Compaction: the survivors grouped per (species, LOD) into indirect draws, on the GPU.
             p.pass(gpu, encoder, "compact", |e| stage.encode_compact(e))?;
             // 4b. Drawing: one indirect draw per group, over the ground, depth-tested against it.
-            p.pass(gpu, encoder, "draw_seeds", |e| stage.encode_draw(e, &t.colour_view, &t.depth_view))?;
+            let draw = |e: &mut _, count: Option<CountedPass<'_>>| stage.encode_draw(e, targets, count);
+            p.pass(gpu, encoder, "draw_seeds", |e| counted("draw_seeds", e, &draw))?;
         }
         Ok(())
     }
@@ -445,7 +471,11 @@ impl Renderer {
             stage.encode_readback(&mut encoder, self.frame);
         }
         self.profiler.resolve(&mut encoder);
+        self.fragments.iter().for_each(|counter| counter.resolve(&mut encoder));
         self.gpu.queue.submit([encoder.finish()]);
+        if let Some(counter) = &self.fragments {
+            report.fragments = counter.read(&self.gpu)?;
+        }
         self.tlm_readback.submitted();
         if let Some(stage) = self.seeds.as_mut() {
             stage.submitted();

@@ -15,8 +15,10 @@ use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::{Dataset, LandcoverLayer};
+use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{CompactParams, SeedCounters, SeedRecord, TerrainUniforms};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
+use crate::gpu::resources::frame_pass;
 use crate::gpu::{Gpu, GpuError};
 use crate::passes::compact::frame::CompactLimits;
 use crate::passes::compact::gpu::{CompactInputs, CompactPass};
@@ -173,11 +175,16 @@ impl SeedStage {
     pub fn encode_draw(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
+        targets: (&wgpu::TextureView, &wgpu::TextureView),
+        count: Option<CountedPass<'_>>,
     ) {
         if let (Some((draw, bind_group)), Some(_)) = (&self.draw, &self.last_frame) {
-            draw.encode(encoder, bind_group, self.compact.draw_args(), colour, depth);
+            draw.encode(encoder, bind_group, self.compact.draw_args(), targets, count);
+        } else if let Some(count) = count {
+            // Nothing to draw: an empty pass still ends its count, at zero.
+            let mut pass = frame_pass(encoder, "draw_seeds", targets.0, targets.1, None);
+            count.begin(&mut pass);
+            count.end(&mut pass);
         }
     }
 

@@ -15,6 +15,7 @@ use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::Gpu;
+use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::TexcellUniforms;
 use crate::gpu::layout::{TEXCELL_MAX_SAMPLES, TEXCELL_MAX_SLICES};
 use crate::passes::terrain::frame::NodeBatches;
@@ -209,10 +210,10 @@ impl TexcellStage {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         mesh: MeshDraw<'_>,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
+        targets: (&wgpu::TextureView, &wgpu::TextureView),
+        count: Option<CountedPass<'_>>,
     ) {
-        self.pass.encode(encoder, mesh, &self.bind_group, colour, depth, self.prepared);
+        self.pass.encode(encoder, (mesh, &self.bind_group), targets, self.prepared, count);
     }
 }
 

@@ -299,7 +299,7 @@ impl Renderer {
             stage.encode_compact(&mut encoder);
         }
         if through == Replay::Draw {
-            stage.encode_draw(&mut encoder, &t.colour_view, &t.depth_view);
+            stage.encode_draw(&mut encoder, (&t.colour_view, &t.depth_view), None);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait()?;

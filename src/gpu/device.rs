@@ -172,7 +172,9 @@ impl Gpu {
             // Imagery sampled as the dataset stores it, in BC1/BC7 blocks (else decoded on load).
             | wgpu::Features::TEXTURE_COMPRESSION_BC
             // The seed draws start at compaction's slots (`first_instance` of indirect draws).
-            | wgpu::Features::INDIRECT_FIRST_INSTANCE;
+            | wgpu::Features::INDIRECT_FIRST_INSTANCE
+            // The foliage passes' fragments counted (`gpu.count_fragments`).
+            | wgpu::Features::PIPELINE_STATISTICS_QUERY;
         let features = adapter.features() & wanted;
         let has_timestamps = features
             .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);

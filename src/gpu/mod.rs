@@ -2,11 +2,13 @@
 //! and bit layouts shared with WGSL (`layout`, a leaf) and the prelude and sources generated from
 //! them (`shaders`), the `#[repr(C)]` structs that cross to WGSL (`gpu_types`, checked through
 //! `struct_layout`), binding tables (`bindings`) and the resources passes build (`resources`),
-//! picking and opening a headless device (`device`), timing passes (`profiler`), and reading back:
+//! picking and opening a headless device (`device`), timing passes (`profiler`) and counting their
+//! fragments (`fragments`), and reading back:
 //! blocking for tools and tests (`readback`), non-blocking for the frame (`readback_ring`).
 
 pub mod bindings;
 pub mod device;
+pub mod fragments;
 pub mod gpu_types;
 pub mod layout;
 pub mod profiler;

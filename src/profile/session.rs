@@ -93,6 +93,9 @@ impl<'r> Session<'r> {
         if let Some(seeds) = &report.seeds {
             self.recording.seeds.insert(seeds.frame, SeedSample::from(seeds));
         }
+        if !report.fragments.is_empty() {
+            self.recording.fragments.insert(report.frame, report.fragments.clone());
+        }
         self.absorb_history();
         Ok(report)
     }

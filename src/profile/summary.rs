@@ -30,6 +30,7 @@ use serde::Serialize;
 use super::stats::{Stat, median};
 use super::{Recording, SeedSample};
 use crate::gpu::TimeSource;
+use crate::gpu::fragments::PassFragments;
 
 /// The version of the JSON layout.
 pub const SCHEMA: &str = "terramp-profile/1";
@@ -119,6 +120,61 @@ pub struct Seeds {
     pub per_frame: Vec<SeedSample>,
 }
 
+/// One foliage pass's overdraw over the profiled frames (`"overdraw"` in the JSON, with
+/// `gpu.count_fragments`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Overdraw {
+    /// The pass's label.
+    pub label: &'static str,
+    /// Profiled frames counted.
+    pub frames: usize,
+    /// Fragments shaded over those frames, discarded ones included.
+    pub shaded: u64,
+    /// Pixels the pass changed over those frames.
+    pub covered_px: u64,
+    /// `shaded / covered_px` (`None` when it covered nothing).
+    pub fragments_per_covered_px: Option<f64>,
+    /// Median fragments shaded per frame.
+    pub shaded_median: Option<f64>,
+}
+
+impl Overdraw {
+    /// Per pass, in the order the frames list them.
+    fn of(frames: Vec<&[PassFragments]>) -> Vec<Self> {
+        let mut rows: Vec<(Self, Vec<f64>)> = Vec::new();
+        for pass in frames.into_iter().flatten() {
+            let at = match rows.iter().position(|(row, _)| row.label == pass.label) {
+                Some(at) => at,
+                None => {
+                    let row = Self {
+                        label: pass.label,
+                        frames: 0,
+                        shaded: 0,
+                        covered_px: 0,
+                        fragments_per_covered_px: None,
+                        shaded_median: None,
+                    };
+                    rows.push((row, Vec::new()));
+                    rows.len() - 1
+                }
+            };
+            let (row, shaded) = &mut rows[at];
+            row.frames += 1;
+            row.shaded += pass.shaded;
+            row.covered_px += pass.covered_px;
+            shaded.push(pass.shaded as f64);
+        }
+        rows.into_iter()
+            .map(|(row, shaded)| Self {
+                fragments_per_covered_px: (row.covered_px > 0)
+                    .then(|| row.shaded as f64 / row.covered_px as f64),
+                shaded_median: median(&shaded),
+                ..row
+            })
+            .collect()
+    }
+}
+
 /// A profiled flight reduced to the figures of the table and the JSON of `--json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
@@ -137,6 +193,8 @@ pub struct Summary {
     pub totals: Totals,
     /// Pass 3's seeds per frame.
     pub seeds: Seeds,
+    /// The foliage passes' fragments per covered pixel (empty unless `gpu.count_fragments`).
+    pub overdraw: Vec<Overdraw>,
 }
 
 impl Summary {
@@ -213,6 +271,7 @@ impl Summary {
             passes,
             totals: Totals { gpu: Stat::of(&gpu_totals), cpu: Stat::of(&cpu_totals), frame_wall },
             seeds,
+            overdraw: Overdraw::of(recording.profiled_fragments().collect()),
         }
     }
 
@@ -308,5 +367,23 @@ mod tests {
     fn an_empty_recording_summarises_to_nothing() {
         let summary = Summary::new(&Recording::default(), test_meta());
         assert!(summary.passes.is_empty() && summary.fps.is_none() && summary.seeds.checked_median.is_none());
+    }
+
+    #[test]
+    fn overdraw_is_the_profiled_frames_fragments_over_their_covered_pixels() {
+        let mut recording = recording();
+        let pass = |shaded, covered_px| vec![PassFragments { label: "draw_seeds", shaded, covered_px }];
+        recording.fragments.insert(9, pass(1000, 1));
+        recording.fragments.insert(10, pass(300, 100));
+        recording.fragments.insert(11, pass(500, 100));
+        let summary = Summary::new(&recording, test_meta());
+        let [row] = summary.overdraw.as_slice() else { panic!("{:?}", summary.overdraw) };
+        assert_eq!((row.frames, row.shaded, row.covered_px), (2, 800, 200), "frame 9 is a warm-up frame");
+        assert_eq!((row.fragments_per_covered_px, row.shaded_median), (Some(4.0), Some(400.0)));
+        let table = super::super::table::render(&summary);
+        assert!(
+            table.contains("Overdraw draw_seeds") && table.contains("4.00 fragments / covered pixel"),
+            "{table}"
+        );
     }
 }

@@ -71,6 +71,18 @@ fn write_table(out: &mut String, s: &Summary) -> std::fmt::Result {
     if seeds.overflow_frames > 0 {
         writeln!(out, "{} {:>10} frames", label("Seed buffer overflowed"), seeds.overflow_frames)?;
     }
+    for pass in &s.overdraw {
+        let per_pixel = pass.fragments_per_covered_px.map_or("-".to_owned(), |f| format!("{f:.2}"));
+        writeln!(
+            out,
+            "{} {:>10} fragments / covered pixel ({} shaded, {} pixels, {} frames)",
+            label(&format!("Overdraw {}", pass.label)),
+            per_pixel,
+            pass.shaded,
+            pass.covered_px,
+            pass.frames
+        )?;
+    }
     match &s.fps {
         Some(fps) => {
             writeln!(out, "{} {:>10.1} Hz median ({:.1} Hz mean)", label("FPS"), fps.median, fps.mean)

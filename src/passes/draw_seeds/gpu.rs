@@ -10,6 +10,7 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 use crate::classes::Species;
 use crate::config::Settings;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{
     DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedShape, SeedVertex,
 };
@@ -292,24 +293,31 @@ impl DrawSeedsPass {
     }
 
     /// Records each group's draw and cross-fade draw from `draw_args` (compaction's) into the
-    /// targets (multisampled when `multisampled` made it so, resolved into `colour`).
+    /// targets (multisampled when `multisampled` made it so, resolved into `colour`); `count`
+    /// counts their fragments.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
         draw_args: &wgpu::Buffer,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
+        (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
+        count: Option<CountedPass<'_>>,
     ) {
         if self.species_drawn == 0 {
+            if let Some(count) = count {
+                // Nothing to draw: an empty pass still ends its count, at zero.
+                let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None);
+                count.begin(&mut pass);
+                count.end(&mut pass);
+            }
             return;
         }
         if let Some((targets, pipeline)) = &self.multisample {
-            targets.encode(encoder, |pass| self.record(pass, pipeline, bind_group, draw_args));
+            targets.encode(encoder, |pass| self.record(pass, pipeline, bind_group, draw_args, count));
             return;
         }
         let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None);
-        self.record(&mut pass, &self.pipeline, bind_group, draw_args);
+        self.record(&mut pass, &self.pipeline, bind_group, draw_args, count);
     }
 
     /// Every group's indirect draws with `pipeline`.
@@ -319,7 +327,9 @@ impl DrawSeedsPass {
         pipeline: &wgpu::RenderPipeline,
         bind_group: &wgpu::BindGroup,
         draw_args: &wgpu::Buffer,
+        count: Option<CountedPass<'_>>,
     ) {
+        count.inspect(|c| c.begin(pass));
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
@@ -330,6 +340,7 @@ impl DrawSeedsPass {
                 pass.draw_indexed_indirect(draw_args, draw as u64 * stride);
             }
         }
+        count.inspect(|c| c.end(pass));
     }
 }
 

@@ -8,6 +8,7 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::dataset::surface::diagonal_rises;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{TexcellRecord, TexcellUniforms};
 use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
 use crate::gpu::shaders::{CLOUDS, DITHER, HASH, IMAGERY, LANDCOVER, TERRAIN_MESH, WgslSource};
@@ -209,25 +210,26 @@ impl TexcellsPass {
         PreparedTexcells { instances: kept.len() as u32 }
     }
 
-    /// Draws the frame's slices over `colour`, depth-tested against the ground in `depth`.
+    /// Draws the frame's slices over `colour`, depth-tested against the ground in `depth`;
+    /// `count` counts their fragments.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: MeshDraw<'_>,
-        bind_group: &wgpu::BindGroup,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
+        (mesh, bind_group): (MeshDraw<'_>, &wgpu::BindGroup),
+        (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
         prepared: PreparedTexcells,
+        count: Option<CountedPass<'_>>,
     ) {
         let mut pass = frame_pass(encoder, "texcells", colour, depth, None);
-        if prepared.instances == 0 {
-            return;
+        count.inspect(|c| c.begin(&mut pass));
+        if prepared.instances > 0 {
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, mesh.bind_group, &[]);
+            pass.set_bind_group(1, bind_group, &[]);
+            pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..self.index_count, 0, 0..prepared.instances);
         }
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, mesh.bind_group, &[]);
-        pass.set_bind_group(1, bind_group, &[]);
-        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..self.index_count, 0, 0..prepared.instances);
+        count.inspect(|c| c.end(&mut pass));
     }
 }
 

@@ -1,0 +1,177 @@
+//! Counting the foliage passes' fragments (`gpu.count_fragments`) over a small synthetic dataset
+//! with the shared models baked:
+//! - the pixels draw_seeds covers are exactly those where the frame differs from the ground-only
+//!   frame of the same view, and it shades at least one fragment for each;
+//! - counting changes no pixel: the frame equals the one drawn without counting, bit for bit;
+//! - a view with no seed in it counts nothing (the query holds the pass's draws alone);
+//! - a full-screen triangle covers every pixel and counts each at least once, and at most the 4 × 4
+//!   blocks along one diagonal more (llvmpipe clips it to the screen, two triangles, and runs
+//!   whole blocks: those the shared edge crosses, twice); half the screen covers half of it, with
+//!   at least a fragment for each pixel.
+#![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
+
+use terramp::camera::Camera;
+use terramp::config::Settings;
+use terramp::frame::FrameReport;
+use terramp::gpu::fragments::FragmentCounter;
+use terramp_testkit::{camera, renderer, small_settings, synth_dataset};
+
+const IMAGE_PX: [u32; 2] = [320, 180];
+
+fn settings(impostors: &str, count_fragments: bool) -> Settings {
+    let mut s = small_settings(IMAGE_PX[0], IMAGE_PX[1]);
+    s.draw_seeds.impostors = impostors.to_owned();
+    s.gpu.count_fragments = count_fragments;
+    s
+}
+
+/// The settled frame of `settings` from the pose `view` gives, and the last frame's report.
+fn frame(
+    dir: &std::path::Path,
+    settings: Settings,
+    view: fn(&terramp::frame::Renderer) -> Camera,
+) -> (image::RgbaImage, FrameReport) {
+    let mut r = renderer(dir, settings);
+    let camera = view(&r);
+    let (report, _) = r.render_resolved(&camera).unwrap();
+    (r.read_colour().unwrap(), report)
+}
+
+fn into_the_trees(r: &terramp::frame::Renderer) -> Camera {
+    camera::over_fraction(r, [0.45, 0.35], 25.0, 20.0, -10.0)
+}
+
+fn at_the_sky(r: &terramp::frame::Renderer) -> Camera {
+    camera::over_fraction(r, [0.45, 0.35], 25.0, 20.0, 60.0)
+}
+
+#[test]
+fn draw_seeds_counts_its_fragments_and_exactly_the_pixels_it_changes() {
+    let Some(impostors) = terramp_testkit::nc_impostors() else { return };
+    let impostors = impostors.to_str().unwrap();
+    let dir = synth_dataset(300, 7);
+    let (ground, _) = frame(&dir, settings("", false), into_the_trees);
+    let (plain, plain_report) = frame(&dir, settings(impostors, false), into_the_trees);
+    let (counted, report) = frame(&dir, settings(impostors, true), into_the_trees);
+    assert!(plain_report.fragments.is_empty(), "counted without gpu.count_fragments");
+    assert_eq!(plain.as_raw(), counted.as_raw(), "counting changed the frame");
+
+    let [seeds] = report.fragments.as_slice() else { panic!("not one counted pass: {:?}", report.fragments) };
+    assert_eq!(seeds.label, "draw_seeds");
+    let changed = counted.pixels().zip(ground.pixels()).filter(|(a, b)| a != b).count() as u64;
+    println!("draw_seeds: {} fragments shaded, {} pixels covered", seeds.shaded, seeds.covered_px);
+    assert!(changed > 500, "only {changed} pixels show trees: a weak test");
+    assert_eq!(seeds.covered_px, changed, "covered pixels against the frame's difference from the ground");
+    assert!(seeds.shaded >= seeds.covered_px, "{seeds:?}: fewer fragments than pixels covered");
+
+    let (_, sky) = frame(&dir, settings(impostors, true), at_the_sky);
+    assert_eq!(
+        sky.fragments.iter().map(|f| (f.shaded, f.covered_px)).collect::<Vec<_>>(),
+        [(0, 0)],
+        "{sky:?}"
+    );
+}
+
+/// Fragments shaded and pixels covered by one triangle (clip-space corners `corners`) drawn in a
+/// constant colour over a black `size` target.
+fn count_triangle(size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u64) {
+    let gpu = terramp_testkit::gpu();
+    let device = &gpu.device;
+    let target = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("counted target"),
+        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let [a, b, c] = corners.map(|[x, y]| format!("vec2<f32>({x:?}, {y:?})"));
+    let source = format!(
+        "@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {{
+             var corners = array<vec2<f32>, 3>({a}, {b}, {c});
+             return vec4<f32>(corners[i], 0.5, 1.0);
+         }}
+         @fragment fn fs() -> @location(0) vec4<f32> {{ return vec4<f32>(1.0, 0.5, 0.25, 1.0); }}"
+    );
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("triangle"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("triangle"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::TextureFormat::Rgba8Unorm.into())],
+        }),
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        multiview_mask: None,
+        cache: None,
+    });
+    let counter = FragmentCounter::new(&gpu, &["triangle"], &target, 4).expect("pipeline-statistics queries");
+    let view = target.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("clear"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        ..Default::default()
+    });
+    FragmentCounter::around(Some(&counter), "triangle", &mut encoder, &target, &|e, count| {
+        let mut pass = e.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("triangle"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+            })],
+            ..Default::default()
+        });
+        let count = count.expect("the triangle pass is counted");
+        count.begin(&mut pass);
+        pass.set_pipeline(&pipeline);
+        pass.draw(0..3, 0..1);
+        count.end(&mut pass);
+    });
+    counter.resolve(&mut encoder);
+    gpu.queue.submit([encoder.finish()]);
+    let [counted] = counter.read(&gpu).unwrap()[..] else { panic!("one pass counted") };
+    (counted.shaded, counted.covered_px)
+}
+
+#[test]
+fn a_full_screen_triangle_counts_each_pixel_once_and_half_the_screen_covers_half() {
+    let size = [64, 48];
+    let pixels = u64::from(size[0] * size[1]);
+    // 4 × 4 blocks a diagonal of the screen crosses, 16 fragments each.
+    let diagonal = 16 * u64::from(size[0] / 4 + size[1] / 4);
+    let (shaded, covered) = count_triangle(size, [[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]]);
+    println!("the whole screen: {shaded} fragments shaded, {covered} pixels covered");
+    assert_eq!(covered, pixels);
+    assert!((pixels..=pixels + diagonal).contains(&shaded), "{shaded} fragments for {pixels} pixels");
+    // The lower-left half, corner to corner: the diagonal's pixels go to one side or the other.
+    let (shaded, covered) = count_triangle(size, [[-1.0, -1.0], [1.0, -1.0], [-1.0, 1.0]]);
+    println!("half the screen: {shaded} fragments shaded, {covered} pixels covered");
+    assert!(covered.abs_diff(pixels / 2) <= u64::from(size[0]), "{covered} of {pixels} pixels covered");
+    assert!((covered..=covered + diagonal).contains(&shaded), "{shaded} fragments for {covered} pixels");
+}
