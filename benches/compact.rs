@@ -2,15 +2,20 @@
 //! synthetic, as pass 3 leaves it: blocks of 0 to 64 records (32 on average) landed in shuffled
 //! order, each record in one of the 48 draw groups at random. A sample records `iters` runs in one
 //! submission and waits, so submission overhead is spread. Sizes whose keys or permutation exceed
-//! the adapter's largest storage binding are skipped with a note. Run with
-//! `WGPU_BACKEND=vulkan cargo bench --bench compact`.
+//! the adapter's largest storage binding are skipped with a note. Beside each size, `compact_floor`
+//! (`support/floor.rs`): a kernel reading the keys and the block table and writing the permutation
+//! and the draws' arguments, as compaction does, timed the same way; and a line with the two medians
+//! of single runs and their ratio. Run with `WGPU_BACKEND=vulkan cargo bench --bench compact`.
 #![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
+
+#[path = "support/floor.rs"]
+mod floor;
 
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use terramp::gpu::gpu_types::SeedBlock;
-use terramp::gpu::layout::{SEED_GROUPS, SEED_WORKGROUP};
+use terramp::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
+use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP};
 use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::passes::compact::frame::CompactLimits;
 use terramp::passes::compact::gpu::{CompactInputs, CompactPass};
@@ -103,6 +108,27 @@ fn compact(c: &mut Criterion) {
                 start.elapsed()
             })
         });
+        let in_bytes = u64::from(records) * 4 + (blocks.len() * size_of::<SeedBlock>()) as u64;
+        let out_bytes = u64::from(records) * 4 + u64::from(SEED_DRAWS) * size_of::<SeedDrawArgs>() as u64;
+        let floor = floor::Floor::new(&gpu, in_bytes, out_bytes);
+        group.bench_function(BenchmarkId::new("floor", records), |b| {
+            b.iter_custom(|iters| {
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                for _ in 0..iters {
+                    floor.encode(&mut encoder);
+                }
+                let start = Instant::now();
+                gpu.queue.submit([encoder.finish()]);
+                gpu.wait().expect("wait");
+                start.elapsed()
+            })
+        });
+        let pass_ms = floor::median_ms(&gpu, 9, |e| pass.encode(e, &bind_group, &params));
+        let floor_ms = floor::median_ms(&gpu, 9, |e| floor.encode(e));
+        eprintln!(
+            "compact/{records}: {pass_ms:.3} ms, floor {floor_ms:.3} ms, ÷floor {:.2}",
+            pass_ms / floor_ms
+        );
         gpu.check().expect("no GPU error");
     }
     group.finish();

@@ -3,9 +3,15 @@
 //! faster the GPU pass is; the twin is one CPU thread). The default synthetic
 //! dataset (10 km) is pinned whole, one resolved frame gives the depth, then pass 3 alone runs over
 //! a square block of ring-0 cells around the camera (4096 seeds each; the nc table's densities ×4
-//! so that nearly every rank can grow a seed and is really checked). Prints a table; run with
-//! `WGPU_BACKEND=vulkan cargo bench --bench seeds`.
+//! so that nearly every rank can grow a seed and is really checked). Beside each size, the pass's
+//! floor (`support/floor.rs`): a kernel that reads the pattern entries of the seeds checked and
+//! the cells, and writes the records and block table pass 3 wrote, timed the same way (texture
+//! fetches are not counted: heights and land cover are read through the caches' textures, shared
+//! by neighbouring seeds). Prints a table; run with `WGPU_BACKEND=vulkan cargo bench --bench seeds`.
 #![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
+
+#[path = "support/floor.rs"]
+mod floor;
 
 use std::path::Path;
 use std::time::Instant;
@@ -15,6 +21,8 @@ use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
+use terramp::gpu::gpu_types::{SeedBlock, SeedCell, SeedRecord};
+use terramp::gpu::layout::SEED_WORKGROUP;
 use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::passes::seed_select::frame::SeedCellRef;
 use terramp::seeds::cell_pattern;
@@ -81,8 +89,17 @@ fn main() {
     println!("{ranks} of {SEEDS_PER_PATTERN} ranks per cell can grow a seed");
     let (seed, colours) = (r.settings.tlm.seed, r.settings.tlm.corner_colours());
     println!(
-        "{:>10} {:>7} {:>10} {:>12} {:>14} {:>12} {:>14} {:>8}",
-        "checked", "cells", "selected", "gpu ms", "gpu seeds/s", "twin ms", "twin seeds/s", "gpu÷twin"
+        "{:>10} {:>7} {:>10} {:>12} {:>14} {:>12} {:>14} {:>8} {:>10} {:>8}",
+        "checked",
+        "cells",
+        "selected",
+        "gpu ms",
+        "gpu seeds/s",
+        "twin ms",
+        "twin seeds/s",
+        "gpu÷twin",
+        "floor ms",
+        "÷floor"
     );
     for target in [100_000u64, 1_000_000, 4_000_000] {
         let side = ((target as f64 / f64::from(ranks)).sqrt().round() as i64).max(1);
@@ -120,8 +137,15 @@ fn main() {
         let twin_ms = start.elapsed().as_secs_f64() * 1e3;
         assert_eq!(twin, counters, "the twin disagrees with the GPU");
         let rate = |ms: f64| checked as f64 / (ms * 1e-3);
+        // Each checked seed reads its pattern entry (8 bytes); each workgroup writes a block.
+        let blocks = cells.len() as u64 * u64::from(ranks.div_ceil(SEED_WORKGROUP));
+        let in_bytes = checked * 8 + cells.len() as u64 * size_of::<SeedCell>() as u64;
+        let out_bytes = u64::from(counters.selected) * size_of::<SeedRecord>() as u64
+            + blocks * size_of::<SeedBlock>() as u64;
+        let floor = floor::Floor::new(&r.gpu, in_bytes, out_bytes);
+        let floor_ms = floor::median_ms(&r.gpu, GPU_RUNS, |e| floor.encode(e));
         println!(
-            "{:>10} {:>7} {:>10} {:>12.2} {:>14.3e} {:>12.1} {:>14.3e} {:>8.2}",
+            "{:>10} {:>7} {:>10} {:>12.2} {:>14.3e} {:>12.1} {:>14.3e} {:>8.2} {:>10.3} {:>8.2}",
             checked,
             cells.len(),
             counters.selected,
@@ -129,7 +153,9 @@ fn main() {
             rate(gpu_ms),
             twin_ms,
             rate(twin_ms),
-            twin_ms / gpu_ms
+            twin_ms / gpu_ms,
+            floor_ms,
+            gpu_ms / floor_ms
         );
     }
 }

@@ -1,13 +1,20 @@
-//! Pass 1's figures at 1280×720 with the default settings: the Tile Load Map's and the depth
-//! pyramid's GPU times (timestamp queries), the CPU preparation of a frame (layout, uniforms,
-//! spans) and the twin's CPU time, for a view over a synthetic dataset and one from 40 km away
-//! (four rings). `cargo bench --bench tile_load_map`.
+//! Pass 1's figures at 1280×720 with the default settings, and rings of 32, 64 (the default) and
+//! 128 cells a side: the Tile Load Map's and the depth pyramid's GPU times (timestamp queries),
+//! the CPU preparation of a frame (layout, uniforms, spans) and the twin's CPU time, for a view
+//! over a synthetic dataset and one from 40 km away (four rings). Beside the pass, its floor
+//! (`support/floor.rs`), timed the same way: a kernel reading what the pass reads per cell (the
+//! 2 × 2 depth-pyramid texels of its screen rectangle and its height tile's range) and writing its
+//! cells. `cargo bench --bench tile_load_map`.
 #![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
+
+#[path = "support/floor.rs"]
+mod floor;
 
 use std::time::Instant;
 
 use glam::DVec3;
 use terramp::config::Settings;
+use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::{Profiler, TimeSource};
 use terramp::passes::depth_pyramid::gpu::DepthPyramid;
 use terramp::passes::tile_load_map::frame::{TlmImagery, TlmInputs, height_tile_ranges};
@@ -19,7 +26,15 @@ use terramp_testkit::tlm::{assert_gpu_equals_twin, run, visible};
 
 fn main() {
     let dataset = terramp_testkit::synth_dataset(1024, 5);
-    let mut r = renderer(&dataset, Settings::default());
+    for cells in [32, 64, 128] {
+        let mut settings = Settings::default();
+        settings.tlm.cells = cells;
+        bench(renderer(&dataset, settings));
+    }
+}
+
+/// The figures of `r`'s settings, near and far.
+fn bench(mut r: terramp::frame::Renderer) {
     let [w, h] = r.dataset.manifest.extent_m();
     let ranges = height_tile_ranges(&r.dataset);
     let near = over(&r, [0.2 * w, 0.2 * h], 300.0, 45.0, -12.0);
@@ -47,6 +62,10 @@ fn main() {
         let prepare_start = Instant::now();
         pass.prepare(&r.gpu.queue, &inputs).unwrap();
         let prepare_ms = prepare_start.elapsed().as_secs_f64() * 1000.0;
+        let cell_count = u64::from(warm.layout.rings) * u64::from(warm.layout.cells).pow(2);
+        // Per cell: 2 × 2 depth-pyramid texels and its height tile's range (two f32s).
+        let floor =
+            floor::Floor::new(&r.gpu, cell_count * (4 * 4 + 8), cell_count * size_of::<TlmCell>() as u64);
         let mut profiler = Profiler::new(&r.gpu, true);
         let depth = r.depth_texture().create_view(&Default::default());
         let mut frames = Vec::new();
@@ -54,6 +73,7 @@ fn main() {
             let mut encoder = device.create_command_encoder(&Default::default());
             profiler.pass(&r.gpu, &mut encoder, "hiz", |e| hiz.encode(e, &depth)).unwrap();
             profiler.pass(&r.gpu, &mut encoder, "tlm", |e| pass.encode(e, &bindings, &warm.frame)).unwrap();
+            profiler.pass(&r.gpu, &mut encoder, "floor", |e| floor.encode(e)).unwrap();
             profiler.resolve(&mut encoder);
             r.gpu.queue.submit([encoder.finish()]);
             profiler.end_frame();
@@ -67,14 +87,17 @@ fn main() {
             warm.layout.cells,
             visible(&warm.gpu)
         );
-        for label in ["hiz", "tlm"] {
+        let median_ms = |label: &str| {
             let mut ms: Vec<f64> =
                 frames.iter().flatten().filter(|t| t.label == label).map(|t| t.ms).collect();
             ms.sort_by(f64::total_cmp);
             let source = frames.iter().flatten().find(|t| t.label == label).map(|t| t.source);
             println!("  {label}: median {:.3} ms over {} frames ({source:?})", ms[ms.len() / 2], ms.len());
             assert!(source.is_some_and(|s| s != TimeSource::Cpu));
-        }
+            ms[ms.len() / 2]
+        };
+        let (_, tlm_ms, floor_ms) = (median_ms("hiz"), median_ms("tlm"), median_ms("floor"));
+        println!("  tlm ÷ floor: {:.2} ({cell_count} cells)", tlm_ms / floor_ms);
         let mut twin_ms: Vec<f64> = (0..5)
             .map(|_| {
                 let start = Instant::now();
