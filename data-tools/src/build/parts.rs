@@ -14,7 +14,8 @@
 //!
 //! The inputs are recorded by absolute path, byte length and CRC-32 of their contents, which the
 //! plan's hash covers: new inputs make a new plan, whose jobs rebuild every partition. A job checks
-//! each input's length (not its CRC, which would read whole files on every job).
+//! each input's length (not its CRC, which would read whole files on every job). A GDAL virtual
+//! path (`/vsis3/…`, `/vsicurl/…`) is recorded by its path alone: only GDAL reads it.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -44,9 +45,12 @@ pub struct InputFile {
 }
 
 impl InputFile {
-    /// Reads `path` once for its length and CRC.
+    /// Reads `path` once for its length and CRC (a GDAL virtual path: its path alone).
     fn measure(path: &Path) -> Result<Self> {
         use std::io::Read;
+        if is_virtual(path) {
+            return Ok(Self { path: path.to_owned(), bytes: 0, crc32: VIRTUAL_CRC.to_owned() });
+        }
         let path = std::path::absolute(path).with_context(|| format!("resolving {}", path.display()))?;
         let mut file = fs::File::open(&path).with_context(|| format!("reading {}", path.display()))?;
         let (mut hasher, mut bytes, mut buffer) = (crc32fast::Hasher::new(), 0u64, vec![0u8; 1 << 20]);
@@ -63,6 +67,9 @@ impl InputFile {
 
     /// Fails unless the file is still there with the planned length.
     fn check(&self) -> Result<()> {
+        if is_virtual(&self.path) {
+            return Ok(());
+        }
         let bytes = fs::metadata(&self.path)
             .with_context(|| format!("{}: an input of the plan is missing", self.path.display()))?
             .len();
@@ -74,6 +81,14 @@ impl InputFile {
         );
         Ok(())
     }
+}
+
+/// What a GDAL virtual path's CRC is recorded as.
+const VIRTUAL_CRC: &str = "not read: a GDAL virtual path";
+
+/// Whether `path` is one of GDAL's virtual file systems (`/vsis3/`, `/vsicurl/`, `/vsizip/`, …).
+fn is_virtual(path: &Path) -> bool {
+    path.to_str().is_some_and(|p| p.starts_with("/vsi"))
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -372,4 +387,19 @@ fn bar_if(progress: bool, name: &str) -> ProgressBar {
     let style = ProgressStyle::with_template("{prefix:>18} {bar:40} {pos}/{len} {elapsed}")
         .unwrap_or_else(|_| ProgressStyle::default_bar());
     ProgressBar::new(0).with_style(style).with_prefix(name.to_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gdal_virtual_path_is_recorded_by_its_path_alone() {
+        let path = Path::new("/vsis3/terrain/dem.tif");
+        let file = InputFile::measure(path).unwrap();
+        assert_eq!((file.path.as_path(), file.bytes, file.crc32.as_str()), (path, 0, VIRTUAL_CRC));
+        assert!(file.check().is_ok(), "a job cannot stat a virtual path, and does not");
+        let missing = InputFile { path: "/nonexistent/dem.tif".into(), bytes: 1, crc32: "0".into() };
+        assert!(missing.check().unwrap_err().to_string().contains("/nonexistent/dem.tif"));
+    }
 }
