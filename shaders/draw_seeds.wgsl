@@ -414,7 +414,9 @@ fn fs_coverage(in: VertexOut, @builtin(sample_mask) covered: u32) -> CoverageOut
     if wanted == 0u || faded_out(in) {
         discard;
     }
-    let turn = (pixel.x + 2u * pixel.y + in.record) % SEED_SAMPLES;
+    // Turned by the seed's own dither shift, never by where its record landed: pass 3's blocks land
+    // in a different order every frame, and the samples kept would change with it.
+    let turn = (pixel.x + 2u * pixel.y + u32(in.keep.z)) % SEED_SAMPLES;
     var mask = 0u;
     var taken = 0u;
     for (var k = 0u; k < SEED_SAMPLES; k++) {
