@@ -141,7 +141,7 @@ fn count_triangle(size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u64) {
         multiview_mask: None,
         cache: None,
     });
-    let counter = FragmentCounter::new(&gpu, &["triangle"], &target, 4).expect("pipeline-statistics queries");
+    let counter = FragmentCounter::new(&gpu, &["triangle"], &target).expect("pipeline-statistics queries");
     let view = target.create_view(&Default::default());
     let mut encoder = device.create_command_encoder(&Default::default());
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -211,8 +211,7 @@ impl Renderer {
             counted.into_iter().filter_map(|(label, drawn)| drawn.then_some(label)).collect();
         let fragments = match settings.gpu.count_fragments {
             true => Some(
-                FragmentCounter::new(&gpu, &labels, &targets.colour, 4)
-                    .ok_or(RenderError::NoFragmentCounts)?,
+                FragmentCounter::new(&gpu, &labels, &targets.colour).ok_or(RenderError::NoFragmentCounts)?,
             ),
             false => None,
         };

@@ -18,7 +18,6 @@ use crate::dataset::{Dataset, LandcoverLayer};
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{CompactParams, SeedCounters, SeedRecord, TerrainUniforms};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
-use crate::gpu::resources::frame_pass;
 use crate::gpu::{Gpu, GpuError};
 use crate::passes::compact::frame::CompactLimits;
 use crate::passes::compact::gpu::{CompactInputs, CompactPass};
@@ -181,10 +180,7 @@ impl SeedStage {
         if let (Some((draw, bind_group)), Some(_)) = (&self.draw, &self.last_frame) {
             draw.encode(encoder, bind_group, self.compact.draw_args(), targets, count);
         } else if let Some(count) = count {
-            // Nothing to draw: an empty pass still ends its count, at zero.
-            let mut pass = frame_pass(encoder, "draw_seeds", targets.0, targets.1, None);
-            count.begin(&mut pass);
-            count.end(&mut pass);
+            count.nothing(encoder, "draw_seeds", targets.0, targets.1);
         }
     }
 

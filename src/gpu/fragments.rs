@@ -16,6 +16,7 @@
 //! included.
 
 use super::readback::{read_buffer, read_texture};
+use super::resources::frame_pass;
 use super::{Gpu, GpuError};
 
 /// What one counted pass did in one frame.
@@ -56,15 +57,30 @@ impl CountedPass<'_> {
     pub fn end(self, pass: &mut wgpu::RenderPass) {
         pass.end_pipeline_statistics_query();
     }
+
+    /// Counts a pass that draws nothing this frame: an empty render pass (labelled `label`, over
+    /// `colour` and `depth`) still ends the query, at zero.
+    pub fn nothing(
+        self,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) {
+        let mut pass = frame_pass(encoder, label, colour, depth, None);
+        self.begin(&mut pass);
+        self.end(&mut pass);
+    }
 }
 
 impl FragmentCounter {
-    /// Counts the passes `labels` over `colour` (a `COPY_SRC` 2D target of `texel_bytes` per texel);
-    /// `None` when the adapter has no pipeline-statistics queries.
-    pub fn new(gpu: &Gpu, labels: &[&'static str], colour: &wgpu::Texture, texel_bytes: u32) -> Option<Self> {
+    /// Counts the passes `labels` over `colour` (a `COPY_SRC` 2D colour target); `None` when the
+    /// adapter has no pipeline-statistics queries.
+    pub fn new(gpu: &Gpu, labels: &[&'static str], colour: &wgpu::Texture) -> Option<Self> {
         if !gpu.device.features().contains(wgpu::Features::PIPELINE_STATISTICS_QUERY) {
             return None;
         }
+        let texel_bytes = colour.format().block_copy_size(None)?;
         let count = labels.len() as u32;
         let queries = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("fragments shaded"),
@@ -121,9 +137,8 @@ impl FragmentCounter {
         encoder.resolve_query_set(&self.queries, 0..self.labels.len() as u32, &self.resolved, 0);
     }
 
-    /// Waits for the frame and returns each counted pass's fragments and pixels. A pass not
-    /// recorded this frame counts none (its copies and query hold an earlier frame's: callers read
-    /// only passes they recorded).
+    /// Waits for the frame and returns each counted pass's fragments and pixels (every pass the
+    /// counter names must have been recorded through `around` this frame).
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<PassFragments>, GpuError> {
         let shaded: Vec<u64> =
             bytemuck::pod_collect_to_vec(&read_buffer(gpu, &self.resolved, self.labels.len() as u64 * 8)?);

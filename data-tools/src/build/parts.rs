@@ -326,14 +326,8 @@ impl GeotiffParts {
                 }
                 IMAGERY_PACK => {
                     let source = self.imagery()?;
-                    let merged = merge_layer::<[u8; 4]>(&path, &source.spec(), split, &packs, &bar);
-                    let mut layer = source.layer();
-                    merged.with_context(|| format!("merging {pack}"))?;
-                    let blocks = bar_if(progress, imagery_format.short_name());
-                    encode_staged_imagery(&staging, &mut layer, imagery_format, &blocks)
-                        .context("encoding the imagery's blocks")?;
-                    imagery = Some(layer);
-                    Ok(())
+                    imagery = Some(source.layer());
+                    merge_layer::<[u8; 4]>(&path, &source.spec(), split, &packs, &bar)
                 }
                 _ => {
                     let (source, coding) = self.landcover()?;
@@ -344,6 +338,11 @@ impl GeotiffParts {
             };
             merged.with_context(|| format!("merging {pack}"))?;
             bar.finish();
+        }
+        if let Some(layer) = imagery.as_mut() {
+            let blocks = bar_if(progress, imagery_format.short_name());
+            encode_staged_imagery(&staging, layer, imagery_format, &blocks)
+                .context("encoding the imagery's blocks")?;
         }
         let planned = &self.source.heights;
         let height = heights::height_layer(

@@ -305,10 +305,7 @@ impl DrawSeedsPass {
     ) {
         if self.species_drawn == 0 {
             if let Some(count) = count {
-                // Nothing to draw: an empty pass still ends its count, at zero.
-                let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None);
-                count.begin(&mut pass);
-                count.end(&mut pass);
+                count.nothing(encoder, "draw_seeds", colour, depth);
             }
             return;
         }
