@@ -7,10 +7,11 @@
 #
 # Steps: the synthetic default dataset (`terramp-data synth`, unless DATASET is given); `terramp
 # profile` over its default path at 1920 × 1080 with the accurate preset and scripts/gpu_bench.toml
-# (over 1 M seeds checked and 100 k drawn a frame), the trees drawn with IMPOSTORS; the compute
+# (over 1 M seeds checked and 100 k drawn a frame), the trees drawn with IMPOSTORS, then the same
+# with the seeds' depth prepass (`draw_seeds.depth_prepass`, off by default) on; the compute
 # passes' criterion benches when BENCH_DIR holds their binaries (`cargo bench --no-run`: compact-*,
 # seeds-*, tile_load_map-*). The JSON: the machine, the profile's whole summary (adapter and driver
-# included) and each bench's mean.
+# included), the prepass run's, and each bench's mean.
 #
 # Environment: BIN (target/release: terramp, terramp-data), TERRAMP / TERRAMP_DATA (the binaries
 # themselves), DATASET, IMPOSTORS (data/trade/impostors), FRAMES (120), WARMUP (30), WIDTH × HEIGHT
@@ -46,12 +47,17 @@ if [ -z "${DATASET:-}" ]; then
   fi
 fi
 
-settings=$OUT/settings.toml
-sed "s|^\[draw_seeds\]|[draw_seeds]\nimpostors = \"$(realpath "$IMPOSTORS")\"|" scripts/gpu_bench.toml >"$settings"
-echo "profile: $FRAMES frames after $WARMUP at ${WIDTH}×${HEIGHT}, preset $PRESET, over $DATASET" >&2
-"$TERRAMP" profile --dataset "$DATASET" --frames "$FRAMES" --warmup "$WARMUP" --width "$WIDTH" \
-  --height "$HEIGHT" --preset "$PRESET" --settings "$settings" --json "$OUT/profile.json" >"$OUT/profile.txt"
-cat "$OUT/profile.txt" >&2
+profile() { # name, depth prepass (true/false)
+  local settings=$OUT/settings-$1.toml
+  sed "s|^\[draw_seeds\]|[draw_seeds]\nimpostors = \"$(realpath "$IMPOSTORS")\"\ndepth_prepass = $2|" \
+    scripts/gpu_bench.toml >"$settings"
+  echo "profile ($1): $FRAMES frames after $WARMUP at ${WIDTH}×${HEIGHT}, preset $PRESET, over $DATASET" >&2
+  "$TERRAMP" profile --dataset "$DATASET" --frames "$FRAMES" --warmup "$WARMUP" --width "$WIDTH" \
+    --height "$HEIGHT" --preset "$PRESET" --settings "$settings" --json "$OUT/$1.json" >"$OUT/$1.txt"
+  cat "$OUT/$1.txt" >&2
+}
+profile profile false
+profile profile_depth_prepass true
 
 # Each bench binary's groups, measured briefly; criterion keeps each estimate in CRITERION_HOME.
 benches=()
@@ -81,6 +87,8 @@ json=$OUT/gpu_bench.json
   printf '  "benches": [%s],\n' "$(IFS=,; echo "${benches[*]:-}")"
   printf '  "profile": '
   cat "$OUT/profile.json"
+  printf ',\n  "profile_depth_prepass": '
+  cat "$OUT/profile_depth_prepass.json"
   printf '\n}\n'
 } >"$json"
 echo "wrote $json in $(($(date +%s) - start)) s" >&2

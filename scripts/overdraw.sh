@@ -2,7 +2,8 @@
 # The foliage passes' overdraw and cost (issue 19, docs/PERFORMANCE.md): `terramp profile` over the
 # synthetic default dataset (its default path) and over nc (config/paths/nc.toml), trees drawn,
 # at 1280 × 720 balanced: once with `gpu.count_fragments` (fragments shaded per pixel covered, per
-# pass; frames serialised by the readback) and once without (the passes' times, to quote).
+# pass, and samples written; frames serialised by the readback) and once without (the passes'
+# times, to quote); each without and with the seeds' depth prepass (`draw_seeds.depth_prepass`).
 #
 #   FRAMES=20 scripts/overdraw.sh            # prints both tables per dataset
 #
@@ -25,20 +26,24 @@ for d in synthetic nc impostors; do
   [ -d "$DATA_DIR/$d" ] || { echo "no $DATA_DIR/$d: scripts/trade.sh builds it" >&2; exit 1; }
 done
 
-trees() { # impostors, count_fragments → a settings file
-  local file="$OUT/settings-$(basename "$1")-$2.toml"
-  printf '[gpu]\ncount_fragments = %s\n[draw_seeds]\nimpostors = "%s"\n' "$2" "$(realpath "$1")" >"$file"
+trees() { # impostors, count_fragments, depth_prepass → a settings file
+  local file="$OUT/settings-$(basename "$1")-$2-$3.toml"
+  printf '[gpu]\ncount_fragments = %s\n[draw_seeds]\nimpostors = "%s"\ndepth_prepass = %s\n' \
+    "$2" "$(realpath "$1")" "$3" >"$file"
   echo "$file"
 }
 
 run() { # name, dataset, impostors, path args...
   local name=$1 dataset=$2 impostors=$3
   shift 3
-  for count in true false; do
-    echo "## $name, gpu.count_fragments = $count"
-    "$bin" profile --dataset "$dataset" "$@" --frames "$FRAMES" --warmup "$WARMUP" --width "$WIDTH" \
-      --height "$HEIGHT" --settings "$(trees "$impostors" "$count")" --json "$OUT/$name-$count.json" 2>/dev/null |
-      grep -E "draw_seeds|texcells|Overdraw|Frame \(wall|Seeds (checked|selected)"
+  for prepass in false true; do
+    for count in true false; do
+      echo "## $name, draw_seeds.depth_prepass = $prepass, gpu.count_fragments = $count"
+      "$bin" profile --dataset "$dataset" "$@" --frames "$FRAMES" --warmup "$WARMUP" --width "$WIDTH" \
+        --height "$HEIGHT" --settings "$(trees "$impostors" "$count" "$prepass")" \
+        --json "$OUT/$name-$prepass-$count.json" 2>/dev/null |
+        grep -E "draw_seeds|texcells|Overdraw|Frame \(wall|Seeds (checked|selected)"
+    done
   done
 }
 

@@ -80,7 +80,10 @@ struct VertexIn {
 }
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the depth prepass and the shading draw after it (`fs_depth`, then a draw whose
+    // depth must equal it) compile this shader with different fragment stages, and each must place
+    // every vertex bit for bit where the other did.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) rel_m: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
@@ -334,8 +337,8 @@ struct Surface {
     alpha_per_px: f32,
 }
 
-fn surface(in: VertexOut) -> Surface {
-    let material = materials[in.material];
+// The fragment's material colour and alpha: its texel (if textured) times the base colour.
+fn texel_of(in: VertexOut, material: SeedMaterial) -> vec4<f32> {
     // Derivatives in uniform control flow; the samplers differ only in wrapping (the mesh's
     // textures repeat, the atlases must not bleed across their edge).
     let dx = dpdx(in.uv);
@@ -349,7 +352,12 @@ fn surface(in: VertexOut) -> Surface {
             texel = textureSampleGrad(textures, clamp_sampler, in.uv, layer, dx, dy);
         }
     }
-    texel *= material.base_colour;
+    return texel * material.base_colour;
+}
+
+fn surface(in: VertexOut) -> Surface {
+    let material = materials[in.material];
+    let texel = texel_of(in, material);
     let albedo = mix(texel.rgb, in.ground.rgb, in.ground.w) * in.tint * in.luminosity;
     // Seen from the side facing the eye (billboards, leaves); foliage lets light wrap around.
     var normal = normalize(in.normal);
@@ -388,45 +396,18 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     return shade(in);
 }
 
-struct CoverageOut {
-    @location(0) colour: vec4<f32>,
-    @builtin(sample_mask) mask: u32,
-}
-
-// The standard 4× sample positions, in an order whose first k spread over the pixel (top,
-// bottom, left, right: the first two are diagonal), turned per pixel and seed.
-const COVERAGE_ORDER = array<u32, 4>(0u, 3u, 2u, 1u);
-
-// Multisampled drawing (`draw_seeds.samples` = SEED_SAMPLES): the alpha test's edge, anti-aliased.
-// The alpha is sharpened to cross the cutoff over one pixel (alpha − cutoff over its change per
-// pixel, centred), so a texture magnified up close keeps crisp leaf edges while a minified one
-// blends. That coverage of the triangle's part of the pixel becomes a share of the samples the
-// triangle covers (dithered, so the mean share is exact), and those samples are written with their
-// own depth: trees behind show through the gaps, and the resolve averages the samples.
+// The depth prepass (`draw_seeds.depth_prepass`): every draw first writes only the depth of what
+// it keeps (the alpha test and the dithers: one texture fetch, no lighting), with colour writes
+// off; the draws are then repeated with the depth test `Equal` and no depth write, so only the
+// fragment each pixel finally shows reaches the lighting, whatever the order the seeds come in.
+// The colour returned is never written.
 @fragment
-fn fs_coverage(in: VertexOut, @builtin(sample_mask) covered: u32) -> CoverageOut {
-    let s = surface(in);
-    let cutoff = materials[in.material].alpha_cutoff;
-    let coverage = clamp((s.alpha - cutoff) / max(s.alpha_per_px, 1e-4) + 0.5, 0.0, 1.0);
-    // A dither of its own, not the cross-fade's (the two would be correlated).
-    let pixel = vec2<u32>(in.clip.xy);
-    let wanted = u32(coverage * f32(countOneBits(covered)) + bayer4(pixel, u32(in.keep.z) + 7u));
-    if wanted == 0u || faded_out(in) {
+fn fs_depth(in: VertexOut) -> @location(0) vec4<f32> {
+    let material = materials[in.material];
+    if texel_of(in, material).a < material.alpha_cutoff || faded_out(in) {
         discard;
     }
-    // Turned by the seed's own dither shift, never by where its record landed: pass 3's blocks land
-    // in a different order every frame, and the samples kept would change with it.
-    let turn = (pixel.x + 2u * pixel.y + u32(in.keep.z)) % SEED_SAMPLES;
-    var mask = 0u;
-    var taken = 0u;
-    for (var k = 0u; k < SEED_SAMPLES; k++) {
-        let bit = 1u << COVERAGE_ORDER[(k + turn) % SEED_SAMPLES];
-        if taken < wanted && (covered & bit) != 0u {
-            mask |= bit;
-            taken++;
-        }
-    }
-    return CoverageOut(s.colour, mask);
+    return vec4<f32>(0.0);
 }
 
 struct TruthOut {
@@ -439,27 +420,4 @@ struct TruthOut {
 @fragment
 fn fs_truth(in: VertexOut) -> TruthOut {
     return TruthOut(shade(in), in.record + 1u);
-}
-
-// Multisampled drawing starts from the frame as the ground passes left it: each pixel's colour
-// (a copy of the frame's) and the terrain's depth written to all of its samples, by one triangle
-// over the whole view.
-@group(0) @binding(8) var frame_colour: texture_2d<f32>;
-@group(0) @binding(9) var frame_depth: texture_depth_2d;
-
-@vertex
-fn vs_fill(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<f32> {
-    let corner = vec2<f32>(f32((vertex << 1u) & 2u), f32(vertex & 2u));
-    return vec4<f32>(corner * 2.0 - 1.0, 0.0, 1.0);
-}
-
-struct FillOut {
-    @location(0) colour: vec4<f32>,
-    @builtin(frag_depth) depth: f32,
-}
-
-@fragment
-fn fs_fill(@builtin(position) position: vec4<f32>) -> FillOut {
-    let texel = vec2<i32>(position.xy);
-    return FillOut(textureLoad(frame_colour, texel, 0), textureLoad(frame_depth, texel, 0));
 }

@@ -4,6 +4,9 @@
 //!   frame of the same view, and it shades at least one fragment for each;
 //! - counting changes no pixel: the frame equals the one drawn without counting, bit for bit;
 //! - a view with no seed in it counts nothing (the query holds the pass's draws alone);
+//! - a depth prepass changes no pixel, single-sampled or multisampled, and its shading draws
+//!   write each sample the seeds show once (the occlusion query), where the draw without one
+//!   writes some twice or more;
 //! - multisampled, the same: covered pixels where the frame differs, counting changes nothing;
 //! - a full-screen triangle covers every pixel and counts each at least once, and at most the 4 × 4
 //!   blocks along one diagonal more (llvmpipe clips it to the screen, two triangles, and runs
@@ -93,6 +96,37 @@ fn draw_seeds_counts_its_fragments_and_exactly_the_pixels_it_changes() {
     assert!(seeds.shaded >= seeds.covered_px && seeds.shaded < 200 * pixels, "{seeds:?}");
 }
 
+#[test]
+fn a_depth_prepass_changes_no_pixel_and_lights_each_sample_once() {
+    let Some(impostors) = terramp_testkit::nc_impostors() else { return };
+    let impostors = impostors.to_str().unwrap();
+    let dir = synth_dataset(300, 7);
+    let draw = |depth_prepass: bool, samples: u32| {
+        let mut s = settings(impostors, true);
+        (s.draw_seeds.depth_prepass, s.draw_seeds.samples) = (depth_prepass, samples);
+        let (image, report) = frame(&dir, s, into_the_trees);
+        let [seeds] = report.fragments[..] else { panic!("not one counted pass: {:?}", report.fragments) };
+        (image, seeds)
+    };
+    for samples in [1, 4] {
+        let (plain_image, plain) = draw(false, samples);
+        let (image, prepassed) = draw(true, samples);
+        println!("{samples} samples: without a prepass {plain:?}\n           with one {prepassed:?}");
+        assert_eq!(plain_image.as_raw(), image.as_raw(), "the prepass changed the frame ({samples} samples)");
+        assert!(plain.covered_px > 500, "{plain:?}: a weak test");
+        assert_eq!((plain.prepass_shaded, prepassed.covered_px), (0, plain.covered_px));
+        assert!(prepassed.prepass_shaded >= prepassed.covered_px, "{prepassed:?}");
+        // Each sample a seed shows is lit once (ties of two fragments at one depth aside), where
+        // the draw without a prepass overwrites those a nearer fragment comes to later.
+        let covered = u64::from(samples) * prepassed.covered_px;
+        assert!(
+            (prepassed.covered_px..=covered + covered / 100).contains(&prepassed.written),
+            "{prepassed:?}"
+        );
+        assert!(plain.written >= prepassed.written, "{plain:?} against {prepassed:?}");
+    }
+}
+
 /// Fragments shaded and pixels covered by one triangle (clip-space corners `corners`) drawn in a
 /// constant colour over a black `size` target.
 fn count_triangle(size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u64) {
@@ -158,6 +192,7 @@ fn count_triangle(size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u64) {
         ..Default::default()
     });
     FragmentCounter::around(Some(&counter), "triangle", &mut encoder, &target, &|e, count| {
+        let count = count.expect("the triangle pass is counted");
         let mut pass = e.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("triangle"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -166,9 +201,9 @@ fn count_triangle(size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u64) {
                 resolve_target: None,
                 ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
             })],
+            occlusion_query_set: Some(count.occlusion_set()),
             ..Default::default()
         });
-        let count = count.expect("the triangle pass is counted");
         count.begin(&mut pass);
         pass.set_pipeline(&pipeline);
         pass.draw(0..3, 0..1);
@@ -177,6 +212,8 @@ fn count_triangle(size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u64) {
     counter.resolve(&mut encoder);
     gpu.queue.submit([encoder.finish()]);
     let [counted] = counter.read(&gpu).unwrap()[..] else { panic!("one pass counted") };
+    // Nothing tests depth or discards: every pixel covered is written, once.
+    assert_eq!((counted.written, counted.prepass_shaded), (counted.covered_px, 0), "{counted:?}");
     (counted.shaded, counted.covered_px)
 }
 

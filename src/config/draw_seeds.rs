@@ -22,6 +22,9 @@ pub struct DrawSeedsSettings {
     /// centre; `SEED_SAMPLES` (4) draws them multisampled, each fragment covering as many of its
     /// pixel's samples as its (sharpened) alpha says, and resolves into the frame.
     pub samples: u32,
+    /// Every draw first writes the depth of what it keeps (alpha test and dithers only), then is
+    /// repeated testing depth for equality, so only the fragment each sample shows is lit.
+    pub depth_prepass: bool,
     /// Meshes whose materials say how they shed detail (generated trees) are drawn with continuous
     /// LOD (Wesslén & Seipel, `impostor::detail`): leaves thin out and sub-pixel stems are drawn
     /// a pixel wide on a share of the seeds as they shrink on screen, and the thinned mesh also

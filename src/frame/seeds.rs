@@ -263,6 +263,9 @@ fn draw_pass(
     let impostors = load_impostors(dir, &table.species)?;
     let choices = LodChoices::of(&settings.draw_seeds, &table.species);
     let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, choices)?;
+    if settings.draw_seeds.depth_prepass {
+        draw = draw.with_depth_prepass(&gpu.device);
+    }
     if settings.draw_seeds.samples > 1 {
         draw = draw.multisampled(&gpu.device, &targets.colour, &targets.depth);
     }

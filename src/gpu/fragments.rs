@@ -12,8 +12,16 @@
 //! whole 4 × 4 blocks and counts 16 for each block it runs, whatever part of it the triangle
 //! covers: the lanes it pays for, an upper bound of the fragments (`tests/overdraw.rs`: a
 //! full-screen triangle, clipped into two, counts each pixel once and the blocks along their shared
-//! edge twice). Hardware GPUs shade 2 × 2 quads and count the covered fragments, helper lanes not
-//! included.
+//! edge twice). It counts them before its early depth test, so a fragment hidden by a nearer one
+//! counts as much as a shaded one. Hardware GPUs shade 2 × 2 quads and count the covered fragments
+//! that pass their early tests, helper lanes not included.
+//!
+//! Two more figures do not depend on the adapter. An occlusion query over the same draws counts
+//! the samples that passed the depth test and were not discarded: those written, overwritten ones
+//! included, a lower bound of the fragments shaded in any order. A pass with a depth prepass
+//! (`draw_seeds.depth_prepass`) counts the prepass's invocations apart (`begin_prepass`), and its
+//! shading draws' written samples are then exactly the fragments that reach the lighting on a GPU
+//! that tests depth before shading.
 
 use super::readback::{read_buffer, read_texture};
 use super::resources::frame_pass;
@@ -24,8 +32,12 @@ use super::{Gpu, GpuError};
 pub struct PassFragments {
     /// The pass's label, as the profiler times it.
     pub label: &'static str,
-    /// Fragment shader invocations, discarded ones included.
+    /// Fragment shader invocations of the shading draws, discarded ones included.
     pub shaded: u64,
+    /// Fragment shader invocations of the depth prepass (0 without one): alpha tests, no lighting.
+    pub prepass_shaded: u64,
+    /// Samples of the shading draws that passed the depth test and were not discarded.
+    pub written: u64,
     /// Pixels whose colour the pass changed.
     pub covered_px: u64,
 }
@@ -33,7 +45,10 @@ pub struct PassFragments {
 /// The queries and colour copies of the passes `labels` names, for one frame at a time.
 pub struct FragmentCounter {
     labels: Vec<&'static str>,
+    /// Per pass, the shading draws' invocations and the prepass's.
     queries: wgpu::QuerySet,
+    /// Per pass, the shading draws' samples written.
+    occlusion: wgpu::QuerySet,
     resolved: wgpu::Buffer,
     /// Per pass, the colour target before and after it.
     copies: Vec<[wgpu::Texture; 2]>,
@@ -47,19 +62,36 @@ pub struct CountedPass<'a> {
     index: u32,
 }
 
-impl CountedPass<'_> {
-    /// Starts counting the pass's fragments (call first in the render pass).
-    pub fn begin(self, pass: &mut wgpu::RenderPass) {
-        pass.begin_pipeline_statistics_query(&self.counter.queries, self.index);
+impl<'a> CountedPass<'a> {
+    /// The occlusion queries: the render pass the counted draws are in must be begun with them.
+    pub fn occlusion_set(self) -> &'a wgpu::QuerySet {
+        &self.counter.occlusion
     }
 
-    /// Stops counting (call after the pass's last draw).
+    /// Starts counting the pass's shading draws.
+    pub fn begin(self, pass: &mut wgpu::RenderPass) {
+        pass.begin_pipeline_statistics_query(&self.counter.queries, 2 * self.index);
+        pass.begin_occlusion_query(self.index);
+    }
+
+    /// Stops counting the shading draws (call after the last).
     pub fn end(self, pass: &mut wgpu::RenderPass) {
+        pass.end_occlusion_query();
+        pass.end_pipeline_statistics_query();
+    }
+
+    /// Starts counting the depth prepass's draws (a pass without one leaves its count at 0).
+    pub fn begin_prepass(self, pass: &mut wgpu::RenderPass) {
+        pass.begin_pipeline_statistics_query(&self.counter.queries, 2 * self.index + 1);
+    }
+
+    /// Stops counting the depth prepass's draws.
+    pub fn end_prepass(self, pass: &mut wgpu::RenderPass) {
         pass.end_pipeline_statistics_query();
     }
 
     /// Counts a pass that draws nothing this frame: an empty render pass (labelled `label`, over
-    /// `colour` and `depth`) still ends the query, at zero.
+    /// `colour` and `depth`) still ends the queries, at zero.
     pub fn nothing(
         self,
         encoder: &mut wgpu::CommandEncoder,
@@ -67,7 +99,9 @@ impl CountedPass<'_> {
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
     ) {
-        let mut pass = frame_pass(encoder, label, colour, depth, None);
+        let mut pass = frame_pass(encoder, label, colour, depth, None, Some(self.occlusion_set()));
+        self.begin_prepass(&mut pass);
+        self.end_prepass(&mut pass);
         self.begin(&mut pass);
         self.end(&mut pass);
     }
@@ -82,16 +116,17 @@ impl FragmentCounter {
         }
         let texel_bytes = colour.format().block_copy_size(None)?;
         let count = labels.len() as u32;
-        let queries = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("fragments shaded"),
-            ty: wgpu::QueryType::PipelineStatistics(
-                wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS,
-            ),
-            count,
-        });
+        let query_set = |label, ty, count| {
+            gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some(label), ty, count })
+        };
+        let invocations =
+            wgpu::QueryType::PipelineStatistics(wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS);
+        let queries = query_set("fragments shaded", invocations, 2 * count);
+        let occlusion = query_set("samples written", wgpu::QueryType::Occlusion, count);
+        // The invocations' 2 × count results, then the samples written.
         let resolved = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fragments shaded"),
-            size: u64::from(count) * 8,
+            size: written_offset(count) + u64::from(count) * 8,
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
@@ -108,7 +143,7 @@ impl FragmentCounter {
             })
         };
         let copies = labels.iter().map(|_| [copy(), copy()]).collect();
-        Some(Self { labels: labels.to_vec(), queries, resolved, copies, texel_bytes })
+        Some(Self { labels: labels.to_vec(), queries, occlusion, resolved, copies, texel_bytes })
     }
 
     /// Records pass `label` (one of this counter's) between copies of `colour`; `record` gets the
@@ -134,20 +169,25 @@ impl FragmentCounter {
 
     /// Copies the queries into a readable buffer: call on the frame's last encoder.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.resolve_query_set(&self.queries, 0..self.labels.len() as u32, &self.resolved, 0);
+        let count = self.labels.len() as u32;
+        encoder.resolve_query_set(&self.queries, 0..2 * count, &self.resolved, 0);
+        encoder.resolve_query_set(&self.occlusion, 0..count, &self.resolved, written_offset(count));
     }
 
     /// Waits for the frame and returns each counted pass's fragments and pixels (every pass the
     /// counter names must have been recorded through `around` this frame).
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<PassFragments>, GpuError> {
-        let shaded: Vec<u64> =
-            bytemuck::pod_collect_to_vec(&read_buffer(gpu, &self.resolved, self.labels.len() as u64 * 8)?);
+        let count = self.labels.len();
+        let offset = written_offset(count as u32);
+        let results: Vec<u64> =
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, &self.resolved, offset + count as u64 * 8)?);
+        let (invocations, written) = (&results[..2 * count], &results[offset as usize / 8..]);
         let texel = self.texel_bytes as usize;
         self.labels
             .iter()
             .zip(&self.copies)
-            .zip(shaded)
-            .map(|((&label, [before, after]), shaded)| {
+            .zip(invocations.chunks_exact(2).zip(written))
+            .map(|((&label, [before, after]), (invocations, &written))| {
                 let aspect = wgpu::TextureAspect::All;
                 let (before, after) = (
                     read_texture(gpu, before, aspect, self.texel_bytes)?,
@@ -156,8 +196,20 @@ impl FragmentCounter {
                 let covered_px =
                     before.chunks_exact(texel).zip(after.chunks_exact(texel)).filter(|(b, a)| b != a).count()
                         as u64;
-                Ok(PassFragments { label, shaded, covered_px })
+                Ok(PassFragments {
+                    label,
+                    shaded: invocations[0],
+                    prepass_shaded: invocations[1],
+                    written,
+                    covered_px,
+                })
             })
             .collect()
     }
+}
+
+/// Where the samples written of `count` passes start in the resolved buffer: after their 2 ×
+/// `count` invocation counts, at the alignment a query resolve needs.
+fn written_offset(count: u32) -> u64 {
+    (u64::from(2 * count) * 8).next_multiple_of(wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT)
 }

@@ -57,13 +57,14 @@ pub fn compute_pipeline(
 }
 
 /// A render pass drawing over the frame: `colour` loaded (or cleared to `clear`), `depth` loaded
-/// and kept, both stored.
+/// and kept, both stored; its draws may run the `occlusion` queries.
 pub fn frame_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     label: &str,
     colour: &wgpu::TextureView,
     depth: &wgpu::TextureView,
     clear: Option<wgpu::Color>,
+    occlusion: Option<&wgpu::QuerySet>,
 ) -> wgpu::RenderPass<'e> {
     let load = clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear);
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -80,7 +81,7 @@ pub fn frame_pass<'e>(
             stencil_ops: None,
         }),
         timestamp_writes: None,
-        occlusion_query_set: None,
+        occlusion_query_set: occlusion,
         multiview_mask: None,
     })
 }

@@ -128,12 +128,20 @@ pub struct Overdraw {
     pub label: &'static str,
     /// Profiled frames counted.
     pub frames: usize,
-    /// Fragments shaded over those frames, discarded ones included.
+    /// Fragments shaded by the shading draws over those frames, discarded ones included.
     pub shaded: u64,
+    /// Fragments shaded by the depth prepass (alpha tests only) over those frames.
+    pub prepass_shaded: u64,
+    /// Samples the shading draws wrote over those frames (`PassFragments::written`).
+    pub written: u64,
     /// Pixels the pass changed over those frames.
     pub covered_px: u64,
     /// `shaded / covered_px` (`None` when it covered nothing).
     pub fragments_per_covered_px: Option<f64>,
+    /// `prepass_shaded / covered_px`.
+    pub prepass_per_covered_px: Option<f64>,
+    /// `written / covered_px`.
+    pub written_per_covered_px: Option<f64>,
     /// Median fragments shaded per frame.
     pub shaded_median: Option<f64>,
 }
@@ -150,8 +158,12 @@ impl Overdraw {
                         label: pass.label,
                         frames: 0,
                         shaded: 0,
+                        prepass_shaded: 0,
+                        written: 0,
                         covered_px: 0,
                         fragments_per_covered_px: None,
+                        prepass_per_covered_px: None,
+                        written_per_covered_px: None,
                         shaded_median: None,
                     };
                     rows.push((row, Vec::new()));
@@ -161,15 +173,21 @@ impl Overdraw {
             let (row, shaded) = &mut rows[at];
             row.frames += 1;
             row.shaded += pass.shaded;
+            row.prepass_shaded += pass.prepass_shaded;
+            row.written += pass.written;
             row.covered_px += pass.covered_px;
             shaded.push(pass.shaded as f64);
         }
         rows.into_iter()
-            .map(|(row, shaded)| Self {
-                fragments_per_covered_px: (row.covered_px > 0)
-                    .then(|| row.shaded as f64 / row.covered_px as f64),
-                shaded_median: median(&shaded),
-                ..row
+            .map(|(row, shaded)| {
+                let per_px = |n: u64| (row.covered_px > 0).then(|| n as f64 / row.covered_px as f64);
+                Self {
+                    fragments_per_covered_px: per_px(row.shaded),
+                    prepass_per_covered_px: per_px(row.prepass_shaded),
+                    written_per_covered_px: per_px(row.written),
+                    shaded_median: median(&shaded),
+                    ..row
+                }
             })
             .collect()
     }
@@ -372,7 +390,10 @@ mod tests {
     #[test]
     fn overdraw_is_the_profiled_frames_fragments_over_their_covered_pixels() {
         let mut recording = recording();
-        let pass = |shaded, covered_px| vec![PassFragments { label: "draw_seeds", shaded, covered_px }];
+        let pass = |shaded, covered_px| {
+            let (prepass_shaded, written) = (shaded / 2, covered_px + 10);
+            vec![PassFragments { label: "draw_seeds", shaded, prepass_shaded, written, covered_px }]
+        };
         recording.fragments.insert(9, pass(1000, 1));
         recording.fragments.insert(10, pass(300, 100));
         recording.fragments.insert(11, pass(500, 100));
@@ -380,10 +401,11 @@ mod tests {
         let [row] = summary.overdraw.as_slice() else { panic!("{:?}", summary.overdraw) };
         assert_eq!((row.frames, row.shaded, row.covered_px), (2, 800, 200), "frame 9 is a warm-up frame");
         assert_eq!((row.fragments_per_covered_px, row.shaded_median), (Some(4.0), Some(400.0)));
+        assert_eq!((row.prepass_per_covered_px, row.written_per_covered_px), (Some(2.0), Some(1.1)));
         let table = super::super::table::render(&summary);
-        assert!(
-            table.contains("Overdraw draw_seeds") && table.contains("4.00 fragments / covered pixel"),
-            "{table}"
-        );
+        for line in ["Overdraw draw_seeds", "4.00 fragments / covered pixel", "prepass 2.00", "written 1.10"]
+        {
+            assert!(table.contains(line), "{line:?} in {table}");
+        }
     }
 }

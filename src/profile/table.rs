@@ -72,15 +72,17 @@ fn write_table(out: &mut String, s: &Summary) -> std::fmt::Result {
         writeln!(out, "{} {:>10} frames", label("Seed buffer overflowed"), seeds.overflow_frames)?;
     }
     for pass in &s.overdraw {
-        let per_pixel = pass.fragments_per_covered_px.map_or("-".to_owned(), |f| format!("{f:.2}"));
+        let per_px = |f: Option<f64>| f.map_or("-".to_owned(), |f| format!("{f:.2}"));
         writeln!(
             out,
-            "{} {:>10} fragments / covered pixel ({} shaded, {} pixels, {} frames)",
+            "{} {:>10} fragments / covered pixel ({} shaded, {} pixels, {} frames; prepass {}, written {})",
             label(&format!("Overdraw {}", pass.label)),
-            per_pixel,
+            per_px(pass.fragments_per_covered_px),
             pass.shaded,
             pass.covered_px,
-            pass.frames
+            pass.frames,
+            per_px(pass.prepass_per_covered_px),
+            per_px(pass.written_per_covered_px),
         )?;
     }
     match &s.fps {

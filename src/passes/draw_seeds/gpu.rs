@@ -14,6 +14,7 @@ use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{
     DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedShape, SeedVertex,
 };
+use crate::gpu::layout::{SEED_GROUPS, SEED_LODS};
 use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
 use crate::gpu::shaders::{CLOUDS, DITHER, HASH, SEED_RECORD, WIND, WgslSource};
 use crate::gpu::struct_layout::GpuLayout;
@@ -31,7 +32,15 @@ pub mod multisample;
 /// Pass 4's shader.
 pub const SHADER: WgslSource = WgslSource {
     name: "draw_seeds",
-    parts: &[SEED_RECORD, DITHER, HASH, CLOUDS, WIND, include_str!("../../../shaders/draw_seeds.wgsl")],
+    parts: &[
+        SEED_RECORD,
+        DITHER,
+        HASH,
+        CLOUDS,
+        WIND,
+        include_str!("../../../shaders/draw_seeds.wgsl"),
+        include_str!("../../../shaders/draw_seeds/multisample.wgsl"),
+    ],
 };
 
 /// Pass 4's bindings: the frame's constants, pass 3's records through compaction's order, and the
@@ -72,7 +81,7 @@ pub struct DrawSeedsInputs<'a> {
 /// Pass 4b on the GPU: the species' geometry, materials and texture array uploaded and the pipeline
 /// built once in `new`; each frame `prepare` writes the constants and `encode` records the draws.
 pub struct DrawSeedsPass {
-    pipeline: wgpu::RenderPipeline,
+    draw: Draw,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     materials: wgpu::Buffer,
@@ -92,8 +101,52 @@ pub struct DrawSeedsPass {
     tallest_m: Vec<f32>,
     species_drawn: usize,
     species_missing: usize,
-    /// With `draw_seeds.samples` > 1: the multisampled targets and `fs_coverage`'s pipeline.
-    multisample: Option<(Multisample, wgpu::RenderPipeline)>,
+    /// With `draw_seeds.samples` > 1: the multisampled targets and their draw.
+    multisample: Option<(Multisample, Draw)>,
+}
+
+/// The pipelines a frame's draws go through: at once, or after a depth prepass.
+enum Draw {
+    /// Each fragment alpha-tested, shaded and its depth written in one draw.
+    Plain(wgpu::RenderPipeline),
+    /// `depth` writes the depth of what the draws keep (colour writes off); `shade` repeats the
+    /// draws with the depth test `Equal` and no depth write, lighting one fragment per sample.
+    Prepassed { depth: wgpu::RenderPipeline, shade: wgpu::RenderPipeline },
+}
+
+impl Draw {
+    /// The draw at 1 sample per pixel or `SEED_SAMPLES` (`multisample`), with or without a prepass.
+    fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, multisample: bool, prepass: bool) -> Self {
+        let colour = [Some(COLOUR_FORMAT.into())];
+        let no_colour =
+            [Some(wgpu::ColorTargetState { write_mask: wgpu::ColorWrites::empty(), ..COLOUR_FORMAT.into() })];
+        let (state, [plain, depth, shade]) = match multisample {
+            false => (Default::default(), ["fs_main", "fs_depth", "fs_main"]),
+            true => (multisample::state(), ["fs_coverage", "fs_depth_coverage", "fs_shade_samples"]),
+        };
+        let written = DepthTest::Written;
+        if !prepass {
+            return Self::Plain(pipeline(device, layout, plain, &colour, state, written));
+        }
+        Self::Prepassed {
+            depth: pipeline(device, layout, depth, &no_colour, state, written),
+            shade: pipeline(device, layout, shade, &colour, state, DepthTest::EqualToWritten),
+        }
+    }
+
+    /// Whether this draw has a depth prepass.
+    fn prepassed(&self) -> bool {
+        matches!(self, Self::Prepassed { .. })
+    }
+}
+
+/// How a pipeline of the pass tests depth (reversed-Z).
+#[derive(Clone, Copy)]
+enum DepthTest {
+    /// Nearer than or as near as what is there, and written.
+    Written,
+    /// Exactly what the prepass wrote, not written again.
+    EqualToWritten,
 }
 
 impl DrawSeedsPass {
@@ -156,8 +209,7 @@ impl DrawSeedsPass {
             })
         };
         let layout = BINDINGS.layout(device);
-        let pipeline =
-            pipeline(device, &layout, "fs_main", &[Some(COLOUR_FORMAT.into())], Default::default());
+        let draw = Draw::new(device, &layout, false, false);
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
         let shapes: Vec<SeedShape> = (built.inv_model_height_m.iter().enumerate())
             .map(|(i, &inv_model_height_m)| SeedShape {
@@ -168,7 +220,7 @@ impl DrawSeedsPass {
             })
             .collect();
         Ok(Self {
-            pipeline,
+            draw,
             layout,
             uniforms: buffer(
                 device,
@@ -194,6 +246,12 @@ impl DrawSeedsPass {
         })
     }
 
+    /// The same pass with a depth prepass (`draw_seeds.depth_prepass`; before `multisampled`).
+    pub fn with_depth_prepass(mut self, device: &wgpu::Device) -> Self {
+        self.draw = Draw::new(device, &self.layout, false, true);
+        self
+    }
+
     /// The same pass drawing multisampled (`draw_seeds.samples` = `SEED_SAMPLES`) over the frame's
     /// `colour` and the terrain's `depth`, resolving into `colour` (`multisample`).
     pub fn multisampled(
@@ -202,9 +260,8 @@ impl DrawSeedsPass {
         colour: &wgpu::Texture,
         depth: &wgpu::Texture,
     ) -> Self {
-        let targets = [Some(COLOUR_FORMAT.into())];
-        let coverage = pipeline(device, &self.layout, "fs_coverage", &targets, multisample::state());
-        self.multisample = Some((Multisample::new(device, colour, depth), coverage));
+        let draw = Draw::new(device, &self.layout, true, self.draw.prepassed());
+        self.multisample = Some((Multisample::new(device, colour, depth), draw));
         self
     }
 
@@ -258,7 +315,7 @@ impl DrawSeedsPass {
     /// fragment's colour and its seed's id (`SEED_ID_FORMAT`).
     pub fn truth_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         let targets = [Some(COLOUR_FORMAT.into()), Some(SEED_ID_FORMAT.into())];
-        pipeline(device, &self.layout, "fs_truth", &targets, Default::default())
+        pipeline(device, &self.layout, "fs_truth", &targets, Default::default(), DepthTest::Written)
     }
 
     /// Species `species`'s full mesh (its LOD 0 geometry), or `None` when its model has none
@@ -309,36 +366,60 @@ impl DrawSeedsPass {
             }
             return;
         }
-        if let Some((targets, pipeline)) = &self.multisample {
-            targets.encode(encoder, |pass| self.record(pass, pipeline, bind_group, draw_args, count));
+        let occlusion = count.map(CountedPass::occlusion_set);
+        if let Some((targets, draw)) = &self.multisample {
+            targets.encode(encoder, occlusion, |pass| self.record(pass, draw, bind_group, draw_args, count));
             return;
         }
-        let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None);
-        self.record(&mut pass, &self.pipeline, bind_group, draw_args, count);
+        let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None, occlusion);
+        self.record(&mut pass, &self.draw, bind_group, draw_args, count);
     }
 
-    /// Every group's indirect draws with `pipeline`.
+    /// Every group's indirect draws through `draw`'s pipelines.
     fn record(
         &self,
         pass: &mut wgpu::RenderPass,
-        pipeline: &wgpu::RenderPipeline,
+        draw: &Draw,
         bind_group: &wgpu::BindGroup,
         draw_args: &wgpu::Buffer,
         count: Option<CountedPass<'_>>,
     ) {
-        count.inspect(|c| c.begin(pass));
-        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        let stride = size_of::<SeedDrawArgs>() as u64;
-        for (draw, template) in self.templates.iter().enumerate() {
-            if template.index_count > 0 {
+        let draws = |pass: &mut wgpu::RenderPass, pipeline| {
+            pass.set_pipeline(pipeline);
+            let stride = size_of::<SeedDrawArgs>() as u64;
+            for draw in near_to_far_draws().filter(|&d| self.templates[d].index_count > 0) {
                 pass.draw_indexed_indirect(draw_args, draw as u64 * stride);
             }
-        }
+        };
+        let shade = match draw {
+            Draw::Plain(shade) => shade,
+            Draw::Prepassed { depth, shade } => {
+                count.inspect(|c| c.begin_prepass(pass));
+                draws(pass, depth);
+                count.inspect(|c| c.end_prepass(pass));
+                shade
+            }
+        };
+        count.inspect(|c| c.begin(pass));
+        draws(pass, shade);
         count.inspect(|c| c.end(pass));
     }
+}
+
+/// The draws (`SEED_DRAWS`) nearest first: LOD by LOD, each LOD's own draws of every species, then
+/// their cross-fades into the next (seeds at that LOD's reach); each draw is near to far within
+/// (pass 3 checks its cells nearest first). Nearer crowns' depth then hides what is behind them
+/// before it is shaded.
+pub(super) fn near_to_far_draws() -> impl Iterator<Item = usize> {
+    let (groups, lods) = (SEED_GROUPS as usize, SEED_LODS as usize);
+    let species = groups / lods;
+    (0..lods).flat_map(move |lod| {
+        let own = (0..species).map(move |s| s * lods + lod);
+        own.clone().chain(own.map(move |g| groups + g))
+    })
 }
 
 fn pipeline(
@@ -347,7 +428,12 @@ fn pipeline(
     fragment: &str,
     targets: &[Option<wgpu::ColorTargetState>],
     multisample: wgpu::MultisampleState,
+    depth_test: DepthTest,
 ) -> wgpu::RenderPipeline {
+    let (depth_write_enabled, depth_compare) = match depth_test {
+        DepthTest::Written => (true, wgpu::CompareFunction::GreaterEqual),
+        DepthTest::EqualToWritten => (false, wgpu::CompareFunction::Equal),
+    };
     let module = SHADER.module(device);
     let pipeline_layout = pipeline_layout(device, "draw_seeds", &[layout]);
     let attributes = SeedVertex::layout().vertex_attributes();
@@ -374,8 +460,8 @@ fn pipeline(
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
+            depth_write_enabled: Some(depth_write_enabled),
+            depth_compare: Some(depth_compare),
             stencil: Default::default(),
             bias: Default::default(),
         }),

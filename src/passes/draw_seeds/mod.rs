@@ -7,16 +7,21 @@
 //!
 //! Each frame `encode` records two `draw_indexed_indirect`s per group from compaction's argument
 //! buffer (an empty group costs nothing): its own, and the same instances with the next LOD's
-//! geometry. `shaders/draw_seeds.wgsl` reads an instance's record through compaction's `order`,
-//! scales the model to the seed's height, turns it by the seed's jitter, places it camera-relative
-//! and projects it with the terrain's matrix; it draws into the colour target with the terrain
+//! geometry; LOD by LOD, and each draw's instances near to far (pass 3 checks its cells nearest
+//! first and compaction keeps that order), so nearer crowns' depth hides what is behind them early.
+//! With `draw_seeds.depth_prepass` every draw is first made writing depth alone (`fs_depth`: the
+//! alpha test and dithers), then again testing depth for equality, so only the fragment a pixel
+//! shows is lit; the pixels are the same either way. `shaders/draw_seeds.wgsl` reads an
+//! instance's record through compaction's `order`, scales the model to the seed's height, turns it
+//! by the seed's jitter, places it camera-relative and projects it with the terrain's matrix; it draws into the colour target with the terrain
 //! depth (reversed-Z, `GreaterEqual`, depth written). A seed in the outer `seeds.fade_fraction`
 //! of its LOD's reach cross-fades: its own geometry keeps the pixels whose (per-seed shifted)
 //! Bayer threshold is below the fade, the next LOD's geometry the others, so each pixel shows
 //! exactly one of the two and nothing pops; outside the band the cross-fade draw collapses its
 //! vertices. The last LOD fades out to nothing at the visibility radius. With `draw_seeds.samples`
-//! at 4 the groups are drawn multisampled instead, each fragment covering as many of its pixel's
-//! samples as its alpha says, and resolved into the frame (`gpu::multisample`).
+//! at 4 the groups are drawn multisampled instead (`shaders/draw_seeds/multisample.wgsl`), each
+//! fragment covering as many of its pixel's samples as its alpha says, and resolved into the frame
+//! (`gpu::multisample`).
 //!
 //! `frame` (the frame's constants, the impostors loaded from a folder) and `assets` (their layout
 //! for one upload) are the CPU half; `gpu` the pipeline, binding table, uploads and draws.

@@ -282,3 +282,15 @@ fn slicings_take_lod_1_with_the_trunk_for_the_species_that_may_and_others_keep_t
     // A cross-fade from the mesh draws the slicings as LOD 1.
     assert_eq!(t[SEED_GROUPS as usize], t[1]);
 }
+
+#[test]
+fn the_draws_go_lod_by_lod_each_draw_once_cross_fades_after_their_lod() {
+    let order: Vec<usize> = super::gpu::near_to_far_draws().collect();
+    let mut sorted = order.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, (0..SEED_DRAWS as usize).collect::<Vec<_>>(), "not every draw once");
+    let (groups, lods) = (SEED_GROUPS as usize, SEED_LODS as usize);
+    // A draw's place: its group's LOD, then own draws before cross-fades.
+    let place = |d: usize| ((d % groups) % lods, d / groups);
+    assert!(order.windows(2).all(|w| place(w[0]) <= place(w[1])), "{order:?}");
+}

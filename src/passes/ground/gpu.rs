@@ -78,7 +78,8 @@ impl GroundPass {
         sky_linear: [f64; 3],
     ) {
         let [r, g, b] = sky_linear;
-        let mut pass = frame_pass(encoder, "ground", colour, depth, Some(wgpu::Color { r, g, b, a: 1.0 }));
+        let mut pass =
+            frame_pass(encoder, "ground", colour, depth, Some(wgpu::Color { r, g, b, a: 1.0 }), None);
         pass.set_pipeline(&self.pipeline);
         mesh.draw(&mut pass);
     }

@@ -35,8 +35,8 @@ pub struct SeedInputs<'a> {
     pub camera_grid_m: DVec3,
     /// The depth target's size, pixels.
     pub viewport_px: [u32; 2],
-    /// The TLM's visible ring-0 cells in its order (`LoadMaps::seed_cells`); the farthest are dropped
-    /// beyond `seeds::max_cells`.
+    /// The TLM's visible ring-0 cells (`LoadMaps::seed_cells`), in any order: they are checked
+    /// near to far, and the farthest are dropped beyond `seeds::max_cells`.
     pub cells: &'a [SeedCellRef],
     /// Ranks worth checking (`SeedTables::active_ranks`).
     pub active_ranks: u32,
@@ -47,9 +47,10 @@ pub struct SeedInputs<'a> {
 pub struct SeedFrame {
     /// The frame's constants, lengths pre-divided into each layer's texels.
     pub uniforms: SeedUniforms,
-    /// The cells kept, each corner as integer texels and a remainder in every layer's grid.
+    /// The cells kept, near to far, each corner as integer texels and a remainder in every layer's
+    /// grid.
     pub cells: Vec<SeedCell>,
-    /// Cells beyond `seeds::max_cells` (the farthest in the TLM's order) that were left out.
+    /// Cells beyond `seeds::max_cells` (the farthest) that were left out.
     pub cells_dropped: usize,
 }
 
@@ -77,6 +78,21 @@ impl SeedOutput {
             .copied()
             .collect()
     }
+}
+
+/// `cells` nearest first, by the distance from `camera_xy` to their centres (`cell_m` wide), ties
+/// by address: pass 3's workgroups walk them in this order, its block table keeps it, and
+/// compaction keeps the table's order within each draw, so every draw comes near to far and a
+/// nearer crown's depth hides the fragments behind it before they are shaded. Deterministic, and
+/// the cells dropped beyond `seeds::max_cells` are the farthest.
+fn near_to_far(cells: &[SeedCellRef], camera_xy: [f64; 2], cell_m: f64) -> Vec<SeedCellRef> {
+    let distance_sq = |c: &SeedCellRef| {
+        let centre = c.address.map(|g| (g as f64 + 0.5) * cell_m);
+        (centre[0] - camera_xy[0]).powi(2) + (centre[1] - camera_xy[1]).powi(2)
+    };
+    let mut sorted: Vec<(f64, SeedCellRef)> = cells.iter().map(|c| (distance_sq(c), *c)).collect();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    sorted.into_iter().map(|(_, c)| c).collect()
 }
 
 /// `value` (≥ 0 or not) as an integer part and a remainder in [0, 1) that f32 can carry.
@@ -171,7 +187,7 @@ impl SeedFrame {
         let (cx, cy) = (split(camera_xy[0] / spacing_m), split(camera_xy[1] / spacing_m));
         (u.camera_sample, u.camera_sample_frac) = ([cx.0, cy.0], [cx.1, cy.1]);
         let kept = inputs.cells.len().min(max_cells(u.active_ranks) as usize);
-        let cells = inputs.cells[..kept]
+        let cells = near_to_far(inputs.cells, camera_xy, cell_m)[..kept]
             .iter()
             .map(|c| {
                 let corner = c.address.map(|g| g as f64 * cell_m);

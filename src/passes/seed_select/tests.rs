@@ -14,9 +14,10 @@ use crate::dataset::{Dataset, Pyramid};
 use crate::seeds::SeedTables;
 use crate::synth::{SynthParams, synthesize};
 
-/// A small synthetic dataset far from the CRS origin (large coordinates are where rounding bites).
-fn dataset() -> Dataset {
-    let dir = std::env::temp_dir().join(format!("terramp-seed-inputs-{}", std::process::id()));
+/// A small synthetic dataset far from the CRS origin (large coordinates are where rounding bites),
+/// in a folder of its own for test `test` (tests run in parallel).
+fn dataset(test: &str) -> Dataset {
+    let dir = std::env::temp_dir().join(format!("terramp-seed-inputs-{test}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let params =
         SynthParams { size: 300, seed: 3, origin_m: [512_345.5, 4_012_345.25], ..Default::default() };
@@ -39,34 +40,47 @@ fn first_entries(pyramid: &Pyramid) -> Vec<u32> {
         .collect()
 }
 
-#[test]
-fn uniforms_and_cells_equal_an_independent_derivation() {
-    let dataset = dataset();
-    let m = &dataset.manifest;
-    let settings = Settings::default();
-    let camera_grid_m = DVec3::new(1234.5, 987.25, 600.0);
+/// Pass 3's frame of `cells` for a camera at `camera_grid_m` (grid space), looking 30° east of
+/// north and 10° down, over a 640 × 360 view.
+fn seed_frame(
+    settings: &Settings,
+    dataset: &Dataset,
+    camera_grid_m: DVec3,
+    cells: &[SeedCellRef],
+    active_ranks: u32,
+) -> SeedFrame {
+    let origin_m = dataset.manifest.origin_m;
     let camera = Camera {
-        position_m: DVec3::new(m.origin_m[0], m.origin_m[1], 0.0) + camera_grid_m,
+        position_m: DVec3::new(origin_m[0], origin_m[1], 0.0) + camera_grid_m,
         yaw_deg: 30.0,
         pitch_deg: -10.0,
         fov_deg: 60.0,
         near_m: 0.1,
     };
+    let inputs = SeedInputs {
+        settings,
+        dataset,
+        camera: &camera,
+        camera_grid_m,
+        viewport_px: [640, 360],
+        cells,
+        active_ranks,
+    };
+    SeedFrame::new(&inputs).unwrap()
+}
+
+#[test]
+fn uniforms_and_cells_equal_an_independent_derivation() {
+    let dataset = dataset("uniforms");
+    let m = &dataset.manifest;
+    let settings = Settings::default();
+    let camera_grid_m = DVec3::new(1234.5, 987.25, 600.0);
     let cells = [
         SeedCellRef { address: [0, 0], pattern: 3, radial_lod: 0 },
         SeedCellRef { address: [4, 3], pattern: 15, radial_lod: 2 },
         SeedCellRef { address: [-1, 7], pattern: 0, radial_lod: 3 },
     ];
-    let inputs = SeedInputs {
-        settings: &settings,
-        dataset: &dataset,
-        camera: &camera,
-        camera_grid_m,
-        viewport_px: [640, 360],
-        cells: &cells,
-        active_ranks: 1000,
-    };
-    let frame = SeedFrame::new(&inputs).unwrap();
+    let frame = seed_frame(&settings, &dataset, camera_grid_m, &cells, 1000);
     let u = &frame.uniforms;
     let spacing_m = m.height.spacing_m;
     let cell_m = settings.tlm.cell_m;
@@ -112,7 +126,8 @@ fn uniforms_and_cells_equal_an_independent_derivation() {
     }
 
     assert_eq!((frame.cells.len(), frame.cells_dropped), (3, 0));
-    for (c, reference) in frame.cells.iter().zip(&cells) {
+    // Near to far: the centres of [4, 3], [0, 0] and [-1, 7] are 123 m, 1.40 km and 1.65 km away.
+    for (c, reference) in frame.cells.iter().zip([&cells[1], &cells[0], &cells[2]]) {
         let corner = reference.address.map(|g| g as f64 * cell_m);
         let what = format!("cell {:?}", reference.address);
         for a in 0..2 {
@@ -132,6 +147,33 @@ fn uniforms_and_cells_equal_an_independent_derivation() {
         assert_eq!(c.address, reference.address.map(|g| g as i32));
         assert_eq!((c.pattern, c.lcc_level), (reference.pattern, reference.radial_lod.min(2)), "{what}");
     }
+}
+
+#[test]
+fn cells_are_checked_near_to_far_and_the_farthest_are_dropped() {
+    let dataset = dataset("near-to-far");
+    let settings = Settings::default();
+    let cell_m = settings.tlm.cell_m;
+    let camera_grid_m = DVec3::new(10.0 * cell_m, 0.0, 600.0);
+    let ranks = settings.seeds.seeds_per_pattern;
+    let kept = crate::seeds::max_cells(ranks) as i64;
+    // A row of cells west and east of the camera's, in an order unlike the distance's, and cells
+    // at equal distances (x = 9 and 10: their centres lie 0.5 cell either side of the camera).
+    let cells: Vec<SeedCellRef> = (0..kept + 5)
+        .map(|i| (i * 7919) % (kept + 5) - 4)
+        .map(|x| SeedCellRef { address: [x, 0], pattern: x.rem_euclid(16) as u32, radial_lod: 0 })
+        .collect();
+    let frame = seed_frame(&settings, &dataset, camera_grid_m, &cells, ranks);
+    assert_eq!((frame.cells.len() as i64, frame.cells_dropped), (kept, 5));
+    let distance = |c: &crate::gpu::gpu_types::SeedCell| (f64::from(c.address[0]) + 0.5 - 10.0).abs();
+    for pair in frame.cells.windows(2) {
+        let (a, b) = (distance(&pair[0]), distance(&pair[1]));
+        assert!(a < b || (a == b && pair[0].address < pair[1].address), "{:?} before {:?}", pair[0], pair[1]);
+    }
+    assert_eq!(frame.cells[..2].iter().map(|c| c.address[0]).collect::<Vec<_>>(), [9, 10]);
+    // The dropped five are the farthest: the row's east end.
+    let farthest_kept = frame.cells.iter().map(|c| c.address[0]).max().unwrap();
+    assert_eq!(i64::from(farthest_kept), kept - 5, "{:?}", frame.cells.last());
 }
 
 const TABLE: &str = r#"

@@ -220,7 +220,8 @@ impl TexcellsPass {
         prepared: PreparedTexcells,
         count: Option<CountedPass<'_>>,
     ) {
-        let mut pass = frame_pass(encoder, "texcells", colour, depth, None);
+        let mut pass =
+            frame_pass(encoder, "texcells", colour, depth, None, count.map(CountedPass::occlusion_set));
         count.inspect(|c| c.begin(&mut pass));
         if prepared.instances > 0 {
             pass.set_pipeline(&self.pipeline);

@@ -128,8 +128,14 @@ impl Multisample {
     }
 
     /// Records the copy of the frame's colour, then one render pass that fills the samples,
-    /// lets `draw` record the seeds into them and resolves them into the frame's colour.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, draw: impl FnOnce(&mut wgpu::RenderPass)) {
+    /// lets `draw` record the seeds into them (its draws may run the `occlusion` queries) and
+    /// resolves them into the frame's colour.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        occlusion: Option<&wgpu::QuerySet>,
+        draw: impl FnOnce(&mut wgpu::RenderPass),
+    ) {
         encoder.copy_texture_to_texture(
             self.frame_colour.as_image_copy(),
             self.ground.as_image_copy(),
@@ -157,7 +163,7 @@ impl Multisample {
                 stencil_ops: None,
             }),
             timestamp_writes: None,
-            occlusion_query_set: None,
+            occlusion_query_set: occlusion,
             multiview_mask: None,
         });
         pass.set_pipeline(&self.fill);
