@@ -72,6 +72,7 @@ fn draw_seeds_counts_its_fragments_and_exactly_the_pixels_it_changes() {
     assert!(changed > 500, "only {changed} pixels show trees: a weak test");
     assert_eq!(seeds.covered_px, changed, "covered pixels against the frame's difference from the ground");
     assert!(seeds.shaded >= seeds.covered_px, "{seeds:?}: fewer fragments than pixels covered");
+    assert!(seeds.vertices > 0 && seeds.triangles > 0, "{seeds:?}");
 
     let (_, sky) = frame(&dir, settings(impostors, true), at_the_sky);
     assert_eq!(
@@ -212,8 +213,10 @@ fn count_triangle(size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u64) {
     counter.resolve(&mut encoder);
     gpu.queue.submit([encoder.finish()]);
     let [counted] = counter.read(&gpu).unwrap()[..] else { panic!("one pass counted") };
-    // Nothing tests depth or discards: every pixel covered is written, once.
+    // Nothing tests depth or discards: every pixel covered is written, once; one triangle of 3
+    // vertices (a fan of a few, where the clipper cuts it at the screen's edge).
     assert_eq!((counted.written, counted.prepass_shaded), (counted.covered_px, 0), "{counted:?}");
+    assert!(counted.vertices >= 3 && (1..=4).contains(&counted.triangles), "{counted:?}");
     (counted.shaded, counted.covered_px)
 }
 

@@ -16,6 +16,10 @@
 //! counts as much as a shaded one. Hardware GPUs shade 2 × 2 quads and count the covered fragments
 //! that pass their early tests, helper lanes not included.
 //!
+//! The same query counts the vertex shader's invocations and the triangles the clipper passes on:
+//! fragments per triangle tell a pass of small triangles (llvmpipe: about a block, 16 lanes, each)
+//! from one of large, overlapping ones.
+//!
 //! Two more figures do not depend on the adapter. An occlusion query over the same draws counts
 //! the samples that passed the depth test and were not discarded: those written, overwritten ones
 //! included, a lower bound of the fragments shaded in any order. A pass with a depth prepass
@@ -27,6 +31,14 @@ use super::readback::{read_buffer, read_texture};
 use super::resources::frame_pass;
 use super::{Gpu, GpuError};
 
+/// What each pipeline-statistics query counts: its results come in the flags' bit order.
+const STATISTICS: wgpu::PipelineStatisticsTypes = wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS
+    .union(wgpu::PipelineStatisticsTypes::CLIPPER_PRIMITIVES_OUT)
+    .union(wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS);
+
+/// Results per pipeline-statistics query (`STATISTICS`' flags).
+const STATISTICS_PER_QUERY: usize = 3;
+
 /// What one counted pass did in one frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct PassFragments {
@@ -36,6 +48,11 @@ pub struct PassFragments {
     pub shaded: u64,
     /// Fragment shader invocations of the depth prepass (0 without one): alpha tests, no lighting.
     pub prepass_shaded: u64,
+    /// Vertex shader invocations of the shading draws (the prepass runs as many again).
+    pub vertices: u64,
+    /// Triangles the shading draws sent to the rasteriser (after clipping; those whose vertices
+    /// a draw collapsed out of the view are not among them).
+    pub triangles: u64,
     /// Samples of the shading draws that passed the depth test and were not discarded.
     pub written: u64,
     /// Pixels whose colour the pass changed.
@@ -119,11 +136,10 @@ impl FragmentCounter {
         let query_set = |label, ty, count| {
             gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some(label), ty, count })
         };
-        let invocations =
-            wgpu::QueryType::PipelineStatistics(wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS);
-        let queries = query_set("fragments shaded", invocations, 2 * count);
+        let queries =
+            query_set("fragments shaded", wgpu::QueryType::PipelineStatistics(STATISTICS), 2 * count);
         let occlusion = query_set("samples written", wgpu::QueryType::Occlusion, count);
-        // The invocations' 2 × count results, then the samples written.
+        // The statistics of 2 × count queries, then the samples written.
         let resolved = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("fragments shaded"),
             size: written_offset(count) + u64::from(count) * 8,
@@ -181,13 +197,16 @@ impl FragmentCounter {
         let offset = written_offset(count as u32);
         let results: Vec<u64> =
             bytemuck::pod_collect_to_vec(&read_buffer(gpu, &self.resolved, offset + count as u64 * 8)?);
-        let (invocations, written) = (&results[..2 * count], &results[offset as usize / 8..]);
+        let statistics = &results[..2 * count * STATISTICS_PER_QUERY];
+        let written = &results[offset as usize / 8..];
         let texel = self.texel_bytes as usize;
         self.labels
             .iter()
             .zip(&self.copies)
-            .zip(invocations.chunks_exact(2).zip(written))
-            .map(|((&label, [before, after]), (invocations, &written))| {
+            .zip(statistics.chunks_exact(2 * STATISTICS_PER_QUERY).zip(written))
+            .map(|((&label, [before, after]), (statistics, &written))| {
+                // Per query, in the flags' order: vertices, triangles, fragments.
+                let (shading, prepass) = statistics.split_at(STATISTICS_PER_QUERY);
                 let aspect = wgpu::TextureAspect::All;
                 let (before, after) = (
                     read_texture(gpu, before, aspect, self.texel_bytes)?,
@@ -198,8 +217,10 @@ impl FragmentCounter {
                         as u64;
                 Ok(PassFragments {
                     label,
-                    shaded: invocations[0],
-                    prepass_shaded: invocations[1],
+                    shaded: shading[2],
+                    prepass_shaded: prepass[2],
+                    vertices: shading[0],
+                    triangles: shading[1],
                     written,
                     covered_px,
                 })
@@ -211,5 +232,6 @@ impl FragmentCounter {
 /// Where the samples written of `count` passes start in the resolved buffer: after their 2 ×
 /// `count` invocation counts, at the alignment a query resolve needs.
 fn written_offset(count: u32) -> u64 {
-    (u64::from(2 * count) * 8).next_multiple_of(wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT)
+    (u64::from(2 * count) * 8 * STATISTICS_PER_QUERY as u64)
+        .next_multiple_of(wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT)
 }

@@ -134,6 +134,10 @@ pub struct Overdraw {
     pub prepass_shaded: u64,
     /// Samples the shading draws wrote over those frames (`PassFragments::written`).
     pub written: u64,
+    /// Vertex shader invocations of the shading draws over those frames.
+    pub vertices: u64,
+    /// Triangles the shading draws rasterised over those frames.
+    pub triangles: u64,
     /// Pixels the pass changed over those frames.
     pub covered_px: u64,
     /// `shaded / covered_px` (`None` when it covered nothing).
@@ -142,6 +146,8 @@ pub struct Overdraw {
     pub prepass_per_covered_px: Option<f64>,
     /// `written / covered_px`.
     pub written_per_covered_px: Option<f64>,
+    /// `triangles / covered_px`.
+    pub triangles_per_covered_px: Option<f64>,
     /// Median fragments shaded per frame.
     pub shaded_median: Option<f64>,
 }
@@ -160,10 +166,13 @@ impl Overdraw {
                         shaded: 0,
                         prepass_shaded: 0,
                         written: 0,
+                        vertices: 0,
+                        triangles: 0,
                         covered_px: 0,
                         fragments_per_covered_px: None,
                         prepass_per_covered_px: None,
                         written_per_covered_px: None,
+                        triangles_per_covered_px: None,
                         shaded_median: None,
                     };
                     rows.push((row, Vec::new()));
@@ -175,6 +184,8 @@ impl Overdraw {
             row.shaded += pass.shaded;
             row.prepass_shaded += pass.prepass_shaded;
             row.written += pass.written;
+            row.vertices += pass.vertices;
+            row.triangles += pass.triangles;
             row.covered_px += pass.covered_px;
             shaded.push(pass.shaded as f64);
         }
@@ -185,6 +196,7 @@ impl Overdraw {
                     fragments_per_covered_px: per_px(row.shaded),
                     prepass_per_covered_px: per_px(row.prepass_shaded),
                     written_per_covered_px: per_px(row.written),
+                    triangles_per_covered_px: per_px(row.triangles),
                     shaded_median: median(&shaded),
                     ..row
                 }
@@ -391,8 +403,17 @@ mod tests {
     fn overdraw_is_the_profiled_frames_fragments_over_their_covered_pixels() {
         let mut recording = recording();
         let pass = |shaded, covered_px| {
-            let (prepass_shaded, written) = (shaded / 2, covered_px + 10);
-            vec![PassFragments { label: "draw_seeds", shaded, prepass_shaded, written, covered_px }]
+            let (prepass_shaded, written, vertices, triangles) =
+                (shaded / 2, covered_px + 10, 7, covered_px / 4);
+            vec![PassFragments {
+                label: "draw_seeds",
+                shaded,
+                prepass_shaded,
+                vertices,
+                triangles,
+                written,
+                covered_px,
+            }]
         };
         recording.fragments.insert(9, pass(1000, 1));
         recording.fragments.insert(10, pass(300, 100));
@@ -402,9 +423,16 @@ mod tests {
         assert_eq!((row.frames, row.shaded, row.covered_px), (2, 800, 200), "frame 9 is a warm-up frame");
         assert_eq!((row.fragments_per_covered_px, row.shaded_median), (Some(4.0), Some(400.0)));
         assert_eq!((row.prepass_per_covered_px, row.written_per_covered_px), (Some(2.0), Some(1.1)));
+        assert_eq!((row.vertices, row.triangles, row.triangles_per_covered_px), (14, 50, Some(0.25)));
         let table = super::super::table::render(&summary);
-        for line in ["Overdraw draw_seeds", "4.00 fragments / covered pixel", "prepass 2.00", "written 1.10"]
-        {
+        let lines = [
+            "Overdraw draw_seeds",
+            "4.00 fragments / covered pixel",
+            "prepass 2.00",
+            "written 1.10",
+            "triangles 0.25",
+        ];
+        for line in lines {
             assert!(table.contains(line), "{line:?} in {table}");
         }
     }

@@ -75,7 +75,7 @@ fn write_table(out: &mut String, s: &Summary) -> std::fmt::Result {
         let per_px = |f: Option<f64>| f.map_or("-".to_owned(), |f| format!("{f:.2}"));
         writeln!(
             out,
-            "{} {:>10} fragments / covered pixel ({} shaded, {} pixels, {} frames; prepass {}, written {})",
+            "{} {:>10} fragments / covered pixel ({} shaded, {} pixels, {} frames; prepass {}, written {}, triangles {})",
             label(&format!("Overdraw {}", pass.label)),
             per_px(pass.fragments_per_covered_px),
             pass.shaded,
@@ -83,6 +83,7 @@ fn write_table(out: &mut String, s: &Summary) -> std::fmt::Result {
             pass.frames,
             per_px(pass.prepass_per_covered_px),
             per_px(pass.written_per_covered_px),
+            per_px(pass.triangles_per_covered_px),
         )?;
     }
     match &s.fps {
