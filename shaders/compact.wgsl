@@ -55,12 +55,15 @@ fn key_at(index: u32) -> u32 {
 }
 
 // Lane `lane`'s block of chunk `chunk` (empty beyond the table), its records counted per group
-// into row `lane` of `wg_rows`.
+// into row `lane` of `wg_rows`. Called by every lane, in uniform control flow.
 fn count_row(chunk: u32, lane: u32) -> SeedBlock {
-    let row = lane * SEED_GROUPS;
-    for (var g = 0u; g < SEED_GROUPS; g += 1u) {
-        wg_rows[row + g] = 0u;
+    // The lanes clear the table together, neighbouring lanes neighbouring words, which a SIMD
+    // group of lanes stores at once (a row per lane would be a scatter).
+    for (var i = lane; i < COMPACT_CHUNK * SEED_GROUPS; i += COMPACT_CHUNK) {
+        wg_rows[i] = 0u;
     }
+    workgroupBarrier();
+    let row = lane * SEED_GROUPS;
     let w = chunk * COMPACT_CHUNK + lane;
     var block = SeedBlock(0u, 0u);
     if w < params.blocks {
