@@ -21,6 +21,7 @@ use crate::gpu::layout::{TEXCELL_MAX_SAMPLES, TEXCELL_MAX_SLICES};
 use crate::passes::terrain::frame::NodeBatches;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
 use crate::passes::texcells::TexcellsError;
+use crate::passes::texcells::dense::DenseCover;
 use crate::passes::texcells::frame::{
     Band, SampleShape, Silhouettes, SliceRule, landcover_tiles, place, records, texcell_uniforms,
 };
@@ -50,6 +51,8 @@ pub struct TexcellReport {
     pub silhouettes: usize,
     /// Farthest patches left out because the frame's instances were full.
     pub patches_dropped: usize,
+    /// Patches left out because no class with a forest sample lies under them (`DenseCover`).
+    pub patches_bare: usize,
 }
 
 pub(super) struct TexcellStage {
@@ -64,6 +67,8 @@ pub(super) struct TexcellStage {
     prepared: PreparedTexcells,
     /// The land-cover tiles under the last frame's patches.
     pub wanted_landcover: Vec<TileId>,
+    /// Where the land cover holds forest: patches elsewhere are not drawn.
+    dense: Option<DenseCover>,
 }
 
 impl TexcellStage {
@@ -155,6 +160,7 @@ impl TexcellStage {
             finest_level: finest.ilog2(),
             prepared: PreparedTexcells::default(),
             wanted_landcover: Vec::new(),
+            dense: DenseCover::new(dataset, &sample_of_class),
         };
         Ok((Some(stage), unbaked))
     }
@@ -185,7 +191,7 @@ impl TexcellStage {
             finest_level: self.finest_level,
         };
         let silhouettes = Silhouettes::of(settings);
-        let patches = place(
+        let mut patches = place(
             batches,
             |q, i| nodes.instance(q, i),
             camera_grid_m,
@@ -193,6 +199,14 @@ impl TexcellStage {
             &rule,
             silhouettes.as_ref(),
         );
+        // A silhouette's rays run through the slab beyond its patch's footprint: it is always drawn.
+        let placed = patches.len();
+        if let Some(dense) = self.dense.as_mut() {
+            patches.retain(|p| {
+                let (min_m, max_m) = (p.bounds.min_m, p.bounds.max_m);
+                p.kinds.silhouette || dense.any_dense(dataset, [min_m.x, min_m.y], [max_m.x, max_m.y])
+            });
+        }
         let (records, dropped) = records(&patches, self.finest_level, camera_grid_m.z, shape.slab_m);
         self.wanted_landcover = landcover_tiles(dataset, &patches);
         self.prepared = self.pass.prepare(&gpu.queue, &records);
@@ -202,6 +216,7 @@ impl TexcellStage {
             slices: records.len() - silhouettes,
             silhouettes,
             patches_dropped: dropped,
+            patches_bare: placed - patches.len(),
         }
     }
 

@@ -2,7 +2,9 @@
 //! Dense land-cover classes have a baked forest sample (`crate::texcell`): horizontal slices of a
 //! wrapping square of trees, a slice pyramid of fewer, aggregated slices, mips. Each frame the CPU
 //! (`frame`) picks the terrain node quadrants the frame draws that reach into the texcell band, far
-//! to near, and a slice pyramid level for each from its distance; every slice of every such patch is
+//! to near, leaves out those with no forest class near them (`dense`: a silhouette's rays reach
+//! beyond its quadrant, so a quadrant that draws one stays), and a slice pyramid level for each
+//! from its distance; every slice of every such patch is
 //! one instance of the quadrant's grid, lifted off the ground it follows, drawn far patch first and
 //! within a patch the slice farthest from the eye's height first. The shader
 //! (`shaders/texcells.wgsl`, `gpu`) shows forest only where the land cover under a fragment is a
@@ -14,6 +16,7 @@
 //! their ray through the samples' 3D texture (the paper's silhouette texcells), the two kinds
 //! sharing the patch's pixels by a dither on each ray's angle below the horizon.
 
+pub mod dense;
 pub mod frame;
 pub mod gpu;
 
