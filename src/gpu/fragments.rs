@@ -11,8 +11,8 @@
 //! What an invocation is belongs to the adapter. Mesa's llvmpipe (lavapipe) runs the shader on
 //! whole 4 × 4 blocks and counts 16 for each block it runs, whatever part of it the triangle
 //! covers: the lanes it pays for, an upper bound of the fragments (`tests/overdraw.rs`: a
-//! full-screen triangle, clipped into two, counts each pixel once and the blocks along their shared
-//! edge twice). It counts them before its early depth test, so a fragment hidden by a nearer one
+//! full-screen triangle, which its clipper cuts at the screen's edge into a fan of three, counts
+//! each pixel once and the blocks along the shared edges twice). It counts them before its early depth test, so a fragment hidden by a nearer one
 //! counts as much as a shaded one. Hardware GPUs shade 2 × 2 quads and count the covered fragments
 //! that pass their early tests, helper lanes not included.
 //!
