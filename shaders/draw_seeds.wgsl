@@ -385,10 +385,16 @@ fn faded_out(in: VertexOut) -> bool {
 // The fragment's lit, hazed colour, or discarded (alpha test, dither).
 fn shade(in: VertexOut) -> vec4<f32> {
     let s = surface(in);
-    if s.alpha < materials[in.material].alpha_cutoff || faded_out(in) {
+    if cut_out(in, s.alpha) {
         discard;
     }
     return s.colour;
+}
+
+// Whether a fragment of alpha `alpha` is cut away: the alpha test, or a dither giving its pixel to
+// another draw. One test for the draw and its depth prepass, which must keep the same fragments.
+fn cut_out(in: VertexOut, alpha: f32) -> bool {
+    return alpha < materials[in.material].alpha_cutoff || faded_out(in);
 }
 
 @fragment
@@ -403,8 +409,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
 // The colour returned is never written.
 @fragment
 fn fs_depth(in: VertexOut) -> @location(0) vec4<f32> {
-    let material = materials[in.material];
-    if texel_of(in, material).a < material.alpha_cutoff || faded_out(in) {
+    if cut_out(in, texel_of(in, materials[in.material]).a) {
         discard;
     }
     return vec4<f32>(0.0);

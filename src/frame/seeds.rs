@@ -262,10 +262,8 @@ fn draw_pass(
 ) -> Result<(DrawSeedsPass, wgpu::BindGroup), RenderError> {
     let impostors = load_impostors(dir, &table.species)?;
     let choices = LodChoices::of(&settings.draw_seeds, &table.species);
-    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, choices)?;
-    if settings.draw_seeds.depth_prepass {
-        draw = draw.with_depth_prepass(&gpu.device);
-    }
+    let prepass = settings.draw_seeds.depth_prepass;
+    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, choices, prepass)?;
     if settings.draw_seeds.samples > 1 {
         draw = draw.multisampled(&gpu.device, &targets.colour, &targets.depth);
     }

@@ -12,8 +12,8 @@
 //! whole 4 × 4 blocks and counts 16 for each block it runs, whatever part of it the triangle
 //! covers: the lanes it pays for, an upper bound of the fragments (`tests/overdraw.rs`: a
 //! full-screen triangle, which its clipper cuts at the screen's edge into a fan of three, counts
-//! each pixel once and the blocks along the shared edges twice). It counts them before its early depth test, so a fragment hidden by a nearer one
-//! counts as much as a shaded one. Hardware GPUs shade 2 × 2 quads and count the covered fragments
+//! each pixel once and the blocks along the shared edges twice). It counts them before its early
+//! depth test, so a fragment hidden by a nearer one counts as much as a shaded one. Hardware GPUs shade 2 × 2 quads and count the covered fragments
 //! that pass their early tests, helper lanes not included.
 //!
 //! The same query counts the vertex shader's invocations and the triangles the clipper passes on:
@@ -36,8 +36,8 @@ const STATISTICS: wgpu::PipelineStatisticsTypes = wgpu::PipelineStatisticsTypes:
     .union(wgpu::PipelineStatisticsTypes::CLIPPER_PRIMITIVES_OUT)
     .union(wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS);
 
-/// Results per pipeline-statistics query (`STATISTICS`' flags).
-const STATISTICS_PER_QUERY: usize = 3;
+/// Results per pipeline-statistics query: one per flag of `STATISTICS`.
+const STATISTICS_PER_QUERY: usize = STATISTICS.bits().count_ones() as usize;
 
 /// What one counted pass did in one frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
@@ -121,6 +121,18 @@ impl<'a> CountedPass<'a> {
         self.end_prepass(&mut pass);
         self.begin(&mut pass);
         self.end(&mut pass);
+    }
+}
+
+impl PassFragments {
+    /// Adds `other`'s counts to these (the label stays).
+    pub fn add(&mut self, other: &Self) {
+        self.shaded += other.shaded;
+        self.prepass_shaded += other.prepass_shaded;
+        self.vertices += other.vertices;
+        self.triangles += other.triangles;
+        self.written += other.written;
+        self.covered_px += other.covered_px;
     }
 }
 

@@ -124,29 +124,18 @@ pub struct Seeds {
 /// `gpu.count_fragments`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Overdraw {
-    /// The pass's label.
-    pub label: &'static str,
+    /// The pass's label and its counts summed over those frames (flat in the JSON).
+    #[serde(flatten)]
+    pub total: PassFragments,
     /// Profiled frames counted.
     pub frames: usize,
-    /// Fragments shaded by the shading draws over those frames, discarded ones included.
-    pub shaded: u64,
-    /// Fragments shaded by the depth prepass (alpha tests only) over those frames.
-    pub prepass_shaded: u64,
-    /// Samples the shading draws wrote over those frames (`PassFragments::written`).
-    pub written: u64,
-    /// Vertex shader invocations of the shading draws over those frames.
-    pub vertices: u64,
-    /// Triangles the shading draws rasterised over those frames.
-    pub triangles: u64,
-    /// Pixels the pass changed over those frames.
-    pub covered_px: u64,
-    /// `shaded / covered_px` (`None` when it covered nothing).
+    /// `total.shaded / total.covered_px` (`None` when it covered nothing).
     pub fragments_per_covered_px: Option<f64>,
-    /// `prepass_shaded / covered_px`.
+    /// `total.prepass_shaded / total.covered_px`.
     pub prepass_per_covered_px: Option<f64>,
-    /// `written / covered_px`.
+    /// `total.written / total.covered_px`.
     pub written_per_covered_px: Option<f64>,
-    /// `triangles / covered_px`.
+    /// `total.triangles / total.covered_px`.
     pub triangles_per_covered_px: Option<f64>,
     /// Median fragments shaded per frame.
     pub shaded_median: Option<f64>,
@@ -155,50 +144,28 @@ pub struct Overdraw {
 impl Overdraw {
     /// Per pass, in the order the frames list them.
     fn of(frames: Vec<&[PassFragments]>) -> Vec<Self> {
-        let mut rows: Vec<(Self, Vec<f64>)> = Vec::new();
+        // Per pass: its summed counts and each frame's fragments shaded.
+        let mut rows: Vec<(PassFragments, Vec<f64>)> = Vec::new();
         for pass in frames.into_iter().flatten() {
-            let at = match rows.iter().position(|(row, _)| row.label == pass.label) {
-                Some(at) => at,
-                None => {
-                    let row = Self {
-                        label: pass.label,
-                        frames: 0,
-                        shaded: 0,
-                        prepass_shaded: 0,
-                        written: 0,
-                        vertices: 0,
-                        triangles: 0,
-                        covered_px: 0,
-                        fragments_per_covered_px: None,
-                        prepass_per_covered_px: None,
-                        written_per_covered_px: None,
-                        triangles_per_covered_px: None,
-                        shaded_median: None,
-                    };
-                    rows.push((row, Vec::new()));
-                    rows.len() - 1
-                }
-            };
-            let (row, shaded) = &mut rows[at];
-            row.frames += 1;
-            row.shaded += pass.shaded;
-            row.prepass_shaded += pass.prepass_shaded;
-            row.written += pass.written;
-            row.vertices += pass.vertices;
-            row.triangles += pass.triangles;
-            row.covered_px += pass.covered_px;
+            let at = rows.iter().position(|(total, _)| total.label == pass.label).unwrap_or_else(|| {
+                rows.push((PassFragments { label: pass.label, ..Default::default() }, Vec::new()));
+                rows.len() - 1
+            });
+            let (total, shaded) = &mut rows[at];
+            total.add(pass);
             shaded.push(pass.shaded as f64);
         }
         rows.into_iter()
-            .map(|(row, shaded)| {
-                let per_px = |n: u64| (row.covered_px > 0).then(|| n as f64 / row.covered_px as f64);
+            .map(|(total, shaded)| {
+                let per_px = |n: u64| (total.covered_px > 0).then(|| n as f64 / total.covered_px as f64);
                 Self {
-                    fragments_per_covered_px: per_px(row.shaded),
-                    prepass_per_covered_px: per_px(row.prepass_shaded),
-                    written_per_covered_px: per_px(row.written),
-                    triangles_per_covered_px: per_px(row.triangles),
+                    frames: shaded.len(),
+                    fragments_per_covered_px: per_px(total.shaded),
+                    prepass_per_covered_px: per_px(total.prepass_shaded),
+                    written_per_covered_px: per_px(total.written),
+                    triangles_per_covered_px: per_px(total.triangles),
                     shaded_median: median(&shaded),
-                    ..row
+                    total,
                 }
             })
             .collect()
@@ -420,10 +387,17 @@ mod tests {
         recording.fragments.insert(11, pass(500, 100));
         let summary = Summary::new(&recording, test_meta());
         let [row] = summary.overdraw.as_slice() else { panic!("{:?}", summary.overdraw) };
-        assert_eq!((row.frames, row.shaded, row.covered_px), (2, 800, 200), "frame 9 is a warm-up frame");
+        assert_eq!(
+            (row.frames, row.total.shaded, row.total.covered_px),
+            (2, 800, 200),
+            "frame 9 is a warm-up frame"
+        );
         assert_eq!((row.fragments_per_covered_px, row.shaded_median), (Some(4.0), Some(400.0)));
         assert_eq!((row.prepass_per_covered_px, row.written_per_covered_px), (Some(2.0), Some(1.1)));
-        assert_eq!((row.vertices, row.triangles, row.triangles_per_covered_px), (14, 50, Some(0.25)));
+        assert_eq!(
+            (row.total.vertices, row.total.triangles, row.triangles_per_covered_px),
+            (14, 50, Some(0.25))
+        );
         let table = super::super::table::render(&summary);
         let lines = [
             "Overdraw draw_seeds",

@@ -76,10 +76,10 @@ fn write_table(out: &mut String, s: &Summary) -> std::fmt::Result {
         writeln!(
             out,
             "{} {:>10} fragments / covered pixel ({} shaded, {} pixels, {} frames; prepass {}, written {}, triangles {})",
-            label(&format!("Overdraw {}", pass.label)),
+            label(&format!("Overdraw {}", pass.total.label)),
             per_px(pass.fragments_per_covered_px),
-            pass.shaded,
-            pass.covered_px,
+            pass.total.shaded,
+            pass.total.covered_px,
             pass.frames,
             per_px(pass.prepass_per_covered_px),
             per_px(pass.written_per_covered_px),

@@ -248,9 +248,10 @@ impl MeshDrawer {
                     return Err(TruthError::NoImpostors);
                 }
                 let impostors = load_impostors(&self.dir, species)?;
-                // Every seed its whole mesh: no continuous LOD.
-                let draw =
-                    DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species, LodChoices::default())?;
+                // Every seed its whole mesh: no continuous LOD; drawn with `truth_pipeline`, not the
+                // frame's draws, so no prepass.
+                let choices = LodChoices::default();
+                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species, choices, false)?;
                 let pipeline = draw.truth_pipeline(&gpu.device);
                 (draw, pipeline)
             }

@@ -151,13 +151,15 @@ enum DepthTest {
 
 impl DrawSeedsPass {
     /// Uploads the impostors of `species` (by species index; `None`: not drawn), LOD 1 as
-    /// `choices` says (continuous LOD, slicings), and builds the pipeline.
+    /// `choices` says (continuous LOD, slicings), and builds the pipelines, with a depth prepass
+    /// when `depth_prepass` (`draw_seeds.depth_prepass`).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         impostors: &[Option<Impostor>],
         species: &[Species],
         choices: LodChoices,
+        depth_prepass: bool,
     ) -> Result<Self, DrawSeedsError> {
         if !device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE) {
             return Err(DrawSeedsError::NoFirstInstance);
@@ -209,7 +211,7 @@ impl DrawSeedsPass {
             })
         };
         let layout = BINDINGS.layout(device);
-        let draw = Draw::new(device, &layout, false, false);
+        let draw = Draw::new(device, &layout, false, depth_prepass);
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
         let shapes: Vec<SeedShape> = (built.inv_model_height_m.iter().enumerate())
             .map(|(i, &inv_model_height_m)| SeedShape {
@@ -244,12 +246,6 @@ impl DrawSeedsPass {
             species_missing: impostors.len() - species_drawn,
             multisample: None,
         })
-    }
-
-    /// The same pass with a depth prepass (`draw_seeds.depth_prepass`; before `multisampled`).
-    pub fn with_depth_prepass(mut self, device: &wgpu::Device) -> Self {
-        self.draw = Draw::new(device, &self.layout, false, true);
-        self
     }
 
     /// The same pass drawing multisampled (`draw_seeds.samples` = `SEED_SAMPLES`) over the frame's
