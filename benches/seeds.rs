@@ -8,6 +8,8 @@
 //! the cells, and writes the records and block table pass 3 wrote, timed the same way (texture
 //! fetches are not counted: heights and land cover are read through the caches' textures, shared
 //! by neighbouring seeds). Prints a table; run with `WGPU_BACKEND=vulkan cargo bench --bench seeds`.
+//! The camera stands 150 m above the ground, or `SEEDS_BENCH_ABOVE_M` (a flight's altitude: the
+//! occlusion march then leaps over most of its way).
 #![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 #[path = "support/floor.rs"]
@@ -75,8 +77,10 @@ fn main() {
     let [w, h] = m.extent_m();
     let centre = [0.5 * w, 0.5 * h];
     let ground = r.dataset.height_at(centre[0], centre[1], 0).expect("height");
+    let above_m: f64 = std::env::var("SEEDS_BENCH_ABOVE_M").map_or(150.0, |v| v.parse().expect("metres"));
+    println!("camera {above_m} m above the ground");
     let camera = Camera {
-        position_m: DVec3::new(m.origin_m[0] + centre[0], m.origin_m[1] + centre[1], ground + 150.0),
+        position_m: DVec3::new(m.origin_m[0] + centre[0], m.origin_m[1] + centre[1], ground + above_m),
         yaw_deg: 30.0,
         pitch_deg: -20.0,
         fov_deg: 60.0,

@@ -115,6 +115,7 @@ struct SeedCounters {
 @group(0) @binding(13) var<storage, read_write> counters: SeedCounters;
 @group(0) @binding(14) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(15) var<storage, read_write> blocks: array<SeedBlock>;
+@group(0) @binding(16) var<storage, read> height_tile_max_m: array<f32>;
 
 // a · b, correctly rounded and never fused into a following add.
 fn mul(a: f32, b: f32) -> f32 {
@@ -258,9 +259,46 @@ fn pixel_of(x: f32, w: f32, n: u32, step: f32) -> u32 {
     return i;
 }
 
+// Sample `k` of `dem_blocks`' march towards camera-relative `summit_rel` (`dt` apart in its
+// parameter): the point, camera-relative, and where it lies in the height grid.
+struct MarchPoint {
+    rel_m: vec3<f32>,
+    sample: GridPos,
+}
+
+fn march_point(summit_rel: vec3<f32>, k: u32, dt: f32) -> MarchPoint {
+    let t = mul(f32(k), dt);
+    let p = vec3<f32>(mul(summit_rel.x, t), mul(summit_rel.y, t), mul(summit_rel.z, t));
+    return MarchPoint(p, grid_pos(u.camera_sample, u.camera_sample_frac, p.xy, u.inv_spacing_m));
+}
+
+fn in_dataset(sample: GridPos) -> bool {
+    return all(sample.texel >= vec2<i32>(0)) && all(sample.texel <= vec2<i32>(u.height_size) - 1);
+}
+
+// The level whose tiles bound the march's leaps: the finest whose tiles are wider than a cell of
+// the coarsest level, so that every level's cells at a sample lie in its tile and the next ones.
+fn leap_level() -> u32 {
+    return u.height_level_count - min(u.height_level_count, countTrailingZeros(HEIGHT_TILE_CELLS) + 1u);
+}
+
+// The page-table index of the `leap_level` tile holding march sample `m`.
+fn leap_tile(m: MarchPoint, level: u32) -> u32 {
+    let info = u.height_levels[level];
+    let tile = min((vec2<u32>(m.sample.texel) >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
+    return info.x + tile.y * info.y + tile.x;
+}
+
 // Whether the drawn ground (finest resident heights) rises above the segment from the eye to
 // camera-relative `summit_rel` anywhere: samples at least every half height spacing (a power of two
 // of them, at most `refine_max_steps`), positions by products only, so the twin agrees exactly.
+//
+// Where the segment passes at or above the highest ground drawn over a `leap_level` tile and its
+// neighbours (`height_tile_max_m`: every level-0 sample under them), the march leaps over the tile's
+// samples, taking the decision visiting them would: whatever level draws a sample there, its cell's
+// corners lie in those tiles, and decimated heights never leave their level-0 range. The leap goes
+// to the last sample still in the tile and still at or above its top, found by bisection: positions
+// are monotone in the sample number (rounding is monotone), so those samples are a run from the first.
 fn dem_blocks(summit_rel: vec3<f32>) -> bool {
     let length_sq = mul(summit_rel.x, summit_rel.x) + mul(summit_rel.y, summit_rel.y);
     let wanted_sq = mul(mul(length_sq, 4.0), mul(u.inv_spacing_m, u.inv_spacing_m));
@@ -269,18 +307,36 @@ fn dem_blocks(summit_rel: vec3<f32>) -> bool {
         steps *= 2u;
     }
     let dt = ldexp(1.0, -i32(countTrailingZeros(steps)));
-    let last = vec2<i32>(u.height_size) - 1;
-    for (var k = 1u; k < steps; k += 1u) {
-        let t = mul(f32(k), dt);
-        let p = vec3<f32>(mul(summit_rel.x, t), mul(summit_rel.y, t), mul(summit_rel.z, t));
-        let sample = grid_pos(u.camera_sample, u.camera_sample_frac, p.xy, u.inv_spacing_m);
-        if any(sample.texel < vec2<i32>(0)) || any(sample.texel > last) {
+    let level = leap_level();
+    var k = 1u;
+    while k < steps {
+        let m = march_point(summit_rel, k, dt);
+        if !in_dataset(m.sample) {
+            k += 1u;
             continue;
         }
-        let ground = ground_at(sample);
-        if ground.found && ground.height_m > p.z + u.camera_z_m {
+        let tile = leap_tile(m, level);
+        let top_m = height_tile_max_m[tile];
+        if top_m <= m.rel_m.z + u.camera_z_m {
+            var clear = k;
+            var beyond = steps;
+            while beyond - clear > 1u {
+                let mid = clear + (beyond - clear) / 2u;
+                let n = march_point(summit_rel, mid, dt);
+                if in_dataset(n.sample) && leap_tile(n, level) == tile && top_m <= n.rel_m.z + u.camera_z_m {
+                    clear = mid;
+                } else {
+                    beyond = mid;
+                }
+            }
+            k = clear + 1u;
+            continue;
+        }
+        let ground = ground_at(m.sample);
+        if ground.found && ground.height_m > m.rel_m.z + u.camera_z_m {
             return true;
         }
+        k += 1u;
     }
     return false;
 }

@@ -1,8 +1,9 @@
 //! Pass 3 on a synthetic dataset: the GPU equals its CPU twin (read in block-table order, in the
 //! same order too; in still air and in wind, with species variants), seeds spread over their
 //! species' variants as the exact oracle picks them, runs and paths agree, seeds sit on the drawn
-//! ground, a too-small output is flagged without corrupting what it keeps, and compaction's draw
-//! order is the same in every run and equals its twin's.
+//! ground, the occlusion march's leaps decide as visiting every sample would, a too-small output is
+//! flagged without corrupting what it keeps, and compaction's draw order is the same in every run
+//! and equals its twin's.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
@@ -10,7 +11,7 @@ use terramp::camera::Camera;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP, SpeciesLod, seed_group};
-use terramp::reference::seed_select::SeedComparison;
+use terramp::reference::seed_select::{SeedComparison, occlusion_march, seed_select};
 use terramp::reference::worst::max_or_nan;
 use terramp_testkit::camera::over_fraction;
 
@@ -185,6 +186,54 @@ fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
     assert!(diff.non_finite.is_empty(), "not finite: {:?}", diff.non_finite);
     assert_eq!(diff.max_length_error_m, 0.0);
     assert!(diff.max_colour_error <= 1, "{}", diff.max_colour_error);
+}
+
+/// The occlusion march leaps over tiles its segment passes above (`height_tile_max_m`): with the
+/// dataset's tops it decides as with every top +∞ (no leap), both for whole frames (the twin, on
+/// views low and high) and for marches from the eye to every kept seed's summit and to points
+/// 40 m under it, while reading fewer samples' ground. With every top −∞ it leaps over all ground
+/// and keeps seeds the march hides: so these views do depend on the march.
+#[test]
+fn the_occlusion_march_leaps_only_where_visiting_would_decide_the_same() {
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let mut r = terramp_testkit::renderer(&dataset, terramp_testkit::small_settings(320, 180));
+    let mut views = cameras(&r);
+    views.push(over_fraction(&r, [0.2, 0.5], 1500.0, 80.0, -12.0));
+    let (mut march_decided, mut hidden) = (0, 0);
+    let (mut read_leaping, mut read_visiting) = (0u64, 0u64);
+    for (i, camera) in views.iter().enumerate() {
+        r.render_resolved(camera).unwrap();
+        let mut snapshot = r.seed_snapshot().unwrap().unwrap();
+        let tops = snapshot.caches.height_tile_max_m.clone();
+        assert!(tops.iter().all(|t| t.is_finite()), "view {i}: a tile without a top");
+        let leaping = seed_select(&snapshot.inputs());
+        let mut no_leap = snapshot.inputs();
+        let every_sample = vec![f32::INFINITY; tops.len()];
+        no_leap.height_tile_max_m = &every_sample;
+        assert!(leaping.1.checked > 0 && !leaping.0.is_empty(), "view {i}: {:?}", leaping.1);
+        assert_eq!(leaping, seed_select(&no_leap), "view {i}");
+        for record in &leaping.0 {
+            let [x, y, z] = record.position_rel_m;
+            for target in [[x, y, z + record.height_m], [x, y, z - 40.0]] {
+                let (a, b) = (occlusion_march(&snapshot.inputs(), target), occlusion_march(&no_leap, target));
+                assert_eq!(a.hidden, b.hidden, "view {i}: the march to {target:?}");
+                hidden += u32::from(a.hidden);
+                read_leaping += u64::from(a.samples_read);
+                read_visiting += u64::from(b.samples_read);
+            }
+        }
+        let none_visible = vec![f32::NEG_INFINITY; tops.len()];
+        snapshot.caches.height_tile_max_m = none_visible;
+        let blind = seed_select(&snapshot.inputs()).1;
+        println!("view {i}: {:?}; leaping over all ground: {} occluded", leaping.1, blind.occlusion);
+        march_decided += leaping.1.occlusion - blind.occlusion;
+    }
+    println!(
+        "{hidden} marches hidden; samples read {read_leaping} leaping, {read_visiting} visiting ({:.2}x)",
+        read_visiting as f64 / read_leaping as f64
+    );
+    assert!(march_decided > 0 && hidden > 0, "no march hides anything");
+    assert!(read_leaping < read_visiting, "the march never leapt");
 }
 
 #[test]

@@ -24,7 +24,7 @@ use crate::passes::compact::gpu::{CompactInputs, CompactPass};
 use crate::passes::draw_seeds::LodChoices;
 use crate::passes::draw_seeds::frame::{draw_uniforms, load_impostors};
 use crate::passes::draw_seeds::gpu::{DrawSeedsInputs, DrawSeedsPass};
-use crate::passes::seed_select::frame::{SeedCellRef, SeedFrame, SeedInputs};
+use crate::passes::seed_select::frame::{SeedCellRef, SeedFrame, SeedInputs, height_tile_max_m};
 use crate::passes::seed_select::gpu::{SeedSelectPass, SeedSources};
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
@@ -96,7 +96,7 @@ impl SeedStage {
         let device = &gpu.device;
         check_capacity(device, settings.seeds.capacity)?;
         let (table, tables, patterns) = seeded_world(settings, landcover)?;
-        let pass = SeedSelectPass::new(device, settings, &patterns, &tables);
+        let pass = SeedSelectPass::new(device, settings, &patterns, &tables, &height_tile_max_m(dataset));
         let bind_group = pass.bind_group(device, &sources);
         let mut compact = CompactPass::new(device, CompactLimits::from(settings))?;
         let compact_bind_group =

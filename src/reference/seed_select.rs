@@ -11,22 +11,25 @@
 use std::collections::HashMap;
 
 use crate::classes::MAX_SPECIES_PER_CLASS;
-use crate::dataset::surface::drawn_height;
 use crate::dataset::{Dataset, PackError, TileId};
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{
     COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_OVERFLOW, COUNT_RULE,
-    COUNT_SELECTED, GROUND_SAMPLES, HEIGHT_BORDER, HEIGHT_TILE_CELLS, IMAGERY_BORDER, IMAGERY_TILE_TEXELS,
-    LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS,
-    SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group,
+    COUNT_SELECTED, GROUND_SAMPLES, IMAGERY_BORDER, IMAGERY_TILE_TEXELS, LCC_LEVELS, LCC_PACKED_LEVEL,
+    LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS, SEED_LODS, SEED_WORKGROUP,
+    SpeciesLod, page_slot, seed_group,
 };
-use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
+use crate::passes::seed_select::frame::{SeedFrame, SeedOutput, height_tile_max_m};
 use crate::seeds::{SeedTables, pcg, seed_hash, seed_variant, unit};
 use crate::streaming::TileCache;
 
 mod compare;
+mod ground;
+
+use ground::ground_at;
 
 pub use compare::SeedComparison;
+pub use ground::{OcclusionMarch, occlusion_march};
 
 /// One cache as the shader sees it: the page table, and the texels (mip 0, border included) of
 /// each resident slot.
@@ -73,6 +76,8 @@ pub struct SeedTwinInputs<'a> {
     pub tables: &'a SeedTables,
     /// The height cache: samples in metres.
     pub heights: &'a TwinCache<f32>,
+    /// Per height tile, the highest ground drawn over it (`frame::height_tile_max_m`).
+    pub height_tile_max_m: &'a [f32],
     /// The land-cover cache: packed class words, as stored.
     pub landcover: &'a TwinCache<u32>,
     /// Imagery texels as stored: RGBA8, sRGB-encoded.
@@ -103,6 +108,7 @@ impl SeedSnapshot {
             patterns_unit: &self.patterns_unit,
             tables: &self.tables,
             heights: &self.caches.heights,
+            height_tile_max_m: &self.caches.height_tile_max_m,
             landcover: &self.caches.landcover,
             imagery: &self.caches.imagery,
             depth: &self.depth,
@@ -114,6 +120,9 @@ impl SeedSnapshot {
 pub struct TwinCaches {
     /// Height samples, metres.
     pub heights: TwinCache<f32>,
+    /// Per height tile, the highest ground drawn over it (`frame::height_tile_max_m`): where the
+    /// occlusion march may leap. All +∞, it visits every sample.
+    pub height_tile_max_m: Vec<f32>,
     /// Land-cover class words, as stored.
     pub landcover: TwinCache<u32>,
     /// Imagery texels: RGBA8, sRGB-encoded.
@@ -142,7 +151,7 @@ pub fn snapshot_caches(
             ..Default::default()
         },
     };
-    Ok(TwinCaches { heights, landcover, imagery })
+    Ok(TwinCaches { heights, height_tile_max_m: height_tile_max_m(dataset), landcover, imagery })
 }
 
 /// The seeds pass 3 keeps, cell by cell and rank by rank, and its counters (with overflow as the
@@ -219,44 +228,6 @@ fn grid_pos(corner: [i32; 2], corner_frac: [f32; 2], pos_unit: [f32; 2], cell_in
 fn to_clip(u: &SeedUniforms, p: [f32; 3]) -> [f32; 4] {
     let m = &u.clip_from_view_world;
     std::array::from_fn(|r| m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r])
-}
-
-struct Ground {
-    height_m: f32,
-    gradient: [f32; 2],
-    level: u32,
-}
-
-fn ground_at(u: &SeedUniforms, heights: &TwinCache<f32>, p: &GridPos) -> Option<Ground> {
-    let s0 = p.texel.map(|v| v as u32);
-    let mut level = 0;
-    let (mut slot, mut tile);
-    loop {
-        let info = u.height_levels[level as usize];
-        tile = [
-            ((s0[0] >> level) / HEIGHT_TILE_CELLS).min(info[1] - 1),
-            ((s0[1] >> level) / HEIGHT_TILE_CELLS).min(info[2] - 1),
-        ];
-        slot = page_slot(heights.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize]);
-        if slot.is_some() || level + 1 >= u.height_level_count {
-            break;
-        }
-        level += 1;
-    }
-    let slot = slot?;
-    let s = s0.map(|v| v >> level);
-    let local = [
-        s[0] - tile[0] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
-        s[1] - tile[1] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
-    ];
-    let load = |dx: u32, dy: u32| heights.load(slot, local[0] + dx, local[1] + dy);
-    let corners = [load(0, 0), load(1, 0), load(0, 1), load(1, 1)];
-    let mask = (1u32 << level) - 1;
-    let scale = 1.0 / (1u32 << level) as f32;
-    let f = [((s0[0] & mask) as f32 + p.frac[0]) * scale, ((s0[1] & mask) as f32 + p.frac[1]) * scale];
-    let (height_m, slope) = drawn_height(s, corners, f);
-    let per_m = scale * u.inv_spacing_m;
-    Some(Ground { height_m, gradient: [slope[0] * per_m, slope[1] * per_m], level })
 }
 
 fn class_at(u: &SeedUniforms, landcover: &TwinCache<u32>, q: [u32; 2], wanted: u32) -> Option<(u32, u32)> {
@@ -340,25 +311,6 @@ fn ground_colour(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, ha
     mean.iter()
         .enumerate()
         .fold(0, |word, (c, v)| word | (((v.clamp(0.0, 1.0) * 255.0).round() as u32) << (8 * c)))
-}
-
-/// The shader's `dem_blocks`: whether the DEM rises above the segment from the eye to `target`.
-fn dem_blocks(u: &SeedUniforms, heights: &TwinCache<f32>, target: [f32; 3]) -> bool {
-    let length_sq = target[0] * target[0] + target[1] * target[1];
-    let wanted_sq = (length_sq * 4.0) * (u.inv_spacing_m * u.inv_spacing_m);
-    let mut steps = 2u32;
-    while steps < u.refine_max_steps && ((steps * steps) as f32) < wanted_sq {
-        steps *= 2;
-    }
-    let dt = 1.0 / steps as f32;
-    let last = u.height_size.map(|n| n as i32 - 1);
-    (1..steps).any(|k| {
-        let t = k as f32 * dt;
-        let p = target.map(|v| v * t);
-        let sample = grid_pos(u.camera_sample, u.camera_sample_frac, [p[0], p[1]], u.inv_spacing_m);
-        let inside = (0..2).all(|a| sample.texel[a] >= 0 && sample.texel[a] <= last[a]);
-        inside && ground_at(u, heights, &sample).is_some_and(|g| g.height_m > p[2] + u.camera_z_m)
-    })
 }
 
 /// Pixel column holding clip-space x at distance w: the shader's `pixel_of`.
@@ -458,7 +410,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
             hidden = if u.refine_max_steps == 0 {
                 behind_m * depth_at(px as i32, py as i32) > u.near_m
             } else {
-                dem_blocks(u, inputs.heights, [rel_xy[0], rel_xy[1], summit_rel_z])
+                occlusion_march(inputs, [rel_xy[0], rel_xy[1], summit_rel_z]).hidden
             };
         }
         if hidden {

@@ -37,8 +37,8 @@ pub const SHADER: WgslSource = WgslSource {
 
 /// Pass 3's bindings: the frame's constants and cells (a storage buffer, not a uniform one: see
 /// `tile_load_map.wgsl`), the patterns and tables, the three caches and the terrain depth it reads,
-/// and what it writes.
-pub const BINDINGS: BindingTable<16> = BindingTable {
+/// what it writes, and the highest ground each height tile can draw (the occlusion march's leaps).
+pub const BINDINGS: BindingTable<17> = BindingTable {
     label: "seed select",
     bindings: [
         Binding::storage::<SeedUniforms>(0, "u", Stage::COMPUTE, Access::Read),
@@ -69,6 +69,7 @@ pub const BINDINGS: BindingTable<16> = BindingTable {
         Binding::storage::<SeedCounters>(13, "counters", Stage::COMPUTE, Access::ReadWrite),
         Binding::storage_array::<u32>(14, "keys", Stage::COMPUTE, Access::ReadWrite),
         Binding::storage_array::<SeedBlock>(15, "blocks", Stage::COMPUTE, Access::ReadWrite),
+        Binding::storage_array::<f32>(16, "height_tile_max_m", Stage::COMPUTE, Access::Read),
     ],
 };
 
@@ -95,6 +96,7 @@ pub struct SeedSelectPass {
     counters: wgpu::Buffer,
     keys: wgpu::Buffer,
     blocks: wgpu::Buffer,
+    height_tile_max: wgpu::Buffer,
     settled: wgpu::Buffer,
     capacity: u32,
     block_capacity: u32,
@@ -113,12 +115,14 @@ pub struct SeedSources<'a> {
 }
 
 impl SeedSelectPass {
-    /// Builds the pipeline and uploads the patterns and tables, which a renderer keeps for life.
+    /// Builds the pipeline and uploads the patterns and tables and the dataset's
+    /// `height_tile_max_m` (`frame::height_tile_max_m`), which a renderer keeps for life.
     pub fn new(
         device: &wgpu::Device,
         settings: &Settings,
         patterns: &SeedPatterns,
         tables: &SeedTables,
+        height_tile_max_m: &[f32],
     ) -> Self {
         let module = SHADER.module(device);
         let layout = BINDINGS.layout(device);
@@ -157,6 +161,14 @@ impl SeedSelectPass {
             counters: empty("seed counters", size_of::<SeedCounters>() as u64, output | U::COPY_DST),
             keys: empty("seed keys", u64::from(capacity.max(1)) * 4, output),
             blocks: empty("seed blocks", blocks_bytes, output),
+            height_tile_max: init(
+                "seed height tile max",
+                bytemuck::cast_slice(if height_tile_max_m.is_empty() {
+                    &[0.0][..]
+                } else {
+                    height_tile_max_m
+                }),
+            ),
             settled,
             capacity,
             block_capacity,
@@ -186,6 +198,7 @@ impl SeedSelectPass {
                 self.counters.as_entire_binding(),
                 self.keys.as_entire_binding(),
                 self.blocks.as_entire_binding(),
+                self.height_tile_max.as_entire_binding(),
             ],
         )
     }

@@ -1,0 +1,128 @@
+//! How it works: the twin of the shader's `ground_at` and its occlusion march `dem_blocks`, with
+//! the same f32 operations in the same order. The march steps from the eye to a seed's summit and
+//! reports whether the drawn ground rises above the segment at any sample; where the segment passes
+//! at or above the highest ground drawn over a tile of the leap level (`height_tile_max_m`), it
+//! leaps to the last sample still over that tile and that top, found by bisection. A leap takes the
+//! decision visiting every sample would (the shader's comment says why); with every top +∞ the
+//! march never leaps, which is how the tests check that.
+
+use crate::dataset::surface::drawn_height;
+use crate::gpu::gpu_types::SeedUniforms;
+use crate::gpu::layout::{HEIGHT_BORDER, HEIGHT_TILE_CELLS, page_slot};
+
+use super::{GridPos, SeedTwinInputs, TwinCache, grid_pos};
+
+pub(super) struct Ground {
+    pub height_m: f32,
+    pub gradient: [f32; 2],
+    pub level: u32,
+}
+
+/// The level-`level` tile holding level-0 sample `s0`, and its page-table index.
+fn tile_at(u: &SeedUniforms, s0: [u32; 2], level: u32) -> ([u32; 2], usize) {
+    let info = u.height_levels[level as usize];
+    let tile = [
+        ((s0[0] >> level) / HEIGHT_TILE_CELLS).min(info[1] - 1),
+        ((s0[1] >> level) / HEIGHT_TILE_CELLS).min(info[2] - 1),
+    ];
+    (tile, (info[0] + tile[1] * info[1] + tile[0]) as usize)
+}
+
+/// The drawn ground at `p` (level-0 samples) from the finest resident level.
+pub(super) fn ground_at(u: &SeedUniforms, heights: &TwinCache<f32>, p: &GridPos) -> Option<Ground> {
+    let s0 = p.texel.map(|v| v as u32);
+    let mut level = 0;
+    let (tile, slot) = loop {
+        let (tile, index) = tile_at(u, s0, level);
+        let slot = page_slot(heights.page_table[index]);
+        if slot.is_some() || level + 1 >= u.height_level_count {
+            break (tile, slot?);
+        }
+        level += 1;
+    };
+    let s = s0.map(|v| v >> level);
+    let local = [
+        s[0] - tile[0] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
+        s[1] - tile[1] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
+    ];
+    let load = |dx: u32, dy: u32| heights.load(slot, local[0] + dx, local[1] + dy);
+    let corners = [load(0, 0), load(1, 0), load(0, 1), load(1, 1)];
+    let mask = (1u32 << level) - 1;
+    let scale = 1.0 / (1u32 << level) as f32;
+    let f = [((s0[0] & mask) as f32 + p.frac[0]) * scale, ((s0[1] & mask) as f32 + p.frac[1]) * scale];
+    let (height_m, slope) = drawn_height(s, corners, f);
+    let per_m = scale * u.inv_spacing_m;
+    Some(Ground { height_m, gradient: [slope[0] * per_m, slope[1] * per_m], level })
+}
+
+/// The shader's `leap_level`: the finest level whose tiles are wider than a cell of the coarsest.
+fn leap_level(u: &SeedUniforms) -> u32 {
+    u.height_level_count - u.height_level_count.min(HEIGHT_TILE_CELLS.trailing_zeros() + 1)
+}
+
+/// Sample `k` of the march towards `target` (`dt` apart): the point, camera-relative, and where it
+/// lies in the height grid.
+fn march_point(u: &SeedUniforms, target: [f32; 3], k: u32, dt: f32) -> ([f32; 3], GridPos) {
+    let t = k as f32 * dt;
+    let p = target.map(|v| v * t);
+    (p, grid_pos(u.camera_sample, u.camera_sample_frac, [p[0], p[1]], u.inv_spacing_m))
+}
+
+fn in_dataset(u: &SeedUniforms, sample: &GridPos) -> bool {
+    (0..2).all(|a| sample.texel[a] >= 0 && sample.texel[a] < u.height_size[a] as i32)
+}
+
+/// What the occlusion march found: whether the ground hides the summit, and how many samples'
+/// ground it read to decide (the leaps skip the rest).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OcclusionMarch {
+    /// The drawn ground rises above the segment from the eye to the summit at some sample.
+    pub hidden: bool,
+    /// Samples whose drawn ground was read.
+    pub samples_read: u32,
+}
+
+/// The shader's `dem_blocks`: whether the drawn ground rises above the segment from the eye to
+/// camera-relative `target`, leaping over tiles the segment passes above.
+pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMarch {
+    let u = &inputs.frame.uniforms;
+    let length_sq = target[0] * target[0] + target[1] * target[1];
+    let wanted_sq = (length_sq * 4.0) * (u.inv_spacing_m * u.inv_spacing_m);
+    let mut steps = 2u32;
+    while steps < u.refine_max_steps && ((steps * steps) as f32) < wanted_sq {
+        steps *= 2;
+    }
+    let dt = 1.0 / steps as f32;
+    let level = leap_level(u);
+    let leap_tile = |sample: &GridPos| tile_at(u, sample.texel.map(|v| v as u32), level).1;
+    let (mut k, mut samples_read) = (1, 0);
+    while k < steps {
+        let (p, sample) = march_point(u, target, k, dt);
+        if !in_dataset(u, &sample) {
+            k += 1;
+            continue;
+        }
+        let tile = leap_tile(&sample);
+        let top_m = inputs.height_tile_max_m[tile];
+        if top_m <= p[2] + u.camera_z_m {
+            let (mut clear, mut beyond) = (k, steps);
+            while beyond - clear > 1 {
+                let mid = clear + (beyond - clear) / 2;
+                let (n, next) = march_point(u, target, mid, dt);
+                if in_dataset(u, &next) && leap_tile(&next) == tile && top_m <= n[2] + u.camera_z_m {
+                    clear = mid;
+                } else {
+                    beyond = mid;
+                }
+            }
+            k = clear + 1;
+            continue;
+        }
+        samples_read += 1;
+        if ground_at(u, inputs.heights, &sample).is_some_and(|g| g.height_m > p[2] + u.camera_z_m) {
+            return OcclusionMarch { hidden: true, samples_read };
+        }
+        k += 1;
+    }
+    OcclusionMarch { hidden: false, samples_read }
+}
