@@ -8,8 +8,8 @@
 //! the cells, and writes the records and block table pass 3 wrote, timed the same way (texture
 //! fetches are not counted: heights and land cover are read through the caches' textures, shared
 //! by neighbouring seeds). Prints a table; run with `WGPU_BACKEND=vulkan cargo bench --bench seeds`.
-//! The camera stands 150 m above the ground, or `SEEDS_BENCH_ABOVE_M` (a flight's altitude: the
-//! occlusion march then leaps over most of its way).
+//! The camera stands 150 m above the ground, or `SEEDS_BENCH_ABOVE_M` metres (a flight's altitude:
+//! fewer summits near a silhouette, and shorter occlusion marches).
 #![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
 
 #[path = "support/floor.rs"]

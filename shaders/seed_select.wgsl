@@ -13,12 +13,13 @@
 // which no compiler can fuse into an FMA. Large coordinates never reach f32: each cell's corner
 // comes as an integer texel plus a remainder in every layer's own grid.
 //
-// Output (`seed_select_blocks.wgsl`): a workgroup numbers its survivors by a ballot (rank order,
-// every run), claims room with one global atomic (where it lands varies), writes them with their
-// draw-group keys, and notes where in its fixed block-table entry: read in table order, records
-// come in the twin's order (compaction keeps it). When the records overflow `capacity`, `settle`
-// renumbers the table in table order and the blocks that keep anything select again into their
-// new places, so the first `capacity` records in the twin's order are kept, on every run.
+// The occlusion march is `seed_select_march.wgsl`. The output (`seed_select_blocks.wgsl`): a
+// workgroup numbers its survivors by a ballot (rank order, every run), claims room with one global
+// atomic (where it lands varies), writes them with their draw-group keys, and notes where in its
+// fixed block-table entry: read in table order, records come in the twin's order (compaction keeps
+// it). When the records overflow `capacity`, `settle` renumbers the table in table order and the
+// blocks that keep anything select again into their new places, so the first `capacity` records in
+// the twin's order are kept, on every run.
 
 struct SeedUniforms {
     clip_from_view_world: mat4x4<f32>,
@@ -116,6 +117,7 @@ struct SeedCounters {
 @group(0) @binding(14) var<storage, read_write> keys: array<u32>;
 @group(0) @binding(15) var<storage, read_write> blocks: array<SeedBlock>;
 @group(0) @binding(16) var<storage, read> height_tile_max_m: array<f32>;
+@group(0) @binding(17) var<storage, read> height_block_max_m: array<f32>;
 
 // a · b, correctly rounded and never fused into a following add.
 fn mul(a: f32, b: f32) -> f32 {
@@ -165,28 +167,46 @@ struct Ground {
     found: bool,
 }
 
-// The drawn ground at `p` (level-0 samples) from the finest resident level: its cell split as that
-// level's mesh splits it.
-fn ground_at(p: GridPos) -> Ground {
-    let s0 = vec2<u32>(p.texel);
+// The tile the drawn ground at level-0 sample `s0` comes from: the finest level whose tile there
+// is resident (slot PAGE_EMPTY when none is, at the coarsest level), and its page-table index.
+struct HeightTile {
+    level: u32,
+    tile: vec2<u32>,
+    index: u32,
+    slot: u32,
+}
+
+fn height_tile(s0: vec2<u32>) -> HeightTile {
     var level = 0u;
-    var slot = PAGE_EMPTY;
-    var tile = vec2<u32>(0u);
     loop {
         let info = u.height_levels[level];
-        tile = min((s0 >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
-        slot = height_page_table[info.x + tile.y * info.y + tile.x];
+        let tile = min((s0 >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
+        let index = info.x + tile.y * info.y + tile.x;
+        let slot = height_page_table[index];
         if slot != PAGE_EMPTY || level + 1u >= u.height_level_count {
-            break;
+            return HeightTile(level, tile, index, slot);
         }
         level += 1u;
     }
-    if slot == PAGE_EMPTY {
+    return HeightTile(0u, vec2<u32>(0u), 0u, PAGE_EMPTY);
+}
+
+// The drawn ground at `p` (level-0 samples) from the finest resident level: its cell split as that
+// level's mesh splits it.
+fn ground_at(p: GridPos) -> Ground {
+    return ground_in(height_tile(vec2<u32>(p.texel)), p);
+}
+
+// The drawn ground at `p` from `hit`, `p`'s `height_tile`.
+fn ground_in(hit: HeightTile, p: GridPos) -> Ground {
+    let level = hit.level;
+    if hit.slot == PAGE_EMPTY {
         return Ground(0.0, vec2<f32>(0.0), level, false);
     }
+    let s0 = vec2<u32>(p.texel);
     let s = s0 >> vec2<u32>(level);
-    let local = vec2<i32>(s - tile * HEIGHT_TILE_CELLS + HEIGHT_BORDER);
-    let layer = page_layer(slot);
+    let local = vec2<i32>(s - hit.tile * HEIGHT_TILE_CELLS + HEIGHT_BORDER);
+    let layer = page_layer(hit.slot);
     let h00 = textureLoad(height_tiles, local, layer, 0).r;
     let h10 = textureLoad(height_tiles, local + vec2<i32>(1, 0), layer, 0).r;
     let h01 = textureLoad(height_tiles, local + vec2<i32>(0, 1), layer, 0).r;
@@ -257,88 +277,6 @@ fn pixel_of(x: f32, w: f32, n: u32, step: f32) -> u32 {
         }
     }
     return i;
-}
-
-// Sample `k` of `dem_blocks`' march towards camera-relative `summit_rel` (`dt` apart in its
-// parameter): the point, camera-relative, and where it lies in the height grid.
-struct MarchPoint {
-    rel_m: vec3<f32>,
-    sample: GridPos,
-}
-
-fn march_point(summit_rel: vec3<f32>, k: u32, dt: f32) -> MarchPoint {
-    let t = mul(f32(k), dt);
-    let p = vec3<f32>(mul(summit_rel.x, t), mul(summit_rel.y, t), mul(summit_rel.z, t));
-    return MarchPoint(p, grid_pos(u.camera_sample, u.camera_sample_frac, p.xy, u.inv_spacing_m));
-}
-
-fn in_dataset(sample: GridPos) -> bool {
-    return all(sample.texel >= vec2<i32>(0)) && all(sample.texel <= vec2<i32>(u.height_size) - 1);
-}
-
-// The level whose tiles bound the march's leaps: the finest whose tiles are wider than a cell of
-// the coarsest level, so that every level's cells at a sample lie in its tile and the next ones.
-fn leap_level() -> u32 {
-    return u.height_level_count - min(u.height_level_count, countTrailingZeros(HEIGHT_TILE_CELLS) + 1u);
-}
-
-// The page-table index of the `leap_level` tile holding march sample `m`.
-fn leap_tile(m: MarchPoint, level: u32) -> u32 {
-    let info = u.height_levels[level];
-    let tile = min((vec2<u32>(m.sample.texel) >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
-    return info.x + tile.y * info.y + tile.x;
-}
-
-// Whether the drawn ground (finest resident heights) rises above the segment from the eye to
-// camera-relative `summit_rel` anywhere: samples at least every half height spacing (a power of two
-// of them, at most `refine_max_steps`), positions by products only, so the twin agrees exactly.
-//
-// Where the segment passes at or above the highest ground drawn over a `leap_level` tile and its
-// neighbours (`height_tile_max_m`: every level-0 sample under them), the march leaps over the tile's
-// samples, taking the decision visiting them would: whatever level draws a sample there, its cell's
-// corners lie in those tiles, and decimated heights never leave their level-0 range. The leap goes
-// to the last sample still in the tile and still at or above its top, found by bisection: positions
-// are monotone in the sample number (rounding is monotone), so those samples are a run from the first.
-fn dem_blocks(summit_rel: vec3<f32>) -> bool {
-    let length_sq = mul(summit_rel.x, summit_rel.x) + mul(summit_rel.y, summit_rel.y);
-    let wanted_sq = mul(mul(length_sq, 4.0), mul(u.inv_spacing_m, u.inv_spacing_m));
-    var steps = 2u;
-    while steps < u.refine_max_steps && f32(steps * steps) < wanted_sq {
-        steps *= 2u;
-    }
-    let dt = ldexp(1.0, -i32(countTrailingZeros(steps)));
-    let level = leap_level();
-    var k = 1u;
-    while k < steps {
-        let m = march_point(summit_rel, k, dt);
-        if !in_dataset(m.sample) {
-            k += 1u;
-            continue;
-        }
-        let tile = leap_tile(m, level);
-        let top_m = height_tile_max_m[tile];
-        if top_m <= m.rel_m.z + u.camera_z_m {
-            var clear = k;
-            var beyond = steps;
-            while beyond - clear > 1u {
-                let mid = clear + (beyond - clear) / 2u;
-                let n = march_point(summit_rel, mid, dt);
-                if in_dataset(n.sample) && leap_tile(n, level) == tile && top_m <= n.rel_m.z + u.camera_z_m {
-                    clear = mid;
-                } else {
-                    beyond = mid;
-                }
-            }
-            k = clear + 1u;
-            continue;
-        }
-        let ground = ground_at(m.sample);
-        if ground.found && ground.height_m > m.rel_m.z + u.camera_z_m {
-            return true;
-        }
-        k += 1u;
-    }
-    return false;
 }
 
 // The seed's fate: a counter index (COUNT_SELECTED when kept), its record and draw group.

@@ -11,6 +11,7 @@ use terramp::camera::Camera;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP, SpeciesLod, seed_group};
+use terramp::passes::seed_select::march::BLOCKS_PER_TILE;
 use terramp::reference::seed_select::{SeedComparison, occlusion_march, seed_select};
 use terramp::reference::worst::max_or_nan;
 use terramp_testkit::camera::over_fraction;
@@ -188,11 +189,12 @@ fn compaction_is_the_same_in_every_run_and_equals_its_twin() {
     assert!(diff.max_colour_error <= 1, "{}", diff.max_colour_error);
 }
 
-/// The occlusion march leaps over tiles its segment passes above (`height_tile_max_m`): with the
-/// dataset's tops it decides as with every top +∞ (no leap), both for whole frames (the twin, on
-/// views low and high) and for marches from the eye to every kept seed's summit and to points
-/// 40 m under it, while reading fewer samples' ground. With every top −∞ it leaps over all ground
-/// and keeps seeds the march hides: so these views do depend on the march.
+/// The occlusion march leaps over tiles and blocks its segment passes above
+/// (`passes::seed_select::march`): with the dataset's tops it decides as with every top +∞ (no
+/// leap), both for whole frames (the twin, on views low and high) and for marches from the eye to
+/// every kept seed's summit and to points 40 m under it, while reading fewer samples' ground. With
+/// every tile's top −∞ it leaps over all ground and keeps seeds the march hides: so these views do
+/// depend on the march.
 #[test]
 fn the_occlusion_march_leaps_only_where_visiting_would_decide_the_same() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
@@ -209,7 +211,14 @@ fn the_occlusion_march_leaps_only_where_visiting_would_decide_the_same() {
         let leaping = seed_select(&snapshot.inputs());
         let mut no_leap = snapshot.inputs();
         let every_sample = vec![f32::INFINITY; tops.len()];
+        let every_block = snapshot
+            .caches
+            .height_block_max_m
+            .keys()
+            .map(|&slot| (slot, vec![f32::INFINITY; BLOCKS_PER_TILE]))
+            .collect();
         no_leap.height_tile_max_m = &every_sample;
+        no_leap.height_block_max_m = &every_block;
         assert!(leaping.1.checked > 0 && !leaping.0.is_empty(), "view {i}: {:?}", leaping.1);
         assert_eq!(leaping, seed_select(&no_leap), "view {i}");
         for record in &leaping.0 {

@@ -8,6 +8,7 @@ use crate::config::Settings;
 use crate::dataset::{Dataset, IMAGERY_MIPS, LayerPack, LayerSpec};
 use crate::gpu::Gpu;
 use crate::gpu::layout::MAX_LEVELS;
+use crate::passes::seed_select::march::BLOCK_TOPS;
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 use crate::streaming::loader::imagery_tile;
 use crate::streaming::wants::pinned_tiles;
@@ -79,7 +80,8 @@ impl Caches {
             1,
             wgpu::TextureFormat::R32Float,
             slots.height_slots,
-        );
+        )
+        .with_summary(device, BLOCK_TOPS);
         let imagery_delivery = dataset.imagery.as_ref().map_or(Delivery::Stored, |layer| {
             let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
             imagery_delivery(layer, device.features(), settings.imagery.decode_blocks_on(software))

@@ -126,11 +126,16 @@ pub const fn mask(bits: u32) -> u32 {
 wgsl_constants! { dataset_constants:
     /// Height tiles: 256 cells (257 shared-edge samples) plus a 1-sample border for normals.
     pub const HEIGHT_TILE_CELLS: u32 = 256;
-    /// Samples of border on each side of a height tile, so normals are central differences at its
-    /// edges too.
+    /// Samples of border on each side of a height tile: normals are central differences at its edges too.
     pub const HEIGHT_BORDER: u32 = 1;
     /// Samples along a stored height tile's edge, borders included.
     pub const HEIGHT_TILE_EXTENT: u32 = HEIGHT_TILE_CELLS + 1 + 2 * HEIGHT_BORDER;
+    /// Cells along a height block, whose top pass 3's occlusion march leaps by (`seed_select::march`).
+    pub const HEIGHT_BLOCK_CELLS: u32 = 16;
+    /// Blocks along a height tile's edge.
+    pub const HEIGHT_TILE_BLOCKS: u32 = HEIGHT_TILE_CELLS / HEIGHT_BLOCK_CELLS;
+    /// Levels down to which a tile's block lies in one tile of each finer level: log2 of the above.
+    pub const HEIGHT_BLOCK_LEVELS: u32 = HEIGHT_TILE_BLOCKS.trailing_zeros();
     /// Imagery and land-cover tiles: 512 texels.
     pub const CELL_TILE_TEXELS: u32 = 512;
     /// Imagery carries an 8-texel border, enough for trilinear and anisotropic filtering down its

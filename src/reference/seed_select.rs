@@ -19,7 +19,8 @@ use crate::gpu::layout::{
     LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS, SEED_LODS, SEED_WORKGROUP,
     SpeciesLod, page_slot, seed_group,
 };
-use crate::passes::seed_select::frame::{SeedFrame, SeedOutput, height_tile_max_m};
+use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
+use crate::passes::seed_select::march::{block_max_m, height_tile_max_m};
 use crate::seeds::{SeedTables, pcg, seed_hash, seed_variant, unit};
 use crate::streaming::TileCache;
 
@@ -76,8 +77,10 @@ pub struct SeedTwinInputs<'a> {
     pub tables: &'a SeedTables,
     /// The height cache: samples in metres.
     pub heights: &'a TwinCache<f32>,
-    /// Per height tile, the highest ground drawn over it (`frame::height_tile_max_m`).
+    /// Per height tile, the highest ground drawn over it (`march::height_tile_max_m`).
     pub height_tile_max_m: &'a [f32],
+    /// Per resident height slot, its tile's block tops (`march::block_max_m`).
+    pub height_block_max_m: &'a HashMap<u32, Vec<f32>>,
     /// The land-cover cache: packed class words, as stored.
     pub landcover: &'a TwinCache<u32>,
     /// Imagery texels as stored: RGBA8, sRGB-encoded.
@@ -109,6 +112,7 @@ impl SeedSnapshot {
             tables: &self.tables,
             heights: &self.caches.heights,
             height_tile_max_m: &self.caches.height_tile_max_m,
+            height_block_max_m: &self.caches.height_block_max_m,
             landcover: &self.caches.landcover,
             imagery: &self.caches.imagery,
             depth: &self.depth,
@@ -120,9 +124,12 @@ impl SeedSnapshot {
 pub struct TwinCaches {
     /// Height samples, metres.
     pub heights: TwinCache<f32>,
-    /// Per height tile, the highest ground drawn over it (`frame::height_tile_max_m`): where the
-    /// occlusion march may leap. All +∞, it visits every sample.
+    /// Per height tile, the highest ground drawn over it (`march::height_tile_max_m`), and per
+    /// resident slot its tile's block tops (`march::block_max_m`): where the occlusion march may
+    /// leap. All +∞, it visits every sample.
     pub height_tile_max_m: Vec<f32>,
+    /// See `height_tile_max_m`.
+    pub height_block_max_m: HashMap<u32, Vec<f32>>,
     /// Land-cover class words, as stored.
     pub landcover: TwinCache<u32>,
     /// Imagery texels: RGBA8, sRGB-encoded.
@@ -151,7 +158,15 @@ pub fn snapshot_caches(
             ..Default::default()
         },
     };
-    Ok(TwinCaches { heights, height_tile_max_m: height_tile_max_m(dataset), landcover, imagery })
+    let height_block_max_m =
+        heights.slots.iter().map(|(&slot, samples)| (slot, block_max_m(samples))).collect();
+    Ok(TwinCaches {
+        heights,
+        height_tile_max_m: height_tile_max_m(dataset),
+        height_block_max_m,
+        landcover,
+        imagery,
+    })
 }
 
 /// The seeds pass 3 keeps, cell by cell and rank by rank, and its counters (with overflow as the

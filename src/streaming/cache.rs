@@ -12,7 +12,9 @@
 //! what is evicted, is `Residency`'s policy (least recently needed first, never a needed tile for a
 //! less important one). `load_now` is the synchronous path for tools and tests: it reads every
 //! fitting tile at once, with no budget. A tile that cannot be read is remembered as failed, and
-//! shaders (and `resident_ancestor`) fall back to its finest resident ancestor.
+//! shaders (and `resident_ancestor`) fall back to its finest resident ancestor. A cache may keep a
+//! few words beside each slot (`with_summary`: the height cache, its tile's block tops for pass 3),
+//! made from the tile as it is placed.
 
 use super::loader::{LayerKind, Loaded};
 use super::residency::{CacheStats, Placement, Residency, UploadBudget};
@@ -35,6 +37,22 @@ pub struct TileCache {
     /// Page-table entries changed since the last write to the GPU.
     dirty: Vec<u32>,
     residency: Residency,
+    /// What it keeps beside each slot's tile, and where (`with_summary`).
+    summary: Option<(SlotSummary, wgpu::Buffer)>,
+}
+
+/// What a cache keeps beside each slot's tile, `words_per_slot` words per slot in a storage buffer
+/// (slot `s` at word `s × words_per_slot`): made from the tile's payload (all mips) when it is
+/// placed, in the same queue order as its texels and before its page-table entry, so a pass that
+/// finds the tile through the page table finds its summary too.
+#[derive(Clone, Copy)]
+pub struct SlotSummary {
+    /// The buffer's label.
+    pub label: &'static str,
+    /// Words kept per slot.
+    pub words_per_slot: u32,
+    /// The summary of a tile from its payload: `words_per_slot` words.
+    pub make: fn(&[u8]) -> Vec<u32>,
 }
 
 impl TileCache {
@@ -83,7 +101,31 @@ impl TileCache {
             page_table_cpu,
             dirty: Vec::new(),
             residency: Residency::new(layer, slots, pyramid.levels),
+            summary: None,
         }
+    }
+
+    /// The cache keeping `summary` beside each slot's tile from now on (call before placing any).
+    pub fn with_summary(mut self, device: &wgpu::Device, summary: SlotSummary) -> Self {
+        let slots = u64::from(self.texture.depth_or_array_layers());
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(summary.label),
+            size: (slots * u64::from(summary.words_per_slot) * 4).max(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.summary = Some((summary, buffer));
+        self
+    }
+
+    /// The slots' summaries (`SlotSummary`), when the cache keeps any.
+    pub fn summary_buffer(&self) -> Option<&wgpu::Buffer> {
+        self.summary.as_ref().map(|(_, buffer)| buffer)
+    }
+
+    /// Slots in the cache: layers of its texture array.
+    pub fn slot_count(&self) -> u32 {
+        self.texture.depth_or_array_layers()
     }
 
     /// The page table as last written to the GPU (`page_entry(slot)` per tile, `PAGE_EMPTY` when
@@ -220,6 +262,12 @@ impl TileCache {
             self.set_entry(old, PAGE_EMPTY);
         }
         self.write_tile(queue, slot, payload);
+        if let Some((summary, buffer)) = &self.summary {
+            let words = (summary.make)(payload);
+            debug_assert_eq!(words.len(), summary.words_per_slot as usize, "{}", summary.label);
+            let offset = u64::from(slot) * u64::from(summary.words_per_slot) * 4;
+            queue.write_buffer(buffer, offset, bytemuck::cast_slice(&words));
+        }
         self.set_entry(id, page_entry(slot));
     }
 

@@ -11,7 +11,7 @@ pub mod loader;
 mod residency;
 pub mod wants;
 
-pub use cache::{TileCache, page_levels};
+pub use cache::{SlotSummary, TileCache, page_levels};
 pub use faults::Faults;
 pub use loader::{Delivery, LayerKind, Loaded, Loader, LoaderError, LoaderOptions, TileRequest};
 pub use residency::{CacheStats, UploadBudget};

@@ -8,7 +8,6 @@ use crate::config::Settings;
 use crate::dataset::Dataset;
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{LCC_LEVELS, MAX_LEVELS};
-use crate::passes::tile_load_map::frame::height_tile_ranges;
 use crate::seeds::wind::Wind;
 use crate::seeds::{max_cells, workgroups_per_cell};
 use crate::streaming::page_levels;
@@ -94,16 +93,6 @@ fn near_to_far(cells: &[SeedCellRef], camera_xy: [f64; 2], cell_m: f64) -> Vec<S
     let mut sorted: Vec<(f64, SeedCellRef)> = cells.iter().map(|c| (distance_sq(c), *c)).collect();
     sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     sorted.into_iter().map(|(_, c)| c).collect()
-}
-
-/// Per height tile, in page-table (pack) order, the highest ground the terrain can draw over it
-/// at any level, finer or coarser, whose cells start in it: the top of the Tile Load Map's ranges
-/// (every level-0 sample under the tile and its eight neighbours, which those cells reach). Pass 3's
-/// occlusion march leaps over a tile where its segment passes at or above this. A tile without a
-/// finite top gets +∞: the march visits its every sample.
-pub fn height_tile_max_m(dataset: &Dataset) -> Vec<f32> {
-    let top = |max_m: f32| if max_m.is_finite() { max_m } else { f32::INFINITY };
-    height_tile_ranges(dataset).into_iter().map(|[_, max_m]| top(max_m)).collect()
 }
 
 /// `value` (≥ 0 or not) as an integer part and a remainder in [0, 1) that f32 can carry.

@@ -20,6 +20,7 @@ use crate::seeds::{MAX_SEED_CELLS, SeedTables, block_capacity, workgroups_per_ce
 use crate::streaming::TileCache;
 
 use super::frame::{SeedFrame, SeedInputs, SeedOutput};
+use super::march::BLOCKS_PER_TILE;
 
 /// Pass 3's shader.
 pub const SHADER: WgslSource = WgslSource {
@@ -31,14 +32,16 @@ pub const SHADER: WgslSource = WgslSource {
         TERRAIN_SURFACE,
         LANDCOVER,
         include_str!("../../../shaders/seed_select.wgsl"),
+        include_str!("../../../shaders/seed_select_march.wgsl"),
         include_str!("../../../shaders/seed_select_blocks.wgsl"),
     ],
 };
 
 /// Pass 3's bindings: the frame's constants and cells (a storage buffer, not a uniform one: see
 /// `tile_load_map.wgsl`), the patterns and tables, the three caches and the terrain depth it reads,
-/// what it writes, and the highest ground each height tile can draw (the occlusion march's leaps).
-pub const BINDINGS: BindingTable<17> = BindingTable {
+/// what it writes, and the tops the occlusion march leaps by (`march`): per height tile, and per
+/// block of each resident tile (the height cache's summary).
+pub const BINDINGS: BindingTable<18> = BindingTable {
     label: "seed select",
     bindings: [
         Binding::storage::<SeedUniforms>(0, "u", Stage::COMPUTE, Access::Read),
@@ -70,6 +73,7 @@ pub const BINDINGS: BindingTable<17> = BindingTable {
         Binding::storage_array::<u32>(14, "keys", Stage::COMPUTE, Access::ReadWrite),
         Binding::storage_array::<SeedBlock>(15, "blocks", Stage::COMPUTE, Access::ReadWrite),
         Binding::storage_array::<f32>(16, "height_tile_max_m", Stage::COMPUTE, Access::Read),
+        Binding::storage_array::<f32>(17, "height_block_max_m", Stage::COMPUTE, Access::Read),
     ],
 };
 
@@ -116,7 +120,7 @@ pub struct SeedSources<'a> {
 
 impl SeedSelectPass {
     /// Builds the pipeline and uploads the patterns and tables and the dataset's
-    /// `height_tile_max_m` (`frame::height_tile_max_m`), which a renderer keeps for life.
+    /// `height_tile_max_m` (`march::height_tile_max_m`), which a renderer keeps for life.
     pub fn new(
         device: &wgpu::Device,
         settings: &Settings,
@@ -175,9 +179,24 @@ impl SeedSelectPass {
         }
     }
 
-    /// The bind group over a renderer's caches and depth target (fixed for its life).
+    /// The bind group over a renderer's caches and depth target (fixed for its life). A height
+    /// cache without block tops (`march::BLOCK_TOPS`) gets tops of +∞: the march visits its blocks.
     pub fn bind_group(&self, device: &wgpu::Device, sources: &SeedSources) -> wgpu::BindGroup {
         use wgpu::BindingResource::TextureView as View;
+        let never_leap;
+        let block_tops = match sources.heights.summary_buffer() {
+            Some(buffer) => buffer,
+            None => {
+                let tops = vec![f32::INFINITY; sources.heights.slot_count() as usize * BLOCKS_PER_TILE];
+                never_leap = buffer_init(
+                    device,
+                    "seed block tops",
+                    bytemuck::cast_slice(&tops),
+                    wgpu::BufferUsages::STORAGE,
+                );
+                &never_leap
+            }
+        };
         BINDINGS.bind_group(
             device,
             &self.layout,
@@ -199,6 +218,7 @@ impl SeedSelectPass {
                 self.keys.as_entire_binding(),
                 self.blocks.as_entire_binding(),
                 self.height_tile_max.as_entire_binding(),
+                block_tops.as_entire_binding(),
             ],
         )
     }

@@ -15,10 +15,11 @@
 //!
 //! `frame` is the CPU half (the frame's uniforms and cells, and the output as CPU data), which the
 //! twin (`reference::seed_select`) and the analysis read; `gpu` the pipeline, binding table,
-//! buffers and recorded dispatch.
+//! buffers and recorded dispatch; `march` the tops its occlusion march leaps by.
 
 pub mod frame;
 pub mod gpu;
+pub mod march;
 
 #[cfg(test)]
 mod tests;

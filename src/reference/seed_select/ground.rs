@@ -1,14 +1,17 @@
-//! How it works: the twin of the shader's `ground_at` and its occlusion march `dem_blocks`, with
-//! the same f32 operations in the same order. The march steps from the eye to a seed's summit and
-//! reports whether the drawn ground rises above the segment at any sample; where the segment passes
-//! at or above the highest ground drawn over a tile of the leap level (`height_tile_max_m`), it
-//! leaps to the last sample still over that tile and that top, found by bisection. A leap takes the
-//! decision visiting every sample would (the shader's comment says why); with every top +∞ the
-//! march never leaps, which is how the tests check that.
+//! How it works: the twin of the shader's ground reads (`height_tile`, `ground_in`) and its
+//! occlusion march (`seed_select_march.wgsl`), with the same f32 operations in the same order. The
+//! march steps from the eye to a seed's summit and reports whether the drawn ground rises above
+//! the segment at any sample; where the segment passes at or above the top of a tile
+//! (`height_tile_max_m`) or of a block of the resident tile drawing the sample (`block_max_m`), it
+//! leaps to the last sample still in that square and over that top, found by bisection. A leap
+//! takes the decision visiting every sample would (the shader's comment says why); with every top
+//! +∞ the march never leaps, which is how the tests check that.
 
 use crate::dataset::surface::drawn_height;
 use crate::gpu::gpu_types::SeedUniforms;
-use crate::gpu::layout::{HEIGHT_BORDER, HEIGHT_TILE_CELLS, page_slot};
+use crate::gpu::layout::{
+    HEIGHT_BLOCK_CELLS, HEIGHT_BLOCK_LEVELS, HEIGHT_BORDER, HEIGHT_TILE_BLOCKS, HEIGHT_TILE_CELLS, page_slot,
+};
 
 use super::{GridPos, SeedTwinInputs, TwinCache, grid_pos};
 
@@ -16,6 +19,14 @@ pub(super) struct Ground {
     pub height_m: f32,
     pub gradient: [f32; 2],
     pub level: u32,
+}
+
+/// The tile the drawn ground at level-0 sample `s0` comes from: the finest level whose tile there
+/// is resident (no slot when none is, at the coarsest level).
+struct HeightTile {
+    level: u32,
+    tile: [u32; 2],
+    slot: Option<u32>,
 }
 
 /// The level-`level` tile holding level-0 sample `s0`, and its page-table index.
@@ -28,18 +39,26 @@ fn tile_at(u: &SeedUniforms, s0: [u32; 2], level: u32) -> ([u32; 2], usize) {
     (tile, (info[0] + tile[1] * info[1] + tile[0]) as usize)
 }
 
-/// The drawn ground at `p` (level-0 samples) from the finest resident level.
-pub(super) fn ground_at(u: &SeedUniforms, heights: &TwinCache<f32>, p: &GridPos) -> Option<Ground> {
-    let s0 = p.texel.map(|v| v as u32);
+fn height_tile(u: &SeedUniforms, heights: &TwinCache<f32>, s0: [u32; 2]) -> HeightTile {
     let mut level = 0;
-    let (tile, slot) = loop {
+    loop {
         let (tile, index) = tile_at(u, s0, level);
         let slot = page_slot(heights.page_table[index]);
         if slot.is_some() || level + 1 >= u.height_level_count {
-            break (tile, slot?);
+            return HeightTile { level, tile, slot };
         }
         level += 1;
-    };
+    }
+}
+
+/// The drawn ground at `p` (level-0 samples) from the finest resident level.
+pub(super) fn ground_at(u: &SeedUniforms, heights: &TwinCache<f32>, p: &GridPos) -> Option<Ground> {
+    ground_in(u, heights, &height_tile(u, heights, p.texel.map(|v| v as u32)), p)
+}
+
+fn ground_in(u: &SeedUniforms, heights: &TwinCache<f32>, hit: &HeightTile, p: &GridPos) -> Option<Ground> {
+    let (slot, level, tile) = (hit.slot?, hit.level, hit.tile);
+    let s0 = p.texel.map(|v| v as u32);
     let s = s0.map(|v| v >> level);
     let local = [
         s[0] - tile[0] * HEIGHT_TILE_CELLS + HEIGHT_BORDER,
@@ -60,16 +79,13 @@ fn leap_level(u: &SeedUniforms) -> u32 {
     u.height_level_count - u.height_level_count.min(HEIGHT_TILE_CELLS.trailing_zeros() + 1)
 }
 
-/// Sample `k` of the march towards `target` (`dt` apart): the point, camera-relative, and where it
-/// lies in the height grid.
-fn march_point(u: &SeedUniforms, target: [f32; 3], k: u32, dt: f32) -> ([f32; 3], GridPos) {
-    let t = k as f32 * dt;
-    let p = target.map(|v| v * t);
-    (p, grid_pos(u.camera_sample, u.camera_sample_frac, [p[0], p[1]], u.inv_spacing_m))
-}
-
-fn in_dataset(u: &SeedUniforms, sample: &GridPos) -> bool {
-    (0..2).all(|a| sample.texel[a] >= 0 && sample.texel[a] < u.height_size[a] as i32)
+/// The shader's `Leap`: the samples in the level-`level` grid square `square` of `cells` cells, while
+/// the segment stays at or above `top_m`.
+struct Leap {
+    level: u32,
+    cells: u32,
+    square: [u32; 2],
+    top_m: f32,
 }
 
 /// What the occlusion march found: whether the ground hides the summit, and how many samples'
@@ -83,7 +99,7 @@ pub struct OcclusionMarch {
 }
 
 /// The shader's `dem_blocks`: whether the drawn ground rises above the segment from the eye to
-/// camera-relative `target`, leaping over tiles the segment passes above.
+/// camera-relative `target`, leaping where the tops allow.
 pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMarch {
     let u = &inputs.frame.uniforms;
     let length_sq = target[0] * target[0] + target[1] * target[1];
@@ -93,33 +109,68 @@ pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMa
         steps *= 2;
     }
     let dt = 1.0 / steps as f32;
-    let level = leap_level(u);
-    let leap_tile = |sample: &GridPos| tile_at(u, sample.texel.map(|v| v as u32), level).1;
+    // Sample `k`: the point, camera-relative, where it lies in the height grid, and whether that is
+    // in the dataset.
+    let point = |k: u32| {
+        let p = target.map(|v| v * (k as f32 * dt));
+        let sample = grid_pos(u.camera_sample, u.camera_sample_frac, [p[0], p[1]], u.inv_spacing_m);
+        let inside = (0..2).all(|a| sample.texel[a] >= 0 && sample.texel[a] < u.height_size[a] as i32);
+        (p, sample, inside)
+    };
+    let square_of =
+        |sample: &GridPos, level: u32, cells: u32| sample.texel.map(|v| ((v as u32) >> level) / cells);
+    // The last sample from `k` (where `leap` holds) to `steps` where it still holds.
+    let leap_end = |k: u32, leap: Leap| {
+        let holds = |j: u32| {
+            let (p, sample, inside) = point(j);
+            inside
+                && square_of(&sample, leap.level, leap.cells) == leap.square
+                && leap.top_m <= p[2] + u.camera_z_m
+        };
+        let (mut clear, mut beyond) = (k, steps);
+        while beyond - clear > 1 {
+            let mid = clear + (beyond - clear) / 2;
+            if holds(mid) {
+                clear = mid;
+            } else {
+                beyond = mid;
+            }
+        }
+        clear
+    };
+    let tile_level = leap_level(u);
     let (mut k, mut samples_read) = (1, 0);
     while k < steps {
-        let (p, sample) = march_point(u, target, k, dt);
-        if !in_dataset(u, &sample) {
+        let (p, sample, inside) = point(k);
+        if !inside {
             k += 1;
             continue;
         }
-        let tile = leap_tile(&sample);
-        let top_m = inputs.height_tile_max_m[tile];
-        if top_m <= p[2] + u.camera_z_m {
-            let (mut clear, mut beyond) = (k, steps);
-            while beyond - clear > 1 {
-                let mid = clear + (beyond - clear) / 2;
-                let (n, next) = march_point(u, target, mid, dt);
-                if in_dataset(u, &next) && leap_tile(&next) == tile && top_m <= n[2] + u.camera_z_m {
-                    clear = mid;
-                } else {
-                    beyond = mid;
-                }
-            }
-            k = clear + 1;
+        let s0 = sample.texel.map(|v| v as u32);
+        let z_m = p[2] + u.camera_z_m;
+        let tile_top_m = inputs.height_tile_max_m[tile_at(u, s0, tile_level).1];
+        if tile_top_m <= z_m {
+            let square = square_of(&sample, tile_level, HEIGHT_TILE_CELLS);
+            k = leap_end(k, Leap { level: tile_level, cells: HEIGHT_TILE_CELLS, square, top_m: tile_top_m })
+                + 1;
             continue;
         }
+        let hit = height_tile(u, inputs.heights, s0);
+        if let Some(slot) = hit.slot.filter(|_| hit.level <= HEIGHT_BLOCK_LEVELS) {
+            let block = square_of(&sample, hit.level, HEIGHT_BLOCK_CELLS);
+            let local = [0, 1].map(|a| block[a].wrapping_sub(hit.tile[a] * HEIGHT_TILE_BLOCKS));
+            if local.iter().all(|&b| b < HEIGHT_TILE_BLOCKS) {
+                let top_m =
+                    inputs.height_block_max_m[&slot][(local[1] * HEIGHT_TILE_BLOCKS + local[0]) as usize];
+                if top_m <= z_m {
+                    let level = hit.level;
+                    k = leap_end(k, Leap { level, cells: HEIGHT_BLOCK_CELLS, square: block, top_m }) + 1;
+                    continue;
+                }
+            }
+        }
         samples_read += 1;
-        if ground_at(u, inputs.heights, &sample).is_some_and(|g| g.height_m > p[2] + u.camera_z_m) {
+        if ground_in(u, inputs.heights, &hit, &sample).is_some_and(|g| g.height_m > z_m) {
             return OcclusionMarch { hidden: true, samples_read };
         }
         k += 1;
