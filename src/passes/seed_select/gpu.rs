@@ -167,8 +167,9 @@ impl SeedSelectPass {
             blocks: empty("seed blocks", blocks_bytes, output),
             height_tile_max: init(
                 "seed height tile max",
+                // A binding may not be empty; a top of +∞ is never leapt over.
                 bytemuck::cast_slice(if height_tile_max_m.is_empty() {
-                    &[0.0][..]
+                    &[f32::INFINITY][..]
                 } else {
                     height_tile_max_m
                 }),
