@@ -1,7 +1,8 @@
 //! Pass 3 on a synthetic dataset: the GPU equals its CPU twin (read in block-table order, in the
 //! same order too; in still air and in wind, with species variants), seeds spread over their
 //! species' variants as the exact oracle picks them, runs and paths agree, seeds sit on the drawn
-//! ground, the occlusion march's leaps decide as visiting every sample would, a too-small output is
+//! ground, the occlusion march's leaps decide as visiting every sample would (and the height cache
+//! keeps the block tops they read true to its tiles), a too-small output is
 //! flagged without corrupting what it keeps, and compaction's draw order is the same in every run
 //! and equals its twin's.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
@@ -243,6 +244,30 @@ fn the_occlusion_march_leaps_only_where_visiting_would_decide_the_same() {
     );
     assert!(march_decided > 0 && hidden > 0, "no march hides anything");
     assert!(read_leaping < read_visiting, "the march never leapt");
+}
+
+/// The height cache keeps beside each slot the block tops of the tile in it, as the twin finds
+/// them from the tile's samples, after views whose tiles outnumber its slots (tiles are evicted
+/// and their slots reused).
+#[test]
+fn the_height_cache_keeps_each_slots_block_tops_true_to_its_tile() {
+    let dataset = terramp_testkit::synth_dataset(SIZE, 7);
+    let mut settings = terramp_testkit::small_settings(320, 180);
+    settings.cache.height_slots = 6;
+    let mut r = terramp_testkit::renderer(&dataset, settings);
+    let mut evicted = 0;
+    for camera in cameras(&r).iter().chain(cameras(&r).iter().rev()) {
+        evicted += r.render_resolved(camera).unwrap().0.height.evicted;
+    }
+    let snapshot = r.seed_snapshot().unwrap().unwrap();
+    let gpu = r.height_block_tops().unwrap();
+    let resident = &snapshot.caches.height_block_max_m;
+    println!("{evicted} evicted, {} resident", resident.len());
+    assert!(evicted > 0 && resident.len() > 1, "{evicted} evicted, {} resident", resident.len());
+    for (&slot, tops) in resident {
+        let start = slot as usize * BLOCKS_PER_TILE;
+        assert_eq!(gpu[start..start + BLOCKS_PER_TILE], tops[..], "slot {slot}");
+    }
 }
 
 #[test]

@@ -8,10 +8,11 @@ use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::gpu::GpuError;
 use crate::gpu::gpu_types::{SeedCounters, SeedDrawArgs, SeedRecord, TerrainUniforms, TlmCell};
-use crate::gpu::readback::read_texture;
+use crate::gpu::readback::{read_texture, read_values};
 use crate::light::CloudShadowFrame;
 use crate::passes::compact::frame::Compacted;
 use crate::passes::seed_select::frame::{SeedCellRef, SeedOutput};
+use crate::passes::seed_select::march::BLOCKS_PER_TILE;
 use crate::reference::oracle::OracleInputs;
 use crate::reference::seed_select::{SeedSnapshot, seed_select, seed_select_blocks, snapshot_caches};
 use crate::seeds::SeedTables;
@@ -196,6 +197,15 @@ impl Renderer {
     pub fn read_compacted(&self) -> Result<Option<Compacted>, RenderError> {
         let Some(stage) = &self.seeds else { return Ok(None) };
         Ok(Some(stage.compact.read_back(&self.gpu)?))
+    }
+
+    /// The block tops the height cache keeps beside its slots (`march::BLOCK_TOPS`), as the GPU
+    /// holds them: `BLOCKS_PER_TILE` per slot, slot by slot.
+    pub fn height_block_tops(&self) -> Result<Vec<f32>, RenderError> {
+        let heights = &self.caches.heights;
+        let Some(buffer) = heights.summary_buffer() else { return Ok(Vec::new()) };
+        let count = u64::from(heights.slot_count()) * BLOCKS_PER_TILE as u64;
+        Ok(read_values(&self.gpu, buffer, count)?)
     }
 
     /// What pass 3 read in the last frame (its cells, the resident tiles, the depth), for its

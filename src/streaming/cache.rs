@@ -111,7 +111,8 @@ impl TileCache {
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(summary.label),
             size: (slots * u64::from(summary.words_per_slot) * 4).max(4),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            // Read back by tests.
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         self.summary = Some((summary, buffer));
