@@ -2,9 +2,9 @@
 //! same order too; in still air and in wind, with species variants), seeds spread over their
 //! species' variants as the exact oracle picks them, runs and paths agree, seeds sit on the drawn
 //! ground, the occlusion march's leaps decide as visiting every sample would (and the height cache
-//! keeps the block tops they read true to its tiles), a too-small output is
-//! flagged without corrupting what it keeps, and compaction's draw order is the same in every run
-//! and equals its twin's.
+//! keeps the block tops they read true to its tiles), a too-small output is flagged without
+//! corrupting what it keeps, and compaction's draw order is the same in every run and equals its
+//! twin's.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
