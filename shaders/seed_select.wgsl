@@ -167,28 +167,32 @@ struct Ground {
     found: bool,
 }
 
+// The level-`level` height tile holding level-0 sample `s0` (x, y), and its page-table index (z).
+fn height_tile_at(s0: vec2<u32>, level: u32) -> vec3<u32> {
+    let info = u.height_levels[level];
+    let tile = min((s0 >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
+    return vec3<u32>(tile, info.x + tile.y * info.y + tile.x);
+}
+
 // The tile the drawn ground at level-0 sample `s0` comes from: the finest level whose tile there
-// is resident (slot PAGE_EMPTY when none is, at the coarsest level), and its page-table index.
+// is resident (slot PAGE_EMPTY when none is, at the coarsest level).
 struct HeightTile {
     level: u32,
     tile: vec2<u32>,
-    index: u32,
     slot: u32,
 }
 
 fn height_tile(s0: vec2<u32>) -> HeightTile {
     var level = 0u;
     loop {
-        let info = u.height_levels[level];
-        let tile = min((s0 >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
-        let index = info.x + tile.y * info.y + tile.x;
-        let slot = height_page_table[index];
+        let at = height_tile_at(s0, level);
+        let slot = height_page_table[at.z];
         if slot != PAGE_EMPTY || level + 1u >= u.height_level_count {
-            return HeightTile(level, tile, index, slot);
+            return HeightTile(level, at.xy, slot);
         }
         level += 1u;
     }
-    return HeightTile(0u, vec2<u32>(0u), 0u, PAGE_EMPTY);
+    return HeightTile(0u, vec2<u32>(0u), PAGE_EMPTY);
 }
 
 // The drawn ground at `p` (level-0 samples) from the finest resident level: its cell split as that

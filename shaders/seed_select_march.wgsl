@@ -41,13 +41,6 @@ fn leap_level() -> u32 {
     return u.height_level_count - min(u.height_level_count, countTrailingZeros(HEIGHT_TILE_CELLS) + 1u);
 }
 
-// The page-table index of the `level` tile holding sample `s0`.
-fn tile_index(s0: vec2<u32>, level: u32) -> u32 {
-    let info = u.height_levels[level];
-    let tile = min((s0 >> vec2<u32>(level)) / HEIGHT_TILE_CELLS, info.yz - 1u);
-    return info.x + tile.y * info.y + tile.x;
-}
-
 // A run of samples the march may leap over: those in the level-`level` grid square `square` of
 // `cells` cells (a tile or a block), while the segment stays at or above `top_m`.
 struct Leap {
@@ -95,7 +88,7 @@ fn dem_blocks(summit_rel: vec3<f32>) -> bool {
         }
         let s0 = vec2<u32>(m.sample.texel);
         let z_m = m.rel_m.z + u.camera_z_m;
-        let tile_top_m = height_tile_max_m[tile_index(s0, tile_level)];
+        let tile_top_m = height_tile_max_m[height_tile_at(s0, tile_level).z];
         if tile_top_m <= z_m {
             let square = (s0 >> vec2<u32>(tile_level)) / HEIGHT_TILE_CELLS;
             k = leap_end(summit_rel, k, steps, dt, Leap(tile_level, HEIGHT_TILE_CELLS, square, tile_top_m)) + 1u;
