@@ -10,7 +10,6 @@ use terramp::gpu::{GpuError, TimeSource};
 use terramp_testkit::camera::over_fraction;
 use terramp_testkit::{renderer, small_settings, synth_dataset};
 
-/// A camera `above_m` over the ground at the dataset's centre.
 /// Depth rows, top first.
 fn depth_rows(renderer: &Renderer) -> Vec<Vec<f32>> {
     let width = renderer.settings.render.width as usize;
