@@ -13,8 +13,9 @@
 //! covers: the lanes it pays for, an upper bound of the fragments (`tests/overdraw.rs`: a
 //! full-screen triangle, which its clipper cuts at the screen's edge into a fan of three, counts
 //! each pixel once and the blocks along the shared edges twice). It counts them before its early
-//! depth test, so a fragment hidden by a nearer one counts as much as a shaded one. Hardware GPUs shade 2 × 2 quads and count the covered fragments
-//! that pass their early tests, helper lanes not included.
+//! depth test, so a fragment hidden by a nearer one counts as much as a shaded one. Hardware GPUs
+//! shade 2 × 2 quads and count the covered fragments that pass their early tests, helper lanes not
+//! included.
 //!
 //! The same query counts the vertex shader's invocations and the triangles the clipper passes on:
 //! fragments per triangle tell a pass of small triangles (llvmpipe: about a block, 16 lanes, each)

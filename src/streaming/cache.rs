@@ -107,7 +107,7 @@ impl TileCache {
 
     /// The cache keeping `summary` beside each slot's tile from now on (call before placing any).
     pub fn with_summary(mut self, device: &wgpu::Device, summary: SlotSummary) -> Self {
-        let slots = u64::from(self.texture.depth_or_array_layers());
+        let slots = u64::from(self.slot_count());
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(summary.label),
             size: (slots * u64::from(summary.words_per_slot) * 4).max(4),

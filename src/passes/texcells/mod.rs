@@ -4,17 +4,17 @@
 //! (`frame`) picks the terrain node quadrants the frame draws that reach into the texcell band, far
 //! to near, leaves out those with no forest class near them (`dense`: a silhouette's rays reach
 //! beyond its quadrant, so a quadrant that draws one stays), and a slice pyramid level for each
-//! from its distance; every slice of every such patch is
-//! one instance of the quadrant's grid, lifted off the ground it follows, drawn far patch first and
-//! within a patch the slice farthest from the eye's height first. The shader
-//! (`shaders/texcells.wgsl`, `gpu`) shows forest only where the land cover under a fragment is a
-//! dense class, maps the sample aperiodically over the ground (eight edge-compatible tiles chosen by
-//! hashed edge colours, `texcell::tiling`), corrects each slice's opacity for the oblique path
-//! between slices, lights it with the ground's sun and tints it with the imagery under it, and
-//! dithers it in where the last billboard clouds dither out. Where the view grazes the canopy
-//! (`texcells.silhouette_deg`), a patch also draws its slab's top face once, whose fragments march
-//! their ray through the samples' 3D texture (the paper's silhouette texcells), the two kinds
-//! sharing the patch's pixels by a dither on each ray's angle below the horizon.
+//! from its distance; every slice of every such patch is one instance of the quadrant's grid,
+//! lifted off the ground it follows, drawn far patch first and within a patch the slice farthest
+//! from the eye's height first. The shader (`shaders/texcells.wgsl`, `gpu`) shows forest only where
+//! the land cover under a fragment is a dense class, maps the sample aperiodically over the ground
+//! (eight edge-compatible tiles chosen by hashed edge colours, `texcell::tiling`), corrects each
+//! slice's opacity for the oblique path between slices, lights it with the ground's sun and tints
+//! it with the imagery under it, and dithers it in where the last billboard clouds dither out.
+//! Where the view grazes the canopy (`texcells.silhouette_deg`), a patch also draws its slab's top
+//! face once, whose fragments march their ray through the samples' 3D texture (the paper's
+//! silhouette texcells), the two kinds sharing the patch's pixels by a dither on each ray's angle
+//! below the horizon.
 
 pub mod dense;
 pub mod frame;
