@@ -21,7 +21,8 @@
 # Always exits 0 once the flights ran: the verdicts are measurements, not tests.
 #
 # Usage: scripts/measure_streaming.sh [OUT_DIR]   (default: a fresh temporary folder, removed after)
-# Environment: FRAMES (240), WIDTH × HEIGHT (1280 × 720), REPEATS (3), JUMP_HOLD (60).
+# Environment: FRAMES (240), WIDTH × HEIGHT (1280 × 720), REPEATS (3), JUMP_HOLD (60), IMAGES_ONLY
+# (1: only the datasets and step 4, as scripts/docs_images.sh makes the images).
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -106,46 +107,49 @@ jump_keys "$hold" | write_path "$out/jump.toml"
 echo "5000.0 5000.0 1000.0 45.0 -60.0" | write_path "$out/still.toml"
 jump_keys 20 | write_path "$out/jump_short.toml"
 
-echo
-echo "== flights: $frames frames at $width × $height, $repeats run(s) per path and dataset"
-for path in default interior; do
-    [[ $path == default ]] && file="$root/config/paths/default.toml" || file="$out/interior.toml"
-    for ((r = 1; r <= repeats; r++)); do
-        fly "$path-small-$r" "$small" "$file" "$frames" 0 "$width" "$height"
-        fly "$path-large-$r" "$large" "$file" "$frames" 0 "$width" "$height"
+measure() {
+    echo
+    echo "== flights: $frames frames at $width × $height, $repeats run(s) per path and dataset"
+    for path in default interior; do
+        [[ $path == default ]] && file="$root/config/paths/default.toml" || file="$out/interior.toml"
+        for ((r = 1; r <= repeats; r++)); do
+            fly "$path-small-$r" "$small" "$file" "$frames" 0 "$width" "$height"
+            fly "$path-large-$r" "$large" "$file" "$frames" 0 "$width" "$height"
+        done
     done
-done
-for ((r = 1; r <= repeats; r++)); do
-    fly "still-small-$r" "$small" "$out/still.toml" 60 0 "$width" "$height"
-    fly "still-large-$r" "$large" "$out/still.toml" 60 0 "$width" "$height"
-done
-fly jump "$large" "$out/jump.toml" "$((2 * hold))" 0 "$width" "$height"
+    for ((r = 1; r <= repeats; r++)); do
+        fly "still-small-$r" "$small" "$out/still.toml" 60 0 "$width" "$height"
+        fly "still-large-$r" "$large" "$out/still.toml" 60 0 "$width" "$height"
+    done
+    fly jump "$large" "$out/jump.toml" "$((2 * hold))" 0 "$width" "$height"
 
-for path in default interior; do
+    for path in default interior; do
+        smalls=() larges=()
+        for ((r = 1; r <= repeats; r++)); do
+            smalls+=("$out/$path-small-$r/log.jsonl")
+            larges+=("$out/$path-large-$r/log.jsonl")
+        done
+        echo
+        if [[ $path == default ]]; then
+            echo "######## path: config/paths/default.toml (the camera stays within 10 km; the view reaches past it)"
+        else
+            echo "######## path: interior.toml (the whole view within the small dataset: the same view over both)"
+        fi
+        python3 "$summary" compare --small "${smalls[@]}" --large "${larges[@]}"
+    done
     smalls=() larges=()
     for ((r = 1; r <= repeats; r++)); do
-        smalls+=("$out/$path-small-$r/log.jsonl")
-        larges+=("$out/$path-large-$r/log.jsonl")
+        smalls+=("$out/still-small-$r/log.jsonl")
+        larges+=("$out/still-large-$r/log.jsonl")
     done
     echo
-    if [[ $path == default ]]; then
-        echo "######## path: config/paths/default.toml (the camera stays within 10 km; the view reaches past it)"
-    else
-        echo "######## path: interior.toml (the whole view within the small dataset: the same view over both)"
-    fi
-    python3 "$summary" compare --small "${smalls[@]}" --large "${larges[@]}"
-done
-smalls=() larges=()
-for ((r = 1; r <= repeats; r++)); do
-    smalls+=("$out/still-small-$r/log.jsonl")
-    larges+=("$out/still-large-$r/log.jsonl")
-done
-echo
-echo "######## still camera: still.toml, 60 frames, timings after the first 20"
-python3 "$summary" compare --brief --warmup 20 --small "${smalls[@]}" --large "${larges[@]}"
-echo
-echo "######## camera jump over synth4096 at $width × $height ($hold frames at each pose)"
-python3 "$summary" jump "$out/jump/log.jsonl" --jump-frame "$hold"
+    echo "######## still camera: still.toml, 60 frames, timings after the first 20"
+    python3 "$summary" compare --brief --warmup 20 --small "${smalls[@]}" --large "${larges[@]}"
+    echo
+    echo "######## camera jump over synth4096 at $width × $height ($hold frames at each pose)"
+    python3 "$summary" jump "$out/jump/log.jsonl" --jump-frame "$hold"
+}
+[[ "${IMAGES_ONLY:-0}" == 1 ]] || measure
 
 echo
 echo "== images (640 × 360) into $root/docs"

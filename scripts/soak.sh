@@ -16,7 +16,8 @@
 # flight rose 357 MiB over 5,000 frames that way, and flying the same views twice more added
 # 2.6 MiB: docs/RELIABILITY.md).
 #
-# Environment: FRAMES (10000), LEGS (5), WIDTH × HEIGHT (320 × 180), SOAKS ("nc globe"), DATA_DIR
+# Environment: FRAMES (10000), LEGS (5), WIDTH × HEIGHT (320 × 180), SOAKS ("nc globe"), PLOT_NAME
+# (the plot is docs/soak_<PLOT_NAME>.png; default: the soak's name), DATA_DIR
 # (data/trade: nc/ and the trade's impostors, as scripts/trade.sh builds them; globe/ is built there
 # from ../shared/data/globe when missing).
 set -euo pipefail
@@ -73,6 +74,6 @@ PY
   /usr/bin/time -v "$bin/terramp" fly --dataset "$dataset" --path "$path" --frames "$FRAMES" --save-every 0 \
     --width "$WIDTH" --height "$HEIGHT" --settings "$weather" --out "out/soak/$name" 2> "out/soak/$name/time.txt" \
     || { tail -5 "out/soak/$name/time.txt"; exit 1; }
-  WARM_UP=$((FRAMES / LEGS)) python3 scripts/soak_plot.py "docs/soak_$name.png" "out/soak/$name/log.jsonl" || failed=1
+  WARM_UP=$((FRAMES / LEGS)) python3 scripts/soak_plot.py "docs/soak_${PLOT_NAME:-$name}.png" "out/soak/$name/log.jsonl" || failed=1
 done
 exit "${failed:-0}"

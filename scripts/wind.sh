@@ -14,7 +14,8 @@
 #    ($OUT/strip/crop_N.png), and every other one side by side (docs/wind_strip.png: 0.5 s apart).
 #
 # Environment: WIND, POPPING_FRAMES, STRIP_FRAMES, STRIP_HZ, DATA_DIR (data/trade), OUT (a scratch
-# folder, default /tmp/terramp-wind).
+# folder, default /tmp/terramp-wind), IMAGES_ONLY (1: the strip alone, as scripts/docs_images.sh
+# makes it).
 set -euo pipefail
 
 source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" nc zion models
@@ -31,12 +32,13 @@ cp "$trees" "$still"
 { cat "$trees"; printf '[wind]\nspeed_m_s = %s\n' "$wind"; } >"$windy"
 
 # 1. Popping, still and windy, each against its own truth.
-for name in still windy; do
+[[ "${IMAGES_ONLY:-0}" == 1 ]] && names=() || names=(still windy)
+for name in "${names[@]}"; do
     echo "## popping, $name" >&2
     "$terramp" sweep --dataset "$data/nc" --out "$out/sweep_$name" --presets balanced --frames 4 --warmup 2 \
         --timing-rounds 1 --samples 1 --popping-frames "${POPPING_FRAMES:-12}" --settings "$out/$name.toml"
 done
-python3 - "$out" "$wind" <<'PY'
+[[ "${IMAGES_ONLY:-0}" == 1 ]] || python3 - "$out" "$wind" <<'PY'
 import json, sys
 out, wind = sys.argv[1], sys.argv[2]
 def popping(name):

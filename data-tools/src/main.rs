@@ -1,11 +1,12 @@
 //! `terramp-data`: builds terramp datasets from GeoTIFF (`build`), synthesizes stress datasets
-//! (`synth`), bakes impostors from glTF models (`bake`), generates trees as glTF (`tree`) and
-//! draws models side by side (`preview`). GDAL does the reading and
+//! (`synth`), bakes impostors from glTF models (`bake`), generates trees as glTF (`tree`), draws
+//! models side by side (`preview`) and lays pictures out for the docs' figures (`compose`). GDAL does the reading and
 //! reprojection here, and only here: the runtime crate reads nothing but its own packs. Baking
 //! lives in the library (`terramp::bake`, which the demo also uses): `bake` only parses its
 //! arguments.
 
 mod build;
+mod compose;
 mod models;
 mod plan;
 
@@ -62,6 +63,8 @@ enum Command {
     Tree(models::TreeArgs),
     /// Draw glTF models side by side on one scale, as the baker sees them, into a PNG.
     Preview(models::PreviewArgs),
+    /// Lay pictures out on a grid (cropped, scaled, over a checkerboard), for the figures in docs/.
+    Compose(compose::ComposeArgs),
 }
 
 #[derive(clap::Args)]
@@ -150,6 +153,7 @@ fn main() -> Result<()> {
         Command::Bake(args) => bake(args),
         Command::Tree(args) => models::tree(&args),
         Command::Preview(args) => models::preview(&args),
+        Command::Compose(args) => compose::compose(&args),
         Command::Synth { size, out, seed, imagery_format } => {
             let params = terramp::synth::SynthParams { size, seed, imagery_format, ..Default::default() };
             let dir = terramp::synth::synthesize(&out, &params, true)?;

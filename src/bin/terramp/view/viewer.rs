@@ -245,6 +245,8 @@ impl Viewer {
             if args.quit_after_path {
                 return Ok(false);
             }
+            // Said on stderr too, so a script can wait for it (scripts/docs_images.sh).
+            eprintln!("terramp: path flown");
             self.message = "path flown: the controls are yours".into();
         }
         Ok(true)

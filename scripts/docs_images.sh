@@ -1,0 +1,392 @@
+#!/usr/bin/env bash
+# Every image in docs/, made again from the code, on whatever adapter wgpu picks (lavapipe here).
+# One maker per figure; the table below lists every image the docs show and the maker that writes
+# it (`tests/docs_images.rs` checks that every image docs/*.md and README.md reference exists and
+# is listed here, and that every image under docs/ is listed and referenced).
+#
+#   scripts/docs_images.sh                 # every maker marked `short` (about an hour on 2 cores)
+#   scripts/docs_images.sh nc light        # only these makers
+#   scripts/docs_images.sh --long          # also the long ones (soaks, sweeps: many hours)
+#   scripts/docs_images.sh --list          # the table
+#
+# Makers marked `shared` read ../shared/data (nc/, zion/, rainier/, models/, globe/). The datasets
+# and impostors are built into DATA_DIR (data/trade, as scripts/trade.sh builds them, reused while
+# current); scratch files go to OUT (/tmp/terramp-docs-images). Needs: the release build (made
+# here), python3 with Pillow for `slicings_tree1` and `wind` (pip install pillow), Xvfb, xdotool
+# and xwd for `viewer` (apt-get install xvfb xdotool x11-apps).
+#
+# A new figure in docs/ gets a maker here and a row in the table, in the same commit.
+set -euo pipefail
+
+# image                                   maker              needs    cost
+table="
+docs/nc.png                               nc                 shared   short
+docs/rainier.png                          rainier            shared   short
+docs/synthetic.png                        synthetic          -        short
+docs/demo_generated.png                   demo               -        short
+docs/impostor_pine.png                    impostor_pine      shared   short
+docs/nc_trees.png                         nc_trees           shared   short
+docs/imagery_blocks_synthetic.png         imagery_blocks     shared   short
+docs/imagery_blocks_nc.png                imagery_blocks     shared   short
+docs/cloud_shadows.png                    light              shared   short
+docs/crown_shading.png                    light              shared   short
+docs/seeds_border.png                     seeds_border       shared   short
+docs/slicings_tree1.png                   slicings_tree1     shared   short
+docs/slicings_edge.png                    slicings_edge      shared   short
+docs/slicings_orbit.png                   slicings_figures   shared   short
+docs/slicings_three_ways.png              slicings_figures   shared   short
+docs/texcells_nc.png                      texcells           shared   short
+docs/texcells_nc_2km.png                  texcells           shared   short
+docs/texcells_switch.png                  texcells           shared   short
+docs/texcells_zion_rim.png                texcells           shared   short
+docs/trees_health.png                     trees_health       -        short
+docs/continuous_lod_compare.png           continuous_lod     -        short
+docs/truth_vs_accurate.png                truth_vs_accurate  -        short
+docs/viewer_nc.png                        viewer             shared   short
+docs/wind_strip.png                       wind               shared   short
+docs/flight_0.png                         streaming          -        long
+docs/flight_1.png                         streaming          -        long
+docs/flight_2.png                         streaming          -        long
+docs/flight_3.png                         streaming          -        long
+docs/flight_4.png                         streaming          -        long
+docs/flight_5.png                         streaming          -        long
+docs/flight_jump_before.png               streaming          -        long
+docs/flight_jump_after.png                streaming          -        long
+docs/soak_globe.png                       soak_globe         shared   long
+docs/soak_nc.png                          soak_nc            shared   long
+docs/soak_nc_growth.png                   soak_nc_growth     shared   long
+docs/soak_nc_there_and_back.png           soak_nc_there_and_back shared long
+docs/trade/synthetic/trade.png            trade              shared   long
+docs/trade/nc/trade.png                   trade              shared   long
+docs/trade/zion/trade.png                 trade              shared   long
+docs/trade/continuous_lod/trade.png       trade_continuous_lod shared long
+docs/trade/slicings/trade.png             trade_slicings     shared   long
+docs/texcells/trade.png                   trade_texcells     shared   long
+"
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
+unset RUST_BACKTRACE
+shared="$root/../shared/data"
+data="${DATA_DIR:-data/trade}"
+out="${OUT:-/tmp/terramp-docs-images}"
+
+rows() { grep -v '^\s*$' <<<"$table"; }
+makers_of() { rows | awk -v cost="$1" '$4 == cost || cost == "any" { print $2 }' | awk '!seen[$0]++'; }
+
+long=0 wanted=()
+for arg in "$@"; do
+    case "$arg" in
+        --list) rows; exit 0 ;;
+        --long) long=1 ;;
+        -*) echo "docs_images.sh: unknown option $arg (--list, --long)" >&2; exit 2 ;;
+        *) makers_of any | grep -qx "$arg" || { echo "docs_images.sh: no maker $arg (--list shows them)" >&2; exit 2; }
+           wanted+=("$arg") ;;
+    esac
+done
+if [[ ${#wanted[@]} -eq 0 ]]; then
+    mapfile -t wanted < <(makers_of short)
+    [[ $long == 1 ]] && mapfile -t -O "${#wanted[@]}" wanted < <(makers_of long)
+fi
+for maker in "${wanted[@]}"; do
+    if rows | awk -v m="$maker" '$2 == m && $3 == "shared"' | grep -q . && [[ ! -d "$shared" ]]; then
+        echo "docs_images.sh: $maker needs $shared (the shared data beside the repository)" >&2
+        exit 1
+    fi
+done
+
+mkdir -p "$out" "$data"
+cargo build --release --workspace -q
+terramp="${CARGO_TARGET_DIR:-$root/target}/release/terramp"
+terramp_data="${CARGO_TARGET_DIR:-$root/target}/release/terramp-data"
+compose() { "$terramp_data" compose "$@"; }
+
+# The trade's datasets (nc, zion, the synthetic default) and the 11 shared models' impostors.
+trade_data_ready=0
+trade_data() {
+    [[ $trade_data_ready == 1 ]] && return
+    # shellcheck source=scripts/trade_data.sh
+    source scripts/trade_data.sh
+    trade_data_ready=1
+}
+
+# A settings layer: layer NAME LINES... (each a TOML line) into $out/NAME.toml; echoes its path.
+layer() {
+    local name="$1"
+    shift
+    printf '%s\n' "# Written by scripts/docs_images.sh." "$@" >"$out/$name.toml"
+    echo "$out/$name.toml"
+}
+
+# The nc table's forest samples (texcells) beside the trade's impostors, as texcells_truth.sh does.
+forest_ready=0
+forest() {
+    [[ $forest_ready == 1 ]] && return
+    trade_data
+    forest="$data/forest"
+    if [[ ! -d "$forest/texcells/5" ]]; then
+        rm -rf "$forest"
+        cp -r "$impostors" "$forest"
+        "$terramp_data" bake --classes nc --models "$shared/models" --out "$forest" >/dev/null
+    fi
+    forest_ready=1
+}
+
+# The shared models baked with their slicings (6 × 5), as slicings_trade.sh does (at 1024 texels).
+sliced_ready=0
+sliced() {
+    [[ $sliced_ready == 1 ]] && return
+    trade_data
+    sliced="$data/sliced-1024"
+    if [[ ! -f "$sliced/Tree_1/slicing_mip0.png" ]]; then
+        local args=()
+        for m in "${models[@]}"; do args+=(--model "$shared/models/$m.glb"); done
+        "$terramp_data" bake "${args[@]}" --out "$sliced" --texels 1024 --slicings 6x5 >/dev/null
+    fi
+    sliced_ready=1
+}
+
+# The demo's dataset and generated trees (data/default, data/impostors), as `terramp demo` makes them.
+demo_ready=0
+demo_data() {
+    [[ $demo_ready == 1 ]] && return
+    rm -rf "$out/demo"
+    "$terramp" demo --out "$out/demo" >"$out/demo.log"
+    demo_ready=1
+}
+
+render() { "$terramp" render "$@" >/dev/null; }
+
+# views NAME DATASET CAMERA WIDTHxHEIGHT LAYER...: the view rendered once per settings layer, into
+# $out/NAME_<layer>.png; the files, in order, are left in the array `shots`.
+views() {
+    local name="$1" dataset="$2" camera="$3" size="$4" layer
+    shift 4
+    shots=()
+    for layer in "$@"; do
+        shots+=("$out/${name}_$(basename "$layer" .toml).png")
+        render --dataset "$dataset" --camera "$camera" --width "${size%x*}" --height "${size#*x}" \
+            --settings "$layer" --out "${shots[-1]}"
+    done
+}
+
+make_nc() {
+    trade_data
+    render --dataset "$data/nc" --camera 634000,212500,4200,5,-32 --width 960 --height 540 --preset accurate \
+        --out docs/nc.png
+}
+
+make_rainier() {
+    if ! "$terramp" info --dataset "$data/rainier" >/dev/null 2>&1; then
+        "$terramp_data" build --dem "$shared/rainier/mt_rainier_90m.tif" --out "$data/rainier" >/dev/null
+    fi
+    render --dataset "$data/rainier" --camera -8000,16000,2600,337,-3 --width 960 --height 540 --preset accurate \
+        --out docs/rainier.png
+}
+
+make_synthetic() {
+    # The embedded default's ground alone (no seeds), over the fields towards the lake.
+    demo_data
+    render --dataset data/default --camera 4000,4500,350,50,-8 --width 1280 --height 720 \
+        --settings "$(layer ground '[seeds]' 'density_scale = 0.0')" --out docs/synthetic.png
+}
+
+make_demo() {
+    demo_data
+    cp "$out/demo/frame_0009.png" docs/demo_generated.png
+}
+
+make_impostor_pine() {
+    "$terramp_data" bake --model "$shared/models/Pine_1.glb" --out "$out/pine" >/dev/null
+    compose --checker 16 --gap 8 --out docs/impostor_pine.png "$out"/pine/Pine_1/lod{0,1,2}_mip1.png
+}
+
+make_nc_trees() {
+    cargo test --release -q -p terramp-data-tools --test draw_seeds -- --ignored >/dev/null
+}
+
+make_imagery_blocks() {
+    trade_data
+    local format
+    for format in bc7 bc1; do
+        "$terramp" info --dataset "$data/synthetic_$format" >/dev/null 2>&1 ||
+            "$terramp_data" synth --size 1024 --imagery-format "$format" --out "$data/synthetic_$format" >/dev/null
+        "$terramp" info --dataset "$data/nc_$format" >/dev/null 2>&1 ||
+            "$terramp_data" build --dem "$shared/nc/elev_ned_30m.tif" --imagery "$shared/nc/landsat_multiband.tif" \
+                --bands 3,2,1 --landcover "$shared/nc/landuse_r.tif" --classes nc --imagery-format "$format" \
+                --out "$data/nc_$format" >/dev/null
+    done
+    FRAMES=8 OUT="$out/blocks" cargo bench -q --bench imagery_formats -- config/paths/default.toml \
+        "$data/synthetic" "$data/synthetic_bc7" "$data/synthetic_bc1" >/dev/null
+    FRAMES=8 OUT="$out/blocks" cargo bench -q --bench imagery_formats -- config/paths/nc.toml \
+        "$data/nc" "$data/nc_bc7" "$data/nc_bc1" >/dev/null
+    cp "$out/blocks/synthetic_crops.png" docs/imagery_blocks_synthetic.png
+    cp "$out/blocks/nc_crops.png" docs/imagery_blocks_nc.png
+}
+
+make_light() {
+    forest
+    local impostors_line="impostors = \"$(cd "$forest" && pwd)\""
+    local clear cloudy flat shaded
+    clear=$(layer clear '[draw_seeds]' "$impostors_line")
+    cloudy=$(layer cloudy '[draw_seeds]' "$impostors_line" '[clouds]' 'coverage = 0.4')
+    views clouds "$data/nc" 631000,215500,2000,40,-12 960x540 "$clear" "$cloudy"
+    compose --columns 1 --scale 0.75 --out docs/cloud_shadows.png "${shots[@]}"
+    # Crown shading 0.5 on every species of the nc table.
+    awk '/^\[\[species\]\]/ { print; print "crown_shading = 0.5"; next } !/^crown_shading/ { print }' \
+        config/classes/nc.toml >"$out/nc_shaded.toml"
+    flat=$(layer flat '[draw_seeds]' "$impostors_line")
+    shaded=$(layer shaded '[seeds]' "class_table = \"$out/nc_shaded.toml\"" '[draw_seeds]' "$impostors_line")
+    views crowns "$data/nc" 636500,216500,125,20,-6 960x540 "$flat" "$shaded"
+    compose --columns 1 --scale 0.75 --out docs/crown_shading.png "${shots[@]}"
+}
+
+make_seeds_border() {
+    rm -rf "$out/spacing" && mkdir -p "$out/spacing"
+    TERRAMP_SPACING_PNG="$out/spacing" cargo test --release -q -p terramp-data-tools --test seed_spacing >/dev/null
+    compose --gap 6 --out docs/seeds_border.png "$out"/spacing/seeds_border_{nc,zion}.png
+}
+
+make_slicings_tree1() {
+    python3 -c 'import PIL' 2>/dev/null || { echo "slicings_tree1 needs Pillow: pip install pillow" >&2; return 1; }
+    "$terramp_data" bake --model "$shared/models/Tree_1.glb" --out "$out/sl" --slicings 6x5 >/dev/null
+    python3 scripts/slices_figure.py "$out/sl/Tree_1" 0 docs/slicings_tree1.png
+}
+
+make_slicings_edge() {
+    sliced
+    local impostors_line="impostors = \"$(cd "$sliced" && pwd)\""
+    local lod1_from_0='reach_m = [0.0, 1000.0, 1400.0, 3000.0]'
+    views edge "$data/nc" 636500,216500,125,20,-6 960x540 "$(layer meshes '[draw_seeds]' "$impostors_line")" \
+        "$(layer clouds '[draw_seeds]' "$impostors_line" "$lod1_from_0")" \
+        "$(layer slices '[draw_seeds]' "$impostors_line" "$lod1_from_0" 'slicings = true')"
+    compose --columns 1 --scale 0.75 --out docs/slicings_edge.png "${shots[@]}"
+}
+
+make_slicings_figures() {
+    cargo test --release -q --test slicings -- --ignored >/dev/null
+    cargo test --release -q --test slicings_views -- --ignored >/dev/null
+}
+
+make_texcells() {
+    forest
+    # texcells_nc.png: the frames of data-tools/tests/texcells.rs (written to its target tmpdir).
+    cargo test --release -q -p terramp-data-tools --test texcells nc_texcells_cover_the_far_forest_and_no_water \
+        >/dev/null
+    local shots="${CARGO_TARGET_DIR:-$root/target}/tmp"
+    compose --columns 1 --gap 0 --out docs/texcells_nc.png "$shots"/texcells_nc_{without,with}.png
+    local impostors_line="impostors = \"$(cd "$forest" && pwd)\""
+    local with without
+    without=$(layer without '[draw_seeds]' "$impostors_line" '[texcells]' 'reach_m = 0.0')
+    with=$(layer with '[draw_seeds]' "$impostors_line")
+    # The forest past the last clouds: a 640 × 200 crop at 1.5×.
+    views switch "$data/nc" 636500,216500,350,20,-8 1280x720 "$without" "$with"
+    compose --columns 1 --crop 320,230,640,200 --scale 1.5 --gap 4 --out docs/texcells_switch.png "${shots[@]}"
+    views nc2km "$data/nc" 631000,215500,2000,40,-12 1280x720 "$without" "$with"
+    compose --columns 1 --scale 0.75 --gap 4 --out docs/texcells_nc_2km.png "${shots[@]}"
+    views zion "$data/zion" 316900,4136000,2600,0,-6 1280x720 "$without" "$with"
+    compose --columns 1 --scale 0.75 --gap 4 --out docs/texcells_zion_rim.png "${shots[@]}"
+}
+
+make_trees_health() {
+    mkdir -p "$out/trees"
+    local args=() health species
+    for health in 1.0 0.5 0.1; do
+        for species in spruce pine birch broadleaf bush; do
+            "$terramp_data" tree --species "$species" --seed 7 --health "$health" \
+                --out "$out/trees/$species-$health.glb" >/dev/null
+            args+=(--model "$out/trees/$species-$health.glb")
+        done
+    done
+    "$terramp_data" preview "${args[@]}" --columns 5 --cell 200,300 --out docs/trees_health.png >/dev/null
+}
+
+make_continuous_lod() {
+    demo_data
+    local trees=('[seeds]' 'class_table = "nc-generated"' '[draw_seeds]' "impostors = \"$root/data/impostors\"")
+    views continuous data/default 4000,4500,350,50,-8 1280x720 "$(layer off "${trees[@]}" 'continuous_lod = false')" \
+        "$(layer on "${trees[@]}" 'continuous_lod = true')"
+    compose --crop 640,300,320,180 --scale 2 --filter nearest --gap 0 --out docs/continuous_lod_compare.png \
+        "${shots[@]}"
+}
+
+make_truth_vs_accurate() {
+    demo_data
+    local pose=4000,4500,350,50,-8
+    local trees
+    trees=$(layer truth_trees '[seeds]' 'class_table = "nc-generated"' '[draw_seeds]' \
+        "impostors = \"$root/data/impostors\"")
+    "$terramp" truth --dataset data/default --camera "$pose" --preset accurate --impostors data/impostors \
+        --settings "$trees" --out "$out/truth_ss4" >/dev/null
+    "$terramp" truth --dataset data/default --camera "$pose" --preset accurate --impostors data/impostors \
+        --settings "$trees" --supersample 1 --out "$out/truth_ss1" >/dev/null
+    render --dataset data/default --camera "$pose" --preset accurate --settings "$trees" --out "$out/accurate.png"
+    # Top: the truth (4 × 4) and the accurate frame; bottom: the FLIP maps against the truth of the
+    # truth at one sample per pixel and of the accurate frame (the means are printed).
+    compose --gap 0 --out "$out/tva_top.png" "$out/truth_ss4/truth.png" "$out/accurate.png"
+    compose --gap 0 --flip-reference "$out/truth_ss4/truth.png" --out "$out/tva_bottom.png" \
+        "$out/truth_ss1/truth.png" "$out/accurate.png"
+    compose --columns 1 --gap 0 --crop 320,240,1280,660 --scale 0.375 --out docs/truth_vs_accurate.png \
+        "$out/tva_top.png" "$out/tva_bottom.png"
+}
+
+make_viewer() {
+    forest
+    for tool in Xvfb xdotool xwd; do
+        command -v "$tool" >/dev/null || { echo "viewer needs $tool: apt-get install xvfb xdotool x11-apps" >&2; return 1; }
+    done
+    local display=":$((90 + RANDOM % 9))"
+    Xvfb "$display" -screen 0 1280x720x24 -nolisten tcp >/dev/null 2>&1 &
+    local xvfb=$!
+    sleep 2
+    local view="$out/viewer.toml"
+    layer viewer '[draw_seeds]' "impostors = \"$(cd "$forest" && pwd)\"" >/dev/null
+    DISPLAY="$display" "$terramp" view --dataset "$data/nc" --settings "$view" --path config/paths/nc.toml \
+        --path-frames 40 --width 1280 --height 720 --out "$out/view" 2>"$out/viewer.log" &
+    local viewer=$!
+    local waited=0
+    until grep -q "path flown" "$out/viewer.log"; do
+        sleep 2
+        waited=$((waited + 2))
+        if [[ $waited -gt 1800 ]] || ! kill -0 "$viewer" 2>/dev/null; then
+            kill "$viewer" "$xvfb" 2>/dev/null || true
+            echo "viewer: the path was never flown (see $out/viewer.log)" >&2
+            return 1
+        fi
+    done
+    sleep 10 # the last view's tiles and seeds settle; the overlay's graphs fill
+    local id
+    id=$(DISPLAY="$display" xdotool search --sync --name terramp | head -1)
+    DISPLAY="$display" xwd -id "$id" -silent >"$out/viewer.xwd"
+    kill "$viewer" "$xvfb" 2>/dev/null || true
+    wait "$viewer" "$xvfb" 2>/dev/null || true
+    compose --out docs/viewer_nc.png "$out/viewer.xwd"
+}
+
+make_wind() {
+    IMAGES_ONLY=1 OUT="$out/wind" DATA_DIR="$data" scripts/wind.sh
+}
+
+make_streaming() {
+    IMAGES_ONLY=1 scripts/measure_streaming.sh "$out/streaming"
+}
+
+make_soak_globe() { FRAMES=10000 SOAKS=globe DATA_DIR="$data" scripts/soak.sh; }
+make_soak_nc() { FRAMES=10000 SOAKS=nc DATA_DIR="$data" scripts/soak.sh; }
+# The one-way flight and the flight there, back and there again of docs/RELIABILITY.md's soak section.
+make_soak_nc_growth() { FRAMES=5000 LEGS=1 SOAKS=nc PLOT_NAME=nc_growth DATA_DIR="$data" scripts/soak.sh; }
+make_soak_nc_there_and_back() {
+    FRAMES=900 LEGS=3 SOAKS=nc PLOT_NAME=nc_there_and_back DATA_DIR="$data" scripts/soak.sh
+}
+make_trade() { DATA_DIR="$data" scripts/trade.sh; }
+make_trade_continuous_lod() { DATA_DIR="$data" scripts/continuous_lod.sh; }
+make_trade_slicings() { DATA_DIR="$data" scripts/slicings_trade.sh; }
+make_trade_texcells() { DATA_DIR="$data" scripts/texcells_truth.sh; }
+
+for maker in "${wanted[@]}"; do
+    started=$SECONDS
+    echo "docs_images.sh: $maker ..." >&2
+    "make_$maker"
+    echo "docs_images.sh: $maker: $(rows | awk -v m="$maker" '$2 == m { printf "%s ", $1 }')($((SECONDS - started)) s)" >&2
+done
