@@ -10,6 +10,7 @@ use glam::Vec3;
 use terramp::bake::{BakeOptions, SlicingOptions, bake_models};
 use terramp::impostor::slicing::orientation;
 use terramp::impostor::{Impostor, MipChain, Plane, load};
+use terramp::reference::slicing::{BlendError, blend_views};
 use terramp_testkit::{TempDir, shared_data};
 
 const OPTIONS: SlicingOptions = SlicingOptions { orientations: 6, slices: 5 };
@@ -110,7 +111,7 @@ fn crowns_are_sliced_trunks_stay_meshes_and_every_crown_vertex_shows_in_a_slicin
 /// A frame of the synthetic forest from 30 m up, with every seed near enough drawn as LOD 1 (no
 /// meshes), by `impostors` (or none), with slicings on or off.
 fn lod1_frame(dir: &std::path::Path, impostors: &str, slicings: bool, brightness: f64) -> image::RgbaImage {
-    let mut s = terramp_testkit::small_settings(320, 180);
+    let mut s = terramp_testkit::small_settings(LOD1_FRAME_PX[0] as u32, LOD1_FRAME_PX[1] as u32);
     s.draw_seeds.impostors = impostors.to_owned();
     s.draw_seeds.reach_m = [0.0, 1000.0, 1400.0, 3000.0];
     s.draw_seeds.slicings = slicings;
@@ -134,22 +135,67 @@ fn slicings_draw_lod_1_where_the_clouds_would_with_their_trunks() {
     };
     let (by_clouds, by_slices, by_uncorrected) = (trees(&clouds), trees(&slices), trees(&uncorrected));
     let count = |mask: &[bool]| mask.iter().filter(|&&t| t).count();
+    let (clouds_px, slices_px) = (count(&by_clouds), count(&by_slices));
     let both = by_clouds.iter().zip(&by_slices).filter(|&(&a, &b)| a && b).count();
     let either = by_clouds.iter().zip(&by_slices).filter(|&(&a, &b)| a || b).count();
     println!(
-        "tree pixels: 17-plane clouds {}, slicings {} ({} without the brightness correction); both {both} of either {either}",
-        count(&by_clouds),
-        count(&by_slices),
+        "tree pixels: 17-plane clouds {clouds_px}, slicings {slices_px} ({} without the brightness correction); both {both} of either {either}",
         count(&by_uncorrected)
     );
-    assert!(count(&by_clouds) > 3000, "too few trees to judge");
-    // The same trees, drawn otherwise: they cover much the same pixels.
-    let ratio = count(&by_slices) as f64 / count(&by_clouds) as f64;
-    assert!((0.6..1.6).contains(&ratio), "slicings cover {ratio:.2} of the clouds' pixels");
-    assert!(both * 2 > either, "slicings and clouds share only {both} of {either} tree pixels");
+    assert!(clouds_px > 3000, "too few trees to judge");
+    // The same trees, drawn otherwise, cover much the same pixels: measured 0.950 of the clouds'
+    // pixels, 0.895 of either's shared, on lavapipe. The margins (±0.02, 0.015: some 300 pixels)
+    // are for other rasterisers' texture filtering at the alpha cutoff, not for a change in what
+    // is drawn: the crowns a pixel fatter or thinner all round (0.72, 1.14), or the trees a pixel
+    // to the side (0.866), fail them.
+    let ratio = |mask: &[bool]| count(mask) as f64 / clouds_px as f64;
+    let shared = |mask: &[bool]| {
+        let both = by_clouds.iter().zip(mask).filter(|&(&a, &b)| a && b).count();
+        both as f64 / by_clouds.iter().zip(mask).filter(|&(&a, &b)| a || b).count() as f64
+    };
+    let coverage_ok = |mask: &[bool]| (0.93..0.97).contains(&ratio(mask));
+    let overlap_ok = |mask: &[bool]| shared(mask) >= 0.88;
+    assert!(coverage_ok(&by_slices), "slicings cover {:.3} of the clouds' pixels", ratio(&by_slices));
+    assert!(
+        overlap_ok(&by_slices),
+        "slicings and clouds share {:.3} of either's tree pixels",
+        shared(&by_slices)
+    );
+    let (fatter, thinner, aside) = (grown(&by_slices), shrunk(&by_slices), to_the_side(&by_slices));
+    println!(
+        "controls: crowns a pixel fatter cover {:.3}, thinner {:.3}; the trees a pixel aside share {:.3}",
+        ratio(&fatter),
+        ratio(&thinner),
+        shared(&aside)
+    );
+    assert!(
+        !coverage_ok(&fatter) && !coverage_ok(&thinner) && !overlap_ok(&aside),
+        "the bounds let a pixel's error pass"
+    );
     // The correction makes up for the blend's thinning: more of each crown shows with it.
-    assert!(count(&by_slices) > count(&by_uncorrected), "the brightness correction changed nothing");
+    assert!(slices_px > count(&by_uncorrected), "the brightness correction changed nothing");
     assert_ne!(slices, clouds);
+}
+
+/// Side of the frames of `lod1_frame`, pixels.
+const LOD1_FRAME_PX: [usize; 2] = [320, 180];
+
+/// `mask` (a `LOD1_FRAME_PX` frame's pixels, row by row) grown by a pixel all round.
+fn grown(mask: &[bool]) -> Vec<bool> {
+    let [w, h] = LOD1_FRAME_PX.map(|n| n as i64);
+    let at = |x: i64, y: i64| x >= 0 && y >= 0 && x < w && y < h && mask[(y * w + x) as usize];
+    (0..w * h).map(|i| (-1..=1).any(|dy| (-1..=1).any(|dx| at(i % w + dx, i / w + dy)))).collect()
+}
+
+/// `mask` shrunk by a pixel all round: its holes grown.
+fn shrunk(mask: &[bool]) -> Vec<bool> {
+    grown(&mask.iter().map(|m| !m).collect::<Vec<_>>()).into_iter().map(|m| !m).collect()
+}
+
+/// `mask` moved a pixel to the right.
+fn to_the_side(mask: &[bool]) -> Vec<bool> {
+    let w = LOD1_FRAME_PX[0];
+    (0..mask.len()).map(|i| i % w > 0 && mask[i - 1]).collect()
 }
 
 #[test]
@@ -159,29 +205,41 @@ fn the_stochastic_blend_keeps_the_sorted_blends_picture_over_its_dither() {
     let options = BakeOptions { texels: 1024, slicing: Some(OPTIONS), ..Default::default() };
     bake_models(None, &[shared.join("models/Tree_1.glb")], out.path(), &options, false).unwrap();
     let tree = load(out.path(), "Tree_1").unwrap();
-    let mut errors = Vec::new();
-    for degrees in [0.0f32, 10.0, 20.0, 29.0] {
+    // docs/slicings.md's table: degrees off slicing 0, the mean difference per block (levels of
+    // 255) and the coverage against the sorted blend's. The model is f32 arithmetic that gives
+    // the same figures on every run; the margins (0.02 levels, 0.002) are for another platform's
+    // trigonometry (std's sin, cos and atan2 are its libm's), which may flip a texel at a slice's
+    // edge. Leaving the brightness correction out of the stochastic blend fails them.
+    const TABLE: [(f32, f64, f64); 4] =
+        [(0.0, 0.0, 1.0), (10.0, 3.97, 1.005), (20.0, 5.64, 1.016), (29.0, 6.53, 1.021)];
+    for (degrees, mean_abs, coverage_ratio) in TABLE {
         let a = degrees.to_radians();
         let eye = Vec3::new(a.cos(), 0.2, a.sin());
-        let e = terramp::reference::slicing::blend_error(&tree, eye, 0.5, 0).unwrap();
+        let views = blend_views(&tree, eye, 0.5, 0).unwrap();
+        let e = BlendError::between(&views.sorted, &views.stochastic);
+        // The control: pass 4 without the correction, against the paper's blend with it.
+        let uncorrected =
+            BlendError::between(&views.sorted, &blend_views(&tree, eye, 0.0, 0).unwrap().stochastic);
         println!(
-            "{degrees:>4}° from slicing 0: {:.2} levels of 255 per 4 × 4 block over {} blocks, coverage {:.3} of the sorted blend's",
-            e.mean_abs, e.blocks, e.coverage_ratio
+            "{degrees:>4}° from slicing 0: {:.4} levels of 255 per 4 × 4 block over {} blocks, coverage {:.4} of the sorted blend's; uncorrected {:.4}, {:.4}",
+            e.mean_abs, e.blocks, e.coverage_ratio, uncorrected.mean_abs, uncorrected.coverage_ratio
         );
-        errors.push(e);
-    }
-    // On an orientation one slicing is drawn, opaque: both blends are its nearest texels.
-    assert_eq!(errors[0].mean_abs, 0.0);
-    assert!((errors[0].coverage_ratio - 1.0).abs() < 1e-9);
-    for e in &errors[1..] {
-        assert!(e.blocks > 100 && e.mean_abs > 0.0, "{e:?}");
-        assert!(e.mean_abs < 15.0 && (0.9..1.1).contains(&e.coverage_ratio), "{e:?}");
+        let as_table = |e: &BlendError| {
+            (e.mean_abs - mean_abs).abs() <= 0.02 && (e.coverage_ratio - coverage_ratio).abs() <= 0.002
+        };
+        assert!(e.blocks > 250, "{degrees}°: the crown is hardly in view: {e:?}");
+        assert!(as_table(&e), "{degrees}°: {e:?}, the table says {mean_abs}, {coverage_ratio}");
+        // On an orientation one slicing is drawn, opaque, and the correction is 1: nothing to
+        // leave out.
+        if degrees > 0.0 {
+            assert!(!as_table(&uncorrected), "{degrees}°: the uncorrected blend passes: {uncorrected:?}");
+        }
     }
 }
 
 /// The figure of docs/slicings.md: Tree_1's crown seen from 0° to 60° off slicing 0 (its slices
 /// facing +X) in 10° steps, 0.2 above the horizon: the paper's sorted blend above, pass 4's
-/// stochastic one below, over grey. `cargo test --release --test slicings -- --ignored`.
+/// stochastic one below, over grey. `cargo test --test slicings -- --ignored`.
 #[test]
 #[ignore = "writes docs/slicings_orbit.png"]
 fn orbit_figure() {
