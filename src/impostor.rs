@@ -30,8 +30,10 @@
 //!   with a checksum; `material{K}_mip{M}.png`: material K's base-colour texture, same conventions
 //!   as the atlases (alpha-masked leaf textures get coverage-preserving mips too).
 //!
-//! [`save`] writes a model's folder beside its final place and renames it into place, so a folder
-//! is either the previous complete impostor or the new one. A folder of another format version is
+//! [`save`] writes a model's folder beside its final place and puts it in place (`crate::publish`),
+//! so a folder is the previous complete impostor or the new one (or, only where the file system
+//! cannot exchange two folders and the baker was killed between the fallback's renames, absent
+//! until the next bake there puts the previous one back). A folder of another format version is
 //! reported as such ([`ImpostorError::Version`]): bake it again.
 
 pub mod detail;

@@ -3,8 +3,8 @@
 //! for GeoTIFF inputs also the DEM's scan and the imagery's stretch, `build::parts`) in a TOML
 //! file with a hash of all of it, and lists each partition's subtrees and input window.
 //! `build --plan P --partition i` writes partition `i`'s part packs into a hidden folder beside
-//! the others and renames it into place with a receipt (the plan's hash, time, peak memory) only
-//! when complete: a killed job leaves nothing that counts, and a partition whose receipt carries
+//! the others and puts it in place (`terramp::publish`) with a receipt (the plan's hash, time, peak
+//! memory) only when complete: a killed job leaves nothing that counts, and a partition whose receipt carries
 //! the plan's hash is skipped, so rerunning every job resumes a build. `merge --plan P --out D`
 //! checks every receipt and assembles the dataset atomically (`terramp::synth::SynthParts`).
 
@@ -311,16 +311,11 @@ pub fn build_partition(plan_path: &Path, part: u32) -> Result<()> {
         println!("partition {part}/{n}: already built for this plan, skipped");
         return Ok(());
     }
-    fs::create_dir_all(&parts).with_context(|| format!("creating {}", parts.display()))?;
-    let prefix = format!(".part-{part:05}.partial-");
-    for entry in fs::read_dir(&parts)?.flatten() {
-        if entry.file_name().to_string_lossy().starts_with(&prefix) {
-            // A killed earlier job for this partition: only one runs per partition at a time.
-            let _ = fs::remove_dir_all(entry.path());
-        }
-    }
-    let staging = parts.join(format!("{prefix}{}", std::process::id()));
-    fs::create_dir_all(&staging).with_context(|| format!("creating {}", staging.display()))?;
+    let done = part_dir(&parts, part);
+    // Sweeps what a killed earlier job for this partition left: only one runs per partition at a
+    // time.
+    let staging = terramp::publish::begin_staging(&done)
+        .map_err(|(path, e)| anyhow::Error::new(e).context(format!("preparing {}", path.display())))?;
     plan.open(plan_path)?.write_part(&staging, part, std::io::stderr().is_terminal())?;
     let receipt = Receipt {
         hash: plan.hash.clone(),
@@ -330,13 +325,8 @@ pub fn build_partition(plan_path: &Path, part: u32) -> Result<()> {
     };
     fs::write(staging.join(RECEIPT_FILE), toml::to_string(&receipt)?)?;
     sync_folder(&staging)?;
-    let done = part_dir(&parts, part);
-    let old = parts.join(format!("{prefix}{}-old", std::process::id()));
-    if done.exists() {
-        fs::rename(&done, &old).with_context(|| format!("moving aside {}", done.display()))?;
-    }
-    fs::rename(&staging, &done).with_context(|| format!("publishing {}", done.display()))?;
-    let _ = fs::remove_dir_all(&old);
+    terramp::publish::publish(&staging, &done)
+        .map_err(|(path, e)| anyhow::Error::new(e).context(format!("publishing {}", path.display())))?;
     println!(
         "partition {part}/{n}: built in {:.1} s, peak RSS {:.0} MiB, {:.1} MiB of parts",
         receipt.seconds,

@@ -1,10 +1,12 @@
 //! How it works: a dataset is built in a hidden sibling folder (`.NAME.partial-PID`) and put in
 //! place (`crate::publish`: exchanged with the previous dataset in one step) only once every pack
-//! and the manifest are written and synced. A build that fails or is dropped removes its staging
-//! folder; one that is killed leaves only that hidden folder (or, killed just after the exchange,
-//! the previous dataset under that name), which the next build in the same place sweeps away.
-//! `DIR` is therefore either absent, the previous complete dataset, or the new complete one: never
-//! half of anything (`data-tools/tests/kill9.rs` kills builds anywhere and checks it).
+//! and the manifest are written and the manifest synced. A build that fails or is dropped removes
+//! its staging folder; one that is killed leaves hidden folders beside `DIR` (its staging folder,
+//! or the previous dataset once it has been exchanged out), which the next build in the same place
+//! sweeps away. `DIR` is therefore the previous complete dataset or the new complete one, or (only
+//! where the exchange is unavailable, killed between the fallback's two renames) absent until the
+//! next build there puts the previous one back: never half of anything. `data-tools/tests/kill9.rs`
+//! kills `synth` and `build` at each step of `crate::publish::Step` and checks it.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -51,11 +53,9 @@ impl Staging {
         let manifest_path = self.staging.join(MANIFEST_FILE);
         fs::write(&manifest_path, text).map_err(io(&manifest_path))?;
         fs::File::open(&manifest_path).and_then(|f| f.sync_all()).map_err(io(&manifest_path))?;
-        let old = crate::publish::swap_into_place(&self.staging, &self.out).map_err(io(&self.out))?;
+        crate::publish::publish(&self.staging, &self.out)
+            .map_err(|(path, source)| DatasetError::Io { path, source })?;
         self.committed = true;
-        if let Some(old) = old {
-            fs::remove_dir_all(&old).map_err(io(&old))?;
-        }
         Ok(self.out.clone())
     }
 }

@@ -1,5 +1,6 @@
 //! How it works: `save` writes a model's folder under a hidden name beside its final place
-//! (`.NAME.partial-PID`), then renames it into place, so `DIR/NAME` is always a complete impostor.
+//! (`.NAME.partial-PID`), then puts it in place (`crate::publish`), so `DIR/NAME` is never a
+//! half-written impostor.
 //! `load` reads the manifest's version alone first, then the manifest, every PNG (checking each
 //! mip's size) and the mesh (checksummed), and checks the whole for consistency before handing it
 //! out, so a draw pass never uploads a half-valid model.
@@ -31,8 +32,9 @@ pub fn save(dir: &Path, impostor: &Impostor) -> Result<PathBuf, ImpostorError> {
 
 /// Makes `out` the folder `fill` writes, atomically: `fill` writes into a hidden folder beside it
 /// (`.NAME.partial-PID`, removed if `fill` fails), which then takes the place of the old `out` in
-/// one step (`crate::publish`), the old one removed last, so `out` is always whole. Hidden folders
-/// that killed runs left beside `out` are swept first. `io` names a failing path.
+/// one step (`crate::publish`, which says when the name may be briefly empty), the old one removed
+/// last, so `out` is never half-written. Hidden folders that killed runs left beside `out` are
+/// swept first. `io` names a failing path.
 pub fn replace_folder<E>(
     out: &Path,
     fill: impl FnOnce(&Path) -> Result<(), E>,
@@ -43,10 +45,7 @@ pub fn replace_folder<E>(
         let _ = fs::remove_dir_all(&staging);
         return Err(e);
     }
-    if let Some(old) = crate::publish::swap_into_place(&staging, out).map_err(|e| io(out, e))? {
-        fs::remove_dir_all(&old).map_err(|e| io(&old, e))?;
-    }
-    Ok(())
+    crate::publish::publish(&staging, out).map_err(|(path, e)| io(&path, e))
 }
 
 fn write_all(folder: &Path, impostor: &Impostor) -> Result<(), ImpostorError> {

@@ -1,5 +1,5 @@
 //! How it works: `save` writes a sample's folder under a hidden name beside its final place, then
-//! renames it into place, so `<dir>/texcells/<code>` is always whole. `load` reads the manifest's
+//! puts it in place (`crate::publish`), so `<dir>/texcells/<code>` is never half-written. `load` reads the manifest's
 //! version alone first (another version is refused as such, not as a malformed file), then the
 //! manifest, then the images, checking their checksum and that every image the manifest lists is
 //! where and as large as it says, and that the levels have the shapes the pyramid gives them.

@@ -2,7 +2,8 @@
 //! and `depth.f32` (per sample, top row first, little-endian `u32` ids and `f32` reversed-Z
 //! depths), `seeds.csv` (one row per seed drawn: its id, identity, species, place, size and the
 //! samples showing it) and `truth.json` (sizes, supersampling, counts). The folder is written
-//! beside its final place and renamed into it, so it is either the previous truth or the new one.
+//! beside its final place and put in place by `crate::publish`, so it is never half-written: the
+//! earlier truth or the new one (or briefly absent where the exchange is unavailable).
 
 use std::fmt::Write as _;
 use std::io;
@@ -41,12 +42,7 @@ struct Meta<'a> {
 impl Truth {
     /// Writes the truth into folder `dir` (replacing it whole).
     pub fn write(&self, dir: &Path) -> io::Result<()> {
-        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        std::fs::create_dir_all(parent)?;
-        let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&staging);
-        std::fs::create_dir_all(&staging)?;
+        let staging = crate::publish::begin_staging(dir).map_err(|(_, e)| e)?;
         self.colour.save(staging.join(IMAGE_FILE)).map_err(io::Error::other)?;
         std::fs::write(staging.join(SEED_IDS_FILE), bytemuck::cast_slice(&self.seed_ids))?;
         std::fs::write(staging.join(DEPTH_FILE), bytemuck::cast_slice(&self.depth))?;
@@ -80,7 +76,6 @@ impl Truth {
         };
         let json = serde_json::to_string_pretty(&meta).map_err(io::Error::other)?;
         std::fs::write(staging.join(META_FILE), json + "\n")?;
-        let _ = std::fs::remove_dir_all(dir);
-        std::fs::rename(&staging, dir)
+        crate::publish::publish(&staging, dir).map_err(|(_, e)| e)
     }
 }
