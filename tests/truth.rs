@@ -37,6 +37,17 @@ const RIDGE_DATASET: (u32, u64) = (512, 1);
 const RIDGE_IMAGE_PX: [u32; 2] = [96, 54];
 /// The tree hidden behind the ridge, metres.
 const TREE_M: f64 = 15.0;
+/// Least share of samples on which the truth and the CPU agree on what they show: only samples on
+/// an edge may differ (the GPU's coverage rule and its filtered, mipmapped alpha against the
+/// CPU's nearest texel), 0.5 % of all.
+const MIN_SAMPLES_AGREEING: f64 = 0.995;
+/// Least intersection over union of each seed's samples, truth against CPU: a seed covers the same
+/// samples bar its outline, and the smallest (a 1.2 m rock 9 m away) has few samples inside it.
+const MIN_SEED_IOU: f64 = 0.85;
+/// Where both show the terrain, its depths agree to f32 rounding of camera-relative positions.
+const DEPTH_TOLERANCE_REL: f64 = 1e-4;
+/// Least share of those samples within it: a sample on a triangle's edge may take the other's.
+const MIN_DEPTHS_AGREEING: f64 = 0.995;
 
 fn impostors() -> Option<&'static Path> {
     terramp_testkit::nc_impostors()
@@ -75,10 +86,19 @@ fn truth_of(r: &Renderer, camera: &Camera, seeds: Vec<OracleSeed>) -> Truth {
     draw_truth(r, camera, seeds, impostors().unwrap(), SUPERSAMPLE).unwrap()
 }
 
+/// What the CPU rasterises otherwise than the truth draws, for the controls.
+#[derive(Clone, Copy, Default)]
+struct Wrong {
+    /// Every second sample of the DEM in each direction: a terrain one level too coarse.
+    coarse_terrain: bool,
+    /// Every seed moved this far aside (metres, grid x).
+    seeds_aside_m: f64,
+}
+
 /// The CPU rasterisation of the truth's scene: the level-0 DEM, two triangles per cell with the
 /// finest mesh's alternating diagonals (south-west–north-east where column + row is even), and
-/// each seed's mesh placed, scaled and turned as pass 4 does.
-fn cpu_raster(r: &Renderer, camera: &Camera, truth: &Truth) -> Raster {
+/// each seed's mesh placed, scaled and turned as pass 4 does (or, for a control, `wrong`).
+fn cpu_raster(r: &Renderer, camera: &Camera, truth: &Truth, wrong: Wrong) -> Raster {
     let size = truth.size_px.map(|n| n * SUPERSAMPLE);
     let view = Pinhole::new(camera, size);
     let mut raster = Raster::new(size);
@@ -90,9 +110,11 @@ fn cpu_raster(r: &Renderer, camera: &Camera, truth: &Truth) -> Raster {
         let h = d.height_sample(0, i, j).unwrap();
         Corner { rel_m: DVec3::new(f64::from(i) * spacing, f64::from(j) * spacing, h) - eye, uv: DVec2::ZERO }
     };
-    for j in 0..ny - 1 {
-        for i in 0..nx - 1 {
-            let (sw, se, nw, ne) = (corner(i, j), corner(i + 1, j), corner(i, j + 1), corner(i + 1, j + 1));
+    let step = if wrong.coarse_terrain { 2 } else { 1 };
+    for j in (0..ny - 1).step_by(step as usize) {
+        for i in (0..nx - 1).step_by(step as usize) {
+            let (i1, j1) = ((i + step).min(nx - 1), (j + step).min(ny - 1));
+            let (sw, se, nw, ne) = (corner(i, j), corner(i1, j), corner(i, j1), corner(i1, j1));
             let pair =
                 if (i + j) % 2 == 0 { [[sw, se, ne], [sw, ne, nw]] } else { [[sw, se, nw], [se, ne, nw]] };
             for t in pair {
@@ -114,6 +136,7 @@ fn cpu_raster(r: &Renderer, camera: &Camera, truth: &Truth) -> Raster {
             / 65536.0;
         let (sin, cos) = angle.sin_cos();
         let [x, y] = s.position_grid_m;
+        let x = x + wrong.seeds_aside_m;
         let anchor = DVec3::new(x, y, s.ground_m - settings.seeds.sink_fraction * s.height_m) - eye;
         let place = |p: [f32; 3]| {
             // Model space is +Y up; the world is z up, the model's −z north, then turned.
@@ -177,48 +200,67 @@ fn the_truth_equals_an_independent_cpu_rasterisation_of_a_small_scene() {
         stand(9.0, 2.0, rock, 3, 1.2),
     ];
     let truth = truth_of(&r, &camera, seeds);
-    let cpu = cpu_raster(&r, &camera, &truth);
+    let cpu = cpu_raster(&r, &camera, &truth, Wrong::default());
     let n = truth.seed_ids.len();
     assert_eq!(n, cpu.ids.len());
-    // What each sample shows: the sky, the terrain, or seed k.
+    let share = samples_agreeing(&truth, &cpu);
+    println!("samples agreeing on what they show: {:.3} %", 100.0 * share);
+    assert!(share >= MIN_SAMPLES_AGREEING, "{share} of the samples agree");
+    let overlaps = seed_overlaps(&truth, &cpu);
+    println!("seeds' overlap (intersection over union): {overlaps:.3?}");
+    assert!(overlaps.iter().all(|&o| o >= MIN_SEED_IOU), "{overlaps:?}");
+    let (close, terrain) = depths_agreeing(&truth, &cpu);
+    println!("terrain samples with depth within {DEPTH_TOLERANCE_REL} (relative): {close} / {terrain}");
+    // Real: a quarter of the samples are the terrain's, so the share below is not of a handful.
+    assert!(terrain > n / 4, "only {terrain} of {n} samples show the terrain to both");
+    assert!(close as f64 >= MIN_DEPTHS_AGREEING * terrain as f64);
+
+    // Controls: a terrain one level too coarse fails the depths, seeds a metre aside the overlap.
+    let coarse = cpu_raster(&r, &camera, &truth, Wrong { coarse_terrain: true, ..Wrong::default() });
+    let (close, terrain) = depths_agreeing(&truth, &coarse);
+    println!("control, every second sample: {close} / {terrain} terrain depths agree");
+    assert!(terrain > n / 4 && (close as f64) < MIN_DEPTHS_AGREEING * terrain as f64);
+    let aside = cpu_raster(&r, &camera, &truth, Wrong { seeds_aside_m: 1.0, ..Wrong::default() });
+    let overlaps = seed_overlaps(&truth, &aside);
+    println!("control, seeds 1 m aside: overlaps {overlaps:.3?}");
+    assert!(overlaps.iter().all(|&o| o < MIN_SEED_IOU), "{overlaps:?}");
+}
+
+/// Share of samples on which truth and CPU show the same: the sky, the terrain, or seed k.
+fn samples_agreeing(truth: &Truth, cpu: &Raster) -> f64 {
     let class = |id: u32, depth: f64| if id > 0 { id + 1 } else { u32::from(depth > 0.0) };
+    let n = truth.seed_ids.len();
     let agree = (0..n)
         .filter(|&i| class(truth.seed_ids[i], truth.depth[i].into()) == class(cpu.ids[i], cpu.depth[i]))
         .count();
-    let share = agree as f64 / n as f64;
-    println!("samples agreeing on what they show: {agree} / {n} ({:.3} %)", 100.0 * share);
-    // Only samples on an edge may differ (the GPU's coverage rule and its filtered, mipmapped
-    // alpha against the CPU's nearest texel): 0.5 % of all.
-    assert!(share >= 0.995, "{agree} / {n} samples agree");
-    for k in 1..=truth.seeds.len() as u32 {
-        let (gpu, cpu_k) = ((0..n).filter(|&i| truth.seed_ids[i] == k), (0..n).filter(|&i| cpu.ids[i] == k));
-        let (g, c): (Vec<usize>, Vec<usize>) = (gpu.collect(), cpu_k.collect());
-        let both = g.iter().filter(|i| cpu.ids[**i] == k).count();
-        let union = g.len() + c.len() - both;
-        println!(
-            "seed {k}: {} GPU samples, {} CPU, overlap {:.3}",
-            g.len(),
-            c.len(),
-            both as f64 / union as f64
-        );
-        // Each seed covers the same samples, bar its outline: 85 % overlap (intersection over union).
-        assert!(
-            !g.is_empty() && both as f64 >= 0.85 * union as f64,
-            "seed {k}: {} GPU, {} CPU, {both} common",
-            g.len(),
-            c.len()
-        );
-    }
-    // Where both show the terrain, the depths agree to f32 rounding of camera-relative positions.
-    let terrain: Vec<usize> = (0..n)
+    agree as f64 / n as f64
+}
+
+/// Per seed, the intersection over union of the samples it covers in the truth and on the CPU;
+/// a seed the truth does not show at all is 0.
+fn seed_overlaps(truth: &Truth, cpu: &Raster) -> Vec<f64> {
+    let n = truth.seed_ids.len();
+    (1..=truth.seeds.len() as u32)
+        .map(|k| {
+            let gpu = (0..n).filter(|&i| truth.seed_ids[i] == k).count();
+            let on_cpu = (0..n).filter(|&i| cpu.ids[i] == k).count();
+            let both = (0..n).filter(|&i| truth.seed_ids[i] == k && cpu.ids[i] == k).count();
+            if gpu == 0 { 0.0 } else { both as f64 / (gpu + on_cpu - both) as f64 }
+        })
+        .collect()
+}
+
+/// Of the samples both show as terrain, how many have their depths within the tolerance, and how
+/// many there are.
+fn depths_agreeing(truth: &Truth, cpu: &Raster) -> (usize, usize) {
+    let terrain: Vec<usize> = (0..truth.seed_ids.len())
         .filter(|&i| truth.seed_ids[i] == 0 && cpu.ids[i] == 0 && cpu.depth[i] > 0.0 && truth.depth[i] > 0.0)
         .collect();
     let close = terrain
         .iter()
-        .filter(|&&i| (f64::from(truth.depth[i]) - cpu.depth[i]).abs() <= 1e-4 * cpu.depth[i])
+        .filter(|&&i| (f64::from(truth.depth[i]) - cpu.depth[i]).abs() <= DEPTH_TOLERANCE_REL * cpu.depth[i])
         .count();
-    println!("terrain samples with depth within 1e-4 (relative): {close} / {}", terrain.len());
-    assert!(terrain.len() > n / 4 && close as f64 >= 0.995 * terrain.len() as f64);
+    (close, terrain.len())
 }
 
 /// A view with a ridge ahead and lower ground behind it: the camera's grid position (2 m above
