@@ -235,7 +235,7 @@ impl ImagerySettings {
 pub struct CacheSettings {
     /// Height tile slots on the GPU (259² × 4 bytes, 262 KiB each).
     pub height_slots: u32,
-    /// Imagery tile slots on the GPU (528² × 4 bytes with mips, 1.45 MiB each; a quarter of that
+    /// Imagery tile slots on the GPU (528² × 4 bytes with mips, 1.41 MiB each; a quarter of that
     /// in BC7 blocks, an eighth in BC1).
     pub imagery_slots: u32,
     /// Land-cover tile slots on the GPU (512² bytes, 256 KiB each), read by seeds near the camera.
