@@ -8,6 +8,21 @@
 
 mod support;
 
+/// Most a ground colour's channel may differ, GPU against twin, in steps of 255: the driver's sRGB
+/// table against the twin's formula may round one step apart.
+const MAX_COLOUR_ERROR: u32 = 1;
+/// Most a seed's base may lie off the f64 drawn ground, millimetres: f32 heights of up to 2,700 m
+/// and camera-relative positions give 0.05–0.30 mm (docs/seeds.md); a centimetre is far above that
+/// rounding and far below the metres by which the bilinear patch missed the triangles.
+const MAX_BASE_MM: f64 = 10.0;
+/// Least recall of the accurate preset against the exact oracle: it marches the DEM where a summit
+/// is within a pixel of a silhouette and lost no visible seed on these views (docs/seeds.md); the
+/// percent is for summits within f32 rounding of a ridge.
+const MIN_RECALL: f64 = 0.99;
+/// Least precision: the preset keeps summits hidden by less than its occlusion tolerance (2 m +
+/// 8 m per km), 0.01–1.8 % of what it keeps on these views (docs/seeds.md).
+const MIN_PRECISION: f64 = 0.95;
+
 use std::collections::HashSet;
 
 use glam::DVec3;
@@ -74,8 +89,8 @@ fn gpu_equals_twin(dataset: Dataset, views: Poses) {
         assert!(diff.mismatched.is_empty(), "{what}: {:?}", diff.mismatched);
         assert!(diff.non_finite.is_empty(), "{what}: not finite: {:?}", diff.non_finite);
         assert_eq!(diff.max_length_error_m, 0.0, "{what}");
-        assert!(diff.max_colour_error <= 1, "{what}");
-        assert!(base_mm <= 10.0, "{what}: a seed's base is {base_mm} mm off the DEM");
+        assert!(diff.max_colour_error <= MAX_COLOUR_ERROR, "{what}");
+        assert!(base_mm <= MAX_BASE_MM, "{what}: a seed's base is {base_mm} mm off the DEM");
     }
 }
 
@@ -187,8 +202,8 @@ fn accurate_preset_against_the_exact_oracle() {
         for &(what, pose) in poses {
             let (recall, precision, visible) = recall_precision(&mut r, what, pose);
             assert!(visible > 100, "{what}: only {visible} visible seeds; pick a better view");
-            assert!(recall >= 0.99, "{what}: recall {recall}");
-            assert!(precision >= 0.95, "{what}: precision {precision}");
+            assert!(recall >= MIN_RECALL, "{what}: recall {recall}");
+            assert!(precision >= MIN_PRECISION, "{what}: precision {precision}");
         }
     }
 }
