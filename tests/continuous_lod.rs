@@ -19,6 +19,11 @@ use terramp_testkit::{camera, ground_settings, renderer, small_settings, synth_d
 
 const IMAGE_PX: [u32; 2] = [480, 270];
 const MODEL: &str = "tree-pine-s1-h100";
+/// How far the thinned trees' pixels may part from the whole meshes' and 17-plane clouds': the
+/// thinning grows each kept leaf back so the crown keeps its projected area (1.05× near, 1.03×
+/// far measured, docs/trees.md); a crown that lost the thinned leaves' area, or drew them twice,
+/// leaves the range.
+const COVER_RATIO: std::ops::RangeInclusive<f64> = 0.85..=1.15;
 
 /// The embedded default's generated table with every species grown as `MODEL`, and its impostor
 /// baked (small atlases), in the target's scratch folder.
@@ -86,7 +91,7 @@ fn thinned_trees_cover_what_whole_ones_do_and_the_frame_is_deterministic() {
     for (half, (w, t)) in ["near", "far"].iter().zip(whole_px.iter().zip(&thinned_px)) {
         assert!(*w > 500, "{half}: only {w} tree pixels: a weak test");
         let ratio = *t as f64 / *w as f64;
-        assert!((0.85..=1.15).contains(&ratio), "{half}: thinned trees cover {ratio:.3} × the whole ones'");
+        assert!(COVER_RATIO.contains(&ratio), "{half}: thinned trees cover {ratio:.3} × the whole ones'");
     }
     assert!(changed > 100, "continuous LOD changed only {changed} pixels: is it on?");
 

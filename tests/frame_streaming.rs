@@ -32,6 +32,9 @@ fn a_fixed_view_converges_to_the_all_resident_picture() {
     let dataset = synth_dataset(1200, 11);
     let mut streamed = renderer(&dataset, trickle(192, 108));
     let camera = view(&streamed);
+    // The first frame, drawn from the pinned coarse levels before anything streamed: the control.
+    streamed.render(&camera).unwrap();
+    let first = streamed.read_colour().unwrap();
     let (report, frames) = streamed.render_resolved(&camera).unwrap();
     assert!(streamed.is_resolved(&report), "not resolved after {frames} frames: {report:?}");
     assert!(frames > 2, "with 2 uploads a frame, streaming takes several frames ({frames})");
@@ -48,11 +51,22 @@ fn a_fixed_view_converges_to_the_all_resident_picture() {
     let mut reference = renderer(&dataset, all);
     reference.pin_everything().unwrap();
     reference.render_resolved(&camera).unwrap();
-    let db = psnr(&streamed.read_colour().unwrap(), &reference.read_colour().unwrap());
-    println!("converged after {frames} frames; PSNR against all-resident: {db:.1} dB");
-    // The Tile Load Map asks for at least the levels the pixels use, so the pictures agree.
-    assert!(db >= 40.0, "PSNR {db:.1} dB");
+    let all_resident = reference.read_colour().unwrap();
+    let db = psnr(&streamed.read_colour().unwrap(), &all_resident);
+    let first_db = psnr(&first, &all_resident);
+    println!(
+        "converged after {frames} more frames; PSNR against all-resident: {db:.1} dB (first frame {first_db:.1} dB)"
+    );
+    assert!(db >= CONVERGED_PSNR_DB, "PSNR {db:.1} dB");
+    // Control: the frame before streaming, coarse where the view needs fine tiles, fails it.
+    assert!(first_db < CONVERGED_PSNR_DB, "the first frame is already at {first_db:.1} dB: a weak test");
 }
+
+/// Least PSNR of the converged frame against the all-resident one, dB: the Tile Load Map asks for
+/// at least the levels the pixels use, so the pictures agree (on lavapipe bit for bit); the bound
+/// leaves room for an adapter whose filtering differs where a finer level than the pixels need is
+/// resident in one and not the other. The first frame, before streaming, is at 32.8 dB.
+const CONVERGED_PSNR_DB: f64 = 40.0;
 
 /// Checks one frame's report against the settings' capacities and budgets.
 fn check_budgets(report: &FrameReport, settings: &Settings) {

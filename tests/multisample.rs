@@ -19,6 +19,15 @@ use terramp::truth::{TruthOptions, render_truth};
 use terramp_testkit::{camera, gpu, renderer, small_settings, synth_dataset};
 
 const IMAGE_PX: [u32; 2] = [320, 180];
+/// How far the multisampled trees' change of the frame (from the ground alone) may part from the
+/// single-sampled trees': coverage from alpha keeps each leaf's area on average, so a tree neither
+/// thinned nor fattened changes the frame by about as much; a fifth of the trees lost or doubled
+/// leaves the range.
+const COVERAGE_RATIO: std::ops::RangeInclusive<f64> = 0.85..=1.15;
+/// Least gain of the multisampled frame over the single-sampled one against the supersampled
+/// truth, PSNR (dB) and SSIM: anti-aliased leaf edges over the whole view, not a rounding's worth.
+const MIN_PSNR_GAIN_DB: f64 = 1.0;
+const MIN_SSIM_GAIN: f64 = 0.01;
 
 fn settings(impostors: &str, samples: u32) -> Settings {
     let mut s = small_settings(IMAGE_PX[0], IMAGE_PX[1]);
@@ -89,7 +98,7 @@ fn multisampled_trees_are_antialiased_keep_their_coverage_and_leave_the_ground_a
         "trees change the frame by {single_change:.0} (1 sample) and {multi_change:.0} (4): ratio {ratio:.3}"
     );
     assert!(single_change > 1000.0, "the view shows too few trees: {single_change}");
-    assert!((0.85..=1.15).contains(&ratio), "multisampling changed the trees' coverage: {ratio:.3}");
+    assert!(COVERAGE_RATIO.contains(&ratio), "multisampling changed the trees' coverage: {ratio:.3}");
 
     // Against the supersampled truth of the same world, the multisampled frame is closer by the
     // pixels' errors and by structure. (FLIP, which weighs the fine contrast of foliage, barely
@@ -106,8 +115,10 @@ fn multisampled_trees_are_antialiased_keep_their_coverage_and_leave_the_ground_a
         "against the truth, 1 and 4 samples: PSNR {psnr_single:.2} and {psnr_multi:.2} dB, SSIM {ssim_single:.4} \
          and {ssim_multi:.4}, FLIP {flip_single:.4} and {flip_multi:.4}"
     );
-    assert!(psnr_multi > psnr_single + 1.0, "multisampling is not closer to the truth (PSNR)");
-    assert!(ssim_multi > ssim_single + 0.01, "multisampling is not closer to the truth (SSIM)");
+    // Real: both frames differ from the truth (a frame equal to it would make PSNR infinite).
+    assert!(psnr_single.is_finite() && psnr_multi.is_finite(), "{psnr_single} {psnr_multi}");
+    assert!(psnr_multi > psnr_single + MIN_PSNR_GAIN_DB, "multisampling is not closer to the truth (PSNR)");
+    assert!(ssim_multi > ssim_single + MIN_SSIM_GAIN, "multisampling is not closer to the truth (SSIM)");
 }
 
 #[test]

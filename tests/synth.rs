@@ -203,6 +203,8 @@ fn odd_and_tiny_sizes_work() {
         let landcover = dataset.landcover.as_ref().unwrap().pyramid;
         assert_eq!((landcover.size_at(LCC_SOURCE_LEVEL), landcover.size), ([2 * size; 2], [4 * size; 2]));
         let heights = level0_heights(&dataset);
+        // Finite first: `f32::min` and `f32::max` below would drop a NaN.
+        assert!(heights.iter().all(|h| h.is_finite()), "size {size}: a height is not finite");
         let layer = &dataset.manifest.height;
         assert_eq!(layer.min_m, heights.iter().copied().fold(f32::INFINITY, f32::min));
         assert_eq!(layer.max_m, heights.iter().copied().fold(f32::NEG_INFINITY, f32::max));

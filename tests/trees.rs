@@ -252,6 +252,8 @@ fn continuous_lod_draws_fewer_primitives_with_distance_and_none_below_a_pixel() 
         println!("{name}: {whole} triangles whole; (distance m, drawn, in the range) {drawn:?}");
         let nearest = drawn[0].1;
         assert_eq!(nearest, whole as f32, "{name}: the whole tree is drawn 1 m away");
+        // Real: still drawn at 1.6 km (a tree thinned to nothing would pass the bound below).
+        assert!(drawn_before > 0.0, "{name}: nothing drawn at 1.6 km");
         assert!(
             drawn_before * 20.0 < nearest,
             "{name}: {drawn_before} of {nearest} primitives drawn at 1.6 km"

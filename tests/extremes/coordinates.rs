@@ -17,6 +17,12 @@ use terramp_testkit::small_settings;
 
 const ORIGINS_M: [[f64; 2]; 3] = [[0.0, 0.0], [500_000.0, 5_000_000.0], [1e7, 1e7]];
 
+/// Most a seed may stand from its exact pattern position, or move between origins, metres: the
+/// promise, to the centimetre; f32 camera-relative offsets put it within a third of a millimetre
+/// (0.12 and 0.28 mm measured, docs/README.md), where f32 grid coordinates 10⁷ m out would be off
+/// by up to a metre.
+const MAX_PLACEMENT_M: f64 = 0.01;
+
 /// Camera poses in grid space (x, y, metres above the ground, yaw, pitch), with fractions of a
 /// millimetre no f64 sum at 10⁷ m carries exactly.
 const POSES: [[f64; 5]; 2] =
@@ -67,7 +73,7 @@ fn render(origin_m: [f64; 2], pose: [f64; 5]) -> Frame {
     let camera_grid_m = camera.position_m - DVec3::new(o[0], o[1], 0.0);
     let placement_m = worst_placement_error_m(&r, &seeds, camera_grid_m);
     println!("{what}: {} seeds, placement error {:.2e} m, {a:?}", seeds.len(), placement_m);
-    assert!(placement_m <= 0.01, "{what}: a seed is {placement_m} m from its pattern position");
+    assert!(placement_m <= MAX_PLACEMENT_M, "{what}: a seed is {placement_m} m from its pattern position");
     Frame { image: r.read_colour().unwrap(), seeds, camera_grid_m }
 }
 
@@ -96,7 +102,7 @@ fn utm_and_1e7_offsets_render_the_same_image_and_seeds() {
             println!(
                 "{origin:?}: {differing} pixels differ (PSNR {psnr:.1} dB), seeds moved ≤ {worst_m:.2e} m"
             );
-            assert!(worst_m <= 0.01, "{origin:?}: a seed moved {worst_m} m");
+            assert!(worst_m <= MAX_PLACEMENT_M, "{origin:?}: a seed moved {worst_m} m");
             assert_eq!(differing, 0, "{origin:?}: the image changed (PSNR {psnr:.1} dB)");
         }
     }
@@ -120,7 +126,7 @@ fn a_planet_size_dataset_places_seeds_to_the_centimetre_10_million_metres_out() 
         let camera_grid_m = DVec3::new(pose[0], pose[1], camera.position_m.z);
         let placement_m = worst_placement_error_m(&r, &seeds, camera_grid_m);
         println!("pose {pose:?}: {} seeds, placement error {placement_m:.2e} m, {a:?}", seeds.len());
-        assert!(placement_m <= 0.01, "a seed is {placement_m} m from its pattern position");
+        assert!(placement_m <= MAX_PLACEMENT_M, "a seed is {placement_m} m from its pattern position");
         grown += seeds.len();
     }
     assert!(grown > 100, "only {grown} seeds: the test saw no land that grows any");
