@@ -118,6 +118,8 @@ fn texcells_at_grazing_incidence_and_inside_the_canopy_leave_no_gaps() {
                 "{what}: only {} pixels see the canopy in the band: a weak test",
                 through.len()
             );
+            // Nine in ten: on lavapipe all of them show forest (822 of 822, docs/texcells.md); the
+            // tenth is room for another rasteriser's coverage of the slices' alpha-tested edges.
             assert!(
                 covered * 10 >= through.len() * 9,
                 "{what}: gaps: {covered} of {} pixels show forest",
