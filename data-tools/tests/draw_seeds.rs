@@ -290,8 +290,8 @@ fn frame_change(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, f64) {
 /// as if the view drew back at 0.2 % of each distance a frame (1.4 m at 700 m). Every change
 /// between frames is then a LOD change. With the cross-fade (`seeds.fade_fraction` 0.1) the
 /// largest change of a 4 × 4 block between frames stays under 12 levels of 255 and under half of
-/// what switching at once gives (measured on lavapipe: 7.8 against 19.5). Single pixels still
-/// flip between the two LODs' geometry (up to ~125 levels either way): that is the dither. In a
+/// what switching at once gives (measured on lavapipe: 7.4 against 15.2). Single pixels still
+/// flip between the two LODs' geometry (up to ~140 levels either way): that is the dither. In a
 /// 12 m/s wind held at one moment the figure stays within 20 % of still air's (issue 14): every
 /// LOD of a seed bends the same way. Where a class stops its seeds at an earlier LOD
 /// (`[[class]] seed_lods`), they fade out there just as softly: within the same 12 levels and
@@ -377,8 +377,7 @@ fn lod_changes_cross_fade_instead_of_popping() {
 /// Steps of the slow distance change.
 const FADE_FRAMES: usize = 24;
 /// Most a cross-fade may change a 4 × 4 block's mean luma between frames, levels of 255: some
-/// 50 % above lavapipe's 7.8, well under a pop (19.5), about what a pixel's dither step moves a
-/// block's mean when a few of its pixels flip.
+/// 60 % above lavapipe's 7.4, under a pop (15.2).
 const MAX_FADE_BLOCK_CHANGE: f64 = 12.0;
 /// Most a cross-fade's largest block change may be of switching at once's in the same frames: a
 /// fade that took out less than half of a pop would not be one.
