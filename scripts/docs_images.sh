@@ -265,8 +265,8 @@ make_slicings_edge() {
 }
 
 make_slicings_figures() {
-    cargo test --release -q --test slicings -- --ignored >/dev/null
-    cargo test --release -q --test slicings_views -- --ignored >/dev/null
+    cargo test -q --test slicings -- --ignored >/dev/null
+    cargo test -q --test slicings_views -- --ignored >/dev/null
 }
 
 make_texcells() {

@@ -239,7 +239,16 @@ fn quoted_tolerances(page: &str) -> Vec<usize> {
             at.push(i);
         }
     }
-    for key in ["test asks", "test asserts", "test allows", "(≥ ", "(≤ "] {
+    // A test's bound in words counts where its sentence holds a number ("the test asserts that
+    // the slicings pop no more than the cloud" quotes none).
+    let sentence_has_number = |i: usize| {
+        let rest = &page[i..];
+        rest[..rest.find(". ").unwrap_or(rest.len())].contains(|c: char| c.is_ascii_digit())
+    };
+    for key in ["test asks", "test asserts", "test allows"] {
+        at.extend(page.match_indices(key).map(|(i, _)| i).filter(|&i| sentence_has_number(i)));
+    }
+    for key in ["(≥ ", "(≤ "] {
         at.extend(page.match_indices(key).map(|(i, _)| i));
     }
     for (i, _) in page.match_indices("≥ ") {
@@ -284,9 +293,9 @@ fn every_quoted_tolerance_is_a_claim() {
         unclaimed.join("\n")
     );
     // Control: the scan finds each kind of quote.
-    let sample =
-        "IoU 0.93 (tolerance 0.85); the test asks ≥ 0.45 (≤ 1.35) (≥ 0.9), ≥ 60 dB; occlusion tolerance m";
-    assert_eq!(quoted_tolerances(sample).len(), 5, "{:?}", quoted_tolerances(sample));
+    let sample = "IoU 0.93 (tolerance 0.85); the test asks ≥ 0.45 (≤ 1.35) (≥ 0.9), ≥ 60 dB; occlusion tolerance m. \
+         The test asserts that it pops no more than the cloud. The test allows 3 pixels.";
+    assert_eq!(quoted_tolerances(sample).len(), 6, "{:?}", quoted_tolerances(sample));
 }
 
 #[test]

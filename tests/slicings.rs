@@ -153,8 +153,8 @@ fn slicings_draw_lod_1_where_the_clouds_would_with_their_trunks() {
         let both = by_clouds.iter().zip(mask).filter(|&(&a, &b)| a && b).count();
         both as f64 / by_clouds.iter().zip(mask).filter(|&(&a, &b)| a || b).count() as f64
     };
-    let coverage_ok = |mask: &[bool]| (0.93..0.97).contains(&ratio(mask));
-    let overlap_ok = |mask: &[bool]| shared(mask) >= 0.88;
+    let coverage_ok = |mask: &[bool]| (MIN_COVERAGE_OF_CLOUDS..MAX_COVERAGE_OF_CLOUDS).contains(&ratio(mask));
+    let overlap_ok = |mask: &[bool]| shared(mask) >= MIN_SHARED_WITH_CLOUDS;
     assert!(coverage_ok(&by_slices), "slicings cover {:.3} of the clouds' pixels", ratio(&by_slices));
     assert!(
         overlap_ok(&by_slices),
@@ -179,6 +179,11 @@ fn slicings_draw_lod_1_where_the_clouds_would_with_their_trunks() {
 
 /// Side of the frames of `lod1_frame`, pixels.
 const LOD1_FRAME_PX: [usize; 2] = [320, 180];
+/// The share of the clouds' tree pixels the slicings may cover, and of either's they must share
+/// (measured 0.950 and 0.895; the margins are in the test).
+const MIN_COVERAGE_OF_CLOUDS: f64 = 0.93;
+const MAX_COVERAGE_OF_CLOUDS: f64 = 0.97;
+const MIN_SHARED_WITH_CLOUDS: f64 = 0.88;
 
 /// `mask` (a `LOD1_FRAME_PX` frame's pixels, row by row) grown by a pixel all round.
 fn grown(mask: &[bool]) -> Vec<bool> {

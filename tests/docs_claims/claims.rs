@@ -370,6 +370,21 @@ pub static CLAIMS: &[Claim] = &[
         quote: "the imagery cache fills its {} slots",
         values: &[(default("cache.imagery_slots"), plain)],
     },
+    // The slicings.
+    Claim {
+        doc: "docs/slicings.md",
+        quote: "The test asks at least {}.",
+        values: &[(test_const("tests/slicings_views.rs", "MIN_AGREEMENT"), plain)],
+    },
+    Claim {
+        doc: "docs/slicings.md",
+        quote: "The test asserts that the slicings cover {} to {} of the clouds' pixels (0.950) and share at least {} of either's",
+        values: &[
+            (test_const("tests/slicings.rs", "MIN_COVERAGE_OF_CLOUDS"), plain),
+            (test_const("tests/slicings.rs", "MAX_COVERAGE_OF_CLOUDS"), plain),
+            (test_const("tests/slicings.rs", "MIN_SHARED_WITH_CLOUDS"), plain),
+        ],
+    },
 ];
 
 pub static PRESET_ROWS: &[PresetRow] = &[
