@@ -133,3 +133,58 @@ fn voids_across_tiles_are_filled_the_same_by_every_tile() {
         }
     }
 }
+
+/// A georeference sidecar (GDAL's PAM `.aux.xml`) beside `image`: UTM 33N, and `NORTH_UP`.
+fn write_sidecar(image: &Path) {
+    let srs = gdal::spatial_ref::SpatialRef::from_epsg(EPSG).unwrap().to_wkt().unwrap();
+    let gt = NORTH_UP.map(|v| v.to_string()).join(", ");
+    let xml =
+        format!("<PAMDataset>\n  <SRS>{srs}</SRS>\n  <GeoTransform>{gt}</GeoTransform>\n</PAMDataset>\n");
+    std::fs::write(format!("{}.aux.xml", image.display()), xml).unwrap();
+}
+
+/// Netpbm images (what GDAL's PNM driver reads) of 40 × 30 texels under a GeoTIFF's name: 8-bit
+/// grey (P5), 16-bit grey (P5, maxval 65535) and 8-bit RGB (P6), each file's name and bytes.
+fn netpbm_images() -> [(&'static str, Vec<u8>); 3] {
+    let [w, h] = [40usize, 30];
+    let header = |magic: &str, max: u32| format!("{magic}\n{w} {h}\n{max}\n").into_bytes();
+    let grey8 = (0..w * h).map(|i| (i * 7 % 256) as u8);
+    let grey16 = (0..w * h).flat_map(|i| ((i * 97 % 65536) as u16).to_be_bytes());
+    let rgb8 = (0..w * h * 3).map(|i| (i * 5 % 256) as u8);
+    [
+        ("grey8.tif", [header("P5", 255), grey8.collect()].concat()),
+        ("grey16.tif", [header("P5", 65535), grey16.collect()].concat()),
+        ("rgb8.tif", [header("P6", 255), rgb8.collect()].concat()),
+    ]
+}
+
+/// GDAL's PNM driver takes a georeference from a world file only: with a PAM sidecar alone the
+/// build fails naming the file, the driver and the sidecar it ignored, and how to georeference it,
+/// never GDAL's empty message. The world file it advises makes the same image build.
+#[test]
+fn netpbm_images_named_tif_with_a_sidecar_fail_naming_the_file_and_the_driver() {
+    let tmp = TempDir::new("netpbm");
+    let out = tmp.path().join("out");
+    for (name, bytes) in netpbm_images() {
+        let image = tmp.path().join(name);
+        std::fs::write(&image, bytes).unwrap();
+        write_sidecar(&image);
+        let image = image.to_str().unwrap();
+        let output = run_build(&["--dem", image, "--out", out.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{name} built without a geotransform GDAL reads");
+        for said in [name, "no geotransform", "PNM driver", &format!("{name}.aux.xml"), ".wld"] {
+            assert!(stderr.contains(said), "{name}: stderr should say {said:?}: {stderr}");
+        }
+        assert!(!stderr.contains("error msg: ''"), "{name}: GDAL's empty message: {stderr}");
+        assert!(!out.exists(), "a failed build must leave nothing at {}", out.display());
+
+        // The control: the same image with a world file (centres of the corner texel) builds.
+        let [x0, dx, _, y0, _, dy] = NORTH_UP;
+        let world = [dx, 0.0, 0.0, dy, x0 + dx / 2.0, y0 + dy / 2.0].map(|v| v.to_string()).join("\n");
+        std::fs::write(Path::new(image).with_extension("wld"), world).unwrap();
+        let (dataset, _) = build(&out, &["--dem", image]);
+        assert_eq!(dataset.manifest.height.pyramid.size, [40, 30], "{name}");
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+}

@@ -50,7 +50,7 @@ impl SourceRaster {
         ensure!(dataset.raster_count() > 0, "{}: holds no raster band", what());
         let geo_transform = dataset
             .geo_transform()
-            .map_err(gdal_error)
+            .map_err(|e| no_geotransform(&dataset, path, e))
             .with_context(|| format!("{}: has no georeferencing (no geotransform)", what()))?;
         check_north_up(&geo_transform).with_context(what)?;
         let mut srs = dataset.spatial_ref().map_err(gdal_error).with_context(|| {
@@ -89,15 +89,47 @@ impl SourceRaster {
     }
 }
 
-/// A GDAL error as its own message, without the Rust wrapper's decoration.
+/// A GDAL error as its own message, without the Rust wrapper's decoration; when GDAL logged no
+/// message, that it gave none (never its empty text).
 pub fn gdal_error(error: gdal::errors::GdalError) -> anyhow::Error {
     use gdal::errors::GdalError;
     match error {
-        GdalError::CplError { msg, .. } | GdalError::NullPointer { msg, .. } if !msg.is_empty() => {
+        GdalError::CplError { msg, .. } | GdalError::NullPointer { msg, .. } if !msg.trim().is_empty() => {
             anyhow::Error::msg(msg)
+        }
+        GdalError::CplError { class, number, .. } => {
+            anyhow::anyhow!("GDAL gave no reason (CPL error class {class}, number {number})")
+        }
+        GdalError::NullPointer { method_name, .. } => {
+            anyhow::anyhow!("GDAL gave no reason ({method_name} failed)")
         }
         other => anyhow::Error::new(other),
     }
+}
+
+/// Why `dataset` (the file at `path`) has no geotransform: GDAL's message when it logged one;
+/// else which driver read the file, whatever its name says, and, when a sidecar beside it
+/// (`<file>.aux.xml`) holds a geotransform, that this driver does not take it from there (GDAL's
+/// PNM driver, for one, reads a world file only).
+fn no_geotransform(dataset: &Dataset, path: &Path, error: gdal::errors::GdalError) -> anyhow::Error {
+    if let gdal::errors::GdalError::CplError { msg, .. } = &error
+        && !msg.trim().is_empty()
+    {
+        return gdal_error(error);
+    }
+    let driver = dataset.driver();
+    let mut why =
+        format!("GDAL reads the file with its {} driver ({})", driver.short_name(), driver.long_name());
+    let sidecar = PathBuf::from(format!("{}.aux.xml", path.display()));
+    if std::fs::read_to_string(&sidecar).is_ok_and(|xml| xml.contains("<GeoTransform>")) {
+        why += &format!(", which does not take the geotransform in {}", sidecar.display());
+    }
+    let world = path.with_extension("wld");
+    anyhow::anyhow!(
+        "{why}: give the georeference in a world file ({}), or convert the file to a GeoTIFF with it \
+         (gdal_translate -of GTiff -a_ullr WEST NORTH EAST SOUTH -a_srs CRS)",
+        world.display()
+    )
 }
 
 /// Rotated or sheared rasters would need a general affine resampling; GDAL's warper can make
