@@ -31,7 +31,7 @@ fn impostors() -> PathBuf {
     let table = terramp::classes::ClassTable::load("nc").expect("nc table");
     let names: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
     let options = terramp::bake::BakeOptions::default();
-    let missing = terramp::bake::bake_missing(&models, &names, &dir, &options, false).expect("bake");
+    let missing = terramp::bake::bake_missing(None, &models, &names, &dir, &options, false).expect("bake");
     assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
     dir
 }

@@ -212,8 +212,10 @@ fn generated_trees_are_baked_by_name_with_no_model_file() {
     let out = TempDir::new("bake-generated");
     let nowhere = out.path().join("no-models-here");
     let names = ["tree-bush-s3-h90", "Nothing"];
+    let gpu = terramp_testkit::gpu();
     let options = BakeOptions { texels: 256, ..Default::default() };
-    let missing = terramp::bake::bake_missing(&nowhere, &names, out.path(), &options, false).unwrap();
+    let missing =
+        terramp::bake::bake_missing(Some(&gpu), &nowhere, &names, out.path(), &options, false).unwrap();
     assert_eq!(missing.baked.iter().map(|r| r.name.as_str()).collect::<Vec<_>>(), ["tree-bush-s3-h90"]);
     assert_eq!(missing.absent, [nowhere.join("Nothing.glb")]);
     let impostor = terramp::impostor::load(out.path(), "tree-bush-s3-h90").unwrap();
@@ -221,6 +223,7 @@ fn generated_trees_are_baked_by_name_with_no_model_file() {
     assert_eq!(missing.baked[0].triangles, tree.mesh.bark.triangles() + tree.mesh.leaves.triangles());
     assert_eq!(impostor.lods.len(), options.planes.len());
     // Baked once: a second call finds it current and bakes nothing.
-    let again = terramp::bake::bake_missing(&nowhere, &names, out.path(), &options, false).unwrap();
+    let again =
+        terramp::bake::bake_missing(Some(&gpu), &nowhere, &names, out.path(), &options, false).unwrap();
     assert!(again.baked.is_empty());
 }

@@ -40,7 +40,8 @@ fn table_and_impostors() -> (PathBuf, PathBuf) {
     std::fs::write(&table, one_model).unwrap();
     let impostors = dir.join("impostors");
     let options = BakeOptions { texels: 256, ..Default::default() };
-    let baked = bake_missing(&dir, &[MODEL], &impostors, &options, false).unwrap();
+    let baked =
+        bake_missing(Some(&terramp_testkit::gpu()), &dir, &[MODEL], &impostors, &options, false).unwrap();
     assert!(baked.absent.is_empty());
     (table, impostors)
 }

@@ -5,7 +5,6 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use serde_json::Value;
 
@@ -23,7 +22,7 @@ struct Run {
 fn profile(dataset: &Path, name: &str, extra: &[&str]) -> Run {
     let out: PathBuf = std::env::temp_dir().join(format!("terramp-profile-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&out).unwrap();
-    let output = Command::new(env!("CARGO_BIN_EXE_terramp"))
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"))
         .args(["profile", "--width", "160", "--height", "90"])
         .args(["--frames", &FRAMES.to_string(), "--warmup", &WARMUP.to_string()])
         .arg("--dataset")

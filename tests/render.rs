@@ -92,7 +92,7 @@ fn cameras_outside_the_dataset_look_in() {
 #[test]
 fn no_adapter_is_a_clear_error_not_a_panic() {
     let dataset = synth_dataset(300, 7);
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_terramp"))
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"))
         .args(["render", "--dataset"])
         .arg(&dataset)
         .args(["--camera", "100,100,900,0,-10", "--width", "32", "--height", "32", "--out"])
@@ -134,7 +134,7 @@ fn passes_are_timed_with_timestamps_or_on_the_cpu() {
 #[test]
 fn a_headless_render_prints_no_window_system_errors() {
     let dataset = synth_dataset(300, 7);
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_terramp"))
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"))
         .args(["render", "--dataset"])
         .arg(&dataset)
         .args(["--camera", "100,100,900,0,-10", "--width", "32", "--height", "32", "--out"])

@@ -399,7 +399,7 @@ fn the_fly_log_counts_seeds_per_frame() {
     let dataset = terramp_testkit::synth_dataset(SIZE, 7);
     let out = std::env::temp_dir().join(format!("terramp-fly-seeds-{}", std::process::id()));
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/paths/default.toml");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_terramp"))
+    let status = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"))
         .args(["fly", "--frames", "10", "--save-every", "0", "--width", "160", "--height", "90", "--dataset"])
         .arg(&dataset)
         .arg("--path")

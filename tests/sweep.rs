@@ -8,7 +8,6 @@
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::path::PathBuf;
-use std::process::Command;
 
 use serde_json::Value;
 use terramp::reference::image_metrics::PSNR_CAP_DB;
@@ -21,7 +20,7 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
     let layer = out.with_extension("toml");
     std::fs::write(&layer, format!("[draw_seeds]\nimpostors = {:?}\n", impostors.display().to_string()))
         .unwrap();
-    let output = Command::new(env!("CARGO_BIN_EXE_terramp"))
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"))
         .args(["sweep", "--presets", "fast,accurate", "--frames", "4", "--warmup", "2", "--samples", "2"])
         .args(["--timing-rounds", "2"])
         .args(["--width", "160", "--height", "90", "--knob", "seeds.frustum_epsilon=0.05"])

@@ -125,7 +125,7 @@ fn the_viewer_flies_in_a_real_window_and_shows_what_render_renders() {
 
     let [w, h] = WINDOW_PX.map(|v| v.to_string());
     let out = tmp.path().join("view");
-    let mut viewer = Command::new(env!("CARGO_BIN_EXE_terramp"))
+    let mut viewer = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"))
         .args(["view", "--dataset", dataset.to_str().unwrap(), "--settings", settings.to_str().unwrap()])
         .args(["--width", &w, "--height", &h, "--no-vsync", "--out", out.to_str().unwrap()])
         .env("DISPLAY", &display)
@@ -173,7 +173,7 @@ fn the_viewer_flies_in_a_real_window_and_shows_what_render_renders() {
 
     // The same view headless, by the line the screenshot gave.
     let args: Vec<&str> = line.split_whitespace().skip(1).collect();
-    let status = Command::new(env!("CARGO_BIN_EXE_terramp")).args(&args).status().unwrap();
+    let status = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp")).args(&args).status().unwrap();
     assert!(status.success(), "{line}");
     let out_at = args.iter().position(|a| *a == "--out").unwrap() + 1;
     let headless = image::open(args[out_at]).unwrap().to_rgba8();
@@ -210,7 +210,7 @@ fn the_viewer_flies_in_a_real_window_and_shows_what_render_renders() {
 /// `terramp view` run as a person would (without a backtrace, without the variables in
 /// `unset`): its standard error, once it has failed cleanly.
 fn view_fails(unset: &[&str], args: &[&str]) -> String {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_terramp"));
+    let mut command = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"));
     command.arg("view").args(args).env("RUST_BACKTRACE", "0");
     for var in unset {
         command.env_remove(var);

@@ -17,14 +17,12 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::{FrameReport, Renderer};
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::reference::frame_change::largest_block_change;
 use terramp::reference::seed_select::SeedComparison;
 
@@ -57,7 +55,8 @@ fn impostors() -> &'static Path {
             ]);
         }
         args.extend(["--out".into(), out.display().to_string(), "--texels".into(), "256".into()]);
-        let output = Command::new(env!("CARGO_BIN_EXE_terramp-data")).args(&args).output().unwrap();
+        let output =
+            terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data")).args(&args).output().unwrap();
         let (stdout, stderr) =
             (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
         assert!(output.status.success(), "bake failed:\n{stdout}\n{stderr}");
@@ -78,7 +77,7 @@ fn open_view(
     settings.render.width = size[0];
     settings.render.height = size[1];
     settings.draw_seeds.impostors = impostors.to_owned();
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
     let ([x, y], yaw_deg) = pose;
     let camera = terramp_testkit::camera::over(&r, [x, y], above_m, yaw_deg, pitch_deg);
@@ -168,7 +167,8 @@ fn nc_forest_draws_trees() {
     let reopened = Dataset::open(&path).unwrap();
     trees_stand_on_forest_not_on_water(&reopened, &camera, size, &bare, &bare_depth, &trees);
     // Without the trees the frame is far from the reference: the tolerance cannot hide them.
-    Golden { tests_dir: &tests_dir(), name: REFERENCE, min_db: MIN_PSNR_DB }.check(&trees, &bare);
+    let golden = Golden { tests_dir: &tests_dir(), name: REFERENCE, min_db: MIN_PSNR_DB };
+    golden.check(&terramp_testkit::gpu(), &trees, &bare);
 }
 
 /// With the trees drawn, pass 3's twin still reads what pass 3 read: the terrain's depth. The depth

@@ -20,7 +20,6 @@ use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
-use terramp::gpu::{AdapterChoice, Gpu};
 
 use support::{build, build_zion, mask_image, write_geotiff};
 use terramp_testkit::audit::{Audit, Dem, Tolerance, audit, camera_at};
@@ -30,7 +29,7 @@ fn renderer(dataset: Dataset, width: u32, height: u32) -> Renderer {
     let mut settings = Settings::default();
     settings.render.width = width;
     settings.render.height = height;
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     Renderer::new(gpu, dataset, settings).unwrap()
 }
 

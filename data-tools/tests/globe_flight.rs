@@ -17,7 +17,6 @@ use std::time::Instant;
 
 use terramp::config::Settings;
 use terramp::frame::Renderer;
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::path::CameraPath;
 
 use support::build;
@@ -66,7 +65,7 @@ fn globe_flight_keeps_memory_fixed() {
     settings.cache.height_slots = HEIGHT_SLOTS;
     let slots = settings.cache.clone();
     let (fov, near) = (settings.render.fov_deg, settings.render.near_m);
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     let mut renderer = Renderer::new(gpu, dataset, settings).unwrap();
 
     let start = Instant::now();

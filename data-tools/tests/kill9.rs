@@ -25,7 +25,7 @@
 use std::collections::BTreeMap;
 use std::io::{BufRead as _, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 use terramp::dataset::{Dataset, Pack};
 use terramp::publish::{NO_EXCHANGE_VAR, STOP_VAR, Step};
@@ -54,7 +54,7 @@ fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 }
 
 fn run(args: &[String]) {
-    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
     let says = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "terramp-data {}: {says}", args.join(" "));
 }
@@ -62,7 +62,7 @@ fn run(args: &[String]) {
 /// Runs `args` until it stops itself at `step` (the fallback forced where `fallback`), kills it
 /// with SIGKILL there, and returns its process id (which names its staging folder).
 fn run_killed_at(args: &[String], step: Step, fallback: bool) -> u32 {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_terramp-data"));
+    let mut command = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data"));
     command.args(args).env(STOP_VAR, step.name()).stdout(Stdio::null()).stderr(Stdio::piped());
     if fallback {
         command.env(NO_EXCHANGE_VAR, "1");

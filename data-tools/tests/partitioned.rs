@@ -15,7 +15,7 @@ const SIZE: &str = "600";
 const SEED: &str = "5";
 
 fn terramp_data(args: &[&str]) -> Output {
-    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
     assert!(
         output.status.success(),
         "terramp-data {}: {}{}",
@@ -112,7 +112,7 @@ fn a_merge_names_the_partitions_not_built_and_writes_nothing() {
     let plan = plan(dir.path(), "300", 3);
     terramp_data(&["build", "--plan", path(&plan), "--partition", "1"]);
     let out = dir.path().join("merged");
-    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data"))
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data"))
         .args(["merge", "--plan", path(&plan), "--out", path(&out)])
         .output()
         .unwrap();
@@ -122,7 +122,7 @@ fn a_merge_names_the_partitions_not_built_and_writes_nothing() {
     // A plan edited by hand is refused rather than built half one way, half another.
     let text = std::fs::read_to_string(&plan).unwrap().replace("seed = 5", "seed = 6");
     std::fs::write(&plan, text).unwrap();
-    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data"))
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data"))
         .args(["build", "--plan", path(&plan), "--partition", "0"])
         .output()
         .unwrap();
@@ -181,7 +181,7 @@ fn a_job_killed_mid_partition_is_rebuilt_and_only_it() {
         terramp_data(&["build", "--plan", path(&plan), "--partition", part]);
     }
     // Partition 0, killed once its part packs are being written.
-    let mut job = Command::new(env!("CARGO_BIN_EXE_terramp-data"))
+    let mut job = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data"))
         .args(["build", "--plan", path(&plan), "--partition", "0"])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -212,7 +212,7 @@ fn a_job_killed_mid_partition_is_rebuilt_and_only_it() {
 
 /// Runs `terramp-data ARGS`, expecting it to fail; returns its stderr.
 fn terramp_data_fails(args: &[&str]) -> String {
-    let output = Command::new(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
+    let output = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data")).args(args).output().unwrap();
     assert!(!output.status.success(), "terramp-data {} succeeded", args.join(" "));
     String::from_utf8_lossy(&output.stderr).into_owned()
 }

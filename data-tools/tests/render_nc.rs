@@ -10,7 +10,6 @@ use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::frame::Renderer;
-use terramp::gpu::{AdapterChoice, Gpu};
 
 use support::{build_nc, tests_dir};
 use terramp_testkit::{Golden, TempDir, shared_data};
@@ -41,7 +40,7 @@ fn nc_renders_like_its_reference() {
         fov_deg: 60.0,
         near_m: 0.1,
     };
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     let mut renderer = Renderer::new(gpu, dataset, settings).unwrap();
     let (report, frames) = renderer.render_resolved(&camera).unwrap();
     assert!(renderer.is_resolved(&report), "not resolved after {frames} frames: {report:?}");
@@ -57,5 +56,6 @@ fn nc_renders_like_its_reference() {
     let shifted = Camera { position_m: camera.position_m + DVec3::X * CONTROL_SHIFT_M, ..camera };
     renderer.render_resolved(&shifted).unwrap();
     let control = renderer.read_colour().unwrap();
-    Golden { tests_dir: &tests_dir(), name: REFERENCE, min_db: MIN_PSNR_DB }.check(&image, &control);
+    let golden = Golden { tests_dir: &tests_dir(), name: REFERENCE, min_db: MIN_PSNR_DB };
+    golden.check(&renderer.gpu, &image, &control);
 }

@@ -15,7 +15,6 @@ use glam::DVec3;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::seeds::spacing::{BorderSpacing, RDF_BIN, RDF_BINS, quantile};
 use terramp_testkit::camera::posed;
 
@@ -125,7 +124,7 @@ fn measure(name: &str, dataset: &Path, views: &[(&str, [f64; 5])]) -> Vec<(&'sta
         let mut settings = Settings::preset(preset).unwrap();
         settings.render.width = 640;
         settings.render.height = 360;
-        let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+        let gpu = terramp_testkit::gpu();
         let mut r = Renderer::new(gpu, dataset, settings).unwrap();
         let mut pooled = BorderSpacing::default();
         for &(view, pose) in views {

@@ -33,7 +33,6 @@ use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::gpu::layout::SpeciesLod;
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::passes::seed_select::frame::SeedCellRef;
 use terramp::reference::accuracy::{HeightError, SeedAgreement, SeedId, record_id};
 use terramp::reference::oracle::{OracleInputs, visible_seeds};
@@ -50,7 +49,7 @@ type Poses<'a> = &'a [(&'a str, [f64; 5])];
 fn renderer(dataset: Dataset, mut settings: Settings, width: u32, height: u32) -> Renderer {
     settings.render.width = width;
     settings.render.height = height;
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     Renderer::new(gpu, dataset, settings).unwrap()
 }
 

@@ -25,7 +25,6 @@ use terramp::config::Settings;
 use terramp::dataset::{Dataset, TileId};
 use terramp::frame::Renderer;
 use terramp::gpu::layout::SpeciesLod;
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::passes::terrain::frame::grid_indices;
 use terramp_testkit::camera::posed;
 use terramp_testkit::{TempDir, shared_data};
@@ -172,7 +171,7 @@ fn stand(what: &str, dir: &Path) -> Standing {
     settings.render.width = 320;
     settings.render.height = 180;
     let cells = settings.terrain.node_cells;
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     let mut r = Renderer::new(gpu, Dataset::open(dir).unwrap(), settings).unwrap();
     let poses = spread_poses(&r.dataset);
     // The mesh reads its own copy of the tiles.

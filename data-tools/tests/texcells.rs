@@ -11,7 +11,6 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use terramp::camera::Camera;
@@ -39,7 +38,7 @@ fn trees_and_forest() -> &'static Path {
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("texcells-trees-and-forest");
         let models = shared_data().expect("../shared/data").join("models");
         let table = ClassTable::load("nc").unwrap();
-        let mut bake = Command::new(env!("CARGO_BIN_EXE_terramp-data"));
+        let mut bake = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data"));
         bake.arg("bake");
         for s in &table.species {
             bake.arg("--model").arg(models.join(format!("{}.glb", s.model)));

@@ -8,7 +8,6 @@ mod support;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp::passes::tile_load_map::frame::height_tile_ranges;
 use terramp_testkit::camera::posed;
 use terramp_testkit::tlm::{assert_gpu_equals_twin, run, visible};
@@ -20,7 +19,7 @@ fn check(dataset: Dataset, cameras: &[(&str, [f64; 5])]) {
     let mut settings = Settings::default();
     settings.render.width = 160;
     settings.render.height = 96;
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
     let ranges = height_tile_ranges(&r.dataset);
     for &(what, pose) in cameras {

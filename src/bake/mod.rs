@@ -268,8 +268,10 @@ pub struct Missing {
 /// Bakes into `out` each of `names` (model file stems) whose impostor is missing there or of
 /// another format ([`crate::impostor::is_current`]), from `models/<name>.glb` or, for a
 /// generated tree's name, the generator ([`ModelSource`]); the others are left as they are.
-/// Names without a model are reported, not an error.
+/// Names without a model are reported, not an error. The GPU is `gpu`, or when `None` one opened
+/// as [`bake_models`] opens it, only if something is to be baked.
 pub fn bake_missing(
+    gpu: Option<&Gpu>,
     models: &Path,
     names: &[&str],
     out: &Path,
@@ -288,8 +290,7 @@ pub fn bake_missing(
             None => absent.push(models.join(format!("{name}.glb"))),
         }
     }
-    let baked =
-        if found.is_empty() { Vec::new() } else { bake_models(None, &found, out, options, progress)? };
+    let baked = if found.is_empty() { Vec::new() } else { bake_models(gpu, &found, out, options, progress)? };
     Ok(Missing { baked, absent })
 }
 

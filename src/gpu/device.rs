@@ -54,14 +54,27 @@ pub enum AdapterChoice {
 impl AdapterChoice {
     /// The `TERRAMP_ADAPTER` environment variable, when set, overrides the setting.
     pub fn with_env(self) -> Result<Self, GpuError> {
-        match std::env::var("TERRAMP_ADAPTER") {
-            Err(_) => Ok(self),
-            Ok(v) => match v.to_ascii_lowercase().as_str() {
-                "auto" | "" => Ok(Self::Auto),
-                "hardware" => Ok(Self::Hardware),
-                "software" => Ok(Self::Software),
-                _ => Err(GpuError::BadChoice(v)),
-            },
+        self.overridden_by(std::env::var(ADAPTER_VARIABLE).ok().as_deref())
+    }
+
+    /// `self`, unless `value` (what `TERRAMP_ADAPTER` holds, if it is set) names another kind:
+    /// `auto` (or empty), `hardware` or `software`, in any case.
+    pub fn overridden_by(self, value: Option<&str>) -> Result<Self, GpuError> {
+        let Some(value) = value else { return Ok(self) };
+        match value.to_ascii_lowercase().as_str() {
+            "auto" | "" => Ok(Self::Auto),
+            "hardware" => Ok(Self::Hardware),
+            "software" => Ok(Self::Software),
+            _ => Err(GpuError::BadChoice(value.to_owned())),
+        }
+    }
+
+    /// The lowercase word `TERRAMP_ADAPTER` takes for this kind.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Hardware => "hardware",
+            Self::Software => "software",
         }
     }
 
@@ -73,7 +86,29 @@ impl AdapterChoice {
             Self::Software => software,
         }
     }
+
+    /// Which of `candidates` (each adapter's device type and backend, in the order wgpu listed
+    /// them) this choice picks: among those it accepts, hardware first (discrete, integrated,
+    /// virtual or other, then a software rasteriser), Vulkan before other backends, then the
+    /// first listed. `None` when it accepts none. The order is the policy.
+    pub fn pick(self, candidates: &[(wgpu::DeviceType, wgpu::Backend)]) -> Option<usize> {
+        let rank = |(device_type, backend): (wgpu::DeviceType, wgpu::Backend)| {
+            let kind = match device_type {
+                wgpu::DeviceType::DiscreteGpu => 0,
+                wgpu::DeviceType::IntegratedGpu => 1,
+                wgpu::DeviceType::VirtualGpu | wgpu::DeviceType::Other => 2,
+                wgpu::DeviceType::Cpu => 3,
+            };
+            (kind, backend != wgpu::Backend::Vulkan)
+        };
+        (0..candidates.len())
+            .filter(|&i| self.accepts(candidates[i].0))
+            .min_by_key(|&i| (rank(candidates[i]), i))
+    }
 }
+
+/// The environment variable that overrides `gpu.adapter`: auto, hardware or software.
+pub const ADAPTER_VARIABLE: &str = "TERRAMP_ADAPTER";
 
 /// What to install when no adapter is usable, and the variables that force an adapter kind or a
 /// backend: the tail of `GpuError::NoAdapter`'s message.
@@ -254,8 +289,8 @@ impl Gpu {
     }
 }
 
-/// The adapter `choice` picks among those `instance` sees (those that present to `surface`, when
-/// given): hardware first, then by backend preference (Vulkan before GL). The order is the policy.
+/// The adapter `choice` picks (`AdapterChoice::pick`) among those `instance` sees (those that
+/// present to `surface`, when given).
 fn pick_adapter(
     instance: &wgpu::Instance,
     choice: AdapterChoice,
@@ -266,27 +301,66 @@ fn pick_adapter(
     let adapters = pollster::block_on(instance.enumerate_adapters(backends));
     let seen: Vec<String> =
         adapters.iter().map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend)).collect();
-    let rank = |info: &wgpu::AdapterInfo| {
-        let kind = match info.device_type {
-            wgpu::DeviceType::DiscreteGpu => 0,
-            wgpu::DeviceType::IntegratedGpu => 1,
-            wgpu::DeviceType::VirtualGpu | wgpu::DeviceType::Other => 2,
-            wgpu::DeviceType::Cpu => 3,
-        };
-        (kind, info.backend != wgpu::Backend::Vulkan)
-    };
-    adapters
-        .into_iter()
-        .filter(|a| choice.accepts(a.get_info().device_type))
-        .filter(|a| surface.is_none_or(|s| a.is_surface_supported(s)))
-        .min_by_key(|a| rank(&a.get_info()))
-        .ok_or_else(|| GpuError::NoAdapter {
-            wanted: match (choice, surface.is_some()) {
-                (AdapterChoice::Auto, false) => "usable",
-                (AdapterChoice::Auto, true) => "window-presenting",
-                (AdapterChoice::Hardware, _) => "hardware",
-                (AdapterChoice::Software, _) => "software",
-            },
-            seen: if seen.is_empty() { "none".into() } else { seen.join(", ") },
-        })
+    let mut usable: Vec<wgpu::Adapter> =
+        adapters.into_iter().filter(|a| surface.is_none_or(|s| a.is_surface_supported(s))).collect();
+    let candidates: Vec<_> =
+        usable.iter().map(|a| (a.get_info().device_type, a.get_info().backend)).collect();
+    choice.pick(&candidates).map(|i| usable.swap_remove(i)).ok_or_else(|| GpuError::NoAdapter {
+        wanted: match (choice, surface.is_some()) {
+            (AdapterChoice::Auto, false) => "usable",
+            (AdapterChoice::Auto, true) => "window-presenting",
+            (AdapterChoice::Hardware, _) => "hardware",
+            (AdapterChoice::Software, _) => "software",
+        },
+        seen: if seen.is_empty() { "none".into() } else { seen.join(", ") },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wgpu::{Backend, DeviceType};
+
+    /// What a machine with an NVIDIA GPU and Mesa's drivers lists: the GPU on Vulkan and GL,
+    /// lavapipe on Vulkan, llvmpipe on GL; lavapipe listed first.
+    const GPU_MACHINE: [(DeviceType, Backend); 4] = [
+        (DeviceType::Cpu, Backend::Vulkan),
+        (DeviceType::DiscreteGpu, Backend::Gl),
+        (DeviceType::DiscreteGpu, Backend::Vulkan),
+        (DeviceType::Cpu, Backend::Gl),
+    ];
+    /// A server without a GPU: llvmpipe on GL first, lavapipe on Vulkan.
+    const SOFTWARE_ONLY: [(DeviceType, Backend); 2] =
+        [(DeviceType::Cpu, Backend::Gl), (DeviceType::Cpu, Backend::Vulkan)];
+
+    #[test]
+    fn each_choice_picks_its_kind_vulkan_first() {
+        use AdapterChoice::{Auto, Hardware, Software};
+        assert_eq!(Auto.pick(&GPU_MACHINE), Some(2));
+        assert_eq!(Hardware.pick(&GPU_MACHINE), Some(2));
+        // The software adapter even where a GPU is present: what the tests run on.
+        assert_eq!(Software.pick(&GPU_MACHINE), Some(0));
+        assert_eq!((Auto.pick(&SOFTWARE_ONLY), Software.pick(&SOFTWARE_ONLY)), (Some(1), Some(1)));
+        assert_eq!(Hardware.pick(&SOFTWARE_ONLY), None);
+        let integrated_and_discrete = [(DeviceType::IntegratedGpu, Backend::Vulkan), GPU_MACHINE[2]];
+        assert_eq!(Hardware.pick(&integrated_and_discrete), Some(1));
+        // Of two equal candidates, the first listed.
+        assert_eq!(Software.pick(&[SOFTWARE_ONLY[1], SOFTWARE_ONLY[1]]), Some(0));
+        assert_eq!(Auto.pick(&[]), None);
+    }
+
+    #[test]
+    fn terramp_adapter_overrides_the_setting_in_any_case() {
+        use AdapterChoice::{Auto, Hardware, Software};
+        assert_eq!(Software.overridden_by(None).unwrap(), Software);
+        assert_eq!(Software.overridden_by(Some("HARDWARE")).unwrap(), Hardware);
+        assert_eq!(Hardware.overridden_by(Some("software")).unwrap(), Software);
+        assert_eq!(Software.overridden_by(Some("")).unwrap(), Auto);
+        assert_eq!(Software.overridden_by(Some("Auto")).unwrap(), Auto);
+        let err = Software.overridden_by(Some("gpu")).unwrap_err();
+        assert!(matches!(&err, GpuError::BadChoice(v) if v == "gpu"), "{err}");
+        for choice in [Auto, Hardware, Software] {
+            assert_eq!(Auto.overridden_by(Some(choice.name())).unwrap(), choice);
+        }
+    }
 }

@@ -18,5 +18,5 @@ pub mod resources;
 pub mod shaders;
 pub mod struct_layout;
 
-pub use device::{AdapterChoice, Gpu, GpuError, skip_device_select_layer};
+pub use device::{ADAPTER_VARIABLE, AdapterChoice, Gpu, GpuError, skip_device_select_layer};
 pub use profiler::{PassTiming, Profiler, TimeSource};

@@ -35,7 +35,7 @@ fn bake_nc(folder: &str, options: BakeOptions) -> Option<PathBuf> {
     let table = ClassTable::load("nc").unwrap();
     let names: Vec<&str> = table.species.iter().map(|s| s.model.as_str()).collect();
     let out = target_tmp_dir().join(folder);
-    let missing = bake_missing(&models, &names, &out, &options, false).unwrap();
+    let missing = bake_missing(Some(&crate::gpu()), &models, &names, &out, &options, false).unwrap();
     assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
     Some(out)
 }

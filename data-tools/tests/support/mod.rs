@@ -6,7 +6,7 @@
 #![allow(dead_code, reason = "each test binary uses a part of these helpers")]
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use gdal::raster::{Buffer, GdalType};
 use gdal::spatial_ref::SpatialRef;
@@ -37,7 +37,7 @@ pub fn write_geotiff<T: GdalType + Copy>(
 
 /// Runs `terramp-data build ARGS`.
 pub fn run_build(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_terramp-data")).arg("build").args(args).output().unwrap()
+    terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data")).arg("build").args(args).output().unwrap()
 }
 
 /// Runs `terramp-data build ARGS --out OUT`, asserts success, returns the opened dataset and stdout.

@@ -10,7 +10,6 @@ use terramp::classes::ClassTable;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::{FrameReport, Renderer};
-use terramp::gpu::{AdapterChoice, Gpu};
 use terramp_testkit::shared_data;
 
 use super::FOREST;
@@ -26,7 +25,7 @@ pub fn samples() -> &'static Path {
         let models = shared_data().expect("../shared/data").join("models");
         let table = ClassTable::load("nc").unwrap();
         let options = ForestOptions { texels: 128, slices: 16, ..ForestOptions::default() };
-        let gpu = Gpu::new(AdapterChoice::Auto).unwrap();
+        let gpu = terramp_testkit::gpu();
         let baked = bake_forests(Some(&gpu), &table, &models, &out, &options, &mut |_| {}).unwrap();
         assert_eq!(baked.iter().map(|r| r.class_code).collect::<Vec<_>>(), [FOREST]);
         out
@@ -52,7 +51,7 @@ pub fn render_from(
     settings.draw_seeds.impostors = impostors.display().to_string();
     settings.texcells.reach_m = reach_m;
     tune(&mut settings);
-    let gpu = Gpu::new(AdapterChoice::Auto).expect("a GPU adapter (install mesa-vulkan-drivers)");
+    let gpu = terramp_testkit::gpu();
     let mut r = Renderer::new(gpu, dataset, settings).unwrap();
     let camera = camera_of(&r);
     r.render_resolved(&camera).unwrap();

@@ -179,7 +179,7 @@ fn ensure_impostors(
     eprintln!("terramp: baking the missing impostors into {} (once)", dir.display());
     let start = Instant::now();
     let options = terramp::bake::BakeOptions::default();
-    let missing = terramp::bake::bake_missing(models, &wanted, dir, &options, true)?;
+    let missing = terramp::bake::bake_missing(None, models, &wanted, dir, &options, true)?;
     for path in &missing.absent {
         eprintln!("terramp: no model {} (--models): its species are selected but not drawn", path.display());
     }
