@@ -331,7 +331,7 @@ fn the_oracle_is_deterministic_and_accounts_for_every_seed() {
 
 /// The oracle's cost on a typical view: `cargo test --lib oracle_runtime -- --ignored --nocapture`.
 #[test]
-#[ignore]
+#[ignore = "measurement, no check: prints the oracle's time on two views of a 1024² dataset"]
 fn oracle_runtime_on_a_typical_view() {
     let ds = synthetic(1024);
     for pose in [[5115.0, 5115.0, 30.0, 30.0, -5.0], [3000.0, 4000.0, 150.0, 120.0, -12.0]] {
