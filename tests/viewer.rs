@@ -208,10 +208,10 @@ fn the_viewer_flies_in_a_real_window_and_shows_what_render_renders() {
 }
 
 /// `terramp view` run as a person would (without a backtrace, without the variables in
-/// `unset`): its standard error, once it has failed cleanly.
-fn view_fails(unset: &[&str], args: &[&str]) -> String {
+/// `unset`, with those in `set`): its standard error, once it has failed cleanly.
+fn view_fails(unset: &[&str], set: &[(&str, &str)], args: &[&str]) -> String {
     let mut command = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"));
-    command.arg("view").args(args).env("RUST_BACKTRACE", "0");
+    command.arg("view").args(args).env("RUST_BACKTRACE", "0").envs(set.iter().copied());
     for var in unset {
         command.env_remove(var);
     }
@@ -224,9 +224,24 @@ fn view_fails(unset: &[&str], args: &[&str]) -> String {
 
 #[test]
 fn without_a_display_or_a_dataset_the_viewer_says_so_and_fails() {
+    const HEADLESS: [&str; 2] = ["DISPLAY", "WAYLAND_DISPLAY"];
     let dataset = synth_dataset(300, 7);
-    let no_display = view_fails(&["DISPLAY", "WAYLAND_DISPLAY"], &["--dataset", dataset.to_str().unwrap()]);
+    let no_display = view_fails(&HEADLESS, &[], &["--dataset", dataset.to_str().unwrap()]);
     assert!(no_display.contains("no display to open a window on (neither DISPLAY"), "{no_display}");
-    let missing = view_fails(&[], &["--dataset", "/nonexistent/terramp-dataset"]);
+    let missing = view_fails(&[], &[], &["--dataset", "/nonexistent/terramp-dataset"]);
     assert!(missing.contains("cannot open the dataset /nonexistent/terramp-dataset"), "{missing}");
+
+    // The embedded default, not made yet: a missing adapter (none on a backend this system lacks)
+    // or display is found before the default is synthesized or its trees baked.
+    let fresh = TempDir::new("view-default");
+    let at = |name: &str| fresh.path().join(name).to_str().unwrap().to_owned();
+    let default =
+        ["--default-dataset", &at("default"), "--impostors", &at("impostors"), "--models", &at("m")];
+    let no_display = view_fails(&HEADLESS, &[], &default);
+    assert!(no_display.contains("no display to open a window on"), "{no_display}");
+    let no_adapter = view_fails(&HEADLESS, &[("WGPU_BACKEND", "metal")], &default);
+    assert!(no_adapter.contains("terramp view needs a GPU adapter"), "{no_adapter}");
+    assert!(no_adapter.contains("GPU adapter found (adapters seen: none)"), "{no_adapter}");
+    let made: Vec<_> = std::fs::read_dir(fresh.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(made.is_empty(), "made before failing: {made:?}");
 }

@@ -184,6 +184,13 @@ impl Gpu {
         Self::open(pick_adapter(&instance, choice, None)?)
     }
 
+    /// The adapter `new` would open for `choice`, without opening it: for a command to learn that
+    /// it has one before work that is no use without it.
+    pub fn probe(choice: AdapterChoice) -> Result<wgpu::AdapterInfo, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Ok(pick_adapter(&instance, choice, None)?.get_info())
+    }
+
     /// Opens a device that can present to a window: `display` is the window system's connection
     /// (winit's `OwnedDisplayHandle`), `window` the window. Among the adapters that can present
     /// to its surface, `choice` picks as in `new`.

@@ -6,7 +6,8 @@
 //! Knobs that need new GPU resources, a new preset and a new window size remake the renderer on
 //! the same device, keeping the camera (a resize waits until the size has held still a moment).
 //! Every failure is one line and a non-zero exit: no display, no adapter, a dataset that does not
-//! open, a frame that fails.
+//! open, a frame that fails. What the window needs (an adapter, then the display) is checked
+//! before the embedded default is synthesized and its trees baked, which takes minutes.
 
 mod capture;
 mod flight;
@@ -25,6 +26,7 @@ use winit::window::WindowId;
 
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
+use terramp::gpu::Gpu;
 
 use crate::demo;
 
@@ -75,13 +77,28 @@ pub struct ViewArgs {
 
 /// Opens the window and flies until it is closed.
 pub fn run(args: ViewArgs) -> Result<()> {
-    let (settings, dataset, dataset_dir) = match &args.dataset {
+    let settings = Settings::load(&args.preset, args.settings.as_deref())?;
+    let given = match &args.dataset {
         Some(dir) => {
-            let settings = Settings::load(&args.preset, args.settings.as_deref())?;
             let dataset =
                 Dataset::open(dir).with_context(|| format!("cannot open the dataset {}", dir.display()))?;
-            (settings, dataset, dir.clone())
+            Some((dataset, dir.clone()))
         }
+        None => None,
+    };
+    let path = args.path.as_deref().map(terramp::path::CameraPath::load).transpose()?;
+    // The window's needs first: the embedded default is minutes of work, no use without them.
+    Gpu::probe(settings.gpu.adapter).context("terramp view needs a GPU adapter")?;
+    let event_loop = EventLoop::new().map_err(|e| {
+        let unset = ["DISPLAY", "WAYLAND_DISPLAY"].iter().all(|v| std::env::var_os(v).is_none());
+        let why = if unset { "neither DISPLAY nor WAYLAND_DISPLAY is set".to_owned() } else { e.to_string() };
+        anyhow!(
+            "no display to open a window on ({why}): terramp view needs X11 or Wayland; headless, use \
+             terramp render, fly or profile"
+        )
+    })?;
+    let (settings, dataset, dataset_dir) = match given {
+        Some((dataset, dir)) => (settings, dataset, dir),
         None => {
             let prepared = demo::prepare(&demo::Prepare {
                 dataset: &args.default_dataset,
@@ -93,15 +110,6 @@ pub fn run(args: ViewArgs) -> Result<()> {
             (prepared.0, prepared.1, args.default_dataset.clone())
         }
     };
-    let path = args.path.as_deref().map(terramp::path::CameraPath::load).transpose()?;
-    let event_loop = EventLoop::new().map_err(|e| {
-        let unset = ["DISPLAY", "WAYLAND_DISPLAY"].iter().all(|v| std::env::var_os(v).is_none());
-        let why = if unset { "neither DISPLAY nor WAYLAND_DISPLAY is set".to_owned() } else { e.to_string() };
-        anyhow!(
-            "no display to open a window on ({why}): terramp view needs X11 or Wayland; headless, use \
-             terramp render, fly or profile"
-        )
-    })?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
         args,
