@@ -1,6 +1,7 @@
 //! `terramp profile`: the JSON lists every pass the frames timed, with positive times; its seed
 //! counts are the log's; the Chrome trace parses and holds the passes; the CPU-timing fallback says
-//! so; the generated orbit stays over the dataset.
+//! so; the generated orbit stays over the dataset; seeds selected with no impostor to draw them
+//! are said.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -17,6 +18,7 @@ struct Run {
     trace: Value,
     log: Vec<Value>,
     stdout: String,
+    stderr: String,
 }
 
 fn profile(dataset: &Path, name: &str, extra: &[&str]) -> Run {
@@ -37,13 +39,15 @@ fn profile(dataset: &Path, name: &str, extra: &[&str]) -> Run {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
-    assert!(output.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&output.stderr));
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(output.status.success(), "{stdout}\n{stderr}");
     let read = |file: &str| std::fs::read_to_string(out.join(file)).unwrap();
     let run = Run {
         json: serde_json::from_str(&read("profile.json")).expect("the profile is JSON"),
         trace: serde_json::from_str(&read("trace.json")).expect("the trace is JSON"),
         log: read("log.jsonl").lines().map(|l| serde_json::from_str(l).unwrap()).collect(),
         stdout,
+        stderr,
     };
     let _ = std::fs::remove_dir_all(&out);
     run
@@ -59,6 +63,9 @@ fn profile_json_trace_and_log_agree() {
     // No --path: the generated orbit, which stays over this small dataset's land cover.
     let run = profile(&dataset, "gpu", &[]);
     let json = &run.json;
+    // No impostor folder: the seeds are selected, and the command says none is drawn.
+    let undrawn = "seeds of the class table nc are selected but none is drawn";
+    assert!(run.stderr.contains(undrawn), "{}", run.stderr);
     assert_eq!(run.log.len() as u64, WARMUP + FRAMES);
     assert_eq!(json["frames"]["profiled"], FRAMES);
     assert_eq!(json["frames"]["first"], WARMUP);

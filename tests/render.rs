@@ -1,5 +1,6 @@
 //! Terrain rendering on the software adapter: frames are not blank, keep their depth, have no
-//! holes between LODs, repeat exactly, and survive cameras outside the dataset.
+//! holes between LODs, repeat exactly, and survive cameras outside the dataset; a command says
+//! when seeds are selected that nothing can draw.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
@@ -166,4 +167,79 @@ fn a_lost_device_is_an_error_not_a_panic() {
     assert!(errors[first..].iter().all(lost), "once lost, always lost: {errors:?}");
     let said = errors[first].to_string();
     assert!(said.starts_with("the GPU device was lost (Destroyed); nothing more can be drawn"), "{said}");
+}
+
+/// `terramp render` of `dataset` with the settings file `settings` (if any): its standard error.
+fn render_stderr(dataset: &std::path::Path, settings: Option<&std::path::Path>) -> String {
+    let mut command = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp"));
+    command.args(["render", "--dataset"]).arg(dataset);
+    command.args(["--camera", "100,100,900,0,-10", "--width", "32", "--height", "32", "--out"]);
+    command.arg(std::env::temp_dir().join(format!("terramp-undrawn-{}.png", std::process::id())));
+    if let Some(file) = settings {
+        command.arg("--settings").arg(file);
+    }
+    let output = command.output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(output.status.success(), "{stderr}");
+    stderr
+}
+
+/// Seeds selected that nothing can draw are said, by the library's `UndrawnSeeds` and by the
+/// commands as they start: no impostor folder, a folder without some of the table's models; and
+/// not said when every model is there, or when no seed is selected.
+#[test]
+fn seeds_selected_but_not_drawn_are_said() {
+    use terramp::config::Settings;
+    use terramp::dataset::Dataset;
+    use terramp::frame::UndrawnSeeds;
+    let dir = synth_dataset(300, 7);
+    let dataset = Dataset::open(&dir).unwrap();
+    let models: Vec<String> = {
+        let mut models = Vec::new();
+        for s in terramp::classes::ClassTable::load("nc").unwrap().species {
+            if !models.contains(&s.model) {
+                models.push(s.model);
+            }
+        }
+        models
+    };
+    assert!(models.len() > 2, "{models:?}");
+    let with = |impostors: &str, density_scale: f64| {
+        let mut settings = Settings::default();
+        settings.draw_seeds.impostors = impostors.to_owned();
+        settings.seeds.density_scale = density_scale;
+        UndrawnSeeds::of(&dataset, &settings).unwrap()
+    };
+    let none = with("", 1.0).expect("no impostor folder: nothing drawn");
+    assert_eq!((none.class_table.as_str(), &none.missing), ("nc", &models));
+    assert!(
+        none.to_string().contains("are selected but none is drawn: draw_seeds.impostors names"),
+        "{none}"
+    );
+    assert_eq!(with("", 0.0), None, "no seed selected, nothing to say");
+    let said = render_stderr(&dir, None);
+    assert!(said.contains(&format!("terramp: {none}")), "{said}");
+
+    let Some(baked) = terramp_testkit::nc_impostors() else { return };
+    assert_eq!(with(baked.to_str().unwrap(), 1.0), None, "every model baked");
+    let tmp = terramp_testkit::TempDir::new("undrawn");
+    let settings = tmp.path().join("settings.toml");
+    std::fs::write(&settings, format!("[draw_seeds]\nimpostors = {:?}\n", baked.display().to_string()))
+        .unwrap();
+    let said = render_stderr(&dir, Some(&settings));
+    assert!(!said.contains("drawn"), "{said}");
+    // A folder with all but the first two models.
+    let partial = tmp.path().join("partial");
+    std::fs::create_dir_all(&partial).unwrap();
+    for model in &models[2..] {
+        std::os::unix::fs::symlink(baked.join(model), partial.join(model)).unwrap();
+    }
+    let some = with(partial.to_str().unwrap(), 1.0).expect("two models missing");
+    assert_eq!(some.missing, models[..2]);
+    let expected = format!(
+        "2 of the class table nc's {} models have no impostor in {}",
+        models.len(),
+        partial.display()
+    );
+    assert!(some.to_string().starts_with(&expected), "{some}");
 }

@@ -275,6 +275,7 @@ fn profile(
     let adapter = gpu.describe();
     eprintln!("terramp: adapter {adapter}");
     let mut renderer = Renderer::new(gpu, dataset, settings)?;
+    say_undrawn(&renderer);
     let (timing, timing_note) = terramp::profile::timing_of(&renderer);
     let mut log = match &outputs.log {
         Some(file) => Some(std::io::BufWriter::new(
@@ -311,11 +312,19 @@ fn profile(
     Ok(())
 }
 
+/// Says which seeds `renderer` selects but cannot draw, if any: a frame shows no sign of them.
+fn say_undrawn(renderer: &Renderer) {
+    if let Some(undrawn) = renderer.undrawn_seeds() {
+        eprintln!("terramp: {undrawn}");
+    }
+}
+
 fn open_renderer(dataset_dir: &Path, settings: Settings) -> Result<Renderer> {
     let dataset = Dataset::open(dataset_dir)?;
     let gpu = Gpu::new(settings.gpu.adapter)?;
     eprintln!("terramp: adapter {}", gpu.describe());
     let renderer = Renderer::new(gpu, dataset, settings)?;
+    say_undrawn(&renderer);
     let unbaked = renderer.texcell_classes_unbaked();
     if !unbaked.is_empty() {
         eprintln!(

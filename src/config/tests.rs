@@ -134,3 +134,14 @@ fn the_wind_is_still_by_default_and_its_ranges_are_checked() {
     let w = with("[wind]\nspeed_m_s = 12\nfrom_deg = 90\n").unwrap().wind;
     assert!(w.speed_m_s == 12.0 && w.from_deg == 90.0);
 }
+
+/// `config/demo.toml` draws the demo's trees for any command over the default dataset: the class
+/// table the demo picks for its scheme (nc, `tests/synth.rs` checks), and the folder it bakes them
+/// into by default.
+#[test]
+fn the_demo_settings_name_the_demos_class_table_and_impostors() {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/demo.toml");
+    let s = Settings::load("balanced", Some(&file)).unwrap();
+    assert_eq!(Some(s.seeds.class_table.as_str()), crate::classes::ClassTable::generated_for("nc"));
+    assert_eq!(s.draw_seeds.impostors, "data/impostors");
+}

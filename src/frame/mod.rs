@@ -35,12 +35,14 @@ mod seeds;
 mod setup;
 mod texcells;
 mod tools;
+mod undrawn;
 
 pub use clearance::GROUND_CLEARANCE_NEAR;
 pub use error::RenderError;
 pub use seeds::SeedReport;
 pub use texcells::TexcellReport;
 pub use tools::{RESOLVE_GUARD_FRAMES, Replay};
+pub use undrawn::UndrawnSeeds;
 
 /// Linear-RGB colour of the sky, also the haze the distance fades into.
 const SKY_LINEAR: [f64; 3] = [0.42, 0.55, 0.75];
@@ -265,6 +267,12 @@ impl Renderer {
     /// Pass timings of the latest frame whose timings have arrived (never blocks for them).
     pub fn last_timings(&self) -> &[PassTiming] {
         &self.last_timings
+    }
+
+    /// Seeds pass 3 selects but pass 4 cannot draw (no `draw_seeds.impostors`, or models missing
+    /// there), if any: what a command says when it starts.
+    pub fn undrawn_seeds(&self) -> Option<&UndrawnSeeds> {
+        self.seeds.as_ref().and_then(|s| s.undrawn.as_ref())
     }
 
     /// Dense land-cover classes (codes) the dataset holds whose forest sample is not in

@@ -31,7 +31,7 @@ use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::wind::WindFrame;
 
-use super::{Caches, RenderError, Targets};
+use super::{Caches, RenderError, Targets, UndrawnSeeds};
 
 /// Pass 3's counters for one frame, as the frame log records them.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
@@ -72,6 +72,8 @@ pub(super) struct SeedStage {
     /// The last frame's inputs, for the twin.
     pub last_frame: Option<SeedFrame>,
     pub latest: Option<SeedReport>,
+    /// Seeds selected that pass 4 cannot draw, if any.
+    pub undrawn: Option<UndrawnSeeds>,
 }
 
 impl SeedStage {
@@ -97,6 +99,7 @@ impl SeedStage {
         let device = &gpu.device;
         check_capacity(device, settings.seeds.capacity)?;
         let (table, tables, patterns) = seeded_world(settings, landcover)?;
+        let undrawn = UndrawnSeeds::find(class_table_name(settings, landcover), &table, settings);
         let pass = SeedSelectPass::new(device, settings, &patterns, &tables, &height_tile_max_m(dataset));
         let bind_group = pass.bind_group(device, &sources);
         let mut compact = CompactPass::new(device, CompactLimits::from(settings))?;
@@ -121,6 +124,7 @@ impl SeedStage {
             counters_ring,
             last_frame: None,
             latest: None,
+            undrawn,
         }))
     }
 
@@ -226,17 +230,21 @@ fn check_capacity(device: &wgpu::Device, capacity: u32) -> Result<(), RenderErro
     Ok(())
 }
 
+/// The name of the class table seeds grow from: `seeds.class_table`, else the land cover's scheme.
+pub(super) fn class_table_name<'a>(settings: &'a Settings, landcover: &'a LandcoverLayer) -> &'a str {
+    match settings.seeds.class_table.as_str() {
+        "" => landcover.scheme.as_str(),
+        name => name,
+    }
+}
+
 /// The class table the land cover's scheme names (or `seeds.class_table`), its species tables for
 /// the land cover's coding, and the P generic patterns: what exists, the same for every frame.
 fn seeded_world(
     settings: &Settings,
     landcover: &LandcoverLayer,
 ) -> Result<(ClassTable, SeedTables, SeedPatterns), RenderError> {
-    let name = match settings.seeds.class_table.as_str() {
-        "" => landcover.scheme.as_str(),
-        name => name,
-    };
-    let table = ClassTable::load(name)?;
+    let table = ClassTable::load(class_table_name(settings, landcover))?;
     let seeds = &settings.seeds;
     let tables = SeedTables::new(
         &table,

@@ -49,6 +49,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     let adapter = gpu.describe();
     eprintln!("terramp: adapter {adapter}");
     let mut renderer = Renderer::new(gpu, dataset, settings)?;
+    crate::say_undrawn(&renderer);
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let path = DemoPath::over(&renderer.dataset);
     let cameras: Vec<Camera> = (0..args.frames)

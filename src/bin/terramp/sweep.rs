@@ -71,6 +71,15 @@ pub struct SweepArgs {
 
 impl SweepArgs {
     pub fn run(self) -> Result<()> {
+        // What the points' frames will not draw, said before the sweep's minutes (the class table
+        // and the impostors are the settings file's: no preset sets them).
+        if let Some(preset) = self.presets.first() {
+            let settings = terramp::config::Settings::load(preset, self.settings.as_deref())?;
+            let dataset = terramp::dataset::Dataset::open(&self.dataset)?;
+            if let Some(undrawn) = terramp::frame::UndrawnSeeds::of(&dataset, &settings)? {
+                eprintln!("terramp: {undrawn}");
+            }
+        }
         let out = self.out;
         let options = SweepOptions {
             dataset: self.dataset,

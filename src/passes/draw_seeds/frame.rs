@@ -32,14 +32,17 @@ pub fn load_impostors(dir: &Path, species: &[Species]) -> Result<Vec<Option<Impo
         let known = loaded.iter().flatten().find(|i| i.name == s.model).cloned();
         let impostor = match known {
             Some(impostor) => Some(impostor),
-            None if dir.join(&s.model).join(MANIFEST_FILE).is_file() => {
-                Some(crate::impostor::load(dir, &s.model)?)
-            }
+            None if has_impostor(dir, &s.model) => Some(crate::impostor::load(dir, &s.model)?),
             None => None,
         };
         loaded.push(impostor);
     }
     Ok(loaded)
+}
+
+/// Whether `dir` holds an impostor of `model` (its manifest): the species of that model are drawn.
+pub fn has_impostor(dir: &Path, model: &str) -> bool {
+    dir.join(model).join(MANIFEST_FILE).is_file()
 }
 
 /// The frame's constants from the settings, the terrain's matrix, sun, clouds and haze, and the

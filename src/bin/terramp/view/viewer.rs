@@ -108,6 +108,7 @@ impl Viewer {
         let size = window.inner_size();
         (settings.render.width, settings.render.height) = (size.width.max(1), size.height.max(1));
         let renderer = Renderer::new(gpu.clone(), start.dataset, settings)?;
+        crate::say_undrawn(&renderer);
         let screen = Screen::new(window, surface, &gpu, &renderer, !args.no_vsync)?;
         let home = overview(&renderer.dataset, &renderer.settings);
         let mut views = vec![home];
