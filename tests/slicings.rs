@@ -59,7 +59,7 @@ fn crowns_are_sliced_trunks_stay_meshes_and_every_crown_vertex_shows_in_a_slicin
     let out = TempDir::new("slicings");
     let files: Vec<_> = ["Pine_1", "Bush_1", "DeadTree_1"].map(|m| models.join(format!("{m}.glb"))).into();
     let options = BakeOptions { texels: 512, slicing: Some(OPTIONS), ..Default::default() };
-    bake_models(None, &files, out.path(), &options, false).unwrap();
+    bake_models(Some(&terramp_testkit::gpu()), &files, out.path(), &options, false).unwrap();
     let [pine, bush, dead] = ["Pine_1", "Bush_1", "DeadTree_1"].map(|m| load(out.path(), m).unwrap());
 
     assert!(dead.slicing.is_none(), "an all-bark model has no crown to slice");
@@ -208,7 +208,14 @@ fn the_stochastic_blend_keeps_the_sorted_blends_picture_over_its_dither() {
     let Some(shared) = shared_data() else { return };
     let out = TempDir::new("slicing-blend");
     let options = BakeOptions { texels: 1024, slicing: Some(OPTIONS), ..Default::default() };
-    bake_models(None, &[shared.join("models/Tree_1.glb")], out.path(), &options, false).unwrap();
+    bake_models(
+        Some(&terramp_testkit::gpu()),
+        &[shared.join("models/Tree_1.glb")],
+        out.path(),
+        &options,
+        false,
+    )
+    .unwrap();
     let tree = load(out.path(), "Tree_1").unwrap();
     // docs/slicings.md's table: degrees off slicing 0, the mean difference per block (levels of
     // 255) and the coverage against the sorted blend's. The model is f32 arithmetic that gives
@@ -251,7 +258,14 @@ fn orbit_figure() {
     let shared = shared_data().expect("../shared/data");
     let out = TempDir::new("slicing-orbit");
     let options = BakeOptions { texels: 1024, slicing: Some(OPTIONS), ..Default::default() };
-    bake_models(None, &[shared.join("models/Tree_1.glb")], out.path(), &options, false).unwrap();
+    bake_models(
+        Some(&terramp_testkit::gpu()),
+        &[shared.join("models/Tree_1.glb")],
+        out.path(),
+        &options,
+        false,
+    )
+    .unwrap();
     let tree = load(out.path(), "Tree_1").unwrap();
     let px = terramp::reference::slicing::VIEW_PX as u32;
     let steps = 7u32;
