@@ -12,8 +12,9 @@
 # Makers marked `shared` read ../shared/data (nc/, zion/, rainier/, models/, globe/). The datasets
 # and impostors are built into DATA_DIR (data/trade, as scripts/trade.sh builds them, reused while
 # current); scratch files go to OUT (/tmp/terramp-docs-images). Needs: the release build (made
-# here), python3 with Pillow for `slicings_tree1` and `wind` (pip install pillow), Xvfb, xdotool
-# and xwd for `viewer` (apt-get install xvfb xdotool x11-apps).
+# here); python3 with Pillow for `slicings_tree1`, `wind` and the soaks (without it, Pillow is
+# installed from PyPI into .venv-docs, scripts/requirements-docs.txt); Xvfb, xdotool and xwd for
+# `viewer` (apt-get install xvfb xdotool x11-apps).
 #
 # A new figure in docs/ gets a maker here and a row in the table, in the same commit.
 set -euo pipefail
@@ -101,6 +102,16 @@ cargo build --release --workspace -q
 terramp="${CARGO_TARGET_DIR:-$root/target}/release/terramp"
 terramp_data="${CARGO_TARGET_DIR:-$root/target}/release/terramp-data"
 compose() { "$terramp_data" compose "$@"; }
+
+# python3 with Pillow first on PATH (the scripts the makers call run `python3`).
+pillow() {
+    python3 -c 'import PIL' 2>/dev/null && return
+    if [[ ! -x .venv-docs/bin/python ]] || ! .venv-docs/bin/python -c 'import PIL' 2>/dev/null; then
+        python3 -m venv .venv-docs
+        .venv-docs/bin/pip install -q -r scripts/requirements-docs.txt
+    fi
+    export PATH="$root/.venv-docs/bin:$PATH"
+}
 
 # The trade's datasets (nc, zion, the synthetic default) and the 11 shared models' impostors.
 trade_data_ready=0
@@ -249,7 +260,7 @@ make_seeds_border() {
 }
 
 make_slicings_tree1() {
-    python3 -c 'import PIL' 2>/dev/null || { echo "slicings_tree1 needs Pillow: pip install pillow" >&2; return 1; }
+    pillow
     "$terramp_data" bake --model "$shared/models/Tree_1.glb" --out "$out/sl" --slicings 6x5 >/dev/null
     python3 scripts/slices_figure.py "$out/sl/Tree_1" 0 docs/slicings_tree1.png
 }
@@ -365,6 +376,7 @@ make_viewer() {
 }
 
 make_wind() {
+    pillow
     IMAGES_ONLY=1 OUT="$out/wind" DATA_DIR="$data" scripts/wind.sh
 }
 
@@ -372,11 +384,12 @@ make_streaming() {
     IMAGES_ONLY=1 scripts/measure_streaming.sh "$out/streaming"
 }
 
-make_soak_globe() { FRAMES=10000 SOAKS=globe DATA_DIR="$data" scripts/soak.sh; }
-make_soak_nc() { FRAMES=10000 SOAKS=nc DATA_DIR="$data" scripts/soak.sh; }
+make_soak_globe() { pillow; FRAMES=10000 SOAKS=globe DATA_DIR="$data" scripts/soak.sh; }
+make_soak_nc() { pillow; FRAMES=10000 SOAKS=nc DATA_DIR="$data" scripts/soak.sh; }
 # The one-way flight and the flight there, back and there again of docs/RELIABILITY.md's soak section.
-make_soak_nc_growth() { FRAMES=5000 LEGS=1 SOAKS=nc PLOT_NAME=nc_growth DATA_DIR="$data" scripts/soak.sh; }
+make_soak_nc_growth() { pillow; FRAMES=5000 LEGS=1 SOAKS=nc PLOT_NAME=nc_growth DATA_DIR="$data" scripts/soak.sh; }
 make_soak_nc_there_and_back() {
+    pillow
     FRAMES=900 LEGS=3 SOAKS=nc PLOT_NAME=nc_there_and_back DATA_DIR="$data" scripts/soak.sh
 }
 make_trade() { DATA_DIR="$data" scripts/trade.sh; }
