@@ -256,7 +256,7 @@ make_light() {
 make_seeds_border() {
     rm -rf "$out/spacing" && mkdir -p "$out/spacing"
     TERRAMP_SPACING_PNG="$out/spacing" cargo test --release -q -p terramp-data-tools --test seed_spacing >/dev/null
-    compose --gap 6 --out docs/seeds_border.png "$out"/spacing/seeds_border_{nc,zion}.png
+    compose --scale 0.5 --gap 10 --out docs/seeds_border.png "$out"/spacing/seeds_border_{nc,zion}.png
 }
 
 make_slicings_tree1() {
