@@ -25,7 +25,7 @@ pub struct ComposeArgs {
     #[arg(long)]
     columns: Option<usize>,
     /// The part of every input kept, in its own pixels: X,Y,WIDTH,HEIGHT.
-    #[arg(long, value_delimiter = ',', num_args = 4)]
+    #[arg(long, value_delimiter = ',')]
     crop: Option<Vec<u32>>,
     /// Scale of every input after cropping (0.75 shrinks a 960 × 540 frame to 720 × 405).
     #[arg(long, default_value_t = 1.0)]
@@ -37,7 +37,7 @@ pub struct ComposeArgs {
     #[arg(long, default_value_t = 3)]
     gap: u32,
     /// Colour of the gaps and of unused cell area, as R,G,B.
-    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [255, 255, 255])]
+    #[arg(long, value_delimiter = ',', default_values_t = [255, 255, 255])]
     background: Vec<u8>,
     /// Put each input over a grey checkerboard of squares this many pixels wide (shows alpha).
     #[arg(long)]
@@ -86,7 +86,7 @@ pub fn compose(args: &ComposeArgs) -> Result<()> {
         |cells: usize, size: u32| cells as u64 * u64::from(size) + (cells as u64 - 1) * u64::from(args.gap);
     let (width, height) = (span(columns, cell[0]), span(rows, cell[1]));
     ensure!(width * height <= 1 << 28, "the composed picture would be {width} × {height} pixels: too large");
-    let [r, g, b] = [args.background[0], args.background[1], args.background[2]];
+    let &[r, g, b] = args.background.as_slice() else { bail!("--background takes three numbers: R,G,B") };
     let mut out = RgbaImage::from_pixel(width as u32, height as u32, Rgba([r, g, b, 255]));
     for (k, picture) in pictures.iter().enumerate() {
         let (column, row) = ((k % columns) as u32, (k / columns) as u32);
@@ -229,6 +229,30 @@ mod tests {
         }
         assert!(xwd_picture(&bytes[..bytes.len() - 1]).is_err(), "a truncated dump reads");
         assert!(xwd_picture(&bytes[..40]).is_err(), "a header cut short reads");
+    }
+
+    #[test]
+    fn lists_parse_from_one_comma_separated_value() {
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            args: ComposeArgs,
+        }
+        let parse = |line: &[&str]| <Cli as clap::Parser>::try_parse_from(line).map(|c| c.args);
+        let args = parse(&[
+            "compose",
+            "--crop",
+            "320,230,640,200",
+            "--background",
+            "0,10,20",
+            "--out",
+            "o.png",
+            "a.png",
+        ])
+        .unwrap();
+        assert_eq!(args.crop, Some(vec![320, 230, 640, 200]));
+        assert_eq!(args.background, vec![0, 10, 20]);
+        assert_eq!(parse(&["compose", "--out", "o.png", "a.png"]).unwrap().background, vec![255, 255, 255]);
     }
 
     #[test]
