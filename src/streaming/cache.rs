@@ -16,7 +16,8 @@
 //! few words beside each slot (`with_summary`: the height cache, its tile's block tops for pass 3),
 //! made from the tile as it is placed.
 
-use super::loader::{LayerKind, Loaded};
+use super::LayerKind;
+use super::loader::Loaded;
 use super::residency::{CacheStats, Placement, Residency, UploadBudget};
 use crate::dataset::{MipLayout, PackError, Pyramid, TileId};
 use crate::gpu::layout::{PAGE_EMPTY, page_entry};

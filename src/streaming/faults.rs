@@ -7,7 +7,7 @@
 
 use std::time::Duration;
 
-use super::loader::LayerKind;
+use super::LayerKind;
 use crate::config::FaultSettings;
 use crate::dataset::TileId;
 

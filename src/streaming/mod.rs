@@ -7,12 +7,14 @@
 
 pub mod cache;
 pub mod faults;
+mod layer;
 pub mod loader;
 mod residency;
 pub mod wants;
 
 pub use cache::{SlotSummary, TileCache, page_levels};
 pub use faults::Faults;
-pub use loader::{Delivery, LayerKind, Loaded, Loader, LoaderError, LoaderOptions, TileRequest};
+pub use layer::LayerKind;
+pub use loader::{Delivery, Loaded, Loader, LoaderError, LoaderOptions, TileRequest};
 pub use residency::{CacheStats, UploadBudget};
 pub use wants::{AreaWant, tiles_over};

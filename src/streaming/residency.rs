@@ -19,7 +19,8 @@
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
-use super::loader::{LayerKind, Loaded, TileRequest};
+use super::LayerKind;
+use super::loader::{Loaded, TileRequest};
 use crate::config::CacheSettings;
 use crate::dataset::TileId;
 
