@@ -84,10 +84,8 @@ impl<'a> FinestMesh<'a> {
         let [nx, ny] = p.tiles_at(0);
         let t = [(i / p.tile).min(nx - 1), (j / p.tile).min(ny - 1)];
         let dataset = self.dataset;
-        let tile = self
-            .tiles
-            .entry(t)
-            .or_insert_with(|| dataset.height_tile(TileId::new(0, t[0], t[1])).unwrap().to_vec());
+        let tile =
+            self.tiles.entry(t).or_insert_with(|| dataset.height_tile(TileId::new(0, t[0], t[1])).unwrap());
         let (x, y) = (i - t[0] * p.tile + p.border, j - t[1] * p.tile + p.border);
         f64::from(tile[(y * p.tile_extent() + x) as usize])
     }

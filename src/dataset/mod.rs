@@ -1,7 +1,9 @@
-//! How it works: a dataset is a folder with `manifest.toml` and one memory-mapped pack per layer
-//! (heights, their validity mask, imagery, land cover). `Dataset::open` checks the manifest and
-//! every pack's header and length up front; tile payloads are checksummed when read, so a damaged
-//! tile is an error for that tile alone and the caller decides how to degrade.
+//! How it works: a dataset is a folder with `manifest.toml` and one pack per layer (heights, their
+//! validity mask, imagery, land cover). `Dataset::open` checks the manifest and every pack's
+//! header, length and index up front; tile payloads are read when asked for (positioned reads,
+//! never a mapping: `pack`), checksummed and decoded (`layer_pack`), so a damaged tile, or a pack
+//! changed on disk while open, is an error for that tile alone and the caller decides how to
+//! degrade.
 //!
 //! The manifest's format version is read on its own before the rest, so a dataset of another
 //! version is reported as such (and rebuilt by whoever owns it), not as a malformed manifest.
@@ -15,6 +17,7 @@
 #[cfg(feature = "bc-encode")]
 pub mod block_encode;
 pub mod imagery_format;
+mod layer_pack;
 pub mod layer_writer;
 pub mod lcc;
 pub mod manifest;
@@ -24,17 +27,16 @@ pub mod pyramid;
 pub mod staging;
 pub mod surface;
 
-use std::borrow::Cow;
-use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
 
 use serde::Deserialize;
 use thiserror::Error;
 
+use layer_pack::word_of;
 use lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
 
 pub use imagery_format::{ImageryFormat, MipLayout};
+pub use layer_pack::LayerPack;
 pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer};
 pub use manifest::{
     CellLayer, ClassName, Crs, FORMAT_VERSION, HeightLayer, LandcoverLayer, MANIFEST_FILE, Manifest,
@@ -117,171 +119,6 @@ pub enum DatasetError {
     Pack(#[from] PackError),
 }
 
-/// Decoded tiles a compressed layer keeps for the next reads: tools and twins read texel by
-/// texel, mostly from the same few tiles.
-const DECODED_TILES_KEPT: usize = 16;
-
-/// One layer's pack with the pyramid that addresses it.
-pub struct LayerPack {
-    /// The tile quadtree that numbers the pack's tiles, as the manifest gives it.
-    pub pyramid: Pyramid,
-    /// Mips stored per tile: the imagery's count, 1 for heights, the mask and land cover.
-    pub mips: u32,
-    /// How the texels are stored when in blocks (block-compressed imagery); `None` when plain.
-    pub block_format: Option<ImageryFormat>,
-    pack: Pack,
-    /// The latest tiles decompressed from the pack (compressed packs only).
-    decoded: RecentTiles,
-    /// The latest tiles decoded from blocks into plain texels (block formats only).
-    plain: RecentTiles,
-}
-
-/// The latest few tiles made by decoding, newest last, by pack index.
-#[derive(Default)]
-struct RecentTiles(Mutex<VecDeque<(u64, Arc<[u8]>)>>);
-
-impl RecentTiles {
-    fn get(&self, index: u64) -> Option<Arc<[u8]>> {
-        let tiles = self.0.lock().ok()?;
-        tiles.iter().find(|(i, _)| *i == index).map(|(_, bytes)| Arc::clone(bytes))
-    }
-
-    fn keep(&self, index: u64, bytes: &Arc<[u8]>) {
-        if let Ok(mut tiles) = self.0.lock() {
-            if tiles.len() == DECODED_TILES_KEPT {
-                tiles.pop_front();
-            }
-            tiles.push_back((index, Arc::clone(bytes)));
-        }
-    }
-}
-
-/// A tile's payload: in the pack's mapping (stored raw), or decoded and shared.
-pub enum TileBytes<'a> {
-    /// Borrowed from the mapping.
-    Mapped(&'a [u8]),
-    /// Decoded from a compressed pack.
-    Decoded(Arc<[u8]>),
-}
-
-impl TileBytes<'_> {
-    /// The payload to keep: the decoded tile itself, or a copy out of the mapping.
-    pub fn into_shared(self) -> Arc<[u8]> {
-        match self {
-            Self::Mapped(bytes) => Arc::from(bytes),
-            Self::Decoded(bytes) => bytes,
-        }
-    }
-}
-
-impl std::ops::Deref for TileBytes<'_> {
-    type Target = [u8];
-
-    fn deref(&self) -> &[u8] {
-        match self {
-            Self::Mapped(bytes) => bytes,
-            Self::Decoded(bytes) => bytes,
-        }
-    }
-}
-
-impl LayerPack {
-    /// The pack `file` in `dir`, checked to hold a tile of `tile_bytes` for every tile of `pyramid`.
-    fn open(
-        dir: &Path,
-        file: &str,
-        pyramid: Pyramid,
-        mips: u32,
-        tile_bytes: u64,
-        block_format: Option<ImageryFormat>,
-    ) -> Result<Self, DatasetError> {
-        let pack = Pack::open(&dir.join(file))?;
-        if pack.tile_count() != pyramid.tile_count() || pack.tile_bytes() != tile_bytes {
-            return Err(DatasetError::PackShape {
-                path: pack.path().to_owned(),
-                found: pack.tile_count(),
-                found_bytes: pack.tile_bytes(),
-                expected: pyramid.tile_count(),
-                expected_bytes: tile_bytes,
-            });
-        }
-        Ok(Self {
-            pyramid,
-            mips,
-            block_format,
-            pack,
-            decoded: RecentTiles::default(),
-            plain: RecentTiles::default(),
-        })
-    }
-
-    /// A pack of plain texels of `texel_bytes` each, `mips` mips a tile.
-    fn open_plain(
-        dir: &Path,
-        file: &str,
-        pyramid: Pyramid,
-        mips: u32,
-        texel_bytes: usize,
-    ) -> Result<Self, DatasetError> {
-        let spec = LayerSpec { name: "", pyramid, mips, reduce: Reduce::Decimate };
-        Self::open(dir, file, pyramid, mips, (spec.tile_texels() * texel_bytes) as u64, None)
-    }
-
-    /// The layer's pack: its codec and sizes.
-    pub fn pack(&self) -> &Pack {
-        &self.pack
-    }
-
-    /// The tile's value range from the pack index (heights: conservative min/max of every
-    /// level-0 sample under the tile), without reading the tile.
-    pub fn tile_range(&self, id: TileId) -> Result<Option<[f32; 2]>, PackError> {
-        let index = self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
-            path: self.pack.path().to_owned(),
-            index: u64::MAX,
-            count: self.pack.tile_count(),
-        })?;
-        self.pack.tile_range(index)
-    }
-
-    fn index_of(&self, id: TileId) -> Result<u64, PackError> {
-        self.pyramid.tile_index(id).ok_or_else(|| PackError::OutOfRange {
-            path: self.pack.path().to_owned(),
-            index: u64::MAX,
-            count: self.pack.tile_count(),
-        })
-    }
-
-    /// The tile's payload (all mips) as stored, checksum verified: from the mapping, or
-    /// decompressed (the last `DECODED_TILES_KEPT` are kept for the next reads).
-    pub fn tile_bytes(&self, id: TileId) -> Result<TileBytes<'_>, PackError> {
-        let index = self.index_of(id)?;
-        if let Some(bytes) = self.decoded.get(index) {
-            return Ok(TileBytes::Decoded(bytes));
-        }
-        Ok(match self.pack.tile(index)? {
-            Cow::Borrowed(bytes) => TileBytes::Mapped(bytes),
-            Cow::Owned(bytes) => {
-                let bytes: Arc<[u8]> = bytes.into();
-                self.decoded.keep(index, &bytes);
-                TileBytes::Decoded(bytes)
-            }
-        })
-    }
-
-    /// The tile's texels (all mips, each `mip_extent`² texels): the payload itself when stored
-    /// plain, else decoded from its blocks into RGBA8 (the last few are kept for the next reads).
-    pub fn tile_texels(&self, id: TileId) -> Result<TileBytes<'_>, PackError> {
-        let Some(format) = self.block_format else { return self.tile_bytes(id) };
-        let index = self.index_of(id)?;
-        if let Some(texels) = self.plain.get(index) {
-            return Ok(TileBytes::Decoded(texels));
-        }
-        let texels: Arc<[u8]> = format.decode_tile(&self.pyramid, self.mips, &self.tile_bytes(id)?).into();
-        self.plain.keep(index, &texels);
-        Ok(TileBytes::Decoded(texels))
-    }
-}
-
 /// An opened dataset.
 pub struct Dataset {
     /// The dataset folder, as given to `open`.
@@ -301,7 +138,7 @@ pub struct Dataset {
 }
 
 impl Dataset {
-    /// Opens the dataset in folder `dir`: checks the manifest (its version first), then maps every
+    /// Opens the dataset in folder `dir`: checks the manifest (its version first), then opens every
     /// pack and checks its header, length and shape against it. Tile checksums wait for each read.
     pub fn open(dir: &Path) -> Result<Self, DatasetError> {
         let manifest_path = dir.join(MANIFEST_FILE);
@@ -360,16 +197,9 @@ impl Dataset {
         Ok(Self { dir: dir.to_owned(), manifest, height, valid_mask, imagery, landcover })
     }
 
-    /// The height tile's samples, `tile_extent`² f32 metres, south row first: borrowed from the
-    /// mapping when stored raw (payloads start 16-byte aligned there), else decoded.
-    pub fn height_tile(&self, id: TileId) -> Result<Cow<'_, [f32]>, PackError> {
-        Ok(match self.height.tile_bytes(id)? {
-            TileBytes::Mapped(bytes) => match bytemuck::try_cast_slice(bytes) {
-                Ok(samples) => Cow::Borrowed(samples),
-                Err(_) => Cow::Owned(bytemuck::pod_collect_to_vec(bytes)),
-            },
-            TileBytes::Decoded(bytes) => Cow::Owned(bytemuck::pod_collect_to_vec(&bytes)),
-        })
+    /// The height tile's samples, `tile_extent`² f32 metres, south row first.
+    pub fn height_tile(&self, id: TileId) -> Result<Vec<f32>, PackError> {
+        Ok(bytemuck::pod_collect_to_vec(&self.height.tile_bytes(id)?))
     }
 
     /// Conservative [min, max] of every level-0 height under tile `id`, metres; O(1).
@@ -443,16 +273,12 @@ impl Dataset {
         let pyramid = &self.height.pyramid;
         let tiles = pyramid.tiles_at(level);
         let (tx, ty) = ((x / pyramid.tile).min(tiles[0] - 1), (y / pyramid.tile).min(tiles[1] - 1));
-        let tile = self.height_tile(TileId::new(level, tx, ty))?;
+        let tile = self.height.tile_bytes(TileId::new(level, tx, ty))?;
         let extent = pyramid.tile_extent();
         let (lx, ly) = (x - tx * pyramid.tile + pyramid.border, y - ty * pyramid.tile + pyramid.border);
-        Ok(f64::from(tile[(ly * extent + lx) as usize]))
+        let at = (ly * extent + lx) as usize * size_of::<f32>();
+        Ok(f64::from(bytemuck::pod_read_unaligned::<f32>(&tile[at..at + size_of::<f32>()])))
     }
-}
-
-/// A little-endian word of 1, 2 or 4 bytes, widened.
-fn word_of(bytes: &[u8]) -> u32 {
-    bytes.iter().rev().fold(0, |word, &b| word << 8 | u32::from(b))
 }
 
 #[cfg(test)]

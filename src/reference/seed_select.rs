@@ -143,7 +143,7 @@ pub fn snapshot_caches(
     landcover: &TileCache,
     imagery: &TileCache,
 ) -> Result<TwinCaches, PackError> {
-    let heights = TwinCache::of(heights, |id| dataset.height_tile(id).map(std::borrow::Cow::into_owned))?;
+    let heights = TwinCache::of(heights, |id| dataset.height_tile(id))?;
     let landcover = TwinCache::of(landcover, |id| dataset.landcover_words(id))?;
     let extent = imagery.pyramid().tile_extent() as usize;
     let imagery = match &dataset.imagery {

@@ -3,13 +3,14 @@
 //! requests not yet started, so a tile the view no longer wants is cancelled for free and a tile
 //! that became urgent moves up at once. N workers share the queue (a binary heap under a mutex,
 //! woken by a condvar) and always take the most important request left. A worker reads the tile
-//! from the dataset's memory-mapped pack, which verifies its checksum, copies it into an owned
-//! buffer (so the render thread never touches the mapping, nor a page fault) and sends it back on
-//! a channel that `try_recv_all` drains without blocking.
+//! from the dataset's pack (a positioned read, so the render thread never waits on the disk),
+//! which verifies its checksum and decodes it (`dataset::LayerPack`), and sends the owned payload
+//! back on a channel that `try_recv_all` drains without blocking.
 //!
 //! A tile is never read twice at once: from the moment a worker takes it until the render thread
 //! drains its result it is *busy*, and a re-submission of it is skipped. A tile that cannot be
-//! read (missing, corrupt, out of range) is logged once per tile, naming the pack and the tile, and
+//! read (missing, corrupt, out of range, or its pack changed on disk since it was opened) is
+//! logged once per tile, naming the pack and the tile, and
 //! comes back as an error so the cache can remember it and let the tile's ancestor stand in.
 //! Dropping the `Loader` discards the queue and joins the workers (each finishes at most the tile
 //! it is reading).
@@ -32,7 +33,7 @@ use thiserror::Error;
 
 use super::LayerKind;
 use super::faults::{Fate, Faults};
-use crate::dataset::{Dataset, LayerPack, PackError, TileBytes, TileId};
+use crate::dataset::{Dataset, LayerPack, PackError, TileId};
 
 /// What the loader delivers of each tile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -332,8 +333,7 @@ fn layer(dataset: &Dataset, kind: LayerKind) -> Option<&LayerPack> {
     }
 }
 
-/// The tile's payload as `delivery` wants it, checksum verified: copied out of the mapping, or
-/// the tile as decoded.
+/// The tile's payload as `delivery` wants it: checksum verified and decoded.
 pub fn read(
     dataset: &Dataset,
     kind: LayerKind,
@@ -341,11 +341,10 @@ pub fn read(
     delivery: Delivery,
 ) -> Result<Arc<[u8]>, LoaderError> {
     let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
-    let bytes = match kind {
+    Ok(match kind {
         LayerKind::Imagery => imagery_tile(pack, id, delivery)?,
         _ => pack.tile_bytes(id)?,
-    };
-    Ok(bytes.into_shared())
+    })
 }
 
 /// As `read`, with the read's fate and wait from `options.faults`.
@@ -363,13 +362,13 @@ fn read_with_faults(
         Fate::Corrupt { at } => {
             let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
             let index = pack.pyramid.tile_index(id).unwrap_or(u64::MAX);
-            Ok(pack.pack().tile_damaged(index, at)?.into_owned().into())
+            Ok(pack.pack().tile_damaged(index, at)?.into())
         }
     }
 }
 
 /// The imagery tile as `delivery` wants it: as stored, or decoded from its blocks.
-pub fn imagery_tile(imagery: &LayerPack, id: TileId, delivery: Delivery) -> Result<TileBytes<'_>, PackError> {
+pub fn imagery_tile(imagery: &LayerPack, id: TileId, delivery: Delivery) -> Result<Arc<[u8]>, PackError> {
     match delivery {
         Delivery::Stored => imagery.tile_bytes(id),
         Delivery::ImageryDecoded => imagery.tile_texels(id),

@@ -129,7 +129,7 @@ pub fn level_image<T: Copy + PartialEq + std::fmt::Debug>(
 
 /// Level `level` of the heights, checked across tile borders.
 pub fn height_image(dataset: &Dataset, level: u32) -> Vec<f32> {
-    level_image(&dataset.height.pyramid, level, |id| dataset.height_tile(id).unwrap().to_vec())
+    level_image(&dataset.height.pyramid, level, |id| dataset.height_tile(id).unwrap())
 }
 
 /// Level 0 of the validity mask pack, checked across tile borders.

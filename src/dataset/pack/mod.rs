@@ -1,4 +1,4 @@
-//! How it works: a pack is one file holding every tile of one layer, memory-mapped at run time.
+//! How it works: a pack is one file holding every tile of one layer.
 //!
 //! Every tile of a layer has the same payload (its texels, all mips), stored as the pack's codec
 //! says (`codec`: as it is, or losslessly compressed by zstd after a predictor). An index after
@@ -12,17 +12,28 @@
 //! for heights, a conservative min/max of every level-0 sample under the tile, so culling can bound
 //! a tile's relief in O(1) without reading it. The index is checksummed in the header.
 //!
+//! Reading (`Pack`): the header and the whole index are read into memory at open (32 bytes a
+//! tile), and each tile's stored bytes with one positioned read (`pread`) when it is asked for,
+//! never through a memory mapping. A viewer runs for hours over packs that another tool may
+//! truncate or rewrite in place meanwhile (`cp` or `rsync --inplace` over them; the builder's own
+//! publishing is an atomic rename, which leaves an open file intact); a mapping of a file cut
+//! short raises SIGBUS at the first touch of a page past its end, and a signal handler cannot
+//! tell which read it broke. A positioned read comes back short instead, and a rewritten tile
+//! fails its checksum: either is `PackError::Changed` for that tile when the file's length,
+//! status-change time or header differs from open's. The cost is one copy of the stored bytes
+//! per tile (the codec decodes into a new buffer anyway); `benches/tile_reads.rs` times it
+//! against a mapping.
+//!
 //! Layout (little-endian): 64-byte header (magic, version, codec, tile bytes, tile count, index
 //! checksum, data bytes, header checksum) | `tile_count` × 32-byte index entries (offset, stored
 //! length, crc, state, range) | padding to 4 KiB | the stored tiles, each at a 16-byte boundary,
 //! in the order they were written. Version 2 packs (raw tiles at fixed places, 16-byte entries)
 //! are still read.
 
-use std::borrow::Cow;
 use std::fs::File;
+use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
-use memmap2::Mmap;
 use thiserror::Error;
 
 mod codec;
@@ -39,7 +50,7 @@ pub const PACK_VERSION: u32 = 3;
 const LEGACY_VERSION: u32 = 2;
 const HEADER_BYTES: u64 = 64;
 const DATA_ALIGN: u64 = 4096;
-/// Stored tiles start at multiples of this (raw `f32` payloads stay aligned in the mapping).
+/// Stored tiles start at multiples of this (part of the layout).
 const TILE_ALIGN: u64 = 16;
 /// Index entry state of a tile that the builder wrote.
 const TILE_PRESENT: u32 = 1;
@@ -47,7 +58,7 @@ const TILE_PRESENT: u32 = 1;
 /// Why a pack could not be written or opened, or could not hand out a tile.
 #[derive(Debug, Error)]
 pub enum PackError {
-    /// Creating, sizing, mapping, reading or writing the pack file failed.
+    /// Creating, sizing, reading or writing the pack file failed.
     #[error("{path}: {source}")]
     Io {
         /// The pack file.
@@ -93,6 +104,18 @@ pub enum PackError {
     /// pack's tile size: that tile alone is unusable.
     #[error("{path}: tile {index} is corrupt (checksum mismatch, or it does not decode)")]
     Corrupt {
+        /// The pack file.
+        path: PathBuf,
+        /// The tile's position in the pack (`Pyramid::tile_index`).
+        index: u64,
+    },
+    /// A tile could not be read as the index read at open describes it (cut short, or failing its
+    /// checksum), and the file is no longer the one opened: truncated or rewritten in place since
+    /// (a `cp` or `rsync --inplace` over it). The tiles read before stand.
+    #[error(
+        "{path}: tile {index} cannot be read: the file changed on disk since it was opened (truncated or rewritten in place); open the dataset again"
+    )]
+    Changed {
         /// The pack file.
         path: PathBuf,
         /// The tile's position in the pack (`Pyramid::tile_index`).
@@ -211,13 +234,44 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> PackError + '_ {
     move |source| PackError::Io { path: path.to_owned(), source }
 }
 
-/// A memory-mapped pack, read-only.
+/// A pack open for reading: its header and tile index read into memory at open, its tiles read
+/// from the file with positioned reads when asked for.
 pub struct Pack {
-    map: Mmap,
-    /// The mapped file, for reads that bypass the mapping (`read_stored`).
     file: File,
     path: PathBuf,
     header: Header,
+    /// The tile index as the file held it at open (`tile_count` entries), checksum verified.
+    index: Vec<u8>,
+    /// The file as it was at open: a failed read of a file no longer like it is `Changed`.
+    opened: Stamp,
+}
+
+/// What changes when a file's contents change in place: its length, its status-change time (a
+/// write moves it, and no tool can set it back, unlike the modification time `rsync` restores;
+/// but it moves by the kernel's clock tick, a few milliseconds) and its header (another pack's
+/// has other data lengths and index checksums, whenever it was written).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Stamp {
+    bytes: u64,
+    changed_s: i64,
+    changed_ns: i64,
+    header: [u8; HEADER_BYTES as usize],
+}
+
+impl Stamp {
+    /// The file's stamp now.
+    fn of(file: &File) -> std::io::Result<Self> {
+        use std::os::unix::fs::MetadataExt;
+        let meta = file.metadata()?;
+        let mut header = [0u8; HEADER_BYTES as usize];
+        match file.read_exact_at(&mut header, 0) {
+            Ok(()) => {}
+            // Shorter than a header: zeros, which are no pack's magic.
+            Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => header = [0; HEADER_BYTES as usize],
+            Err(e) => return Err(e),
+        }
+        Ok(Self { bytes: meta.len(), changed_s: meta.ctime(), changed_ns: meta.ctime_nsec(), header })
+    }
 }
 
 /// One tile's index entry, decoded.
@@ -231,15 +285,14 @@ struct Entry {
 }
 
 impl Pack {
-    /// Maps the pack at `path` read-only and checks its header, version, length and index checksum;
-    /// tiles are checked when read.
+    /// Opens the pack at `path` and reads and checks its header, version, length and tile index
+    /// (its checksum); tiles are read, and checked, when asked for.
     pub fn open(path: &Path) -> Result<Self, PackError> {
         let file = File::open(path).map_err(io(path))?;
-        // SAFETY: packs are written once by the builder and never modified in place; a dataset is
-        // replaced by an atomic rename, which leaves this mapping's inode intact.
-        let map = unsafe { Mmap::map(&file) }.map_err(io(path))?;
-        let header = Header::decode(&map, path)?;
-        let actual = map.len() as u64;
+        // Taken first: a change while the index is read shows at the next failed read.
+        let opened = Stamp::of(&file).map_err(io(path))?;
+        let actual = opened.bytes;
+        let header = Header::decode(&opened.header, path)?;
         let expected = header.tile_count.checked_mul(header.entry_bytes()).map(|_| header.file_bytes());
         if expected.is_none_or(|e| actual < e) {
             return Err(PackError::Truncated {
@@ -248,13 +301,17 @@ impl Pack {
                 actual,
             });
         }
-        if crc32fast::hash(&map[header.index_range()]) != header.index_crc {
+        // No larger than the file, checked above.
+        let range = header.index_range();
+        let mut index = vec![0u8; range.len()];
+        file.read_exact_at(&mut index, range.start as u64).map_err(io(path))?;
+        if crc32fast::hash(&index) != header.index_crc {
             return Err(PackError::CorruptIndex { path: path.to_owned() });
         }
-        Ok(Self { map, file, path: path.to_owned(), header })
+        Ok(Self { file, path: path.to_owned(), header, index, opened })
     }
 
-    /// The mapped pack file, for messages.
+    /// The pack file, for messages.
     pub fn path(&self) -> &Path {
         &self.path
     }
@@ -280,8 +337,8 @@ impl Pack {
         if index >= h.tile_count {
             return Err(PackError::OutOfRange { path: self.path.clone(), index, count: h.tile_count });
         }
-        let at = (HEADER_BYTES + index * h.entry_bytes()) as usize;
-        let e = &self.map[at..at + h.entry_bytes() as usize];
+        let at = (index * h.entry_bytes()) as usize;
+        let e = &self.index[at..at + h.entry_bytes() as usize];
         let u32_at = |i: usize| u32::from_le_bytes(e[i..i + 4].try_into().unwrap_or([0; 4]));
         let u64_at = |i: usize| u64::from_le_bytes(e[i..i + 8].try_into().unwrap_or([0xff; 8]));
         Ok(if h.version == LEGACY_VERSION {
@@ -306,72 +363,75 @@ impl Pack {
         Ok(unpack_range(self.entry(index)?.range))
     }
 
-    /// Where tile `index`'s stored bytes lie (from the file's start) and their checksum, after
-    /// checking that it was written and that they lie within the data.
-    fn stored_place(&self, index: u64) -> Result<(std::ops::Range<usize>, u32), PackError> {
+    /// Tile `index`'s stored bytes as the file holds them now, and the checksum the index gives
+    /// them, after checking that it was written and that they lie within the data. The read is
+    /// positioned (`pread`): a file cut short since `open` is an error here, where a mapping of
+    /// it would have raised SIGBUS.
+    fn read_place(&self, index: u64) -> Result<(Vec<u8>, u32), PackError> {
         let entry = self.entry(index)?;
         if entry.state != TILE_PRESENT {
             return Err(PackError::Missing { path: self.path.clone(), index });
         }
         let end = entry.offset.checked_add(entry.stored_bytes).filter(|&end| end <= self.header.data_bytes);
-        let end = end.ok_or_else(|| PackError::Corrupt { path: self.path.clone(), index })?;
-        let base = self.header.data_offset();
-        Ok(((base + entry.offset) as usize..(base + end) as usize, entry.crc))
-    }
-
-    /// The tile's stored bytes (as its codec wrote them), from the mapping, after checking that
-    /// it was written and that they hold their checksum.
-    pub fn stored(&self, index: u64) -> Result<&[u8], PackError> {
-        let (place, crc) = self.stored_place(index)?;
-        let stored = &self.map[place];
-        if crc32fast::hash(stored) != crc {
-            return Err(PackError::Corrupt { path: self.path.clone(), index });
+        end.ok_or_else(|| PackError::Corrupt { path: self.path.clone(), index })?;
+        // At most the data's length, which `open` found within the file.
+        let mut stored = vec![0; entry.stored_bytes as usize];
+        let at = self.header.data_offset() + entry.offset;
+        match self.file.read_exact_at(&mut stored, at) {
+            Ok(()) => Ok((stored, entry.crc)),
+            Err(source) => Err(self.changed_or(index, PackError::Io { path: self.path.clone(), source })),
         }
-        Ok(stored)
     }
 
-    /// As `stored`, but read from the file rather than the mapping: a tool copying a whole pack
-    /// (the partitioned build's merge) keeps its resident memory flat.
-    pub fn read_stored(&self, index: u64) -> Result<Vec<u8>, PackError> {
-        use std::os::unix::fs::FileExt;
-        let (place, crc) = self.stored_place(index)?;
-        let mut stored = vec![0; place.len()];
-        self.file.read_exact_at(&mut stored, place.start as u64).map_err(io(&self.path))?;
+    /// `Changed` when the file is no longer the one opened, else `error`: why a read failed.
+    fn changed_or(&self, index: u64, error: PackError) -> PackError {
+        match Stamp::of(&self.file) {
+            Ok(now) if now != self.opened => PackError::Changed { path: self.path.clone(), index },
+            _ => error,
+        }
+    }
+
+    /// `stored` if it holds checksum `crc`.
+    fn checked(&self, index: u64, stored: Vec<u8>, crc: u32) -> Result<Vec<u8>, PackError> {
         if crc32fast::hash(&stored) != crc {
-            return Err(PackError::Corrupt { path: self.path.clone(), index });
+            return Err(self.changed_or(index, PackError::Corrupt { path: self.path.clone(), index }));
         }
         Ok(stored)
     }
 
-    /// The tile's payload, after checking that it was written and that its stored bytes hold
-    /// their checksum: borrowed from the mapping when stored raw, else decoded.
-    pub fn tile(&self, index: u64) -> Result<Cow<'_, [u8]>, PackError> {
-        self.payload(index, self.stored(index)?)
+    /// The tile's stored bytes (as its codec wrote them), read from the file, after checking that
+    /// it was written and that they hold their checksum (the partitioned build's merge copies
+    /// packs this way, never decoding).
+    pub fn read_stored(&self, index: u64) -> Result<Vec<u8>, PackError> {
+        let (stored, crc) = self.read_place(index)?;
+        self.checked(index, stored, crc)
+    }
+
+    /// The tile's payload, read from the file, after checking that it was written and that its
+    /// stored bytes hold their checksum, decoded as the pack's codec says.
+    pub fn tile(&self, index: u64) -> Result<Vec<u8>, PackError> {
+        self.payload(index, self.read_stored(index)?)
     }
 
     /// The tile as `tile` would give it had byte `at` (modulo their length) of its stored bytes
     /// been flipped on the way from the disk, through the same checks (fault injection's corrupt
     /// read: the checksum catches it).
-    pub fn tile_damaged(&self, index: u64, at: usize) -> Result<Cow<'_, [u8]>, PackError> {
-        let (place, crc) = self.stored_place(index)?;
-        let mut stored = self.map[place].to_vec();
+    pub fn tile_damaged(&self, index: u64, at: usize) -> Result<Vec<u8>, PackError> {
+        let (mut stored, crc) = self.read_place(index)?;
         let len = stored.len().max(1);
         if let Some(byte) = stored.get_mut(at % len) {
             *byte ^= 0xa5;
         }
-        if crc32fast::hash(&stored) != crc {
-            return Err(PackError::Corrupt { path: self.path.clone(), index });
-        }
-        Ok(Cow::Owned(self.payload(index, &stored)?.into_owned()))
+        let stored = self.checked(index, stored, crc)?;
+        self.payload(index, stored)
     }
 
     /// A tile's payload from its checked stored bytes.
-    fn payload<'a>(&self, index: u64, stored: &'a [u8]) -> Result<Cow<'a, [u8]>, PackError> {
+    fn payload(&self, index: u64, stored: Vec<u8>) -> Result<Vec<u8>, PackError> {
         match self.header.codec {
-            Codec::Raw if stored.len() as u64 == self.header.tile_bytes => Ok(Cow::Borrowed(stored)),
+            Codec::Raw if stored.len() as u64 == self.header.tile_bytes => Ok(stored),
             codec => codec
-                .decode(stored, self.header.tile_bytes as usize)
-                .map(Cow::Owned)
+                .decode(&stored, self.header.tile_bytes as usize)
                 .ok_or_else(|| PackError::Corrupt { path: self.path.clone(), index }),
         }
     }

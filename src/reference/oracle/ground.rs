@@ -4,7 +4,6 @@
 //! over it (the DDA walk described in `reference::oracle`). `LandcoverTiles` decodes the level-1 land-cover tiles
 //! under the same rectangle and answers palette indices.
 
-use std::borrow::Cow;
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
 
@@ -35,7 +34,7 @@ impl DemWindow {
         let last = [0, 1].map(|a| clamp((max_m[a] / spacing_m).ceil() + 1.0, a).max(first[a]));
         let held = [0, 1].map(|a| last[a] - first[a] + 1);
         let (tiles_at, extent) = (pyramid.tiles_at(0), pyramid.tile_extent());
-        let mut tiles: HashMap<[u32; 2], Cow<'_, [f32]>> = HashMap::new();
+        let mut tiles: HashMap<[u32; 2], Vec<f32>> = HashMap::new();
         let mut heights_m = Vec::with_capacity(held[0] as usize * held[1] as usize);
         for y in first[1]..=last[1] {
             for x in first[0]..=last[0] {
