@@ -2,7 +2,7 @@
 //! dataset given: every tile's stored bytes checked against their CRC-32 straight from a mapping
 //! of the pack (how packs were read before, mapped once and kept), then read with `pread` and
 //! checked (`Pack::read_stored`, how they are read now), and the whole read a loader worker makes
-//! (`streaming::loader::read`: read, checksum, decode). Each is the median of `RUNS`
+//! (`streaming::loader::read`: read, checksum, decode, range check). Each is the median of `RUNS`
 //! passes over every tile, the page cache warm (a first pass, untimed, reads every file).
 //! `cargo bench --bench tile_reads -- DATASET...`; `RUNS` (default 7) sets the passes.
 #![allow(clippy::unwrap_used, reason = "a benchmark that cannot set up has nothing to measure")]
@@ -20,7 +20,7 @@ fn main() {
     let runs: usize = std::env::var("RUNS").ok().and_then(|v| v.parse().ok()).unwrap_or(7);
     println!("Median of {runs} passes, µs per tile, page cache warm.\n");
     println!(
-        "| dataset | layer | tiles | stored bytes (mean) | mapped + CRC | pread + CRC | loader read (pread, decode) |"
+        "| dataset | layer | tiles | stored bytes (mean) | mapped + CRC | pread + CRC | loader read (pread, decode, check) |"
     );
     println!("|---|---|---|---|---|---|---|");
     for dir in &dirs {

@@ -14,17 +14,22 @@ pub struct FaultSettings {
     pub fail: f64,
     /// Share of tiles read with one byte flipped (the pack's checksum catches it), 0 to 1.
     pub corrupt: f64,
+    /// Share of tiles read with one byte flipped under a checksum that matches it (the decoders
+    /// meet the damage), 0 to 1.
+    pub damage: f64,
     /// Each read waits up to this many milliseconds first (0 to 10000).
     pub delay_ms: u32,
-    /// Which tiles fail, are corrupt and how long each waits: a hash of this and the tile.
+    /// Which tiles fail, are corrupt or damaged and how long each waits: a hash of this and the
+    /// tile.
     pub seed: u32,
 }
 
 impl FaultSettings {
     pub(super) fn validate(&self) -> Result<(), SettingsError> {
-        let checks: [RangeCheck; 3] = [
+        let checks: [RangeCheck; 4] = [
             ((0.0..=1.0).contains(&self.fail), "faults.fail", self.fail.to_string(), "0 to 1"),
             ((0.0..=1.0).contains(&self.corrupt), "faults.corrupt", self.corrupt.to_string(), "0 to 1"),
+            ((0.0..=1.0).contains(&self.damage), "faults.damage", self.damage.to_string(), "0 to 1"),
             (
                 self.delay_ms <= 10_000,
                 "faults.delay_ms",

@@ -1,9 +1,9 @@
 //! How it works: a dataset is a folder with `manifest.toml` and one pack per layer (heights, their
 //! validity mask, imagery, land cover). `Dataset::open` checks the manifest and every pack's
 //! header, length and index up front; tile payloads are read when asked for (positioned reads,
-//! never a mapping: `pack`), checksummed and decoded (`layer_pack`), so a damaged tile, or a pack
-//! changed on disk while open, is an error for that tile alone and the caller decides how to
-//! degrade.
+//! never a mapping: `pack`), checksummed, decoded and checked against the value range their index
+//! entry records (`layer_pack`), so a damaged tile, or a pack changed on disk while open, is an
+//! error for that tile alone and the caller decides how to degrade.
 //!
 //! The manifest's format version is read on its own before the rest, so a dataset of another
 //! version is reported as such (and rebuilt by whoever owns it), not as a malformed manifest.
@@ -36,12 +36,12 @@ use layer_pack::word_of;
 use lcc::{LCC_LEVELS, LCC_SOURCE_LEVEL, LccCoding};
 
 pub use imagery_format::{ImageryFormat, MipLayout};
-pub use layer_pack::LayerPack;
+pub use layer_pack::{LayerPack, ValueCheck};
 pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer};
 pub use manifest::{
     CellLayer, ClassName, Crs, FORMAT_VERSION, HeightLayer, LandcoverLayer, MANIFEST_FILE, Manifest,
 };
-pub use pack::{Codec, PACK_VERSION, Pack, PackError, Predictor};
+pub use pack::{Codec, Damage, PACK_VERSION, Pack, PackError, Predictor};
 pub use pyramid::{Pyramid, Sampling, TileId};
 pub use staging::Staging;
 
@@ -159,7 +159,8 @@ impl Dataset {
         }
         let manifest: Manifest = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
         let height =
-            LayerPack::open_plain(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?;
+            LayerPack::open_plain(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?
+                .with_check(ValueCheck::Heights);
         let valid_mask = manifest
             .height
             .valid_mask_pack
@@ -190,7 +191,8 @@ impl Dataset {
                     );
                     return Err(bad(message));
                 }
-                Some(LayerPack::open_plain(dir, &l.layer.pack, *p, 1, l.coding.word_bytes())?)
+                let layer = LayerPack::open_plain(dir, &l.layer.pack, *p, 1, l.coding.word_bytes())?;
+                Some(layer.with_check(ValueCheck::Landcover(l.coding.clone())))
             }
             None => None,
         };

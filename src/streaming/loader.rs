@@ -4,8 +4,9 @@
 //! that became urgent moves up at once. N workers share the queue (a binary heap under a mutex,
 //! woken by a condvar) and always take the most important request left. A worker reads the tile
 //! from the dataset's pack (a positioned read, so the render thread never waits on the disk),
-//! which verifies its checksum and decodes it (`dataset::LayerPack`), and sends the owned payload
-//! back on a channel that `try_recv_all` drains without blocking.
+//! which verifies its checksum, decodes it and checks its values against their recorded range
+//! (`dataset::LayerPack`), and sends the owned payload back on a channel that `try_recv_all`
+//! drains without blocking.
 //!
 //! A tile is never read twice at once: from the moment a worker takes it until the render thread
 //! drains its result it is *busy*, and a re-submission of it is skipped. A tile that cannot be
@@ -16,7 +17,8 @@
 //! it is reading).
 //!
 //! Faults can be injected into the reads (`faults`, off by default): a failed or corrupt read
-//! comes back as the error a real one would, a slow one late.
+//! comes back as the error a real one would, a damaged one as whatever the decoders make of it
+//! (an error, or a payload within the layer's checks), a slow one late.
 //!
 //! A cache whose texture cannot take a layer's stored blocks (BC imagery on an adapter without BC
 //! sampling) is fed plain texels: the loader made with `Delivery::ImageryDecoded` decodes each
@@ -33,7 +35,7 @@ use thiserror::Error;
 
 use super::LayerKind;
 use super::faults::{Fate, Faults};
-use crate::dataset::{Dataset, LayerPack, PackError, TileId};
+use crate::dataset::{Damage, Dataset, LayerPack, PackError, TileId};
 
 /// What the loader delivers of each tile.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -333,7 +335,7 @@ fn layer(dataset: &Dataset, kind: LayerKind) -> Option<&LayerPack> {
     }
 }
 
-/// The tile's payload as `delivery` wants it: checksum verified and decoded.
+/// The tile's payload as `delivery` wants it: checksum verified, decoded and checked.
 pub fn read(
     dataset: &Dataset,
     kind: LayerKind,
@@ -356,15 +358,18 @@ fn read_with_faults(
 ) -> Result<Arc<[u8]>, LoaderError> {
     let (fate, wait) = options.faults.fate(kind, id);
     std::thread::sleep(wait);
-    match fate {
-        Fate::Read => read(dataset, kind, id, options.delivery),
-        Fate::Fail => Err(LoaderError::Injected),
-        Fate::Corrupt { at } => {
-            let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
-            let index = pack.pyramid.tile_index(id).unwrap_or(u64::MAX);
-            Ok(pack.pack().tile_damaged(index, at)?.into())
-        }
-    }
+    let damage = match fate {
+        Fate::Read => return read(dataset, kind, id, options.delivery),
+        Fate::Fail => return Err(LoaderError::Injected),
+        Fate::Corrupt { at } => Damage::Caught { at },
+        Fate::Damage { at } => Damage::Unseen { at },
+    };
+    let pack = layer(dataset, kind).ok_or(LoaderError::NoLayer(kind))?;
+    let payload = pack.tile_damaged(id, damage)?;
+    Ok(match (kind, options.delivery) {
+        (LayerKind::Imagery, Delivery::ImageryDecoded) => pack.texels_of(payload),
+        _ => payload,
+    })
 }
 
 /// The imagery tile as `delivery` wants it: as stored, or decoded from its blocks.

@@ -22,7 +22,7 @@
 //! fails its checksum: either is `PackError::Changed` for that tile when the file's length,
 //! status-change time or header differs from open's. The cost is one copy of the stored bytes
 //! per tile (the codec decodes into a new buffer anyway); `benches/tile_reads.rs` times it
-//! against a mapping.
+//! against a mapping (docs/streaming.md has the figures).
 //!
 //! Layout (little-endian): 64-byte header (magic, version, codec, tile bytes, tile count, index
 //! checksum, data bytes, header checksum) | `tile_count` × 32-byte index entries (offset, stored
@@ -120,6 +120,21 @@ pub enum PackError {
         path: PathBuf,
         /// The tile's position in the pack (`Pyramid::tile_index`).
         index: u64,
+    },
+    /// A tile decodes to a value outside the range its index entry records (a height, or a
+    /// land-cover palette index): damage that its checksum did not see. `LayerPack` checks this.
+    #[error("{path}: tile {index} decodes to {value}, outside its recorded range {min} to {max}")]
+    OutsideRange {
+        /// The pack file.
+        path: PathBuf,
+        /// The tile's position in the pack (`Pyramid::tile_index`).
+        index: u64,
+        /// The first value found outside.
+        value: f32,
+        /// The range's lower end.
+        min: f32,
+        /// The range's upper end.
+        max: f32,
     },
     /// A tile the builder never wrote is read, from a pack or back through `PackWriter::read_tile`.
     #[error("{path}: tile {index} was never written")]
@@ -274,6 +289,24 @@ impl Stamp {
     }
 }
 
+/// Damage done to a tile's stored bytes as they are read: fault injection's corrupt reads
+/// (`Pack::tile_damaged`, `[faults]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Damage {
+    /// Byte `at` (modulo their length) flipped after the checksum was made, as a disk's or a
+    /// network's error would: the checksum catches it.
+    Caught {
+        /// Which stored byte is flipped.
+        at: usize,
+    },
+    /// Byte `at` (modulo their length) flipped before the checksum was made, so it matches: the
+    /// codec, and the layer's checks after it, meet the damage.
+    Unseen {
+        /// Which stored byte is flipped.
+        at: usize,
+    },
+}
+
 /// One tile's index entry, decoded.
 struct Entry {
     /// Where its stored bytes start, from the start of the data.
@@ -413,14 +446,17 @@ impl Pack {
         self.payload(index, self.read_stored(index)?)
     }
 
-    /// The tile as `tile` would give it had byte `at` (modulo their length) of its stored bytes
-    /// been flipped on the way from the disk, through the same checks (fault injection's corrupt
-    /// read: the checksum catches it).
-    pub fn tile_damaged(&self, index: u64, at: usize) -> Result<Vec<u8>, PackError> {
-        let (mut stored, crc) = self.read_place(index)?;
+    /// The tile as `tile` would give it had its stored bytes been damaged as `damage` says
+    /// (fault injection's corrupt reads), through the same checks.
+    pub fn tile_damaged(&self, index: u64, damage: Damage) -> Result<Vec<u8>, PackError> {
+        let (mut stored, mut crc) = self.read_place(index)?;
+        let (Damage::Caught { at } | Damage::Unseen { at }) = damage;
         let len = stored.len().max(1);
         if let Some(byte) = stored.get_mut(at % len) {
             *byte ^= 0xa5;
+        }
+        if matches!(damage, Damage::Unseen { .. }) {
+            crc = crc32fast::hash(&stored);
         }
         let stored = self.checked(index, stored, crc)?;
         self.payload(index, stored)

@@ -153,3 +153,35 @@ fn a_pack_cut_short_or_rewritten_while_open_fails_its_reads_and_nothing_crashes(
     // Opened again, the new file reads whole.
     assert_eq!(Pack::open(pack.path()).unwrap().tile(2).unwrap(), [102; 16]);
 }
+
+#[test]
+fn damage_before_the_checksum_reaches_the_codec_and_after_it_is_caught() {
+    for codec in CODECS {
+        let pack = Pack::open(&written_pack(&format!("damage-{}", codec.word()), codec)).unwrap();
+        let stored = pack.read_stored(1).unwrap();
+        let (mut decoded, mut refused) = (0, 0);
+        for at in 0..stored.len() {
+            let caught = pack.tile_damaged(1, Damage::Caught { at });
+            assert!(matches!(caught, Err(PackError::Corrupt { index: 1, .. })), "{codec:?} byte {at}");
+            match pack.tile_damaged(1, Damage::Unseen { at }) {
+                Ok(payload) => {
+                    decoded += 1;
+                    // Raw: the payload is the stored bytes, and the one flipped byte shows.
+                    if codec == Codec::Raw {
+                        let changed: Vec<usize> = (0..16).filter(|&k| payload[k] != 1).collect();
+                        assert_eq!((changed, payload[at]), (vec![at], 1 ^ 0xa5));
+                    }
+                }
+                Err(PackError::Corrupt { index: 1, .. }) => refused += 1,
+                Err(error) => panic!("{codec:?} byte {at}: {error}"),
+            }
+        }
+        // Past the checksum every time: a raw tile always decodes, and zstd decodes some damage
+        // (into other bytes) and refuses some.
+        match codec {
+            Codec::Raw => assert_eq!((decoded, refused), (stored.len(), 0)),
+            _ => assert!(decoded > 0 && refused > 0, "{codec:?}: {decoded} decoded, {refused} refused"),
+        }
+        assert_eq!(pack.tile(1).unwrap(), [1; 16], "the damage is to the read, not the file");
+    }
+}
