@@ -256,7 +256,7 @@ make_light() {
 make_seeds_border() {
     rm -rf "$out/spacing" && mkdir -p "$out/spacing"
     TERRAMP_SPACING_PNG="$out/spacing" cargo test --release -q -p terramp-data-tools --test seed_spacing >/dev/null
-    compose --scale 0.5 --gap 10 --out docs/seeds_border.png "$out"/spacing/seeds_border_{nc,zion}.png
+    compose --scale 0.5 --gap 6 --background 90,90,90 --out docs/seeds_border.png "$out"/spacing/seeds_border_{nc,zion}.png
 }
 
 make_slicings_tree1() {
@@ -325,21 +325,24 @@ make_continuous_lod() {
 make_truth_vs_accurate() {
     demo_data
     local pose=4000,4500,350,50,-8
-    local trees
-    trees=$(layer truth_trees '[seeds]' 'class_table = "nc-generated"' '[draw_seeds]' \
-        "impostors = \"$root/data/impostors\"")
+    local trees=config/demo.toml
     "$terramp" truth --dataset data/default --camera "$pose" --preset accurate --impostors data/impostors \
         --settings "$trees" --out "$out/truth_ss4" >/dev/null
-    "$terramp" truth --dataset data/default --camera "$pose" --preset accurate --impostors data/impostors \
-        --settings "$trees" --supersample 1 --out "$out/truth_ss1" >/dev/null
+    local ss
+    for ss in 1 2; do
+        "$terramp" truth --dataset data/default --camera "$pose" --preset accurate --impostors data/impostors \
+            --settings "$trees" --supersample "$ss" --out "$out/truth_ss$ss" >/dev/null
+    done
     render --dataset data/default --camera "$pose" --preset accurate --settings "$trees" --out "$out/accurate.png"
     # Top: the truth (4 × 4) and the accurate frame; bottom: the FLIP maps against the truth of the
-    # truth at one sample per pixel and of the accurate frame (the means are printed).
-    compose --gap 0 --out "$out/tva_top.png" "$out/truth_ss4/truth.png" "$out/accurate.png"
-    compose --gap 0 --flip-reference "$out/truth_ss4/truth.png" --out "$out/tva_bottom.png" \
-        "$out/truth_ss1/truth.png" "$out/accurate.png"
-    compose --columns 1 --gap 0 --crop 320,240,1280,660 --scale 0.375 --out docs/truth_vs_accurate.png \
-        "$out/tva_top.png" "$out/tva_bottom.png"
+    # truth at one sample per pixel and of the accurate frame (their means are printed, and the
+    # truth at 2 × 2 samples', for docs/truth.md).
+    local ss1_map="$out/tva_flip_ss1.png" accurate_map="$out/tva_flip_accurate.png"
+    compose --flip-reference "$out/truth_ss4/truth.png" --out "$ss1_map" "$out/truth_ss1/truth.png"
+    compose --flip-reference "$out/truth_ss4/truth.png" --out "$out/tva_flip_ss2.png" "$out/truth_ss2/truth.png"
+    compose --flip-reference "$out/truth_ss4/truth.png" --out "$accurate_map" "$out/accurate.png"
+    compose --columns 2 --gap 6 --crop 320,250,640,330 --scale 0.75 --out docs/truth_vs_accurate.png \
+        "$out/truth_ss4/truth.png" "$out/accurate.png" "$ss1_map" "$accurate_map"
 }
 
 make_viewer() {
@@ -353,7 +356,10 @@ make_viewer() {
     sleep 2
     local view="$out/viewer.toml"
     layer viewer '[draw_seeds]' "impostors = \"$(cd "$forest" && pwd)\"" >/dev/null
-    DISPLAY="$display" "$terramp" view --dataset "$data/nc" --settings "$view" --path config/paths/nc.toml \
+    # A short flight down nc.toml's second leg, ending over the forest by the lakes.
+    printf '[[key]]\nat = [%s]\nyaw_deg = %s\npitch_deg = %s\n\n' '635000.0, 220000.0, 700.0' 30.0 -15.0 '636560.0, 222060.0, 414.0' 41.0 -14.0 \
+        >"$out/viewer_path.toml"
+    DISPLAY="$display" "$terramp" view --dataset "$data/nc" --settings "$view" --path "$out/viewer_path.toml" \
         --path-frames 40 --width 1280 --height 720 --out "$out/view" 2>"$out/viewer.log" &
     local viewer=$!
     local waited=0

@@ -118,8 +118,9 @@ pub fn on_off(v: f64) -> String {
     if v != 0.0 { "on".to_owned() } else { "off".to_owned() }
 }
 
-/// Where `tests/streaming_faults.rs` sets its faults (its control flight sets none before it).
-const FAULTS: &str = "let faults = FaultSettings";
+/// Where `tests/streaming_faults.rs` sets its flight's faults (after its control flight, which
+/// sets none).
+const FAULTS: &str = "let control = fly(";
 
 const fn test_const(file: &'static str, name: &'static str) -> Source {
     Source::Const { file, name }
@@ -300,11 +301,15 @@ pub static CLAIMS: &[Claim] = &[
     },
     Claim {
         doc: "docs/RELIABILITY.md",
-        quote: "(`[faults]`: {} % of tiles fail, {} % of the rest arrive with a byte flipped, every read waits up to {} ms",
+        quote: "(`[faults]`: {} % of tiles fail, {} % of the rest arrive corrupt, {} % of the rest damaged, every read waits up to {} ms",
         values: &[
             (Source::Code { file: "tests/streaming_faults.rs", from: FAULTS, pattern: "fail: {}," }, percent),
             (
                 Source::Code { file: "tests/streaming_faults.rs", from: FAULTS, pattern: "corrupt: {}," },
+                percent,
+            ),
+            (
+                Source::Code { file: "tests/streaming_faults.rs", from: FAULTS, pattern: "damage: {}," },
                 percent,
             ),
             (
