@@ -34,9 +34,10 @@ impl MipChain {
     }
 }
 
-/// Level `level`'s size: halved per level, never below 1.
+/// Level `level`'s size: halved per level, never below 1 (also for levels of 32 and more, which a
+/// plain shift would overflow).
 pub fn mip_size(size: [u32; 2], level: u32) -> [u32; 2] {
-    size.map(|s| (s >> level).max(1))
+    size.map(|s| s.checked_shr(level).unwrap_or(0).max(1))
 }
 
 /// A rectangle of texels at level 0.

@@ -145,8 +145,8 @@ pub fn load(dir: &Path, model: &str) -> Result<Impostor, ImpostorError> {
     }
     let manifest: Manifest = toml::from_str(&text).map_err(bad_manifest)?;
     let mut lods = Vec::new();
-    for lod in &manifest.lods {
-        let atlas = read_chain(&folder, &lod.atlas)?;
+    for (l, lod) in manifest.lods.iter().enumerate() {
+        let atlas = read_chain(&folder, &lod.atlas, &format!("lods[{l}].atlas"))?;
         lods.push(ImpostorLod { epsilon_m: lod.epsilon_m, planes: lod.planes.clone(), atlas });
     }
     let slicing = match &manifest.slicing {
@@ -158,15 +158,15 @@ pub fn load(dir: &Path, model: &str) -> Result<Impostor, ImpostorError> {
             lod: ImpostorLod {
                 epsilon_m: s.lod.epsilon_m,
                 planes: s.lod.planes.clone(),
-                atlas: read_chain(&folder, &s.lod.atlas)?,
+                atlas: read_chain(&folder, &s.lod.atlas, "slicing.lod.atlas")?,
             },
         }),
         None => None,
     };
     let mut materials = Vec::new();
-    for m in &manifest.materials {
+    for (k, m) in manifest.materials.iter().enumerate() {
         let texture = match &m.texture {
-            Some(entry) => Some(read_chain(&folder, entry)?),
+            Some(entry) => Some(read_chain(&folder, entry, &format!("materials[{k}].texture"))?),
             None => None,
         };
         materials.push(Material {
@@ -208,12 +208,24 @@ pub fn load(dir: &Path, model: &str) -> Result<Impostor, ImpostorError> {
     Ok(impostor)
 }
 
-fn read_chain(folder: &Path, entry: &ImageEntry) -> Result<MipChain, ImpostorError> {
-    if entry.files.len() != entry.mip_count as usize || entry.mip_count == 0 {
-        return Err(ImpostorError::Invalid {
-            path: folder.join(MANIFEST_FILE),
-            reason: format!("{} mip files listed for {} mips", entry.files.len(), entry.mip_count),
-        });
+/// The image the manifest's entry `what` lists, each mip checked against its size.
+fn read_chain(folder: &Path, entry: &ImageEntry, what: &str) -> Result<MipChain, ImpostorError> {
+    let invalid = |reason: String| ImpostorError::Invalid {
+        path: folder.join(MANIFEST_FILE),
+        reason: format!("{what}: {reason}"),
+    };
+    let [w, h] = entry.size;
+    if w == 0 || h == 0 {
+        return Err(invalid(format!("size {w} × {h}: an image is at least 1 × 1 texels")));
+    }
+    // Past the 1 × 1 level a mip is that texel again, which no texture holds (and at 32 mips, the
+    // size's shift would overflow).
+    let most = w.max(h).ilog2() + 1;
+    if !(1..=most).contains(&entry.mip_count) {
+        return Err(invalid(format!("{} mips, where a {w} × {h} image has 1 to {most}", entry.mip_count)));
+    }
+    if entry.files.len() != entry.mip_count as usize {
+        return Err(invalid(format!("{} mip files listed for {} mips", entry.files.len(), entry.mip_count)));
     }
     let mut levels = Vec::new();
     for (m, file) in entry.files.iter().enumerate() {
@@ -284,11 +296,15 @@ fn check(impostor: &Impostor) -> Result<(), ImpostorError> {
             return fail(format!("{what}: plane {p}'s atlas rectangle leaves the atlas"));
         }
     }
-    if let Some(s) = &impostor.slicing
-        && s.lod.planes.len() != (s.orientations * s.slices) as usize
-    {
-        let planes = s.lod.planes.len();
-        return fail(format!("the slicing has {planes} slices, not {} × {}", s.orientations, s.slices));
+    if let Some(s) = &impostor.slicing {
+        let (planes, [o, n]) = (s.lod.planes.len(), [s.orientations, s.slices]);
+        match o.checked_mul(n) {
+            None => return fail(format!("the slicing's orientations × slices, {o} × {n}, overflows u32")),
+            Some(product) if product as usize != planes => {
+                return fail(format!("the slicing has {planes} slices, not {o} × {n}"));
+            }
+            Some(_) => {}
+        }
     }
     let mesh = &impostor.mesh;
     for m in &mesh.materials {

@@ -178,3 +178,51 @@ fn bark_is_known_by_its_material_name() {
         assert!(!named(foliage).is_bark(), "{foliage}");
     }
 }
+
+/// `impostor.toml`'s counts feed products and shifts: 2 orientations × (2^31 + 1) slices wraps
+/// to 2 (the sample's plane count) in u32, and a 33rd mip of a 16 × 8 atlas shifts its size by 32
+/// bits. Both panicked with overflow in a debug build (found by the overflow audit, issue 42) and
+/// passed or misread in a release one; both are errors naming the manifest's fields now, as is an
+/// atlas of width 0.
+#[test]
+fn manifest_counts_whose_arithmetic_would_overflow_are_refused_not_a_panic() {
+    let dir = temp_dir("overflow");
+    let folder = save(&dir, &sample()).unwrap();
+    let manifest_path = folder.join(MANIFEST_FILE);
+    let original: toml::Table = toml::from_str(&std::fs::read_to_string(&manifest_path).unwrap()).unwrap();
+    let load_with = |edit: &dyn Fn(&mut toml::Table)| {
+        let mut manifest = original.clone();
+        edit(&mut manifest);
+        std::fs::write(&manifest_path, toml::to_string(&manifest).unwrap()).unwrap();
+        load(&dir, "Quads").map(|_| ()).unwrap_err().to_string()
+    };
+    let error = load_with(&|m| m["slicing"]["slices"] = toml::Value::Integer((1 << 31) + 1));
+    assert!(error.contains("orientations × slices") && error.contains("2 × 2147483649"), "{error}");
+    // The atlas's 3 mips, then a 2 × 1 and 1 × 1 images for the rest of 33 mips.
+    for (name, size) in [("two.png", [2, 1]), ("one.png", [1, 1])] {
+        let texels = vec![255; 4 * size[0] as usize];
+        image::save_buffer(folder.join(name), &texels, size[0], size[1], image::ColorType::Rgba8).unwrap();
+    }
+    let error = load_with(&|m| {
+        let atlas = &mut m["lods"][0]["atlas"];
+        let files = atlas["files"].as_array_mut().unwrap();
+        files.push("two.png".into());
+        files.resize(33, "one.png".into());
+        atlas["mip_count"] = toml::Value::Integer(33);
+    });
+    assert!(error.contains(MANIFEST_FILE) && error.contains("33 mips"), "{error}");
+    // An atlas 0 texels wide, its one mip a 1 × 8 image (mips are never below 1 texel): loaded, it
+    // made a texture of width 0 (found by the same audit).
+    image::save_buffer(folder.join("thin.png"), &[255; 32], 1, 8, image::ColorType::Rgba8).unwrap();
+    let error = load_with(&|m| {
+        let atlas = &mut m["lods"][0]["atlas"];
+        atlas["size"] = toml::Value::Array(vec![0.into(), 8.into()]);
+        atlas["mip_count"] = toml::Value::Integer(1);
+        atlas["files"] = toml::Value::Array(vec!["thin.png".into()]);
+    });
+    assert!(error.contains("lods[0].atlas: size 0 × 8"), "{error}");
+    // The manifest as saved still loads: the checks refuse only what is wrong.
+    std::fs::write(&manifest_path, toml::to_string(&original).unwrap()).unwrap();
+    assert!(load(&dir, "Quads").is_ok());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -169,10 +169,13 @@ pub fn load(dir: &Path, code: u8) -> Result<Option<ForestSample>, TexcellError> 
         )));
     }
     let image = |e: &ImageEntry| -> Result<Vec<u8>, TexcellError> {
-        let len = 4 * u64::from(e.side) * u64::from(e.side) * u64::from(e.depth);
-        let end = e.offset.checked_add(len).filter(|&end| end <= bytes.len() as u64);
+        // 4 · side² · depth bytes, which passes u64 for sides near 2^32.
+        let len = [e.side, e.side, e.depth].into_iter().try_fold(4u64, |n, k| n.checked_mul(u64::from(k)));
+        let end = len.and_then(|len| e.offset.checked_add(len)).filter(|&end| end <= bytes.len() as u64);
         let end = end.ok_or_else(|| {
-            corrupt(format!("image {} {}/{}/{} runs past the file", e.kind, e.level, e.slice, e.mip))
+            let (side, depth) = (e.side, e.depth);
+            let place = format!("{} {}/{}/{}", e.kind, e.level, e.slice, e.mip);
+            corrupt(format!("image {place} of side {side} and depth {depth} runs past the file"))
         })?;
         Ok(bytes[e.offset as usize..end as usize].to_vec())
     };
@@ -195,10 +198,15 @@ pub fn load(dir: &Path, code: u8) -> Result<Option<ForestSample>, TexcellError> 
                 let chain = chains
                     .get_mut(slice)
                     .ok_or_else(|| corrupt(format!("slice {slice} listed out of order")))?;
-                if e.mip as usize != chain.levels.len() || e.side != (chain.side >> e.mip).max(1) {
+                // A chain ends at 1 texel; the side's shift checked only below that.
+                let mips = chain.side.max(1).ilog2() + 1;
+                if e.mip as usize != chain.levels.len()
+                    || e.mip >= mips
+                    || e.side != (chain.side >> e.mip).max(1)
+                {
                     return Err(corrupt(format!(
-                        "slice {level}/{slice}: mip {} of side {} out of place",
-                        e.mip, e.side
+                        "slice {level}/{slice}: mip {} of side {} out of place (a chain of side {} has {mips} mips)",
+                        e.mip, e.side, chain.side
                     )));
                 }
                 chain.levels.push(image(e)?);
@@ -228,7 +236,9 @@ fn check_shape(s: &ForestSample) -> Result<(), String> {
         return Err(format!("{n} finest slices of {side} texels: both must be powers of two"));
     }
     for (k, level) in s.slices.iter().enumerate() {
-        let (want_n, want_side) = (n >> k, (side >> k).max(1));
+        // The manifest may list any number of levels: halving by 32 or more gives 0, no overflow.
+        let halved = |v: u32| u32::try_from(k).ok().and_then(|k| v.checked_shr(k)).unwrap_or(0);
+        let (want_n, want_side) = (halved(n), halved(side).max(1));
         if level.len() as u32 != want_n || level.iter().any(|c| c.side != want_side) {
             return Err(format!(
                 "slice level {k}: {} slices; {want_n} of {want_side} texels expected",
@@ -242,9 +252,17 @@ fn check_shape(s: &ForestSample) -> Result<(), String> {
     if s.slices.len() as u32 != n.ilog2() + 1 {
         return Err(format!("{} slice levels; {} expected", s.slices.len(), n.ilog2() + 1));
     }
-    match s.volume.first() {
-        Some(v) if v.side == side && v.depth == n => Ok(()),
-        _ => Err("the volume's finest level is not the finest slices stacked".into()),
+    // `volume_chain`'s levels: the finest slices stacked, each dimension halved per level (none
+    // below 1) down to 1³. The upload cuts each level into slices of 4 · side² bytes.
+    let levels = side.ilog2().max(n.ilog2()) + 1;
+    let halved = |v: u32, m: usize| (v >> m).max(1);
+    let chain =
+        s.volume.iter().enumerate().all(|(m, v)| v.side == halved(side, m) && v.depth == halved(n, m));
+    match s.volume.len() as u32 == levels && chain {
+        true => Ok(()),
+        false => {
+            Err("the volume's levels are not the finest slices stacked and halved down to 1 texel".into())
+        }
     }
 }
 
@@ -322,6 +340,61 @@ mod tests {
         // Garbage manifest.
         fs::write(&manifest, "format_version = \"one\"").unwrap();
         assert!(matches!(load(&dir, 5), Err(TexcellError::Manifest { .. })));
+        let _ = fs::remove_dir_all(&dir);
+    }
+
+    /// `texcell.toml`'s sizes feed a product and a shift: an image of 2^32 − 1 texels a side is
+    /// 4 · side² bytes, past u64, and a 33rd mip of a 1-texel chain shifts its side by 32 bits.
+    /// Both panicked with overflow in a debug build (found by the overflow audit, issue 42); both
+    /// are `Corrupt` errors naming the file and the image now.
+    #[test]
+    fn sizes_whose_arithmetic_would_overflow_are_refused_not_a_panic() {
+        let dir = temp("overflow");
+        let folder = save(&dir, &sample()).unwrap();
+        let manifest_path = folder.join(MANIFEST_FILE);
+        let original: toml::Table = toml::from_str(&fs::read_to_string(&manifest_path).unwrap()).unwrap();
+        let load_with = |edit: &dyn Fn(&mut toml::Table)| {
+            let mut manifest = original.clone();
+            edit(&mut manifest);
+            fs::write(&manifest_path, toml::to_string(&manifest).unwrap()).unwrap();
+            load(&dir, 5).map(|_| ()).unwrap_err()
+        };
+        let error = load_with(&|m| m["image"][0]["side"] = toml::Value::Integer(i64::from(u32::MAX)));
+        assert!(
+            matches!(&error, TexcellError::Corrupt { path, .. } if path.ends_with(TEXELS_FILE)),
+            "{error}"
+        );
+        assert!(
+            error.to_string().contains("slice 0/0/0") && error.to_string().contains("4294967295"),
+            "{error}"
+        );
+        // One 1-texel slice with 33 mips, each the first 4 bytes of the file: the 33rd shifted the
+        // side by 32 bits; now the second is refused, a 1-texel chain having 1 mip.
+        let error = load_with(&|m| {
+            let image = |mip: i64| {
+                let entry =
+                    [("kind", "slice".into()), ("level", 0.into()), ("slice", 0.into()), ("mip", mip.into())];
+                let sizes = [("side", 1.into()), ("depth", 1.into()), ("offset", 0.into())];
+                toml::Value::Table(entry.into_iter().chain(sizes).map(|(k, v)| (k.to_owned(), v)).collect())
+            };
+            m["image"] = toml::Value::Array((0..33).map(image).collect());
+        });
+        assert!(matches!(&error, TexcellError::Corrupt { .. }), "{error}");
+        assert!(error.to_string().contains("mip 1 of side 1 out of place"), "{error}");
+        // A volume level of no texels: the upload would cut it into slices of 0 bytes (found by the
+        // same audit: only the volume's finest level was checked).
+        let error = load_with(&|m| {
+            let images = m["image"].as_array_mut().unwrap();
+            let volume = images.iter_mut().filter(|i| i["kind"].as_str() == Some("volume"));
+            for image in volume.filter(|i| i["level"].as_integer() == Some(1)) {
+                image["side"] = toml::Value::Integer(0);
+                image["depth"] = toml::Value::Integer(0);
+            }
+        });
+        assert!(error.to_string().contains("the volume's levels"), "{error}");
+        // The manifest as saved still loads: the checks refuse only what is wrong.
+        fs::write(&manifest_path, toml::to_string(&original).unwrap()).unwrap();
+        assert!(load(&dir, 5).unwrap().is_some());
         let _ = fs::remove_dir_all(&dir);
     }
 }
