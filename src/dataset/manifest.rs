@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::pyramid::Pyramid;
+use super::pyramid::{Pyramid, Sampling};
 use crate::dataset::lcc::LccCoding;
 
 /// Version 2: land cover is the LCC quadtree of palette indices (`crate::dataset::lcc`).
@@ -121,6 +121,54 @@ impl Manifest {
     /// Size of the pixel-area extent, metres.
     pub fn extent_m(&self) -> [f64; 2] {
         self.height.pyramid.size.map(|n| f64::from(n) * self.height.spacing_m)
+    }
+
+    /// Checks the numbers the readers compute with, before they do, naming the first field wrong:
+    /// positive, finite spacings; each pyramid sampled as its layer is, its tiles within
+    /// `MAX_TILE_EXTENT` (`Pyramid::check_tiles`), and as many levels as `Pyramid::new` gives (land
+    /// cover's LCC quadtree has its own, checked with its coding); imagery's mips down to no less
+    /// than 1 texel. Unchecked, a level count or mips shifted sizes past 32 bits, a tile of 0
+    /// divided by zero, a border doubled past u32.
+    pub fn check_numbers(&self) -> Result<(), String> {
+        let metres = |field: &str, value: f64| match value.is_finite() && value > 0.0 {
+            true => Ok(()),
+            false => Err(format!("{field} = {value}: must be a positive, finite number of metres")),
+        };
+        let pyramid = |layer: &str, p: &Pyramid, sampling: Sampling, own_levels: bool| {
+            if p.sampling != sampling {
+                return Err(format!(
+                    "{layer}.pyramid.sampling = {:?}: {layer} is {sampling:?}-sampled",
+                    p.sampling
+                ));
+            }
+            p.check_tiles().map_err(|(field, reason)| format!("{layer}.pyramid.{field} = {reason}"))?;
+            let levels = Pyramid::new(p.size, p.tile, p.border, sampling).levels;
+            if !own_levels && p.levels != levels {
+                let [w, h] = p.size;
+                let tile = p.tile;
+                return Err(format!(
+                    "{layer}.pyramid.levels = {}: {w} × {h} in tiles of {tile} take {levels}",
+                    p.levels
+                ));
+            }
+            Ok(())
+        };
+        metres("height.spacing_m", self.height.spacing_m)?;
+        pyramid("height", &self.height.pyramid, Sampling::Vertex, false)?;
+        if let Some(l) = &self.imagery {
+            metres("imagery.texel_m", l.texel_m)?;
+            pyramid("imagery", &l.pyramid, Sampling::Cell, false)?;
+            let (extent, mips) = (l.pyramid.tile_extent(), l.mips);
+            let most = extent.ilog2() + 1;
+            if !(1..=most).contains(&mips) {
+                return Err(format!("imagery.mips = {mips}: tiles of {extent} texels have 1 to {most}"));
+            }
+        }
+        if let Some(l) = &self.landcover {
+            metres("landcover.texel_m", l.layer.texel_m)?;
+            pyramid("landcover", &l.layer.pyramid, Sampling::Cell, true)?;
+        }
+        Ok(())
     }
 }
 

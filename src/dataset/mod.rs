@@ -158,6 +158,7 @@ impl Dataset {
             return Err(DatasetError::Version { path: manifest_path, found: version.format_version });
         }
         let manifest: Manifest = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        manifest.check_numbers().map_err(bad)?;
         let height =
             LayerPack::open_plain(dir, &manifest.height.pack, manifest.height.pyramid, 1, size_of::<f32>())?
                 .with_check(ValueCheck::Heights);

@@ -10,6 +10,11 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The largest stored tile a pyramid read from a file may have, texels a side, border included:
+/// the largest 2D texture wgpu's default limits allow (`max_texture_dimension_2d`). Its bytes,
+/// 16 a texel at most, stay within u32 (2^30), so no size computed from it overflows.
+pub const MAX_TILE_EXTENT: u32 = 8192;
+
 /// Where a layer's values sit on its grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -71,9 +76,15 @@ impl Pyramid {
 
     /// Texels (samples) per axis at `level`.
     pub fn size_at(&self, level: u32) -> [u32; 2] {
-        self.size.map(|n| match self.sampling {
-            Sampling::Vertex => (n.max(1) - 1).div_ceil(1 << level) + 1,
-            Sampling::Cell => n.max(1).div_ceil(1 << level),
+        // In u64: a 2^32-texel layer in 1-texel tiles reaches level 32, whose 2^32 passes u32.
+        let halvings = 1u64 << level.min(63);
+        self.size.map(|n| {
+            let n = u64::from(n.max(1));
+            let at_level = match self.sampling {
+                Sampling::Vertex => (n - 1).div_ceil(halvings) + 1,
+                Sampling::Cell => n.div_ceil(halvings),
+            };
+            at_level as u32
         })
     }
 
@@ -130,6 +141,26 @@ impl Pyramid {
             let [nx, ny] = self.tiles_at(level);
             (0..ny).flat_map(move |y| (0..nx).map(move |x| TileId::new(level, x, y)))
         })
+    }
+
+    /// Checks the tile of a pyramid read from a file (a manifest): at least one step, and stored
+    /// tiles of at most `MAX_TILE_EXTENT` texels a side, so that no size computed from them passes
+    /// u32. The error names the field and says why, its value first.
+    pub fn check_tiles(&self) -> Result<(), (&'static str, String)> {
+        let (tile, border) = (self.tile, self.border);
+        if tile == 0 {
+            return Err(("tile", "0: a tile is at least 1 step".into()));
+        }
+        let shared_edge = u64::from(self.sampling == Sampling::Vertex);
+        let extent = u64::from(tile) + shared_edge + 2 * u64::from(border);
+        if extent > u64::from(MAX_TILE_EXTENT) {
+            let (field, value) = if tile >= MAX_TILE_EXTENT { ("tile", tile) } else { ("border", border) };
+            let reason = format!(
+                "{value}: tiles of {tile} with a border of {border} are stored {extent} texels a side, over {MAX_TILE_EXTENT}"
+            );
+            return Err((field, reason));
+        }
+        Ok(())
     }
 
     /// Level-`level` grid coordinate of the first stored texel (border included) of tile `id`.

@@ -333,22 +333,28 @@ fn stored_tiles_have_the_extents_the_shaders_read() {
     }
 }
 
+/// Writes 40 × 24 texels of RGBA8 imagery as `imagery.pack` in `dir`; its manifest layer.
+fn write_imagery(dir: &std::path::Path) -> CellLayer {
+    let imagery = LayerSpec::imagery([40, 24]);
+    let colour = |x: u32, y: u32| [x as u8, y as u8, 0, 255];
+    write_layer(&dir.join("imagery.pack"), &imagery, source_of(colour), &ProgressBar::hidden()).unwrap();
+    CellLayer {
+        pack: "imagery.pack".into(),
+        texel_m: 28.5,
+        pyramid: imagery.pyramid,
+        mips: imagery.mips,
+        format: ImageryFormat::Rgba8.name().into(),
+        source: "test".into(),
+    }
+}
+
 #[test]
 fn an_imagery_format_unknown_or_unlike_its_pack_is_refused() {
     let (path, spec) = write_heights("imagery-format", [37, 21]);
     let dir = path.parent().unwrap();
-    let imagery = LayerSpec::imagery([40, 24]);
-    let colour = |x: u32, y: u32| [x as u8, y as u8, 0, 255];
-    write_layer(&dir.join("imagery.pack"), &imagery, source_of(colour), &ProgressBar::hidden()).unwrap();
+    let imagery = write_imagery(dir);
     let with_format = |format: &str| {
-        let layer = CellLayer {
-            pack: "imagery.pack".into(),
-            texel_m: 28.5,
-            pyramid: imagery.pyramid,
-            mips: imagery.mips,
-            format: format.into(),
-            source: "test".into(),
-        };
+        let layer = CellLayer { format: format.into(), ..imagery.clone() };
         let text = toml::to_string_pretty(&Manifest { imagery: Some(layer), ..manifest_for(&spec) }).unwrap();
         std::fs::write(dir.join(MANIFEST_FILE), text).unwrap();
         Dataset::open(dir)
@@ -362,4 +368,39 @@ fn an_imagery_format_unknown_or_unlike_its_pack_is_refused() {
     // An RGBA8 pack under a BC7 manifest: its tiles are 4 times the size the format says.
     let err = with_format("bc7 srgb").err().expect("a pack of another format");
     assert!(matches!(err, DatasetError::PackShape { .. }), "{err}");
+}
+
+/// A manifest's pyramid and mips feed shifts, products and divisions: 40 levels shift by 32 bits
+/// and more, a tile of 0 divides by zero, a border of 2^31 doubles past u32, 40 imagery mips
+/// shift the tile's side away. Each panicked (the division in every build, the rest with overflow
+/// in a debug one; found by the overflow audit, issue 42); each is refused naming the manifest and
+/// the field now, as is a spacing of 0 m, which made every position NaN.
+#[test]
+fn pyramids_whose_arithmetic_would_overflow_are_refused_naming_the_field() {
+    let (path, spec) = write_heights("overflow", [37, 21]);
+    let dir = path.parent().unwrap();
+    let good = Manifest { imagery: Some(write_imagery(dir)), ..manifest_for(&spec) };
+    let open_with = |edit: &dyn Fn(&mut Manifest)| {
+        let mut manifest = good.clone();
+        edit(&mut manifest);
+        std::fs::write(dir.join(MANIFEST_FILE), toml::to_string_pretty(&manifest).unwrap()).unwrap();
+        Dataset::open(dir).map(|_| ())
+    };
+    assert!(open_with(&|_| ()).is_ok());
+    type Edit<'a> = &'a dyn Fn(&mut Manifest);
+    let cases: [(&str, Edit); 5] = [
+        ("height.pyramid.levels", &|m| m.height.pyramid.levels = 40),
+        ("height.pyramid.tile", &|m| m.height.pyramid.tile = 0),
+        ("height.pyramid.border", &|m| m.height.pyramid.border = 1 << 31),
+        ("imagery.mips", &|m| m.imagery.iter_mut().for_each(|l| l.mips = 40)),
+        ("height.spacing_m", &|m| m.height.spacing_m = 0.0),
+    ];
+    for (field, edit) in cases {
+        let err = open_with(edit).expect_err(field);
+        assert!(
+            matches!(&err, DatasetError::Manifest { path, .. } if path.ends_with(MANIFEST_FILE)),
+            "{err}"
+        );
+        assert!(err.to_string().contains(field), "{field}: {err}");
+    }
 }
