@@ -404,3 +404,41 @@ fn pyramids_whose_arithmetic_would_overflow_are_refused_naming_the_field() {
         assert!(err.to_string().contains(field), "{field}: {err}");
     }
 }
+
+/// A pack's header sizes feed sums and allocations: a data size of 2^64 − 1 bytes or a tile count
+/// just under 2^59 pass past u64 when the file's length is summed, a tile size of 2^64 − 2 bytes
+/// overflows with Grid32's 3 leading bytes, and one of 2^40 bytes was allocated up front to
+/// decompress into. The sums panicked with overflow in a debug build (found by the overflow audit,
+/// issue 42), the allocation aborted in any (found by `fuzz/`'s `pack` once it made the checksums
+/// match); each is an error naming the pack now: truncated at open, or that tile corrupt.
+#[test]
+fn pack_headers_whose_arithmetic_would_overflow_are_refused_not_a_panic() {
+    let dir = temp_dir("pack-overflow");
+    let pack_with = |name: &str, codec: Codec, field: std::ops::Range<usize>, value: u64| {
+        let path = dir.join(name);
+        let writer = pack::PackWriter::create(&path, 16, 1, codec).unwrap();
+        writer.write_tile(0, &[7; 16], None).unwrap();
+        writer.finish().unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes[field].copy_from_slice(&value.to_le_bytes());
+        let crc = crc32fast::hash(&bytes[0..60]);
+        bytes[60..64].copy_from_slice(&crc.to_le_bytes());
+        std::fs::write(&path, bytes).unwrap();
+        Pack::open(&path)
+    };
+    let (tile_bytes, tile_count, data_bytes) = (16..24, 24..32, 40..48);
+    let raw = Codec::Raw;
+    let err = pack_with("data.pack", raw, data_bytes, u64::MAX).err().expect("a data size past u64");
+    assert!(matches!(err, PackError::Truncated { .. }), "{err}");
+    let err = pack_with("count.pack", raw, tile_count, u64::MAX / 32).err().expect("an index past u64");
+    assert!(matches!(err, PackError::Truncated { .. }), "{err}");
+    for (name, predictor, size) in
+        [("grid.pack", Predictor::Grid32, u64::MAX - 1), ("big.pack", Predictor::None, 1 << 40)]
+    {
+        let pack = pack_with(name, Codec::Zstd(predictor), tile_bytes.clone(), size).unwrap();
+        assert!(matches!(pack.tile(0), Err(PackError::Corrupt { index: 0, .. })), "{name}");
+    }
+    // The pack as written reads back.
+    let good = pack_with("good.pack", raw, 0..8, u64::from_le_bytes(*b"TRMPPACK")).unwrap();
+    assert_eq!(&*good.tile(0).unwrap(), &[7; 16]);
+}

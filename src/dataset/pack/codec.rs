@@ -24,6 +24,11 @@ use std::path::Path;
 
 /// zstd's level for tiles: fast to write (a build compresses every tile once) and to read.
 const ZSTD_LEVEL: i32 = 3;
+/// The most bytes a stored tile may decode to. zstd's bulk decompressor allocates the size it is
+/// given before it reads a byte, and a pack's header gives any size; no tile terramp makes comes
+/// near (the largest a manifest may describe, `MAX_TILE_EXTENT`² RGBA8 texels and their mips, is
+/// 358 MB).
+const MAX_TILE_BYTES: usize = 1 << 30;
 
 /// What is done to a tile's bytes before zstd compresses them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,6 +105,9 @@ impl Codec {
         let Self::Zstd(predictor) = self else {
             return (stored.len() == tile_bytes).then(|| stored.to_vec());
         };
+        if tile_bytes > MAX_TILE_BYTES {
+            return None;
+        }
         // Grid32 leads with its mode and the grid's exponent.
         let header = if predictor == Predictor::Grid32 { GRID_HEADER } else { 0 };
         let bytes = zstd::bulk::decompress(stored, tile_bytes + header).ok()?;

@@ -198,8 +198,10 @@ impl Header {
         (HEADER_BYTES + self.tile_count * self.entry_bytes()).next_multiple_of(DATA_ALIGN)
     }
 
-    fn file_bytes(&self) -> u64 {
-        self.data_offset() + self.data_bytes
+    /// The length the header implies; `None` past u64 (a damaged or forged header).
+    fn file_bytes(&self) -> Option<u64> {
+        let index_end = self.tile_count.checked_mul(self.entry_bytes())?.checked_add(HEADER_BYTES)?;
+        index_end.checked_next_multiple_of(DATA_ALIGN)?.checked_add(self.data_bytes)
     }
 
     fn encode(&self) -> [u8; HEADER_BYTES as usize] {
@@ -326,7 +328,7 @@ impl Pack {
         let opened = Stamp::of(&file).map_err(io(path))?;
         let actual = opened.bytes;
         let header = Header::decode(&opened.header, path)?;
-        let expected = header.tile_count.checked_mul(header.entry_bytes()).map(|_| header.file_bytes());
+        let expected = header.file_bytes();
         if expected.is_none_or(|e| actual < e) {
             return Err(PackError::Truncated {
                 path: path.to_owned(),
@@ -386,8 +388,12 @@ impl Pack {
     /// Where tile `index`'s stored bytes lie in the file (for tools that inspect or damage packs).
     pub fn stored_span(&self, index: u64) -> Result<std::ops::Range<u64>, PackError> {
         let entry = self.entry(index)?;
-        let start = self.header.data_offset() + entry.offset;
-        Ok(start..start + entry.stored_bytes)
+        let start = self.header.data_offset().checked_add(entry.offset);
+        let end = start.and_then(|start| start.checked_add(entry.stored_bytes));
+        match (start, end) {
+            (Some(start), Some(end)) => Ok(start..end),
+            _ => Err(PackError::Corrupt { path: self.path.clone(), index }),
+        }
     }
 
     /// The tile's value range (heights: conservative min/max of the level-0 samples under it), or
