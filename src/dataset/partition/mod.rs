@@ -47,10 +47,12 @@ impl Split {
         let partitions = partitions.max(1);
         let top = pyramid.levels - 1;
         let min_level = min_level.min(top);
-        // A subtree rooted at k spans 2^k tiles per side at level 0, plus a margin of borders.
+        // A subtree rooted at k spans 2^k tiles per side at level 0, plus a margin of borders. In
+        // u128: a source of 2^31 texels a side (a GeoTIFF's header may say so) has subtrees past
+        // u64's bytes.
         let fits = |k: u32| {
-            let side = u64::from(pyramid.tile + 2 * pyramid.border + 2) << k;
-            side * side * texel_bytes * 4 / 3 <= SUBTREE_IMAGE_BYTES
+            let side = u128::from(pyramid.tile + 2 * pyramid.border + 2) << k;
+            side * side * u128::from(texel_bytes) * 4 / 3 <= u128::from(SUBTREE_IMAGE_BYTES)
         };
         let roots = |k: u32| {
             let [nx, ny] = pyramid.tiles_at(k);
@@ -68,9 +70,10 @@ impl Split {
     /// roots than partitions and this one is left over).
     pub fn roots(&self, part: u32) -> Vec<TileId> {
         let [nx, ny] = self.pyramid.tiles_at(self.level);
-        let count = u64::from(nx) * u64::from(ny);
-        let (part, parts) = (u64::from(part), u64::from(self.partitions));
-        let (first, end) = (part * count / parts, (part + 1) * count / parts);
+        // In u128: up to 2^32 partitions times up to 2^48 roots.
+        let count = u128::from(nx) * u128::from(ny);
+        let (part, parts) = (u128::from(part), u128::from(self.partitions));
+        let (first, end) = ((part * count / parts) as u64, ((part + 1) * count / parts) as u64);
         (first..end)
             .map(|i| TileId::new(self.level, (i % u64::from(nx)) as u32, (i / u64::from(nx)) as u32))
             .collect()
@@ -80,10 +83,10 @@ impl Split {
     pub fn part_of(&self, id: TileId) -> u32 {
         let shift = self.level - id.level;
         let [nx, ny] = self.pyramid.tiles_at(self.level);
-        let root = u64::from(id.y >> shift) * u64::from(nx) + u64::from(id.x >> shift);
-        let count = u64::from(nx) * u64::from(ny);
-        // The largest part whose first root is at or before `root`.
-        let parts = u64::from(self.partitions);
+        let root = u128::from(id.y >> shift) * u128::from(nx) + u128::from(id.x >> shift);
+        let count = u128::from(nx) * u128::from(ny);
+        // The largest part whose first root is at or before `root` (in u128, as in `roots`).
+        let parts = u128::from(self.partitions);
         let mut part = (root * parts / count).min(parts - 1);
         while (part + 1) * count / parts <= root {
             part += 1;

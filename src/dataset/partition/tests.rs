@@ -90,6 +90,20 @@ fn the_roots_are_dealt_once_and_every_tile_is_in_one_part() {
     assert_eq!(Split::new(pyramid, 1000, 4, 0).level, 0);
 }
 
+/// A source of 2^32 − 1 texels a side (its GeoTIFF's header may say so) dealt to 2^32 − 1
+/// partitions: the subtree's bytes passed u64, and a partition's first root times the partitions
+/// too; both panicked with overflow in a debug build (found by the overflow audit, issue 42).
+#[test]
+fn the_largest_layer_is_split_without_overflow() {
+    let pyramid = LayerSpec::heights([u32::MAX; 2]).pyramid;
+    let split = Split::new(pyramid, u32::MAX, 4, 0);
+    let side = u64::from(pyramid.tile + 2 * pyramid.border + 2) << split.level;
+    assert!(side * side * 4 * 4 / 3 <= SUBTREE_IMAGE_BYTES, "level {}", split.level);
+    let last = split.roots(u32::MAX - 1);
+    let root = last.last().copied().expect("the last partition has roots");
+    assert_eq!(split.part_of(root), u32::MAX - 1);
+}
+
 #[test]
 fn a_subtree_never_outgrows_its_memory_bound() {
     // A planet's imagery: 4 M texels per side.
