@@ -137,8 +137,10 @@ impl CoarseGrid {
             .chunks_exact(8)
             .map(|c| f64::from_le_bytes(c.try_into().unwrap_or_default()))
             .collect();
-        let whole =
-            rest.len() == 12 + 8 * heights.len() && heights.len() == cells[0].checked_mul(cells[1])?;
+        // At least one cell: `at` reads cell n − 1 of each axis.
+        let whole = rest.len() == 12 + 8 * heights.len()
+            && !heights.is_empty()
+            && heights.len() == cells[0].checked_mul(cells[1])?;
         (whole && step > 0 && heights.iter().all(|h| h.is_finite())).then_some(Self { step, cells, heights })
     }
 
@@ -389,5 +391,9 @@ mod tests {
         assert_eq!(CoarseGrid::from_bytes(&bytes[..bytes.len() - 1]), None, "a truncated grid");
         assert_eq!(CoarseGrid::from_bytes(&bytes[..10]), None, "a header cut short");
         assert_eq!(CoarseGrid::from_bytes(b"something else entirely"), None);
+        // No cells (and so no heights): `at` would take cell 0 − 1 (found by the overflow audit,
+        // issue 42).
+        let empty: Vec<u8> = [COARSE_TAG.as_slice(), &1u32.to_le_bytes(), &[0; 8]].concat();
+        assert_eq!(CoarseGrid::from_bytes(&empty), None, "a grid of no cells");
     }
 }
