@@ -41,7 +41,7 @@ if [ -d "$shared/models" ]; then
   if [ -x "$impostor" ]; then
     TERRAMP_FUZZ_SEEDS="$corpus/impostor" "$impostor" -runs=0 >/dev/null 2>&1
   else
-    echo "seed_corpora: $impostor is not built (cargo +stable fuzz build --sanitizer none -O): its corpus starts empty" >&2
+    echo "seed_corpora: $impostor is not built (cargo +stable fuzz build --sanitizer none -O -a): its corpus starts empty" >&2
   fi
 else
   echo "seed_corpora: $shared/models is missing: the glTF and impostor corpora start empty" >&2

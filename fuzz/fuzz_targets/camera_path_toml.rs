@@ -3,7 +3,9 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|text: &str| {
+mod build_checks;
+
+fuzz_target!(init: build_checks::probe(), |text: &str| {
     if let Ok(path) = terramp::path::CameraPath::parse(text, "fuzz.toml") {
         for k in 0..=8 {
             let camera = path.camera_at(f64::from(k) / 8.0, 60.0, 1.0);

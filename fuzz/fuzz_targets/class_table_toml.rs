@@ -3,6 +3,8 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|text: &str| {
+mod build_checks;
+
+fuzz_target!(init: build_checks::probe(), |text: &str| {
     let _ = terramp::classes::ClassTable::parse(text, "fuzz.toml");
 });

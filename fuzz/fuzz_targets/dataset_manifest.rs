@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
+
+mod build_checks;
 use terramp::dataset::{Dataset, TileId};
 
 /// A 64-sample synthetic dataset, made once per process.
@@ -19,7 +21,7 @@ fn dataset() -> &'static PathBuf {
     })
 }
 
-fuzz_target!(|text: &str| {
+fuzz_target!(init: build_checks::probe(), |text: &str| {
     let dir = dataset();
     if std::fs::write(dir.join("manifest.toml"), text).is_err() {
         return;

@@ -16,6 +16,8 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
+
+mod build_checks;
 use terramp::texcell::pyramid::Layer;
 use terramp::texcell::{ForestSample, SampleTree};
 
@@ -104,6 +106,7 @@ fn template() -> &'static Template {
 
 fuzz_target!(
     init: {
+        build_checks::probe();
         if let Some(seeds) = std::env::var_os("TERRAMP_FUZZ_SEEDS") {
             let seeds = PathBuf::from(seeds);
             std::fs::create_dir_all(&seeds).expect("the seeds' folder");

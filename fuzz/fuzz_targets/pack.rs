@@ -3,7 +3,9 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|bytes: &[u8]| {
+mod build_checks;
+
+fuzz_target!(init: build_checks::probe(), |bytes: &[u8]| {
     let path = std::env::temp_dir().join(format!("terramp-fuzz-pack-{}.pack", std::process::id()));
     if std::fs::write(&path, bytes).is_err() {
         return;
