@@ -25,8 +25,9 @@ for d in "$tmp/tiny" "$tmp/tiny-bc1" "$root"/data/*/ "$root"/data/trade/*/; do
   name=$(basename "$d")
   cp "$d/manifest.toml" "$corpus/dataset_manifest/$name.toml"
   for p in "$d"/*.pack; do
-    # Packs up to 1 MiB: libFuzzer's inputs are kept small.
-    [ "$(stat -c %s "$p")" -le 1048576 ] && cp "$p" "$corpus/pack/$name-$(basename "$p")"
+    # Packs up to 1 MiB: libFuzzer's inputs are kept small. The pack target's inputs lead with a
+    # byte saying which checksums it makes match (7: all).
+    [ "$(stat -c %s "$p")" -le 1048576 ] && { printf '\007'; cat "$p"; } >"$corpus/pack/$name-$(basename "$p")"
   done
 done
 if [ -d "$shared/models" ]; then
