@@ -142,8 +142,9 @@ fn baking_every_model_gives_three_lods_with_their_planes_and_non_empty_atlases()
 
 /// Models that made the glTF crate panic, found by `fuzz/`'s `gltf_model`, are refused with an
 /// error naming what is wrong: a POSITION naming an accessor past the file's (its validation
-/// indexed it), indices stored as floats (its reader's `unreachable!`); and a node that is its own
-/// child (a walk of the scene that never ends).
+/// indexed it), indices stored as floats (its reader's `unreachable!`), a GLB header's length under
+/// 12 bytes (its reader's underflow); and a node that is its own child (a walk of the scene that
+/// never ends).
 #[test]
 fn malformed_models_found_by_fuzzing_are_refused_not_a_panic() {
     let dir = TempDir::new("bake-fuzzed");
@@ -173,6 +174,13 @@ fn malformed_models_found_by_fuzzing_are_refused_not_a_panic() {
         ),
         ("Floats", triangle(tree, 5126, 0), Some("indices accessor 1: (F32, Scalar) elements")),
         ("Loop", triangle(r#"[{"mesh": 0, "children": [0]}]"#, 5125, 0), Some("node 0 is reached twice")),
+        // A GLB header whose length, 0, is under the header's own 12 bytes (the glTF crate took
+        // 12 from it: an underflow, found once the fuzz build checked overflow, issue 42).
+        (
+            "ShortGlb",
+            format!("glTF\u{2}\0\0\0{}", "\0".repeat(40)),
+            Some("the GLB header gives a length of 0 bytes"),
+        ),
     ];
     for (name, json, expected) in cases {
         let model = dir.path().join(format!("{name}.gltf"));

@@ -45,6 +45,12 @@ pub enum ModelError {
         /// Accessors in the file.
         accessors: usize,
     },
+    /// A `.glb` header gives the file a length shorter than the header itself.
+    #[error("not a valid glTF model: the GLB header gives a length of {length} bytes, under its own 12")]
+    GlbLength {
+        /// The length the header gives, bytes.
+        length: u32,
+    },
     /// A buffer or image is embedded as a `data:` URI, which the baker does not decode.
     #[error("unusable glTF model: embedded data URIs are not supported: use a .glb")]
     DataUri,
@@ -150,9 +156,17 @@ pub fn load(path: &Path) -> Result<Mesh, ModelError> {
 /// Parses and validates a model's bytes. gltf-json 1.4's validation reads a primitive's POSITION
 /// accessor before it checks that the accessor exists, and panics when it does not (found by
 /// `fuzz/`'s `gltf_model`): those indices are checked here first, then the crate validates the rest.
+/// So is a GLB header's length, from which gltf 1.4 takes the header's 12 bytes unchecked (an
+/// underflow, found once the fuzz build checked overflow).
 fn parse(bytes: &[u8]) -> Result<gltf::Gltf, ModelError> {
     use gltf::json::mesh::Semantic;
     use gltf::json::validation::Checked;
+    if let Some(&[l0, l1, l2, l3]) = bytes.strip_prefix(b"glTF").and_then(|header| header.get(4..8)) {
+        let length = u32::from_le_bytes([l0, l1, l2, l3]);
+        if length < 12 {
+            return Err(ModelError::GlbLength { length });
+        }
+    }
     let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(ModelError::NotGltf)?;
     let json = unchecked.document.into_json();
     let accessors = json.accessors.len();
