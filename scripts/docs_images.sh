@@ -393,7 +393,7 @@ make_streaming() {
 make_soak_globe() { pillow; FRAMES=10000 SOAKS=globe DATA_DIR="$data" scripts/soak.sh; }
 make_soak_nc() { pillow; FRAMES=10000 SOAKS=nc DATA_DIR="$data" scripts/soak.sh; }
 # The one-way flight and the flight there, back and there again of docs/RELIABILITY.md's soak section.
-make_soak_nc_growth() { pillow; FRAMES=5000 LEGS=1 SOAKS=nc PLOT_NAME=nc_growth DATA_DIR="$data" scripts/soak.sh; }
+make_soak_nc_growth() { pillow; FRAMES=10000 LEGS=1 SOAKS=nc PLOT_NAME=nc_growth DATA_DIR="$data" scripts/soak.sh; }
 make_soak_nc_there_and_back() {
     pillow
     FRAMES=900 LEGS=3 SOAKS=nc PLOT_NAME=nc_there_and_back DATA_DIR="$data" scripts/soak.sh

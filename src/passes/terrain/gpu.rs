@@ -115,7 +115,8 @@ impl TerrainPass {
             // shows none, and drawing them (measured) closed no hole a consistent rasteriser opens:
             // where the morph shrinks triangles to slivers, one that snaps backwards lies over front
             // faces, and unculled it won the depth test on nc and was shaded from its sliver's
-            // derivatives (a stray bright pixel), for 12 % more time in this pass. Lavapipe is not
+            // derivatives (a stray bright pixel), and this pass took longer (a build not kept,
+            // docs/RELIABILITY.md). Lavapipe is not
             // consistent: it culls in floating point but rasterises in fixed point, and drops one
             // sliver its rasteriser finds front-facing, one sky pixel in the 100 frames of
             // `tests/streaming_faults.rs`'s control.
