@@ -5,10 +5,11 @@
 // at the record's camera-relative anchor, scaled to its height and turned about the vertical by
 // its jitter, bent by the wind (`shared/wind.wgsl`: the same field for every LOD, so a cross-fade
 // shows one plant swaying), and projects it like the terrain. Fragments take their material's
-// colour (times a layer of the texture array), are alpha-tested, tinted towards the ground colour
-// (foliage, by its species' `ground_blend`; bark keeps its own), by the seed's colour variation
-// and by the luminosity of their place in the plant (`crown_luminosity`), lit (the sun through
-// the clouds, `shared/clouds.wgsl`) and hazed like the ground.
+// colour (times a layer of the texture array), are alpha-tested, follow the photograph's colour
+// under the seed (foliage, by its species' `ground_blend`; bark keeps its own: the colour
+// follow-up, a ratio transfer, `photo_scale`), are varied by the seed's colour variation and by
+// the luminosity of their place in the plant (`crown_luminosity`), lit (the sun through the
+// clouds, `shared/clouds.wgsl`) and hazed like the ground.
 //
 // Continuous LOD (`draw_seeds.continuous_lod`, `u.focal_px` > 0): a mesh whose materials say how
 // they shed detail thins its leaves and its thin stems as they shrink on screen, per seed
@@ -34,6 +35,7 @@ struct DrawSeedsUniforms {
     wind_wave: vec4<f32>,
     cloud_field: vec4<f32>,
     cloud_shift: vec4<f32>,
+    photo_scale: array<vec4<f32>, SEED_GROUPS>,
 }
 
 struct SeedShape {
@@ -90,8 +92,8 @@ struct VertexOut {
     // Albedo tint (rgb).
     @location(3) @interpolate(flat) tint: vec3<f32>,
     @location(4) @interpolate(flat) material: u32,
-    // The ground colour (rgb) and how much of it to blend in (w).
-    @location(5) @interpolate(flat) ground: vec4<f32>,
+    // The colour follow-up's factor on the albedo, per channel (`photo_scale`).
+    @location(5) @interpolate(flat) follow: vec3<f32>,
     // Dither thresholds this draw keeps, [x, y), and the seed's shift of the dither pattern (z).
     @location(6) @interpolate(flat) keep: vec3<f32>,
     // The seed's record: what the ground truth's id buffer names.
@@ -318,13 +320,17 @@ fn vs_main(
     let shift = vec3<f32>(1.0 + 0.3 * variation, 1.0, 1.0 - 0.3 * variation);
     out.tint = shift * (1.0 + 0.3 * variation);
     out.material = in.material;
-    // Foliage takes on the ground's colour; bark keeps its own.
+    // The colour follow-up: foliage is scaled so that, seen from above, its geometry's mean lit
+    // colour is the photograph's under the seed, lit as the ground lights it (a ratio transfer:
+    // the model keeps its texture, shading and gaps). Bark keeps its own colour, as does
+    // geometry with no foliage to measure (a scale of 0).
     let ground = unpack4x8unorm(record.ground_colour);
-    var blend = shape.ground_blend;
-    if (material.flags & MATERIAL_BARK) != 0u {
-        blend = 0.0;
+    let photo_scale = u.photo_scale[seed_group(species, material.lod)].rgb;
+    var follow = shape.ground_blend * ground.a;
+    if (material.flags & MATERIAL_BARK) != 0u || photo_scale.g <= 0.0 {
+        follow = 0.0;
     }
-    out.ground = vec4<f32>(ground.rgb, ground.a * blend);
+    out.follow = mix(vec3<f32>(1.0), ground.rgb * photo_scale, follow);
     out.luminosity = crown_luminosity(shape, position_model_m, angle);
     return out;
 }
@@ -358,15 +364,15 @@ fn texel_of(in: VertexOut, material: SeedMaterial) -> vec4<f32> {
 fn surface(in: VertexOut) -> Surface {
     let material = materials[in.material];
     let texel = texel_of(in, material);
-    let albedo = mix(texel.rgb, in.ground.rgb, in.ground.w) * in.tint * in.luminosity;
+    let albedo = texel.rgb * in.follow * in.tint * in.luminosity;
     // Seen from the side facing the eye (billboards, leaves); foliage lets light wrap around.
     var normal = normalize(in.normal);
     if dot(normal, in.rel_m) > 0.0 {
         normal = -normal;
     }
-    let sun = (0.55 * max(dot(normal, u.sun_dir.xyz), 0.0) + 0.35 * max(u.sun_dir.z, 0.0))
+    let sun = (FOLIAGE_SUN * max(dot(normal, u.sun_dir.xyz), 0.0) + FOLIAGE_SUN_WRAP * max(u.sun_dir.z, 0.0))
         * sun_through_clouds(u.cloud_field, u.cloud_shift, in.rel_m);
-    let sky = 0.3;
+    let sky = FOLIAGE_SKY;
     let lit = albedo * (sun + sky);
     let haze = 1.0 - exp2(-length(in.rel_m) / u.haze.w);
     return Surface(vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0), texel.a, fwidth(texel.a));

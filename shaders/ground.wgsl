@@ -15,8 +15,8 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         albedo = mix(albedo, imagery.rgb, imagery.a);
     }
     let sun = max(dot(normal, u.sun_dir.xyz), 0.0) * sun_through_clouds(u.cloud_field, u.cloud_shift, in.rel_m);
-    let sky = 0.35 * (0.5 + 0.5 * normal.z);
-    let lit = albedo * (sun * 0.9 + sky);
+    let sky = GROUND_SKY * (0.5 + 0.5 * normal.z);
+    let lit = albedo * (sun * GROUND_SUN + sky);
     let haze = 1.0 - exp2(-length(in.rel_m) / u.haze.w);
     // The target is sRGB: the hardware encodes on store.
     return vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0);

@@ -9,8 +9,9 @@
 // colours hashed from the lattice's vertices: Rust `texcell::tiling`), and reads that tile's texel
 // of its slice in the slice pyramid level the patch draws, at that level's mip or coarser. The
 // texel is premultiplied coverage; its opacity is corrected for the oblique path between slices
-// (A' = 1 − (1 − A)^k, k = 1 / cos of the view to the ground's normal, clamped), its colour lit
-// like the seeds' and blended towards the imagery under it, hazed like the ground, and it fades in
+// (A' = 1 − (1 − A)^k, k = 1 / cos of the view to the ground's normal, clamped), its colour made
+// to follow the photograph under it (a ratio transfer, `shade`), lit and hazed like the ground,
+// and it fades in
 // (dithered) where the last billboard clouds fade out, and out before the reach.
 //
 // Where the view grazes the canopy a patch also draws a silhouette instance (Decaudin & Neyret
@@ -43,6 +44,7 @@ struct TexcellUniforms {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
+    sample_albedo: array<vec4<f32>, TEXCELL_MAX_SAMPLES>,
 }
 
 struct TexcellRecord {
@@ -216,23 +218,38 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     let path = min(normal.z / max(abs(dot(normal, view)), 1e-4), tu.opacity_max_factor);
     let corrected = 1.0 - pow(1.0 - min(alpha, 0.9999), max(path, 0.25));
 
-    return shade(sampled.rgb / max(sampled.a, 1e-4), ground, in.rel_m, view, distance_m, corrected);
+    let surface = Surface(sampled.rgb / max(sampled.a, 1e-4), tu.sample_albedo[forest.sample].rgb, normalize(in.normal));
+    return shade(surface, ground, in.rel_m, view, distance_m, corrected);
 }
 
-// The premultiplied colour of forest of colour `albedo` and opacity `opacity` at `rel_m` from the
-// camera, seen along `view` at `distance_m`, over ground of imagery colour `ground`.
-fn shade(albedo: vec3<f32>, ground: vec4<f32>, rel_m: vec3<f32>, view: vec3<f32>, distance_m: f32, opacity: f32) -> vec4<f32> {
-    var tinted = albedo;
-    if u.imagery_texels != IMAGERY_NONE {
-        tinted = mix(albedo, ground.rgb, ground.a * tu.ground_blend);
-    }
-    // Lit as the seeds are, on average: the leaves the eye sees face it (the seeds turn every
-    // surface towards the eye), their normals spread over the half of directions facing it, whose
-    // mean clamped cosine towards the sun is (1 + cos(eye, sun)) / 4. Lighting the slices by
-    // the ground's normal instead made the far forest a quarter brighter than the clouds before it.
+// What a texcell fragment shows: the forest's albedo there, its sample's mean albedo seen from
+// above, and the ground's normal under it.
+struct Surface {
+    albedo: vec3<f32>,
+    sample_mean: vec3<f32>,
+    normal: vec3<f32>,
+}
+
+// The premultiplied colour of forest `surface` of opacity `opacity` at `rel_m` from the camera,
+// seen along `view`, `distance_m` away, over ground of imagery colour `ground`. In its own colours
+// it is lit as the seeds' leaves are on average: the leaves the eye sees face it (the seeds turn
+// every surface towards the eye), their normals spread over the half of directions facing it,
+// whose mean clamped cosine towards the sun is (1 + cos(eye, sun)) / 4. The colour follow-up (a
+// ratio transfer, as the seeds'), by `ground_blend`: the albedo times the photograph's colour over
+// the sample's mean seen from above, lit as the ground under it is (its normal, the sun through
+// the clouds, the sky), so that followed fully its mean from above is the ground's own frame and
+// each texel keeps its contrast.
+fn shade(surface: Surface, ground: vec4<f32>, rel_m: vec3<f32>, view: vec3<f32>, distance_m: f32, opacity: f32) -> vec4<f32> {
+    let clouds = sun_through_clouds(u.cloud_field, u.cloud_shift, rel_m);
     let facing = 0.25 * (1.0 - dot(view, u.sun_dir.xyz));
-    let sun = (0.55 * facing + 0.35 * max(u.sun_dir.z, 0.0)) * sun_through_clouds(u.cloud_field, u.cloud_shift, rel_m);
-    let lit = tinted * (sun + 0.3);
+    let own = surface.albedo * ((FOLIAGE_SUN * facing + FOLIAGE_SUN_WRAP * max(u.sun_dir.z, 0.0)) * clouds + FOLIAGE_SKY);
+    var lit = own;
+    if u.imagery_texels != IMAGERY_NONE && all(surface.sample_mean > vec3<f32>(0.0)) {
+        let n = surface.normal;
+        let ground_light = max(dot(n, u.sun_dir.xyz), 0.0) * clouds * GROUND_SUN + GROUND_SKY * (0.5 + 0.5 * n.z);
+        let followed = surface.albedo * ground.rgb / surface.sample_mean * ground_light;
+        lit = mix(own, followed, ground.a * tu.ground_blend);
+    }
     let haze = 1.0 - exp2(-distance_m / u.haze.w);
     return vec4<f32>(mix(lit, u.haze.rgb, haze) * opacity, opacity);
 }
@@ -261,6 +278,7 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
     var t = (ceil(along / base_m - 0.5) + 0.5) * base_m - along;
 
     var colour = vec3<f32>(0.0);
+    var sample_mean = vec3<f32>(0.0);
     var transmit = 1.0;
     var entered = false;
     var hit_m = distance_m;
@@ -301,6 +319,7 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
         let alpha = 1.0 - pow(1.0 - min(a, 0.9999), step_m / slice_m);
         if transmit == 1.0 {
             hit_m = distance_m + p_along_m;
+            sample_mean = tu.sample_albedo[forest.sample].rgb;
         }
         colour += transmit * alpha * (voxel.rgb / max(voxel.a, 1e-4));
         transmit *= 1.0 - alpha;
@@ -313,7 +332,10 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
         discard;
     }
     // Shaded where the ray first met the canopy, as its haze is.
-    return shade(colour / opacity, ground, view * hit_m, view, hit_m, opacity);
+    // The forest's colour follows the photograph by the first sample the ray met; the ground's
+    // normal is taken as up (the ray crosses the slab, not one point of the ground).
+    let surface = Surface(colour / opacity, sample_mean, vec3<f32>(0.0, 0.0, 1.0));
+    return shade(surface, ground, view * hit_m, view, hit_m, opacity);
 }
 
 // --- For the test that holds `forest_uv` equal to its twin (`passes::texcells::gpu::probe`) ---

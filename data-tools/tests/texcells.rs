@@ -21,7 +21,7 @@ use terramp::passes::texcells::frame::Band;
 use terramp::reference::frame_change::{BLOCK_PX, block_changes};
 use terramp_testkit::{TempDir, shared_data};
 
-use support::texcells::{Frame, SIZE, changed, render_from, samples};
+use support::texcells::{Frame, SIZE, changed, own_colours, render_from, samples};
 use support::{FOREST, PixelGround, WATER, build_nc, code_at, ground_under_pixels};
 
 /// The camera's height above the ground at the map's centre, and its pitch.
@@ -74,8 +74,19 @@ fn towards_far_water(dataset: &Dataset) -> ([f64; 2], f64) {
 
 /// Renders nc's centre, looking towards its far water from `[above_m, pitch_deg]`, with the
 /// impostors (and forest samples) in `impostors` and texcells to `reach_m` (0: none), settled.
-fn render(dataset: Dataset, impostors: &Path, reach_m: f64, [above_m, pitch]: [f64; 2]) -> Frame {
-    render_from(dataset, impostors, reach_m, &|_| {}, &|r| {
+fn render(dataset: Dataset, impostors: &Path, reach_m: f64, view: [f64; 2]) -> Frame {
+    render_tuned(dataset, impostors, reach_m, view, &|_| {})
+}
+
+/// `render`, with the settings `tune` changes.
+fn render_tuned(
+    dataset: Dataset,
+    impostors: &Path,
+    reach_m: f64,
+    [above_m, pitch]: [f64; 2],
+    tune: &dyn Fn(&mut Settings),
+) -> Frame {
+    render_from(dataset, impostors, reach_m, tune, &|r| {
         let (centre, yaw) = towards_far_water(&r.dataset);
         terramp_testkit::camera::over(r, centre, above_m, yaw, pitch)
     })
@@ -139,7 +150,10 @@ fn nc_texcells_cover_the_far_forest_and_no_water() {
 
     let reopened = Dataset::open(&path).unwrap();
     let ground = ground_under_pixels(&reopened, &camera, SIZE, &depth);
-    let changed = |i: usize| changed(&bare, &forest, i);
+    // Where texcells are drawn is judged in their models' own colours: following the photograph,
+    // their mean is the ground's (`own_colours`).
+    let (_, own, ..) = render_tuned(Dataset::open(&path).unwrap(), samples(), REACH_M, VIEW, &own_colours);
+    let changed = |i: usize| changed(&bare, &own, i);
     let band = band();
     // Forest pixels that a texcell slab standing in front could cover: up to its height above the
     // ground in pixels at that distance, over any ground.
@@ -218,6 +232,10 @@ fn the_switch_from_clouds_to_texcells_pops_no_more_than_the_cloud_switches() {
     // share of them the trees or texcells change from the ground.
     let switch_m = Settings::preset("balanced").unwrap().draw_seeds.reach_m[3];
     let (_, bare, ..) = render(Dataset::open(&path).unwrap(), samples(), 0.0, VIEW);
+    // Cover and colour are compared in the models' own colours (`own_colours`): following the
+    // photograph, both sides' mean is the ground's by design.
+    let (_, first_own, ..) =
+        render_tuned(Dataset::open(&path).unwrap(), trees_and_forest(), REACH_M, VIEW, &own_colours);
     let side = |from: f64, to: f64| {
         let pixels: Vec<usize> = (0..ground.len())
             .filter(|&i| {
@@ -225,10 +243,11 @@ fn the_switch_from_clouds_to_texcells_pops_no_more_than_the_cloud_switches() {
             })
             .collect();
         let mean = |c: usize| {
-            pixels.iter().map(|&i| f64::from(first.as_raw()[4 * i + c])).sum::<f64>() / pixels.len() as f64
+            pixels.iter().map(|&i| f64::from(first_own.as_raw()[4 * i + c])).sum::<f64>()
+                / pixels.len() as f64
         };
         let cover =
-            pixels.iter().filter(|&&i| changed(&bare, &first, i)).count() as f64 / pixels.len() as f64;
+            pixels.iter().filter(|&&i| changed(&bare, &first_own, i)).count() as f64 / pixels.len() as f64;
         (pixels.len(), [mean(0), mean(1), mean(2)], cover)
     };
     let (clouds_side, texcells_side) = (side(0.85, 0.97), side(1.03, 1.15));

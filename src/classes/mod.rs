@@ -170,8 +170,10 @@ pub struct Species {
     pub altitude_m: [f32; 2],
     /// Steepest ground it grows on, degrees (0..90).
     pub max_slope_deg: f32,
-    /// How much of the ground's colour under a seed (pass 3's sample) its foliage takes on, 0 to
-    /// 1 (Amara et al.'s colour follow-up); its bark keeps its own. Default `DEFAULT_GROUND_BLEND`.
+    /// How much its foliage follows the photograph's colour under a seed (pass 3's sample), 0 to
+    /// 1 (Amara et al.'s colour follow-up, a ratio transfer: at 1 its foliage seen from above has
+    /// the photograph's local mean and keeps its own detail; at 0 its model's colours); its bark
+    /// keeps its own. Default `DEFAULT_GROUND_BLEND`.
     pub ground_blend: f32,
     /// How much darker a plant is low in its crown and on its side away from the sun, 0 (flat) to
     /// 1 (black at the bottom of the shaded side): the luminosity by position inside the object.
@@ -179,7 +181,7 @@ pub struct Species {
 }
 
 /// `Species::ground_blend` where a table does not say.
-pub const DEFAULT_GROUND_BLEND: f32 = 0.2;
+pub const DEFAULT_GROUND_BLEND: f32 = 1.0;
 
 fn default_ground_blend() -> f32 {
     DEFAULT_GROUND_BLEND

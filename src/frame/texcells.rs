@@ -137,6 +137,9 @@ impl TexcellStage {
             finest_slices: finest,
             tile_cells: tiling::sample_cells_word(),
             samples: samples.len() as u32,
+            albedo_from_above: std::array::from_fn(|i| {
+                samples.get(i).map_or([0.0; 3], ForestSample::albedo_from_above)
+            }),
         };
         let band = Band::of(settings);
         // The pixel's footprint comes with the first frame's view, which rewrites the uniforms.

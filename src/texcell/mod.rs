@@ -152,6 +152,18 @@ impl ForestSample {
         self.slices.first().and_then(|l| l.first()).map_or(0, |c| c.side)
     }
 
+    /// The mean linear albedo of what the sample shows from above (its top view, each texel
+    /// weighted by its opacity): the colour follow-up's yardstick (`texcells.ground_blend`).
+    /// Black where the sample is empty.
+    pub fn albedo_from_above(&self) -> [f32; 3] {
+        let texels = pyramid::decode(&self.top_view());
+        let opacity: f32 = texels.iter().map(|t| t[3]).sum();
+        if opacity <= 0.0 {
+            return [0.0; 3];
+        }
+        std::array::from_fn(|c| texels.iter().map(|t| t[c]).sum::<f32>() / opacity)
+    }
+
     /// The sample seen from above: every finest slice composited over the next lower one,
     /// premultiplied, as RGBA8 (colour sRGB-encoded).
     pub fn top_view(&self) -> Vec<u8> {
@@ -165,5 +177,45 @@ impl ForestSample {
             }
         }
         pyramid::encode(&out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pyramid::Layer;
+    use super::*;
+
+    #[test]
+    fn the_albedo_from_above_is_the_top_view_s_colour_per_opacity() {
+        // An opaque green floor under a layer whose left half is half-covered red (premultiplied)
+        // and right half empty: from above, the left half is red over green, the right green.
+        let side = 8u32;
+        let green = [0.1, 0.4, 0.1, 1.0];
+        let floor = Layer { side, texels: vec![green; 64] };
+        let top = Layer {
+            side,
+            texels: (0..64)
+                .map(|i| if i % side < side / 2 { [0.5, 0.0, 0.0, 0.5] } else { [0.0; 4] })
+                .collect(),
+        };
+        let (slices, volume) = sample_images(vec![floor, top]);
+        let sample = ForestSample {
+            class_code: 5,
+            class_name: "forest".into(),
+            cell_m: 32.0,
+            height_m: 13.0,
+            trees: Vec::new(),
+            slices,
+            volume,
+        };
+        let left = [0.5 + 0.5 * green[0], 0.5 * green[1], 0.5 * green[2]];
+        let want: [f32; 3] = std::array::from_fn(|c| 0.5 * (left[c] + green[c]));
+        let got = sample.albedo_from_above();
+        // Stored as 8-bit sRGB colour and 8-bit alpha: within 1 % of each channel.
+        for c in 0..3 {
+            assert!((got[c] - want[c]).abs() <= 0.01 * want[c], "{got:?} against {want:?}");
+        }
+        let empty = ForestSample { slices: Vec::new(), volume: Vec::new(), ..sample };
+        assert_eq!(empty.albedo_from_above(), [0.0; 3]);
     }
 }

@@ -331,7 +331,7 @@ pub static CLAIMS: &[Claim] = &[
     },
     Claim {
         doc: "docs/texcells.md",
-        quote: "(`texcells.ground_blend` {}, measured best below)",
+        quote: "by `texcells.ground_blend` ({} by default, the photograph's",
         values: &[(default("texcells.ground_blend"), plain)],
     },
     Claim {

@@ -32,6 +32,32 @@ pub fn samples() -> &'static Path {
     })
 }
 
+/// Settings that draw the trees and the texcells in their models' own colours (the colour
+/// follow-up off: `texcells.ground_blend` and every nc species' `ground_blend` 0). Following the
+/// photograph, the forest's mean colour is the ground's by design, so whether a pixel changed from
+/// the bare ground no longer tells where the forest is drawn; in the models' colours it does.
+pub fn own_colours(settings: &mut Settings) {
+    static TABLE: OnceLock<PathBuf> = OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        let nc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../config/classes/nc.toml"))
+            .unwrap();
+        let own = nc.lines().fold(String::new(), |mut out, line| {
+            out.push_str(line);
+            out.push('\n');
+            if line.starts_with("max_slope_deg = ") {
+                out.push_str("ground_blend = 0.0\n");
+            }
+            out
+        });
+        assert!(own.matches("ground_blend = 0.0").count() >= 4, "nc's table has too few species");
+        let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("nc-own-colours.toml");
+        std::fs::write(&path, own).unwrap();
+        path
+    });
+    settings.texcells.ground_blend = 0.0;
+    settings.seeds.class_table = table.display().to_string();
+}
+
 /// A rendered, settled frame: the renderer, its colour, its depth, its report and its camera.
 pub type Frame = (Renderer, image::RgbaImage, Vec<f32>, FrameReport, Camera);
 

@@ -2,12 +2,13 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::gpu::layout::SEED_GROUPS;
 use crate::gpu::struct_layout::gpu_struct;
 
 gpu_struct! {
     /// Per-frame constants of the seed-drawing pass. WGSL: `DrawSeedsUniforms` in
     /// `shaders/draw_seeds.wgsl`.
-    #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
+    #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
     pub struct DrawSeedsUniforms {
         /// The terrain's: clip space from camera-relative world space.
         pub clip_from_view_world: [[f32; 4]; 4],
@@ -37,6 +38,11 @@ gpu_struct! {
         pub cloud_field: [f32; 4],
         /// See `cloud_field`.
         pub cloud_shift: [f32; 4],
+        /// The colour follow-up, per (species, draw LOD) group (`species · SEED_LODS + lod`): the
+        /// factor per channel (xyz) that turns the group's geometry's mean lit colour seen from
+        /// above into that of flat ground of albedo 1 under this sun (`draw_seeds::from_above`);
+        /// 0: the model keeps its colours.
+        pub photo_scale: [[f32; 4]; SEED_GROUPS as usize],
     }
 }
 
@@ -48,7 +54,8 @@ gpu_struct! {
         pub inv_model_height_m: f32,
         /// How much the wind bends it (`seeds::wind::bend_of`): 1 a plant, 0 a rock.
         pub wind_bend: f32,
-        /// How much of the ground's colour its foliage takes on (`classes::Species::ground_blend`).
+        /// How much its foliage follows the photograph's colour under it
+        /// (`classes::Species::ground_blend`): 1 the photograph's local mean, 0 its own colours.
         pub ground_blend: f32,
         /// How much darker it is low in its crown and away from the sun
         /// (`classes::Species::crown_shading`).

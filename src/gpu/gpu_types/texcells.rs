@@ -2,6 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::gpu::layout::TEXCELL_MAX_SAMPLES;
 use crate::gpu::struct_layout::gpu_struct;
 
 gpu_struct! {
@@ -37,7 +38,8 @@ gpu_struct! {
         pub finest_slices: u32,
         /// Largest factor the opacity correction raises a slice's transmittance to (the paper's k_M).
         pub opacity_max_factor: f32,
-        /// How much of the imagery's colour under them texcells take on (0 to 1).
+        /// How much texcells follow the photograph's colour under them (0 to 1): at 1 their mean
+        /// seen from above is the photograph's (a ratio transfer by `sample_albedo`).
         pub ground_blend: f32,
         /// Sines of a pixel's ray's angle below the horizon under which silhouette texcells show
         /// alone (x) and over which regular ones do (y), between them dithered; 0, 0: none.
@@ -50,6 +52,10 @@ gpu_struct! {
         pub sample_count: u32,
         /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 3],
+        /// Each forest sample's mean linear albedo seen from above (its slices composited, alpha
+        /// weighted; `texcell::ForestSample::albedo_from_above`), w unused: the colour follow-up's
+        /// yardstick.
+        pub sample_albedo: [[f32; 4]; TEXCELL_MAX_SAMPLES as usize],
     }
 }
 

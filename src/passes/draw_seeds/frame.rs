@@ -9,7 +9,7 @@ use std::path::Path;
 use crate::classes::Species;
 use crate::config::Settings;
 use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, TerrainUniforms};
-use crate::gpu::layout::SEED_LODS;
+use crate::gpu::layout::{SEED_GROUPS, SEED_LODS};
 use crate::impostor::detail::{first_leaf_kept, leaf_share, projected_px};
 use crate::impostor::{Impostor, MANIFEST_FILE};
 use crate::seeds::wind::WindFrame;
@@ -60,6 +60,8 @@ pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &Wind
         wind_wave: wind.wave,
         cloud_field: terrain.cloud_field,
         cloud_shift: terrain.cloud_shift,
+        // The pass fills it in from its geometry (`DrawSeedsPass::prepare`).
+        photo_scale: [[0.0; 4]; SEED_GROUPS as usize],
         focal_px: if settings.draw_seeds.continuous_lod {
             focal_px(terrain, settings.render.height)
         } else {

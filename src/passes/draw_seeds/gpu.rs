@@ -24,6 +24,7 @@ use crate::seeds::wind::bend_of;
 
 use super::assets::{self, MeshDetail};
 use super::frame::detail_templates;
+use super::from_above::{FromAbove, Layers, from_above};
 use super::{DrawSeedsError, LodChoices};
 use multisample::Multisample;
 
@@ -101,6 +102,9 @@ pub struct DrawSeedsPass {
     tallest_m: Vec<f32>,
     species_drawn: usize,
     species_missing: usize,
+    /// What each (species, draw LOD) group's geometry shows from above: the colour follow-up's
+    /// yardstick, turned into `DrawSeedsUniforms::photo_scale` for each frame's sun.
+    from_above: Vec<Option<FromAbove>>,
     /// With `draw_seeds.samples` > 1: the multisampled targets and their draw.
     multisample: Option<(Multisample, Draw)>,
 }
@@ -213,6 +217,17 @@ impl DrawSeedsPass {
         let layout = BINDINGS.layout(device);
         let draw = Draw::new(device, &layout, false, depth_prepass);
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
+        let layers = Layers { levels: &built.layers, size: built.size };
+        let from_above = (0..SEED_GROUPS as usize)
+            .map(|group| {
+                let species_index = group / SEED_LODS as usize;
+                let crown_shading = species.get(species_index).map_or(0.0, |s| s.crown_shading);
+                let inv_height_m = built.inv_model_height_m.get(species_index).copied().unwrap_or(0.0);
+                let geometry = (built.vertices.as_slice(), built.indices.as_slice());
+                let template = built.templates.get(group)?;
+                from_above(template, geometry, &built.materials, &layers, (crown_shading, inv_height_m))
+            })
+            .collect();
         let shapes: Vec<SeedShape> = (built.inv_model_height_m.iter().enumerate())
             .map(|(i, &inv_model_height_m)| SeedShape {
                 inv_model_height_m,
@@ -244,6 +259,7 @@ impl DrawSeedsPass {
             tallest_m: species.iter().map(|s| s.height_m[1]).collect(),
             species_drawn,
             species_missing: impostors.len() - species_drawn,
+            from_above,
             multisample: None,
         })
     }
@@ -340,9 +356,14 @@ impl DrawSeedsPass {
         }
     }
 
-    /// Writes the frame's constants.
+    /// Writes the frame's constants, with each group's colour follow-up under their sun.
     pub fn prepare(&self, queue: &wgpu::Queue, uniforms: &DrawSeedsUniforms) {
-        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+        let mut uniforms = *uniforms;
+        let sun = glam::Vec4::from(uniforms.sun_dir).truncate();
+        for (scale, seen) in uniforms.photo_scale.iter_mut().zip(&self.from_above) {
+            *scale = seen.as_ref().map_or([0.0; 4], |seen| seen.photo_scale(sun));
+        }
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
     }
 
     /// Records each group's draw and cross-fade draw from `draw_args` (compaction's) into the

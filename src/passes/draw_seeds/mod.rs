@@ -28,6 +28,7 @@
 
 pub mod assets;
 pub mod frame;
+pub mod from_above;
 pub mod gpu;
 
 use std::path::PathBuf;

@@ -24,7 +24,8 @@ use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::gpu_types::{TexcellRecord, TexcellUniforms};
 use crate::gpu::layout::{
-    LCC_PACKED_LEVEL, TEXCELL_REGULAR, TEXCELL_REGULAR_SHARED, TEXCELL_SILHOUETTE, TexcellSlice,
+    LCC_PACKED_LEVEL, TEXCELL_MAX_SAMPLES, TEXCELL_REGULAR, TEXCELL_REGULAR_SHARED, TEXCELL_SILHOUETTE,
+    TexcellSlice,
 };
 use crate::passes::terrain::frame::{NodeBatches, QuadrantBox};
 use crate::streaming::page_levels;
@@ -280,6 +281,9 @@ pub struct SampleShape {
     pub tile_cells: u32,
     /// Forest samples (one per dense class baked).
     pub samples: u32,
+    /// Each sample's mean albedo from above (`ForestSample::albedo_from_above`), linear RGB
+    /// (samples past `samples` unused).
+    pub albedo_from_above: [[f32; 3]; TEXCELL_MAX_SAMPLES as usize],
 }
 
 /// The pass's uniforms, for a view whose pixels are `metres_per_px_at_1m` wide a metre away.
@@ -312,6 +316,10 @@ pub fn texcell_uniforms(
         metres_per_px_at_1m: metres_per_px_at_1m as f32,
         silhouette_steps: t.silhouette_steps,
         sample_count: shape.samples,
+        sample_albedo: std::array::from_fn(|i| {
+            let [r, g, b] = shape.albedo_from_above[i];
+            [r, g, b, 0.0]
+        }),
         lcc_level: LCC_PACKED_LEVEL,
         ..Default::default()
     };
