@@ -1,5 +1,6 @@
 //! The `terramp` command line: render a frame of a dataset, fly the demo or a path, profile the
-//! passes, measure the speed trade, render the ground truth, describe a dataset.
+//! passes, measure the speed trade, render the ground truth, measure a view against its
+//! photograph, describe a dataset.
 
 // Under `terramp/`, not beside this file: every `src/bin/*.rs` is a binary of its own.
 #[path = "terramp/demo.rs"]
@@ -22,6 +23,8 @@ use terramp::profile::{Meta, Summary};
 // Crate roots look for modules beside themselves: this one keeps its own in src/bin/terramp/.
 #[path = "terramp/info.rs"]
 mod info;
+#[path = "terramp/photo.rs"]
+mod photo;
 #[path = "terramp/sweep.rs"]
 mod sweep;
 #[path = "terramp/truth.rs"]
@@ -139,6 +142,10 @@ enum Command {
     /// The ground truth of one view: every seed the land cover grows, as its full mesh, every
     /// tile at its finest level, supersampled, with a per-sample seed id and depth.
     Truth(truth::TruthArgs),
+    /// One view's amplified frame against its photograph frame (the same settings with nothing
+    /// grown: the imagery on the terrain alone): CIEDE2000 of mean colours per imagery texel
+    /// footprint and per 5 × 5 block, detail, the share of vegetated pixels changed.
+    Photo(photo::PhotoArgs),
     /// Fly a camera path (config/paths/*.toml) and write the frames and a log: one JSON object per
     /// frame in `log.jsonl` (tiles needed, resident, uploaded, evicted, failed, bytes uploaded;
     /// seeds checked, selected, culled by class, rule, distance, frustum and occlusion, overflow;
@@ -243,6 +250,7 @@ fn main() -> Result<()> {
         Command::View(args) => view::run(args),
         Command::Sweep(args) => args.run(),
         Command::Truth(args) => args.run(),
+        Command::Photo(args) => args.run(),
         Command::Info { dataset } => info::run(&dataset),
     }
 }
