@@ -20,6 +20,7 @@ pub mod impostor;
 pub mod light;
 pub mod passes;
 pub mod path;
+pub mod photo;
 pub mod profile;
 pub mod publish;
 pub mod reference;

@@ -105,7 +105,7 @@ const LAYERS: &[&[&str]] = &[
     &["passes", "bake"],
     &["reference"],
     &["frame"],
-    &["profile", "truth"],
+    &["profile", "truth", "photo"],
     &["sweep"],
 ];
 

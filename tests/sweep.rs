@@ -2,7 +2,8 @@
 //! 160 × 90, trees drawn (the shared models baked): it writes trade.csv, trade.json and trade.png;
 //! the CSV and the JSON hold the same figures; every point has positive times and sensible errors
 //! against the ground truth, whole and per distance band; `fast`, which grows half the density,
-//! misses about half the truth's visible seeds, `accurate` nearly none. (The product of presets
+//! misses about half the truth's visible seeds, `accurate` nearly none; each point's frames differ
+//! from their photograph frames (nothing grown) by a finite CIEDE2000. (The product of presets
 //! and knob values is `sweep::knobs`' unit test: each point here costs the software adapter a
 //! minute.)
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
@@ -86,6 +87,8 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
             ("precision_pct", &seeds["precision_pct"]),
             ("height_error_max_m", &seeds["height_error_max_m"]),
             ("visible", &seeds["visible"]),
+            ("photo_de2000_mean", &point["photo_de2000"]["mean"]),
+            ("photo_de2000_p95", &point["photo_de2000"]["p95"]),
         ] {
             let csv_value: f64 = row[column(name)].parse().unwrap_or_else(|_| panic!("{name}: {row:?}"));
             // serde_json's float parsing may land one ulp away from the shortest form it wrote.
@@ -142,6 +145,10 @@ fn sweep_writes_agreeing_csv_json_and_plot() {
         assert!(popping["popping"].as_f64().unwrap() <= largest, "{popping}");
         let flip = point["frame_flip"].as_f64().unwrap();
         assert!(flip > 0.0 && flip < 0.5, "{}: FLIP {flip}", row[0]);
+        // Against the photograph (nothing grown): the trees change the forest's blocks, finitely.
+        let photo = &point["photo_de2000"];
+        let [mean, p95, max] = ["mean", "p95", "max"].map(|k| photo[k].as_f64().unwrap());
+        assert!(mean > 0.0 && mean <= max && p95 <= max && max.is_finite(), "{}: {photo}", row[0]);
         // The bands: meshes first, beyond last; their pixels are the frame's bar the sky.
         let error = &point["error"];
         let bands = error["bands"].as_array().unwrap();

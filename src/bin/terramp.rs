@@ -1,5 +1,6 @@
 //! The `terramp` command line: render a frame of a dataset, fly the demo or a path, profile the
-//! passes, measure the speed trade, render the ground truth, describe a dataset.
+//! passes, measure the speed trade, render the ground truth, measure a view against its
+//! photograph, describe a dataset.
 
 // Under `terramp/`, not beside this file: every `src/bin/*.rs` is a binary of its own.
 #[path = "terramp/demo.rs"]
@@ -20,6 +21,10 @@ use terramp::path::CameraPath;
 use terramp::profile::{Meta, Summary};
 
 // Crate roots look for modules beside themselves: this one keeps its own in src/bin/terramp/.
+#[path = "terramp/info.rs"]
+mod info;
+#[path = "terramp/photo.rs"]
+mod photo;
 #[path = "terramp/sweep.rs"]
 mod sweep;
 #[path = "terramp/truth.rs"]
@@ -137,6 +142,10 @@ enum Command {
     /// The ground truth of one view: every seed the land cover grows, as its full mesh, every
     /// tile at its finest level, supersampled, with a per-sample seed id and depth.
     Truth(truth::TruthArgs),
+    /// One view's amplified frame against its photograph frame (the same settings with nothing
+    /// grown: the imagery on the terrain alone): CIEDE2000 of mean colours per imagery texel
+    /// footprint and per 5 × 5 block, detail, the share of vegetated pixels changed.
+    Photo(photo::PhotoArgs),
     /// Fly a camera path (config/paths/*.toml) and write the frames and a log: one JSON object per
     /// frame in `log.jsonl` (tiles needed, resident, uploaded, evicted, failed, bytes uploaded;
     /// seeds checked, selected, culled by class, rule, distance, frustum and occlusion, overflow;
@@ -241,7 +250,8 @@ fn main() -> Result<()> {
         Command::View(args) => view::run(args),
         Command::Sweep(args) => args.run(),
         Command::Truth(args) => args.run(),
-        Command::Info { dataset } => info(&dataset),
+        Command::Photo(args) => args.run(),
+        Command::Info { dataset } => info::run(&dataset),
     }
 }
 
@@ -447,54 +457,4 @@ fn status_kib(key: &str) -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with(key))?;
     line.split_whitespace().nth(1)?.parse().ok()
-}
-
-fn info(dataset_dir: &Path) -> Result<()> {
-    let dataset = Dataset::open(dataset_dir)?;
-    let m = &dataset.manifest;
-    let [w, h] = m.extent_m();
-    let corner = m.corner_m();
-    println!("{} ({})", m.name, dataset_dir.display());
-    println!("  CRS: {}", m.crs.note);
-    println!(
-        "  extent: {:.1} .. {:.1} E, {:.1} .. {:.1} N ({:.1} × {:.1} km)",
-        corner[0],
-        corner[0] + w,
-        corner[1],
-        corner[1] + h,
-        w / 1000.0,
-        h / 1000.0
-    );
-    let p = &m.height.pyramid;
-    println!(
-        "  heights: {}×{} samples at {} m, {} levels, {:.1} .. {:.1} m, {} filled",
-        p.size[0],
-        p.size[1],
-        m.height.spacing_m,
-        p.levels,
-        m.height.min_m,
-        m.height.max_m,
-        m.height.filled_samples
-    );
-    if let Some(i) = &m.imagery {
-        println!(
-            "  imagery: {}×{} texels at {} m, {} levels, {}",
-            i.pyramid.size[0], i.pyramid.size[1], i.texel_m, i.pyramid.levels, i.format
-        );
-    }
-    if let Some(l) = &m.landcover {
-        let source = l.layer.pyramid.size_at(terramp::dataset::lcc::LCC_SOURCE_LEVEL);
-        println!(
-            "  land cover ({}, {} classes): {}×{} texels at {} m, LCC quadtree of {} levels in {}-bit words, {} codes",
-            l.scheme,
-            l.classes.len(),
-            source[0],
-            source[1],
-            2.0 * l.layer.texel_m,
-            l.layer.pyramid.levels,
-            l.coding.word_bits,
-            l.coding.palette.len()
-        );
-    }
-    Ok(())
 }

@@ -9,7 +9,10 @@
 //! settled, it flies the popping flight frame by frame as a user would (streaming and readbacks a
 //! frame or two behind), and its frames' changes are judged against the truth's along the same
 //! flight (`frame_change::Popping`). With seeds drawn, a second renderer of the same settings
-//! without impostors settles the same poses for the ground alone, judged against the truth's ground.
+//! with nothing grown (no impostors, `photo::photograph_settings`) settles the same poses for the
+//! ground alone, judged against the truth's ground; it is also the photograph frame each pose's
+//! frame is measured against (`photo::measure`: CIEDE2000 of 5 × 5 block means, pooled over the
+//! poses). Without seeds drawn the frame is its own photograph.
 
 use std::path::Path;
 
@@ -27,6 +30,8 @@ use crate::gpu::Gpu;
 use crate::gpu::TimeSource;
 use crate::gpu::gpu_types::SeedRecord;
 use crate::path::CameraPath;
+use crate::photo::measure::DeltaE;
+use crate::photo::{PixelKeys, measure, photograph_settings, pixel_keys};
 use crate::profile::{Meta, Recording, Session, Summary, timing_of};
 use crate::reference::accuracy::{HeightError, SeedAgreement};
 use crate::reference::frame_change::Popping;
@@ -197,7 +202,9 @@ impl Flight<'_> {
         let mut seeds: Option<(SeedAgreement, HeightError)> = None;
         let mut per_pose: Vec<(SeedAgreement, HeightError)> = Vec::new();
         let mut any_part: Vec<(Visibility, Missed)> = Vec::new();
+        let mut keys: Vec<PixelKeys> = Vec::new();
         let frames = self.settle(&mut renderer, &label, progress, |r, camera| {
+            keys.push(pixel_keys(r, camera)?);
             let kept = r.read_seeds()?.map(|(records, _)| records);
             if let Some((agreement, height)) = seed_figures(r, camera, kept.as_deref())? {
                 let (a, h) = seeds.get_or_insert_default();
@@ -223,11 +230,17 @@ impl Flight<'_> {
         let grounds = match draws_seeds {
             false => None,
             true => {
-                let mut r = self.renderer(without_impostors(&settings))?;
+                let mut r = self.renderer(photograph_settings(&without_impostors(&settings)))?;
                 Some(self.settle(&mut r, &format!("{label} ground"), progress, |_, _| Ok(()))?)
             }
         };
 
+        // Each frame against its photograph: the ground alone, or itself when nothing is drawn.
+        let mut photo_blocks = Vec::new();
+        for (i, (frame, keys)) in frames.iter().zip(&keys).enumerate() {
+            let photograph = grounds.as_ref().map_or(frame, |g| &g[i]);
+            photo_blocks.extend(measure(frame, photograph, keys)?.blocks.values);
+        }
         let mut samples = Vec::with_capacity(frames.len());
         let mut errors = Vec::with_capacity(frames.len());
         let mut ground_mse = 0.0;
@@ -285,6 +298,7 @@ impl Flight<'_> {
             frame_psnr_db: error.frame.psnr_db,
             frame_ssim: error.frame.ssim,
             frame_flip: error.frame.flip,
+            photo_de2000: DeltaE::of(&photo_blocks)?,
             popping,
             error,
             samples,

@@ -19,6 +19,9 @@
 //!   height from the f64 drawn ground (`reference::accuracy`), and recall and precision against pass 3's
 //!   own rule, done exactly.
 //!
+//! Each sample pose's frame is also measured against its photograph frame (the same settings with
+//! nothing grown, `photo`): CIEDE2000 of 5 × 5 block means, pooled over the poses.
+//!
 //! Popping is measured along a short flight of consecutive frames at a steady speed
 //! (`popping_frames` frames `popping_step_m` apart, from the middle sample pose on): the largest
 //! 4 × 4 block change between frames, against the reference world's truth along the same flight
@@ -70,6 +73,9 @@ pub enum SweepError {
     /// A height tile could not be read for the default path or the seeds' height error.
     #[error(transparent)]
     Pack(#[from] crate::dataset::PackError),
+    /// A frame could not be measured against its photograph.
+    #[error(transparent)]
+    Photo(#[from] crate::photo::PhotoError),
     /// A ground truth could not be rendered.
     #[error(transparent)]
     Truth(#[from] crate::truth::TruthError),

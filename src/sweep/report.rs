@@ -16,6 +16,7 @@
 //!                 "passes": [ { "label": str, "source": str, "median_ms": float } ],
 //!                 "seeds": seeds | null, "any_part": any_part | null,
 //!                 "ground_psnr_db", "frame_psnr_db", "frame_ssim", "frame_flip": float,
+//!                 "photo_de2000": { "mean", "p95", "max": float } | null,
 //!                 "popping": { "pairs": int, "largest", "truth_largest", "popping": float } | null,
 //!                 "error": { "frame": region, "bands": [region] },
 //!                 "samples": [ { "t", "ground_psnr_db", "frame_psnr_db", "frame_ssim",
@@ -42,6 +43,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::gpu::TimeSource;
+use crate::photo::measure::DeltaE;
 use crate::reference::accuracy::{HeightError, SeedAgreement};
 use crate::reference::frame_change::Popping;
 use crate::truth::compare::FrameError;
@@ -130,6 +132,9 @@ pub struct TradePoint {
     pub frame_ssim: f64,
     /// The frame against the truth: mean FLIP over all sample poses' pixels (0 = identical).
     pub frame_flip: f64,
+    /// The frame against its photograph frame (`photo`): CIEDE2000 of the 5 × 5 blocks at least
+    /// half vegetated, pooled over the sample poses; `None` when no block counted.
+    pub photo_de2000: Option<DeltaE>,
     /// Along the popping flight, the largest 4 × 4 block change between frames against the
     /// truth's; `None` when not measured.
     pub popping: Option<Popping>,
@@ -278,7 +283,7 @@ pub fn pass_labels(trade: &Trade) -> Vec<String> {
 }
 
 /// The fixed CSV columns before the passes' `<label>_ms`.
-pub const CSV_COLUMNS: [&str; 31] = [
+pub const CSV_COLUMNS: [&str; 33] = [
     "label",
     "preset",
     "knobs",
@@ -307,6 +312,8 @@ pub const CSV_COLUMNS: [&str; 31] = [
     "frame_psnr_db",
     "frame_ssim",
     "frame_flip",
+    "photo_de2000_mean",
+    "photo_de2000_p95",
     "popping",
     "block_change_largest",
     "truth_block_change_largest",
@@ -358,6 +365,8 @@ pub fn csv(trade: &Trade) -> String {
                 Some(p.frame_psnr_db),
                 Some(p.frame_ssim),
                 Some(p.frame_flip),
+                p.photo_de2000.map(|d| d.mean),
+                p.photo_de2000.map(|d| d.p95),
                 p.popping.map(|q| q.popping),
                 p.popping.map(|q| q.largest),
                 p.popping.map(|q| q.truth_largest),
@@ -426,6 +435,7 @@ pub(crate) mod tests {
             frame_psnr_db: 30.25,
             frame_ssim: ssim,
             frame_flip: 0.125,
+            photo_de2000: Some(DeltaE { mean: 23.5, p95: 44.25, max: 50.0 }),
             popping: Some(Popping { pairs: 7, largest: 14.5, truth_largest: 9.25, popping: 6.0 }),
             error: crate::truth::compare::tests::error(30.25, ssim, 0.125),
             samples: Vec::new(),
@@ -459,7 +469,8 @@ pub(crate) mod tests {
         assert!(
             lines[0].starts_with("label,preset,knobs,frame_ms")
                 && lines[0].ends_with(
-                    "frame_flip,popping,block_change_largest,truth_block_change_largest,terrain_ms,ground_ms,streaming_ms"
+                    "frame_flip,photo_de2000_mean,photo_de2000_p95,popping,block_change_largest,truth_block_change_largest,\
+                     terrain_ms,ground_ms,streaming_ms"
                 ),
             "{}",
             lines[0]

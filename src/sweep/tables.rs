@@ -31,9 +31,9 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
         out,
         "| point | frame ms | GPU ms | visible (truth) | recall | precision | pixel-weighted recall | \
          recall / precision (summit oracle) | seed height error max / mean | ground PSNR | frame PSNR | SSIM | FLIP | \
-         popping (truth's) | off the fronts (FLIP; pixels missed) |"
+         ΔE2000 vs photograph (mean / p95) | popping (truth's) | off the fronts (FLIP; pixels missed) |"
     )?;
-    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")?;
+    writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")?;
     for (i, p) in t.points.iter().enumerate() {
         let slack = |points: &[(f64, f64)]| {
             let s = front_slack(points, points[i]);
@@ -49,7 +49,7 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
         let popping = popping_text(p);
         writeln!(
             out,
-            "| {} | {:.1} | {} | {} | {} | {} | {} | {summit} | {height} | {:.1} dB | {:.1} dB | {:.4} | {:.4} | {popping} | {fronts} |",
+            "| {} | {:.1} | {} | {} | {} | {} | {} | {summit} | {height} | {:.1} dB | {:.1} dB | {:.4} | {:.4} | {} | {popping} | {fronts} |",
             p.label,
             p.frame_ms,
             opt(p.gpu_ms, 1),
@@ -60,7 +60,8 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
             p.ground_psnr_db,
             p.frame_psnr_db,
             p.frame_ssim,
-            p.frame_flip
+            p.frame_flip,
+            photo_text(p, " / ")
         )?;
     }
     if t.points.iter().any(|p| p.any_part.is_some()) {
@@ -140,6 +141,11 @@ fn write_markdown(out: &mut String, t: &Trade) -> std::fmt::Result {
     Ok(())
 }
 
+/// CIEDE2000 against the photograph, mean and p95, joined by `between`.
+fn photo_text(p: &super::TradePoint, between: &str) -> String {
+    p.photo_de2000.map_or("–".to_owned(), |d| format!("{:.2}{between}{:.2}", d.mean, d.p95))
+}
+
 /// Popping and, in brackets, the truth's largest block change along the same flight.
 fn popping_text(p: &super::TradePoint) -> String {
     p.popping.map_or("–".to_owned(), |q| format!("{:+.1} ({:.1})", q.popping, q.truth_largest))
@@ -171,7 +177,7 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
     let opt = |v: Option<f64>, digits: usize| v.map_or("-".to_owned(), |v| format!("{v:.digits$}"));
     writeln!(
         out,
-        "{:<w$} {:>9} {:>8} {:>9} {:>11} {:>8} {:>15} {:>11} {:>10} {:>7} {:>7} {:>14}",
+        "{:<w$} {:>9} {:>8} {:>9} {:>11} {:>8} {:>15} {:>11} {:>10} {:>7} {:>7} {:>13} {:>14}",
         "point",
         "frame ms",
         "GPU ms",
@@ -183,6 +189,7 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
         "frame PSNR",
         "SSIM",
         "FLIP",
+        "ΔE00 photo",
         "popping (truth)"
     )?;
     for p in &t.points {
@@ -192,7 +199,7 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
         });
         writeln!(
             out,
-            "{:<w$} {:>9.1} {:>8} {:>9} {:>11} {:>8} {:>15} {:>8.1} dB {:>7.1} dB {:>7.4} {:>7.4} {:>14}",
+            "{:<w$} {:>9.1} {:>8} {:>9} {:>11} {:>8} {:>15} {:>8.1} dB {:>7.1} dB {:>7.4} {:>7.4} {:>13} {:>14}",
             p.label,
             p.frame_ms,
             opt(p.gpu_ms, 1),
@@ -204,6 +211,7 @@ fn write_table(out: &mut String, t: &Trade) -> std::fmt::Result {
             p.frame_psnr_db,
             p.frame_ssim,
             p.frame_flip,
+            photo_text(p, "/"),
             popping_text(p)
         )?;
     }
@@ -245,6 +253,7 @@ mod tests {
             "0.20/0.05 mm",
             "streaming",
             "+6.0 (9.2)",
+            "23.50/44.25",
         ] {
             assert!(table.contains(text), "no {text:?} in\n{table}");
         }
@@ -256,6 +265,7 @@ mod tests {
                 && md.contains("97.00 / 99.00 %")
                 && md.contains("| streaming |")
                 && md.contains("| +6.0 (9.2) |")
+                && md.contains("| 23.50 / 44.25 |")
                 && md.contains("| fast | 2.50 % | 1.50 % | 0.50 % | 0.00 % | 0.25 % | 0.25 % |"),
             "{md}"
         );

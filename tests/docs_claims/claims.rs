@@ -4,6 +4,7 @@
 
 use terramp::camera::{MAX_COORDINATE_M, MIN_FOV_DEG};
 use terramp::classes::{DEFAULT_GROUND_BLEND, MAX_SPECIES};
+use terramp::photo::measure::{BLOCK_PX, MIN_PIXELS_PER_TEXEL};
 use terramp::seeds::wind::{GUST_WAVELENGTH_M, LEAN_PER_SPEED_SQ, MAX_LEAN};
 use terramp::truth::DEFAULT_REACH_M;
 
@@ -154,6 +155,16 @@ pub static CLAIMS: &[Claim] = &[
         doc: "docs/truth.md",
         quote: "`--reach-m` (default {} km:",
         values: &[(Source::Value(DEFAULT_REACH_M), km)],
+    },
+    Claim {
+        doc: "docs/photo.md",
+        quote: "counted when there are at least {} of them",
+        values: &[(Source::Value(MIN_PIXELS_PER_TEXEL as f64), plain)],
+    },
+    Claim {
+        doc: "docs/photo.md",
+        quote: "**per {} × {} pixel block**",
+        values: &[(Source::Value(BLOCK_PX as f64), plain), (Source::Value(BLOCK_PX as f64), plain)],
     },
     // The README's trees.
     Claim {

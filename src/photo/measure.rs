@@ -1,0 +1,270 @@
+//! How it works: the amplified frame against the photograph frame, pixel for pixel of one camera,
+//! on the CPU. Both come as sRGB bytes and are decoded to linear light first; every mean is taken
+//! there, then turned to CIELAB and compared by CIEDE2000 (`colour`). Three groupings:
+//! - **imagery texel footprints**: the pixels whose terrain point falls in one level-0 imagery
+//!   texel (`PixelKeys::texel`). A footprint counts when it has `MIN_PIXELS_PER_TEXEL` pixels or
+//!   more and at least half of them vegetated; its mean colour in each frame is what the
+//!   photograph says of that texel and what the amplified frame makes of it. Within it the spread
+//!   (standard deviation) of the frame's luminance is its detail: a flat paint of the photograph's
+//!   colour has none.
+//! - **blocks** of `BLOCK_PX` × `BLOCK_PX` pixels (full blocks only), for far views where a texel
+//!   is a pixel or less and footprints do not form: a block counts when at least half its pixels
+//!   are vegetated.
+//! - **changed share**: of the vegetated pixels, those whose bytes differ between the frames.
+//!
+//! A grouping with nothing counted has no ΔE figures (`None`), rather than a 0 that would read as
+//! a perfect match.
+
+use std::collections::BTreeMap;
+
+use image::RgbaImage;
+use serde::Serialize;
+
+use super::PhotoError;
+use super::colour::{Lab, delta_e_2000, lab_of_linear, linear_table, luminance};
+use crate::reference::worst::worst;
+
+/// A pixel whose terrain point lies in no imagery texel: sky, or beyond the imagery.
+pub const NO_TEXEL: u64 = u64::MAX;
+
+/// Fewest pixels a texel footprint needs to count. A footprint of one to three pixels is mostly
+/// edge (pixels half in a neighbouring texel) and its mean is one pixel's colour: it says nothing
+/// about the texel, and the spread of luminance inside it is no measure of detail. Four is a
+/// texel at least 2 × 2 pixels on screen; at nc's 7 m imagery texels that is within about 1.5 km
+/// of a 640-pixel, 60° view looking down.
+pub const MIN_PIXELS_PER_TEXEL: usize = 4;
+
+/// Edge of the pixel blocks, pixels: 5 × 5 keeps a block near a few texels in the far views
+/// (where a texel is about a pixel) and small against the forest stands it averages.
+pub const BLOCK_PX: u32 = 5;
+
+/// The level-0 imagery texel (column, row) as a key of `PixelKeys::texel`.
+pub fn texel_key(texel: [u32; 2]) -> u64 {
+    (u64::from(texel[1]) << 32) | u64::from(texel[0])
+}
+
+/// What each pixel of a view stands on, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PixelKeys {
+    /// The frames' size, pixels.
+    pub size_px: [u32; 2],
+    /// Per pixel, the level-0 imagery texel its terrain point falls in (`texel_key`), or `NO_TEXEL`.
+    pub texel: Vec<u64>,
+    /// Per pixel, whether the land cover there grows seeds or texcells.
+    pub vegetated: Vec<bool>,
+}
+
+/// CIEDE2000 over a grouping's members.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DeltaE {
+    /// The mean.
+    pub mean: f64,
+    /// The 95th percentile, nearest rank (always a member's value).
+    pub p95: f64,
+    /// The largest.
+    pub max: f64,
+}
+
+impl DeltaE {
+    /// The figures of `values` (`None` for none); an error names a value that is not finite.
+    pub fn of(values: &[f64]) -> Result<Option<Self>, PhotoError> {
+        if values.is_empty() {
+            return Ok(None);
+        }
+        let max = worst(values.iter().copied()).map_err(|e| PhotoError::NotFinite(e.value))?;
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let rank = (0.95 * sorted.len() as f64).ceil() as usize;
+        let p95 = sorted[rank.clamp(1, sorted.len()) - 1];
+        Ok(Some(Self { mean: values.iter().sum::<f64>() / values.len() as f64, p95, max }))
+    }
+}
+
+/// The imagery texel footprints' figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Footprints {
+    /// Footprints counted: `MIN_PIXELS_PER_TEXEL` pixels or more, at least half vegetated.
+    pub counted: usize,
+    /// CIEDE2000 between the frames' mean colours, per footprint.
+    pub delta_e: Option<DeltaE>,
+    /// Mean L* of the amplified frame's footprint means.
+    pub amplified_mean_l: Option<f64>,
+    /// Mean L* of the photograph frame's footprint means.
+    pub photograph_mean_l: Option<f64>,
+    /// Mean over footprints of the standard deviation of the amplified frame's luminance (CIE Y,
+    /// linear, 0 to 1) within each.
+    pub amplified_detail_y: Option<f64>,
+    /// The same of the photograph frame (its texels magnified and filtered), for scale.
+    pub photograph_detail_y: Option<f64>,
+}
+
+/// The pixel blocks' figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Blocks {
+    /// Blocks counted: at least half their pixels vegetated.
+    pub counted: usize,
+    /// CIEDE2000 between the frames' mean colours, per block.
+    pub delta_e: Option<DeltaE>,
+    /// Every counted block's ΔE, row by row, for pooling views (`DeltaE::of`).
+    #[serde(skip)]
+    pub values: Vec<f64>,
+}
+
+/// The amplified frame against the photograph frame.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PhotoFigures {
+    /// The frames' size, pixels.
+    pub size_px: [u32; 2],
+    /// Per imagery texel footprint.
+    pub texels: Footprints,
+    /// Per `BLOCK_PX` block.
+    pub blocks: Blocks,
+    /// Pixels whose land cover grows seeds or texcells.
+    pub vegetated_px: usize,
+    /// Of those, pixels whose bytes differ between the frames.
+    pub changed_px: usize,
+    /// `changed_px` / `vegetated_px` (`None` without vegetated pixels).
+    pub changed_share: Option<f64>,
+}
+
+/// A footprint's or block's pixels, summed in linear light.
+#[derive(Debug, Default, Clone, Copy)]
+struct Sums {
+    pixels: usize,
+    vegetated: usize,
+    amplified: [f64; 3],
+    photograph: [f64; 3],
+}
+
+impl Sums {
+    fn add(&mut self, amplified: [f64; 3], photograph: [f64; 3], vegetated: bool) {
+        self.pixels += 1;
+        self.vegetated += usize::from(vegetated);
+        for c in 0..3 {
+            self.amplified[c] += amplified[c];
+            self.photograph[c] += photograph[c];
+        }
+    }
+
+    fn mostly_vegetated(&self) -> bool {
+        2 * self.vegetated >= self.pixels && self.pixels > 0
+    }
+
+    fn means(&self) -> ([f64; 3], [f64; 3]) {
+        let n = self.pixels.max(1) as f64;
+        (self.amplified.map(|v| v / n), self.photograph.map(|v| v / n))
+    }
+
+    /// The means' Labs and their CIEDE2000.
+    fn compared(&self) -> (Lab, Lab, f64) {
+        let (a, p) = self.means();
+        let (a, p) = (lab_of_linear(a), lab_of_linear(p));
+        (a, p, delta_e_2000(p, a))
+    }
+}
+
+/// Measures `amplified` against `photograph` (sRGB frames of one camera) over `keys`.
+pub fn measure(
+    amplified: &RgbaImage,
+    photograph: &RgbaImage,
+    keys: &PixelKeys,
+) -> Result<PhotoFigures, PhotoError> {
+    let size_px = [amplified.width(), amplified.height()];
+    let pixels = (size_px[0] * size_px[1]) as usize;
+    if [photograph.width(), photograph.height()] != size_px
+        || keys.size_px != size_px
+        || keys.texel.len() != pixels
+        || keys.vegetated.len() != pixels
+    {
+        return Err(PhotoError::Size {
+            amplified: size_px,
+            photograph: [photograph.width(), photograph.height()],
+            keys: keys.size_px,
+        });
+    }
+    let table = linear_table();
+    let linear = |image: &RgbaImage, i: usize| {
+        let p = &image.as_raw()[4 * i..4 * i + 3];
+        [table[p[0] as usize], table[p[1] as usize], table[p[2] as usize]]
+    };
+
+    // Footprints: sums, then the luminance spread about each one's mean (a second pass, so a flat
+    // footprint's spread is exactly 0).
+    let mut texels: BTreeMap<u64, Sums> = BTreeMap::new();
+    let (mut vegetated_px, mut changed_px) = (0, 0);
+    for i in 0..pixels {
+        let vegetated = keys.vegetated[i];
+        if vegetated {
+            vegetated_px += 1;
+            changed_px +=
+                usize::from(amplified.as_raw()[4 * i..4 * i + 3] != photograph.as_raw()[4 * i..4 * i + 3]);
+        }
+        if keys.texel[i] != NO_TEXEL {
+            texels.entry(keys.texel[i]).or_default().add(
+                linear(amplified, i),
+                linear(photograph, i),
+                vegetated,
+            );
+        }
+    }
+    texels.retain(|_, s| s.pixels >= MIN_PIXELS_PER_TEXEL && s.mostly_vegetated());
+    let mut spread: BTreeMap<u64, [f64; 2]> = BTreeMap::new();
+    for i in 0..pixels {
+        let Some(sums) = texels.get(&keys.texel[i]) else { continue };
+        let (a, p) = sums.means();
+        let d =
+            [luminance(linear(amplified, i)) - luminance(a), luminance(linear(photograph, i)) - luminance(p)];
+        let s = spread.entry(keys.texel[i]).or_default();
+        s[0] += d[0] * d[0];
+        s[1] += d[1] * d[1];
+    }
+    let (mut delta_e, mut l_sums, mut detail) = (Vec::with_capacity(texels.len()), [0.0; 2], [0.0; 2]);
+    for (key, sums) in &texels {
+        let (a, p, de) = sums.compared();
+        delta_e.push(de);
+        l_sums[0] += a.l;
+        l_sums[1] += p.l;
+        let s = spread.get(key).copied().unwrap_or_default();
+        detail[0] += (s[0] / sums.pixels as f64).sqrt();
+        detail[1] += (s[1] / sums.pixels as f64).sqrt();
+    }
+    let counted = texels.len();
+    let per_texel = |sum: f64| (counted > 0).then(|| sum / counted as f64);
+    let footprints = Footprints {
+        counted,
+        delta_e: DeltaE::of(&delta_e)?,
+        amplified_mean_l: per_texel(l_sums[0]),
+        photograph_mean_l: per_texel(l_sums[1]),
+        amplified_detail_y: per_texel(detail[0]),
+        photograph_detail_y: per_texel(detail[1]),
+    };
+
+    let mut block_values = Vec::new();
+    for by in 0..size_px[1] / BLOCK_PX {
+        for bx in 0..size_px[0] / BLOCK_PX {
+            let mut sums = Sums::default();
+            for y in by * BLOCK_PX..(by + 1) * BLOCK_PX {
+                for x in bx * BLOCK_PX..(bx + 1) * BLOCK_PX {
+                    let i = (y * size_px[0] + x) as usize;
+                    sums.add(linear(amplified, i), linear(photograph, i), keys.vegetated[i]);
+                }
+            }
+            if sums.mostly_vegetated() {
+                block_values.push(sums.compared().2);
+            }
+        }
+    }
+    let blocks =
+        Blocks { counted: block_values.len(), delta_e: DeltaE::of(&block_values)?, values: block_values };
+    Ok(PhotoFigures {
+        size_px,
+        texels: footprints,
+        blocks,
+        vegetated_px,
+        changed_px,
+        changed_share: (vegetated_px > 0).then(|| changed_px as f64 / vegetated_px as f64),
+    })
+}
+
+#[cfg(test)]
+mod tests;

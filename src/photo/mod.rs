@@ -1,0 +1,175 @@
+//! How it works: the amplified frame against the photograph (issue 43). The forest terramp grows
+//! is meant to look, from afar, like the aerial imagery it grows from; this measures how far it
+//! does, with no reference but the dataset's own imagery. One camera, two renderers of one
+//! dataset and one device:
+//! - the **amplified frame**: the settings as given (seeds, texcells, whatever they draw);
+//! - the **photograph frame**: the same settings with nothing grown (`photograph_settings`:
+//!   `seeds.density_scale` 0, `texcells.reach_m` 0), which is the ground pass alone: the imagery
+//!   draped on the terrain, lit by the same sun and clouds and hazed by the same distance.
+//!
+//! Both are settled (`Renderer::render_resolved`) and read straight from the colour target
+//! (`Renderer::read_colour`): there is no tone mapping anywhere in terramp, so the target's sRGB
+//! bytes decode to the linear light the passes wrote, and every mean is taken in linear light.
+//! The ground's lighting and haze are in both frames alike: where the amplified frame shows its
+//! ground they cancel, and where it shows a tree the tree is lit by the same sun and hazed by the
+//! same distance as the ground it stands on, so what is left is what the amplification changed.
+//! Each pixel is keyed by the terrain point it shows (`keys`: the level-0 imagery texel, and
+//! whether its land cover grows anything), and `measure` compares the frames per texel footprint,
+//! per 5 × 5 block and per pixel (CIEDE2000 of mean colours, `colour`; the amplified frame's
+//! detail within footprints; the share of vegetated pixels changed).
+
+pub mod colour;
+pub mod keys;
+pub mod measure;
+
+use std::sync::Arc;
+
+use image::RgbaImage;
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::camera::{Camera, CameraError};
+use crate::config::Settings;
+use crate::dataset::{Dataset, PackError};
+use crate::frame::{RenderError, Renderer};
+use crate::gpu::Gpu;
+pub use keys::pixel_keys;
+pub use measure::{PhotoFigures, PixelKeys, measure};
+
+/// Why a view could not be measured against its photograph.
+#[derive(Debug, Error)]
+pub enum PhotoError {
+    /// A renderer could not be made, or a frame or a readback failed.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The camera does not project onto the viewport.
+    #[error(transparent)]
+    Camera(#[from] CameraError),
+    /// A land-cover tile could not be read.
+    #[error(transparent)]
+    Pack(#[from] PackError),
+    /// The frames and the keys are not of one size, pixels.
+    #[error(
+        "photo: frames of {amplified:?} and {photograph:?} px, keys of {keys:?} px: one camera has one size"
+    )]
+    Size {
+        /// The amplified frame's size.
+        amplified: [u32; 2],
+        /// The photograph frame's size.
+        photograph: [u32; 2],
+        /// The keys' size.
+        keys: [u32; 2],
+    },
+    /// A colour difference came out NaN or infinite.
+    #[error("photo: a colour difference is {0}")]
+    NotFinite(f64),
+}
+
+/// The settings of the photograph frame: `settings` with nothing grown (no seeds selected, no
+/// texcells drawn), the ground pass over the imagery alone.
+pub fn photograph_settings(settings: &Settings) -> Settings {
+    let mut s = settings.clone();
+    s.seeds.density_scale = 0.0;
+    s.texcells.reach_m = 0.0;
+    s
+}
+
+/// One view measured: both frames, what each pixel stands on, the figures.
+pub struct PhotoView {
+    /// The frame with the settings as given (sRGB).
+    pub amplified: RgbaImage,
+    /// The frame with `photograph_settings` (sRGB).
+    pub photograph: RgbaImage,
+    /// Per pixel, its imagery texel and whether it is vegetated.
+    pub keys: PixelKeys,
+    /// The amplified frame against the photograph frame.
+    pub figures: PhotoFigures,
+}
+
+/// What `photo.json` holds: the view and its figures.
+#[derive(Debug, Clone, Serialize)]
+pub struct PhotoReport {
+    /// The dataset's folder.
+    pub dataset: String,
+    /// The camera: x, y, z (CRS metres), yaw, pitch (degrees).
+    pub camera: [f64; 5],
+    /// Vertical field of view, degrees.
+    pub fov_deg: f64,
+    /// The scene's time, seconds (wind, clouds).
+    pub time_s: f64,
+    /// The adapter the frames were rendered on.
+    pub adapter: String,
+    /// The figures.
+    pub figures: PhotoFigures,
+}
+
+/// Renders the view from `camera` (at `settings.render`'s size) with `settings` and with
+/// `photograph_settings`, both settled at scene time `time_s`, and measures one against the other.
+pub fn measure_view(
+    gpu: &Gpu,
+    dataset: Arc<Dataset>,
+    settings: &Settings,
+    camera: &Camera,
+    time_s: f64,
+) -> Result<PhotoView, PhotoError> {
+    let settle = |settings: Settings| -> Result<(Renderer, RgbaImage), PhotoError> {
+        let mut renderer = Renderer::new(gpu.clone(), Arc::clone(&dataset), settings)?;
+        renderer.set_time_s(time_s);
+        renderer.render_resolved(camera)?;
+        let image = renderer.read_colour()?;
+        Ok((renderer, image))
+    };
+    let (_, amplified) = settle(settings.clone())?;
+    let (photo_renderer, photograph) = settle(photograph_settings(settings))?;
+    let keys = pixel_keys(&photo_renderer, camera)?;
+    let figures = measure(&amplified, &photograph, &keys)?;
+    Ok(PhotoView { amplified, photograph, keys, figures })
+}
+
+/// The two frames side by side: the photograph on the left, the amplified frame on the right.
+pub fn side_by_side(photograph: &RgbaImage, amplified: &RgbaImage) -> RgbaImage {
+    let (w, h) = (photograph.width(), photograph.height().max(amplified.height()));
+    let mut out = RgbaImage::new(w + amplified.width(), h);
+    image::imageops::overlay(&mut out, photograph, 0, 0);
+    image::imageops::overlay(&mut out, amplified, i64::from(w), 0);
+    out
+}
+
+/// The figures as a table for a terminal, one line each.
+pub fn table(figures: &PhotoFigures) -> String {
+    let num = |v: Option<f64>, digits: usize| v.map_or("-".to_string(), |v| format!("{v:.digits$}"));
+    let de = |d: Option<measure::DeltaE>| match d {
+        Some(d) => format!("{:>7.2} {:>7.2} {:>7.2}", d.mean, d.p95, d.max),
+        None => format!("{:>7} {:>7} {:>7}", "-", "-", "-"),
+    };
+    let (t, b) = (&figures.texels, &figures.blocks);
+    let mut out = String::new();
+    out.push_str(&format!(
+        "{:<34} {:>7} {:>7} {:>7} {:>7}\n",
+        "CIEDE2000, amplified vs photograph", "counted", "mean", "p95", "max"
+    ));
+    out.push_str(&format!("{:<34} {:>7} {}\n", "  imagery texel footprints", t.counted, de(t.delta_e)));
+    out.push_str(&format!(
+        "{:<34} {:>7} {}\n",
+        format!("  {0} x {0} pixel blocks", measure::BLOCK_PX),
+        b.counted,
+        de(b.delta_e)
+    ));
+    out.push_str(&format!(
+        "mean L* over footprints            amplified {}, photograph {}\n",
+        num(t.amplified_mean_l, 2),
+        num(t.photograph_mean_l, 2)
+    ));
+    out.push_str(&format!(
+        "detail (std of linear Y in a footprint)  amplified {}, photograph {}\n",
+        num(t.amplified_detail_y, 4),
+        num(t.photograph_detail_y, 4)
+    ));
+    out.push_str(&format!(
+        "changed share of vegetated pixels  {} ({} of {})\n",
+        num(figures.changed_share, 4),
+        figures.changed_px,
+        figures.vegetated_px
+    ));
+    out
+}
