@@ -45,6 +45,7 @@ docs/continuous_lod_compare.png           continuous_lod     -        short
 docs/truth_vs_accurate.png                truth_vs_accurate  -        short
 docs/viewer_nc.png                        viewer             shared   short
 docs/wind_strip.png                       wind               shared   short
+docs/photo_nc.png                         photo              shared   long
 docs/flight_0.png                         streaming          -        long
 docs/flight_1.png                         streaming          -        long
 docs/flight_2.png                         streaming          -        long
@@ -298,6 +299,32 @@ make_texcells() {
     compose --columns 1 --scale 0.75 --gap 4 --out docs/texcells_nc_2km.png "${shots[@]}"
     views zion "$data/zion" 316900,4136000,2600,0,-6 1280x720 "$without" "$with"
     compose --columns 1 --scale 0.75 --gap 4 --out docs/texcells_zion_rim.png "${shots[@]}"
+}
+
+# The photograph, before the colour follow-up and after it: nc's forest from 3 km straight down,
+# 1.5 km at 45° and 300 m at 30°. "Before" is the release build of c1e844b (the last commit before
+# it), built once in a worktree of its own (long: a second release build), or BEFORE_BIN if given.
+make_photo() {
+    forest
+    local trees before_bin="${BEFORE_BIN:-}"
+    trees=$(layer photo_trees '[draw_seeds]' "impostors = \"$(cd "$forest" && pwd)\"")
+    if [[ -z $before_bin ]]; then
+        local tree="$out/before-c1e844b"
+        [[ -d $tree ]] || git worktree add --detach "$tree" c1e844b >/dev/null
+        (cd "$tree" && CARGO_TARGET_DIR="$out/before-target" cargo build --release -q --bin terramp)
+        before_bin="$out/before-target/release/terramp"
+    fi
+    local rows=() view name pose
+    for view in 3km:637500,221750,3000,0,-89 1500m_45:637500,221750,1600,0,-45 300m_30:637500,221750,400,0,-30; do
+        name=${view%%:*} pose=${view#*:}
+        "$before_bin" render --dataset "$data/nc" --camera "$pose" --width 640 --height 640 --settings "$trees" \
+            --out "$out/photo_before_$name.png" >/dev/null
+        "$terramp" photo --dataset "$data/nc" --camera "$pose" --width 640 --height 640 --settings "$trees" \
+            --out "$out/photo_after_$name" >/dev/null
+        rows+=("$out/photo_after_$name/photograph.png" "$out/photo_before_$name.png" \
+            "$out/photo_after_$name/amplified.png")
+    done
+    compose --columns 3 --scale 0.5 --gap 4 --out docs/photo_nc.png "${rows[@]}"
 }
 
 make_trees_health() {

@@ -8,12 +8,12 @@
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
     let height_m = in.rel_m.z + u.camera_grid_m.z;
-    var albedo = tint(height_m, normal);
+    // Where the imagery has no data (or no tile is resident yet), the relief tint shows.
+    var imagery = vec4<f32>(0.0);
     if u.imagery_texels != IMAGERY_NONE {
-        // Where the imagery has no data (or no tile is resident yet), the relief tint shows.
-        let imagery = imagery_albedo(in.grid_m);
-        albedo = mix(albedo, imagery.rgb, imagery.a);
+        imagery = imagery_albedo(in.grid_m);
     }
+    let albedo = ground_albedo(imagery, height_m, normal);
     let sun = max(dot(normal, u.sun_dir.xyz), 0.0) * sun_through_clouds(u.cloud_field, u.cloud_shift, in.rel_m);
     let sky = GROUND_SKY * (0.5 + 0.5 * normal.z);
     let lit = albedo * (sun * GROUND_SUN + sky);

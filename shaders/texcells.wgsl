@@ -179,7 +179,8 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     // (the tiling's jumps between tiles would spike it), the imagery's from the grid position.
     let texel = in.grid_m * (tu.inv_cell_m / f32(TEXCELL_REFERENCE_CELLS) * tu.texels);
     let footprint = max(length(dpdx(texel)), length(dpdy(texel)));
-    let ground = imagery_albedo(in.grid_m);
+    let normal = normalize(in.normal);
+    let ground = ground_albedo(imagery_albedo(in.grid_m), in.rel_m.z + u.camera_grid_m.z, normal);
 
     let distance_m = length(in.rel_m);
     let fade = clamp((distance_m - tu.fade_m.x) / tu.fade_m.y, 0.0, 1.0)
@@ -214,11 +215,10 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
         discard;
     }
     // The path between two slices, seen along the view, is 1 / cos longer than straight through.
-    let normal = normalize(in.normal);
     let path = min(normal.z / max(abs(dot(normal, view)), 1e-4), tu.opacity_max_factor);
     let corrected = 1.0 - pow(1.0 - min(alpha, 0.9999), max(path, 0.25));
 
-    let surface = Surface(sampled.rgb / max(sampled.a, 1e-4), tu.sample_albedo[forest.sample].rgb, normalize(in.normal));
+    let surface = Surface(sampled.rgb / max(sampled.a, 1e-4), tu.sample_albedo[forest.sample].rgb, normal);
     return shade(surface, ground, in.rel_m, view, distance_m, corrected);
 }
 
@@ -231,24 +231,32 @@ struct Surface {
 }
 
 // The premultiplied colour of forest `surface` of opacity `opacity` at `rel_m` from the camera,
-// seen along `view`, `distance_m` away, over ground of imagery colour `ground`. In its own colours
+// seen along `view`, `distance_m` away, over ground of albedo `ground` (`ground_albedo`: the
+// photograph, or the relief tint where it has no data, as the ground pass shows). In its own colours
 // it is lit as the seeds' leaves are on average: the leaves the eye sees face it (the seeds turn
 // every surface towards the eye), their normals spread over the half of directions facing it,
 // whose mean clamped cosine towards the sun is (1 + cos(eye, sun)) / 4. The colour follow-up (a
 // ratio transfer, as the seeds'), by `ground_blend`: the albedo times the photograph's colour over
 // the sample's mean seen from above, lit as the ground under it is (its normal, the sun through
 // the clouds, the sky), so that followed fully its mean from above is the ground's own frame and
-// each texel keeps its contrast.
-fn shade(surface: Surface, ground: vec4<f32>, rel_m: vec3<f32>, view: vec3<f32>, distance_m: f32, opacity: f32) -> vec4<f32> {
+// each texel keeps its contrast, until, seen from above, a pixel spans a crown
+// (`TEXCELL_DETAIL_*`): there the followed forest has nothing left to add to the photograph, which
+// already shows it, and fades out (its slab's parallax would only shift the photograph).
+fn shade(surface: Surface, ground: vec3<f32>, rel_m: vec3<f32>, view: vec3<f32>, distance_m: f32, coverage: f32) -> vec4<f32> {
     let clouds = sun_through_clouds(u.cloud_field, u.cloud_shift, rel_m);
     let facing = 0.25 * (1.0 - dot(view, u.sun_dir.xyz));
     let own = surface.albedo * ((FOLIAGE_SUN * facing + FOLIAGE_SUN_WRAP * max(u.sun_dir.z, 0.0)) * clouds + FOLIAGE_SKY);
     var lit = own;
+    var opacity = coverage;
     if u.imagery_texels != IMAGERY_NONE && all(surface.sample_mean > vec3<f32>(0.0)) {
         let n = surface.normal;
         let ground_light = max(dot(n, u.sun_dir.xyz), 0.0) * clouds * GROUND_SUN + GROUND_SKY * (0.5 + 0.5 * n.z);
-        let followed = surface.albedo * ground.rgb / surface.sample_mean * ground_light;
-        lit = mix(own, followed, ground.a * tu.ground_blend);
+        let followed = ground * surface.albedo / surface.sample_mean * ground_light;
+        lit = mix(own, followed, tu.ground_blend);
+        let px_m = distance_m * tu.metres_per_px_at_1m;
+        let from_above = smoothstep(TEXCELL_DETAIL_GRAZING_SIN, TEXCELL_DETAIL_STEEP_SIN, -view.z);
+        let flat = smoothstep(TEXCELL_DETAIL_FULL_PX_M, TEXCELL_DETAIL_NONE_PX_M, px_m) * from_above;
+        opacity *= 1.0 - flat * tu.ground_blend;
     }
     let haze = 1.0 - exp2(-distance_m / u.haze.w);
     return vec4<f32>(mix(lit, u.haze.rgb, haze) * opacity, opacity);
@@ -260,7 +268,7 @@ fn shade(surface: Surface, ground: vec4<f32>, rel_m: vec3<f32>, view: vec3<f32>,
 // needs apart (the paper's slicing rate: where the ray enters the canopy, which draws the skyline);
 // the rest grow apart evenly so that all of them span the ray's path through a flat slab
 // (slab / sin of the ray's descent), each read at the level its spacing needs.
-fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f32, ground: vec4<f32>) -> vec4<f32> {
+fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f32, ground: vec3<f32>) -> vec4<f32> {
     let node = nodes[node_index];
     let slab_m = tu.slab_height_m;
     let texel_m = f32(TEXCELL_REFERENCE_CELLS) / (tu.inv_cell_m * tu.texels);

@@ -9,27 +9,13 @@
 use std::path::PathBuf;
 
 use terramp::frame::Renderer;
-use terramp_testkit::{camera, renderer, settled_colour, small_settings, synth_dataset};
+use terramp_testkit::{camera, nc_table_with, renderer, settled_colour, small_settings, synth_dataset};
 
 const IMAGE_PX: [u32; 2] = [320, 180];
 
 /// nc's table with every species' `key` set to `value`, written to a temporary file.
 fn nc_with(key: &str, value: f32) -> PathBuf {
-    let nc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/config/classes/nc.toml")).unwrap();
-    let species = nc.matches("max_slope_deg = ").count();
-    assert!(species >= 4, "nc's table has {species} species");
-    let text = nc.lines().fold(String::new(), |mut out, line| {
-        out.push_str(line);
-        out.push('\n');
-        if line.starts_with("max_slope_deg = ") {
-            out.push_str(&format!("{key} = {value}\n"));
-        }
-        out
-    });
-    let path =
-        std::env::temp_dir().join(format!("terramp-seed-colour-{key}-{value}-{}.toml", std::process::id()));
-    std::fs::write(&path, text).unwrap();
-    path
+    nc_table_with(&format!("seed-colour-{key}-{value}"), &format!("{key} = {value}"))
 }
 
 /// The settled frame of a renderer with `table` (and the shared impostors unless `bare`), the sun

@@ -17,6 +17,16 @@ fn tint(height_m: f32, normal: vec3<f32>) -> vec3<f32> {
     return mix(ramp, rock, smoothstep(0.6, 0.35, normal.z));
 }
 
+// The ground's albedo under grid point `grid_m`, `height_m` high with normal `normal`: the
+// imagery (`imagery_albedo`'s, `imagery`), or the relief tint where it has no data or there is none.
+fn ground_albedo(imagery: vec4<f32>, height_m: f32, normal: vec3<f32>) -> vec3<f32> {
+    let relief = tint(height_m, normal);
+    if u.imagery_texels == IMAGERY_NONE {
+        return relief;
+    }
+    return mix(relief, imagery.rgb, imagery.a);
+}
+
 // Linear RGB, and in alpha the imagery's coverage (0 where the source had no data).
 fn imagery_albedo(grid_m: vec2<f32>) -> vec4<f32> {
     // Level-0 texel coordinates, continuous across tiles: their derivatives are the footprint.

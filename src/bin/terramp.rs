@@ -144,7 +144,7 @@ enum Command {
     Truth(truth::TruthArgs),
     /// One view's amplified frame against its photograph frame (the same settings with nothing
     /// grown: the imagery on the terrain alone): CIEDE2000 of mean colours per imagery texel
-    /// footprint and per 5 × 5 block, detail, the share of vegetated pixels changed.
+    /// footprint and per 5 × 5 block, detail, the share of wooded pixels changed.
     Photo(photo::PhotoArgs),
     /// Fly a camera path (config/paths/*.toml) and write the frames and a log: one JSON object per
     /// frame in `log.jsonl` (tiles needed, resident, uploaded, evicted, failed, bytes uploaded;

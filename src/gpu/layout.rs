@@ -336,6 +336,20 @@ wgsl_constants! { texcell_constants:
     /// Most slices of a forest sample's finest level (2^N): the texture array holds this many
     /// layers per sample.
     pub const TEXCELL_MAX_SLICES: u32 = 64;
+    /// The colour follow-up fades the forest's own detail out where a pixel grows past a crown
+    /// (nc's broadleaves and pines are 5 to 10 m across): full where a pixel spans at most this
+    /// many metres...
+    pub const TEXCELL_DETAIL_FULL_PX_M: f32 = 4.0;
+    /// ... none where it spans this many: a tree is then smaller than a pixel, and the forest
+    /// shows the photograph's colour alone, which already holds what the trees look like there.
+    pub const TEXCELL_DETAIL_NONE_PX_M: f32 = 8.0;
+    /// That fade applies to views from above, which the photograph was taken from: none where
+    /// the eye looks down at the forest less steeply than this (sine of the angle below the
+    /// horizon, 20°), where the canopy's side and the ground it hides are what the photograph
+    /// cannot show...
+    pub const TEXCELL_DETAIL_GRAZING_SIN: f32 = 0.342;
+    /// ... all where it looks down more steeply than this (45°).
+    pub const TEXCELL_DETAIL_STEEP_SIN: f32 = 0.707;
     /// Points per workgroup of the shader's probe of its tiling (`passes::texcells::gpu::probe`).
     pub const TEXCELL_PROBE_WORKGROUP: u32 = 64;
     /// `TexcellSlice::kind`: a regular slice of a patch drawn with regular slices only.

@@ -5,21 +5,25 @@
 //! moved into grid space (the camera's CRS position less the dataset's origin). The imagery's
 //! level-0 texel there is `floor((p + ½ height spacing) / texel_m)`, as the ground truth's seeds
 //! find it (`truth::scene`): cell layers cover the DEM's pixel-area extent, half a spacing beyond
-//! grid space. The pixel is vegetated when the land cover's class there (its source level, which
-//! the exact oracle classifies seeds by; every level agrees) has a seed rule or texcells in the
-//! renderer's class table.
+//! grid space. The pixel is wooded when the land cover's class there (its source level, which
+//! the exact oracle classifies seeds by; every level agrees) grows trees in the renderer's class
+//! table (a rule of a tree species, or texcells): the forest the photograph is compared over, not
+//! the fields whose bushes and stones are too small to show from above.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
+use std::sync::Arc;
 
 use glam::{DVec3, DVec4};
 
 use super::PhotoError;
 use super::measure::{NO_TEXEL, PixelKeys, texel_key};
 use crate::camera::Camera;
-use crate::classes::ClassTable;
+use crate::classes::{ClassTable, SpeciesKind};
 use crate::dataset::lcc::{LCC_BARE_INDEX, LCC_SOURCE_LEVEL};
 use crate::dataset::{Dataset, TileId};
 use crate::frame::Renderer;
+use crate::gpu::layout::{IMAGERY_BORDER, IMAGERY_TILE_EXTENT, IMAGERY_TILE_TEXELS};
 
 /// The keys of the view `renderer` last settled from `camera` (its terrain depth read back).
 pub fn pixel_keys(renderer: &Renderer, camera: &Camera) -> Result<PixelKeys, PhotoError> {
@@ -46,8 +50,9 @@ pub fn keys_of_depth(
         _ => None,
     };
     let mut landcover = Landcover::new(dataset, table);
+    let mut coverage = Coverage { dataset, tiles: HashMap::new() };
     let pixels = (w as usize) * (h as usize);
-    let mut keys = PixelKeys { size_px, texel: vec![NO_TEXEL; pixels], vegetated: vec![false; pixels] };
+    let mut keys = PixelKeys { size_px, texel: vec![NO_TEXEL; pixels], wooded: vec![false; pixels] };
     for (i, &d) in depth.iter().enumerate().take(pixels) {
         if d <= 0.0 {
             continue;
@@ -64,18 +69,43 @@ pub fn keys_of_depth(
         if let Some((texel_m, size)) = imagery {
             let t = [p.x, p.y].map(|v| ((v + half_spacing_m) / texel_m).floor());
             if t[0] >= 0.0 && t[1] >= 0.0 && t[0] < f64::from(size[0]) && t[1] < f64::from(size[1]) {
-                keys.texel[i] = texel_key([t[0] as u32, t[1] as u32]);
+                let t = [t[0] as u32, t[1] as u32];
+                // Where the imagery has no data there is no photograph to compare with.
+                if !coverage.has_data(t)? {
+                    continue;
+                }
+                keys.texel[i] = texel_key(t);
             }
         }
-        keys.vegetated[i] = landcover.vegetated([p.x, p.y], half_spacing_m)?;
+        keys.wooded[i] = landcover.wooded([p.x, p.y], half_spacing_m)?;
     }
     Ok(keys)
+}
+
+/// Whether the imagery has data at a level-0 texel (its alpha above 0), read tile by tile.
+struct Coverage<'a> {
+    dataset: &'a Dataset,
+    tiles: HashMap<[u32; 2], Arc<[u8]>>,
+}
+
+impl Coverage<'_> {
+    fn has_data(&mut self, t: [u32; 2]) -> Result<bool, PhotoError> {
+        let Some(layer) = &self.dataset.imagery else { return Ok(false) };
+        let tile = t.map(|v| v / IMAGERY_TILE_TEXELS);
+        let texels = match self.tiles.entry(tile) {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => e.insert(layer.tile_texels(TileId::new(0, tile[0], tile[1]))?),
+        };
+        let local = [0, 1].map(|a| t[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
+        let alpha = 4 * (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize + 3;
+        Ok(texels.get(alpha).is_some_and(|&a| a > 0))
+    }
 }
 
 /// The land cover's source level, read tile by tile as pixels need it.
 struct Landcover<'a> {
     dataset: &'a Dataset,
-    /// Per palette index (0: bare), whether its class grows anything; empty without land cover.
+    /// Per palette index (0: bare), whether its class grows trees; empty without land cover.
     grows: Vec<bool>,
     /// Source texel edge, metres, the level's size and tile edge, and its tile extent.
     grid: Option<(f64, [u32; 2], u32, u32)>,
@@ -88,7 +118,11 @@ impl<'a> Landcover<'a> {
         else {
             return Self { dataset, grows: Vec::new(), grid: None, tiles: HashMap::new() };
         };
-        let grows_code = |code: u8| table.class(code).is_some_and(|c| !c.seeds.is_empty() || c.texcells);
+        let is_tree =
+            |name: &str| table.species.iter().any(|s| s.name == name && s.kind == SpeciesKind::Tree);
+        let grows_code = |code: u8| {
+            table.class(code).is_some_and(|c| c.texcells || c.seeds.iter().any(|r| is_tree(&r.species)))
+        };
         let grows =
             std::iter::once(false).chain(meta.coding.palette.iter().map(|&c| grows_code(c))).collect();
         let p = &layer.pyramid;
@@ -97,8 +131,8 @@ impl<'a> Landcover<'a> {
         Self { dataset, grows, grid, tiles: HashMap::new() }
     }
 
-    /// Whether the class at grid point `p` grows seeds or texcells (never outside the layer).
-    fn vegetated(&mut self, p: [f64; 2], half_spacing_m: f64) -> Result<bool, PhotoError> {
+    /// Whether the class at grid point `p` grows trees (never outside the layer).
+    fn wooded(&mut self, p: [f64; 2], half_spacing_m: f64) -> Result<bool, PhotoError> {
         let Some((texel_m, size, tile, extent)) = self.grid else { return Ok(false) };
         let q = p.map(|v| ((v + half_spacing_m) / texel_m).floor());
         if q[0] < 0.0 || q[1] < 0.0 || q[0] >= f64::from(size[0]) || q[1] >= f64::from(size[1]) {
@@ -107,8 +141,8 @@ impl<'a> Landcover<'a> {
         let q = q.map(|v| v as u32);
         let t = q.map(|v| v / tile);
         let words = match self.tiles.entry(t) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(e) => {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => {
                 e.insert(self.dataset.landcover_words(TileId::new(LCC_SOURCE_LEVEL, t[0], t[1]))?)
             }
         };

@@ -3,14 +3,14 @@
 //! there, then turned to CIELAB and compared by CIEDE2000 (`colour`). Three groupings:
 //! - **imagery texel footprints**: the pixels whose terrain point falls in one level-0 imagery
 //!   texel (`PixelKeys::texel`). A footprint counts when it has `MIN_PIXELS_PER_TEXEL` pixels or
-//!   more and at least half of them vegetated; its mean colour in each frame is what the
+//!   more and at least half of them wooded; its mean colour in each frame is what the
 //!   photograph says of that texel and what the amplified frame makes of it. Within it the spread
 //!   (standard deviation) of the frame's luminance is its detail: a flat paint of the photograph's
 //!   colour has none.
 //! - **blocks** of `BLOCK_PX` × `BLOCK_PX` pixels (full blocks only), for far views where a texel
 //!   is a pixel or less and footprints do not form: a block counts when at least half its pixels
-//!   are vegetated.
-//! - **changed share**: of the vegetated pixels, those whose bytes differ between the frames.
+//!   are wooded.
+//! - **changed share**: of the wooded pixels, those whose bytes differ between the frames.
 //!
 //! A grouping with nothing counted has no ΔE figures (`None`), rather than a 0 that would read as
 //! a perfect match.
@@ -50,8 +50,8 @@ pub struct PixelKeys {
     pub size_px: [u32; 2],
     /// Per pixel, the level-0 imagery texel its terrain point falls in (`texel_key`), or `NO_TEXEL`.
     pub texel: Vec<u64>,
-    /// Per pixel, whether the land cover there grows seeds or texcells.
-    pub vegetated: Vec<bool>,
+    /// Per pixel, whether the land cover there grows trees (`keys`).
+    pub wooded: Vec<bool>,
 }
 
 /// CIEDE2000 over a grouping's members.
@@ -83,7 +83,7 @@ impl DeltaE {
 /// The imagery texel footprints' figures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Footprints {
-    /// Footprints counted: `MIN_PIXELS_PER_TEXEL` pixels or more, at least half vegetated.
+    /// Footprints counted: `MIN_PIXELS_PER_TEXEL` pixels or more, at least half wooded.
     pub counted: usize,
     /// CIEDE2000 between the frames' mean colours, per footprint.
     pub delta_e: Option<DeltaE>,
@@ -96,12 +96,18 @@ pub struct Footprints {
     pub amplified_detail_y: Option<f64>,
     /// The same of the photograph frame (its texels magnified and filtered), for scale.
     pub photograph_detail_y: Option<f64>,
+    /// Mean over footprints of the amplified frame's luminance contrast within each: its standard
+    /// deviation over its mean (a footprint of black counts 0). Detail that does not scale with
+    /// the footprint's brightness: a forest made darker keeps its contrast, a flat paint has none.
+    pub amplified_contrast: Option<f64>,
+    /// The same of the photograph frame.
+    pub photograph_contrast: Option<f64>,
 }
 
 /// The pixel blocks' figures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Blocks {
-    /// Blocks counted: at least half their pixels vegetated.
+    /// Blocks counted: at least half their pixels wooded.
     pub counted: usize,
     /// CIEDE2000 between the frames' mean colours, per block.
     pub delta_e: Option<DeltaE>,
@@ -119,11 +125,11 @@ pub struct PhotoFigures {
     pub texels: Footprints,
     /// Per `BLOCK_PX` block.
     pub blocks: Blocks,
-    /// Pixels whose land cover grows seeds or texcells.
-    pub vegetated_px: usize,
+    /// Pixels whose land cover grows trees.
+    pub wooded_px: usize,
     /// Of those, pixels whose bytes differ between the frames.
     pub changed_px: usize,
-    /// `changed_px` / `vegetated_px` (`None` without vegetated pixels).
+    /// `changed_px` / `wooded_px` (`None` without wooded pixels).
     pub changed_share: Option<f64>,
 }
 
@@ -131,23 +137,23 @@ pub struct PhotoFigures {
 #[derive(Debug, Default, Clone, Copy)]
 struct Sums {
     pixels: usize,
-    vegetated: usize,
+    wooded: usize,
     amplified: [f64; 3],
     photograph: [f64; 3],
 }
 
 impl Sums {
-    fn add(&mut self, amplified: [f64; 3], photograph: [f64; 3], vegetated: bool) {
+    fn add(&mut self, amplified: [f64; 3], photograph: [f64; 3], wooded: bool) {
         self.pixels += 1;
-        self.vegetated += usize::from(vegetated);
+        self.wooded += usize::from(wooded);
         for c in 0..3 {
             self.amplified[c] += amplified[c];
             self.photograph[c] += photograph[c];
         }
     }
 
-    fn mostly_vegetated(&self) -> bool {
-        2 * self.vegetated >= self.pixels && self.pixels > 0
+    fn mostly_wooded(&self) -> bool {
+        2 * self.wooded >= self.pixels && self.pixels > 0
     }
 
     fn means(&self) -> ([f64; 3], [f64; 3]) {
@@ -174,7 +180,7 @@ pub fn measure(
     if [photograph.width(), photograph.height()] != size_px
         || keys.size_px != size_px
         || keys.texel.len() != pixels
-        || keys.vegetated.len() != pixels
+        || keys.wooded.len() != pixels
     {
         return Err(PhotoError::Size {
             amplified: size_px,
@@ -191,23 +197,19 @@ pub fn measure(
     // Footprints: sums, then the luminance spread about each one's mean (a second pass, so a flat
     // footprint's spread is exactly 0).
     let mut texels: BTreeMap<u64, Sums> = BTreeMap::new();
-    let (mut vegetated_px, mut changed_px) = (0, 0);
+    let (mut wooded_px, mut changed_px) = (0, 0);
     for i in 0..pixels {
-        let vegetated = keys.vegetated[i];
-        if vegetated {
-            vegetated_px += 1;
+        let wooded = keys.wooded[i];
+        if wooded {
+            wooded_px += 1;
             changed_px +=
                 usize::from(amplified.as_raw()[4 * i..4 * i + 3] != photograph.as_raw()[4 * i..4 * i + 3]);
         }
         if keys.texel[i] != NO_TEXEL {
-            texels.entry(keys.texel[i]).or_default().add(
-                linear(amplified, i),
-                linear(photograph, i),
-                vegetated,
-            );
+            texels.entry(keys.texel[i]).or_default().add(linear(amplified, i), linear(photograph, i), wooded);
         }
     }
-    texels.retain(|_, s| s.pixels >= MIN_PIXELS_PER_TEXEL && s.mostly_vegetated());
+    texels.retain(|_, s| s.pixels >= MIN_PIXELS_PER_TEXEL && s.mostly_wooded());
     let mut spread: BTreeMap<u64, [f64; 2]> = BTreeMap::new();
     for i in 0..pixels {
         let Some(sums) = texels.get(&keys.texel[i]) else { continue };
@@ -219,14 +221,21 @@ pub fn measure(
         s[1] += d[1] * d[1];
     }
     let (mut delta_e, mut l_sums, mut detail) = (Vec::with_capacity(texels.len()), [0.0; 2], [0.0; 2]);
+    let mut contrast = [0.0; 2];
     for (key, sums) in &texels {
         let (a, p, de) = sums.compared();
         delta_e.push(de);
         l_sums[0] += a.l;
         l_sums[1] += p.l;
         let s = spread.get(key).copied().unwrap_or_default();
-        detail[0] += (s[0] / sums.pixels as f64).sqrt();
-        detail[1] += (s[1] / sums.pixels as f64).sqrt();
+        let std = [0, 1].map(|k| (s[k] / sums.pixels as f64).sqrt());
+        let (mean_a, mean_p) = sums.means();
+        for (k, mean_y) in [luminance(mean_a), luminance(mean_p)].into_iter().enumerate() {
+            detail[k] += std[k];
+            if mean_y > 0.0 {
+                contrast[k] += std[k] / mean_y;
+            }
+        }
     }
     let counted = texels.len();
     let per_texel = |sum: f64| (counted > 0).then(|| sum / counted as f64);
@@ -237,6 +246,8 @@ pub fn measure(
         photograph_mean_l: per_texel(l_sums[1]),
         amplified_detail_y: per_texel(detail[0]),
         photograph_detail_y: per_texel(detail[1]),
+        amplified_contrast: per_texel(contrast[0]),
+        photograph_contrast: per_texel(contrast[1]),
     };
 
     let mut block_values = Vec::new();
@@ -246,10 +257,10 @@ pub fn measure(
             for y in by * BLOCK_PX..(by + 1) * BLOCK_PX {
                 for x in bx * BLOCK_PX..(bx + 1) * BLOCK_PX {
                     let i = (y * size_px[0] + x) as usize;
-                    sums.add(linear(amplified, i), linear(photograph, i), keys.vegetated[i]);
+                    sums.add(linear(amplified, i), linear(photograph, i), keys.wooded[i]);
                 }
             }
-            if sums.mostly_vegetated() {
+            if sums.mostly_wooded() {
                 block_values.push(sums.compared().2);
             }
         }
@@ -260,9 +271,9 @@ pub fn measure(
         size_px,
         texels: footprints,
         blocks,
-        vegetated_px,
+        wooded_px,
         changed_px,
-        changed_share: (vegetated_px > 0).then(|| changed_px as f64 / vegetated_px as f64),
+        changed_share: (wooded_px > 0).then(|| changed_px as f64 / wooded_px as f64),
     })
 }
 

@@ -14,9 +14,9 @@
 //! ground they cancel, and where it shows a tree the tree is lit by the same sun and hazed by the
 //! same distance as the ground it stands on, so what is left is what the amplification changed.
 //! Each pixel is keyed by the terrain point it shows (`keys`: the level-0 imagery texel, and
-//! whether its land cover grows anything), and `measure` compares the frames per texel footprint,
+//! whether its land cover grows trees), and `measure` compares the frames per texel footprint,
 //! per 5 × 5 block and per pixel (CIEDE2000 of mean colours, `colour`; the amplified frame's
-//! detail within footprints; the share of vegetated pixels changed).
+//! detail within footprints; the share of wooded pixels changed).
 
 pub mod colour;
 pub mod keys;
@@ -80,7 +80,7 @@ pub struct PhotoView {
     pub amplified: RgbaImage,
     /// The frame with `photograph_settings` (sRGB).
     pub photograph: RgbaImage,
-    /// Per pixel, its imagery texel and whether it is vegetated.
+    /// Per pixel, its imagery texel and whether it is wooded.
     pub keys: PixelKeys,
     /// The amplified frame against the photograph frame.
     pub figures: PhotoFigures,
@@ -104,13 +104,16 @@ pub struct PhotoReport {
 }
 
 /// Renders the view from `camera` (at `settings.render`'s size) with `settings` and with
-/// `photograph_settings`, both settled at scene time `time_s`, and measures one against the other.
+/// `photograph_settings`, both settled at scene time `time_s`, and measures one against the other;
+/// `amplified`, when given, stands for the first (a frame of the same view and size rendered
+/// elsewhere, e.g. by another build), and only the photograph frame is rendered.
 pub fn measure_view(
     gpu: &Gpu,
     dataset: Arc<Dataset>,
     settings: &Settings,
     camera: &Camera,
     time_s: f64,
+    amplified: Option<RgbaImage>,
 ) -> Result<PhotoView, PhotoError> {
     let settle = |settings: Settings| -> Result<(Renderer, RgbaImage), PhotoError> {
         let mut renderer = Renderer::new(gpu.clone(), Arc::clone(&dataset), settings)?;
@@ -119,7 +122,10 @@ pub fn measure_view(
         let image = renderer.read_colour()?;
         Ok((renderer, image))
     };
-    let (_, amplified) = settle(settings.clone())?;
+    let amplified = match amplified {
+        Some(image) => image,
+        None => settle(settings.clone())?.1,
+    };
     let (photo_renderer, photograph) = settle(photograph_settings(settings))?;
     let keys = pixel_keys(&photo_renderer, camera)?;
     let figures = measure(&amplified, &photograph, &keys)?;
@@ -166,10 +172,15 @@ pub fn table(figures: &PhotoFigures) -> String {
         num(t.photograph_detail_y, 4)
     ));
     out.push_str(&format!(
-        "changed share of vegetated pixels  {} ({} of {})\n",
+        "contrast (that std over the mean)  amplified {}, photograph {}\n",
+        num(t.amplified_contrast, 3),
+        num(t.photograph_contrast, 3)
+    ));
+    out.push_str(&format!(
+        "changed share of wooded pixels  {} ({} of {})\n",
         num(figures.changed_share, 4),
         figures.changed_px,
-        figures.vegetated_px
+        figures.wooded_px
     ));
     out
 }

@@ -133,7 +133,7 @@ pub struct TradePoint {
     /// The frame against the truth: mean FLIP over all sample poses' pixels (0 = identical).
     pub frame_flip: f64,
     /// The frame against its photograph frame (`photo`): CIEDE2000 of the 5 × 5 blocks at least
-    /// half vegetated, pooled over the sample poses; `None` when no block counted.
+    /// half wooded, pooled over the sample poses; `None` when no block counted.
     pub photo_de2000: Option<DeltaE>,
     /// Along the popping flight, the largest 4 × 4 block change between frames against the
     /// truth's; `None` when not measured.

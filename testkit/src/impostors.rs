@@ -39,3 +39,25 @@ fn bake_nc(folder: &str, options: BakeOptions) -> Option<PathBuf> {
     assert!(missing.absent.is_empty(), "models missing: {:?}", missing.absent);
     Some(out)
 }
+
+/// nc's class table with `line` (e.g. `ground_blend = 0.0`) added to every species, written once
+/// per process to the target's temporary folder under `name`: a table that differs from nc's by
+/// one key of every species.
+pub fn nc_table_with(name: &str, line: &str) -> std::path::PathBuf {
+    let nc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../config/classes/nc.toml"))
+        .expect("config/classes/nc.toml");
+    let species = nc.matches("max_slope_deg = ").count();
+    assert!(species >= 4, "nc's table has {species} species");
+    let text = nc.lines().fold(String::new(), |mut out, l| {
+        out.push_str(l);
+        out.push('\n');
+        if l.starts_with("max_slope_deg = ") {
+            out.push_str(line);
+            out.push('\n');
+        }
+        out
+    });
+    let path = std::env::temp_dir().join(format!("terramp-{name}-{}.toml", std::process::id()));
+    std::fs::write(&path, text).expect("writing a class table");
+    path
+}

@@ -21,5 +21,5 @@ pub mod tlm;
 pub use data::{TempDir, shared_data};
 pub use datasets::{synth_dataset, synth_dataset_with};
 pub use images::{Golden, differing_pixels, psnr};
-pub use impostors::{nc_impostors, nc_sliced_impostors};
+pub use impostors::{nc_impostors, nc_sliced_impostors, nc_table_with};
 pub use setup::{command, gpu, ground_settings, lavapipe_only, renderer, settled_colour, small_settings};

@@ -4,6 +4,7 @@
 
 use terramp::camera::{MAX_COORDINATE_M, MIN_FOV_DEG};
 use terramp::classes::{DEFAULT_GROUND_BLEND, MAX_SPECIES};
+use terramp::gpu::layout::{TEXCELL_DETAIL_FULL_PX_M, TEXCELL_DETAIL_NONE_PX_M};
 use terramp::photo::measure::{BLOCK_PX, MIN_PIXELS_PER_TEXEL};
 use terramp::seeds::wind::{GUST_WAVELENGTH_M, LEAN_PER_SPEED_SQ, MAX_LEAN};
 use terramp::truth::DEFAULT_REACH_M;
@@ -160,6 +161,22 @@ pub static CLAIMS: &[Claim] = &[
         doc: "docs/photo.md",
         quote: "counted when there are at least {} of them",
         values: &[(Source::Value(MIN_PIXELS_PER_TEXEL as f64), plain)],
+    },
+    Claim {
+        doc: "docs/texcells.md",
+        quote: "(from {} to {} m a pixel, `TEXCELL_DETAIL_*_PX_M`)",
+        values: &[
+            (Source::Value(TEXCELL_DETAIL_FULL_PX_M as f64), plain),
+            (Source::Value(TEXCELL_DETAIL_NONE_PX_M as f64), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/photo.md",
+        quote: "(`TEXCELL_DETAIL_FULL_PX_M` {} m to `TEXCELL_DETAIL_NONE_PX_M` {} m a pixel,",
+        values: &[
+            (Source::Value(TEXCELL_DETAIL_FULL_PX_M as f64), plain),
+            (Source::Value(TEXCELL_DETAIL_NONE_PX_M as f64), plain),
+        ],
     },
     Claim {
         doc: "docs/photo.md",

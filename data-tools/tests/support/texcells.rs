@@ -38,22 +38,7 @@ pub fn samples() -> &'static Path {
 /// the bare ground no longer tells where the forest is drawn; in the models' colours it does.
 pub fn own_colours(settings: &mut Settings) {
     static TABLE: OnceLock<PathBuf> = OnceLock::new();
-    let table = TABLE.get_or_init(|| {
-        let nc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../config/classes/nc.toml"))
-            .unwrap();
-        let own = nc.lines().fold(String::new(), |mut out, line| {
-            out.push_str(line);
-            out.push('\n');
-            if line.starts_with("max_slope_deg = ") {
-                out.push_str("ground_blend = 0.0\n");
-            }
-            out
-        });
-        assert!(own.matches("ground_blend = 0.0").count() >= 4, "nc's table has too few species");
-        let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("nc-own-colours.toml");
-        std::fs::write(&path, own).unwrap();
-        path
-    });
+    let table = TABLE.get_or_init(|| terramp_testkit::nc_table_with("nc-own-colours", "ground_blend = 0.0"));
     settings.texcells.ground_blend = 0.0;
     settings.seeds.class_table = table.display().to_string();
 }

@@ -28,6 +28,10 @@ pub struct PhotoArgs {
     /// Folder written: photograph.png, amplified.png, side_by_side.png, photo.json.
     #[arg(long)]
     out: PathBuf,
+    /// Measure this PNG as the amplified frame instead of rendering it: a frame of the same view
+    /// and size rendered elsewhere (another build's `terramp render`, say).
+    #[arg(long)]
+    amplified: Option<PathBuf>,
 }
 
 impl PhotoArgs {
@@ -37,7 +41,14 @@ impl PhotoArgs {
         let gpu = Gpu::new(settings.gpu.adapter)?;
         let adapter = gpu.describe();
         eprintln!("terramp: adapter {adapter}");
-        let view = measure_view(&gpu, dataset, &settings, &camera, self.view.time_s)?;
+        let given = match &self.amplified {
+            Some(path) => {
+                let image = image::open(path).with_context(|| format!("reading {}", path.display()))?;
+                Some(image.to_rgba8())
+            }
+            None => None,
+        };
+        let view = measure_view(&gpu, dataset, &settings, &camera, self.view.time_s, given)?;
         let out = &self.out;
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
         let save = |image: &image::RgbaImage, name: &str| {

@@ -14,10 +14,10 @@ fn frame(w: u32, h: u32, colour: impl Fn(u32, u32) -> [u8; 3]) -> RgbaImage {
     })
 }
 
-/// Keys of a `w` × `h` view over texels `texel_px` pixels wide, every pixel vegetated.
+/// Keys of a `w` × `h` view over texels `texel_px` pixels wide, every pixel wooded.
 fn grid_keys(w: u32, h: u32, texel_px: u32) -> PixelKeys {
     let texel = (0..h).flat_map(|y| (0..w).map(move |x| texel_key([x / texel_px, y / texel_px]))).collect();
-    PixelKeys { size_px: [w, h], texel, vegetated: vec![true; (w * h) as usize] }
+    PixelKeys { size_px: [w, h], texel, wooded: vec![true; (w * h) as usize] }
 }
 
 fn lab_of_bytes(rgb: [u8; 3]) -> Lab {
@@ -32,7 +32,7 @@ fn a_frame_against_itself_is_zero_everywhere() {
     assert_eq!(figures.blocks.counted, 16);
     assert_eq!(figures.texels.delta_e.unwrap().max, 0.0);
     assert_eq!(figures.blocks.delta_e.unwrap().max, 0.0);
-    assert_eq!((figures.vegetated_px, figures.changed_px, figures.changed_share), (400, 0, Some(0.0)));
+    assert_eq!((figures.wooded_px, figures.changed_px, figures.changed_share), (400, 0, Some(0.0)));
     assert_eq!(figures.texels.amplified_mean_l, figures.texels.photograph_mean_l);
 }
 
@@ -75,13 +75,13 @@ fn means_are_taken_in_linear_light() {
 }
 
 #[test]
-fn footprints_count_only_with_enough_pixels_mostly_vegetated() {
-    // Texel 0: 4 pixels, 2 vegetated (counts); texel 1: 4 pixels, 1 vegetated (does not); texel 2:
-    // 3 pixels, all vegetated (too few); the last pixel is sky.
+fn footprints_count_only_with_enough_pixels_mostly_wooded() {
+    // Texel 0: 4 pixels, 2 wooded (counts); texel 1: 4 pixels, 1 wooded (does not); texel 2:
+    // 3 pixels, all wooded (too few); the last pixel is sky.
     let texel = [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, NO_TEXEL]
         .map(|t| if t == NO_TEXEL { t } else { texel_key([t as u32, 0]) });
-    let vegetated = [true, true, false, false, true, false, false, false, true, true, true, false];
-    let keys = PixelKeys { size_px: [12, 1], texel: texel.to_vec(), vegetated: vegetated.to_vec() };
+    let wooded = [true, true, false, false, true, false, false, false, true, true, true, false];
+    let keys = PixelKeys { size_px: [12, 1], texel: texel.to_vec(), wooded: wooded.to_vec() };
     let photo = frame(12, 1, |_, _| [50, 70, 30]);
     let amplified = frame(12, 1, |x, _| if x == 0 { [20, 30, 10] } else { [50, 70, 30] });
     let figures = measure(&amplified, &photo, &keys).unwrap();
@@ -89,15 +89,15 @@ fn footprints_count_only_with_enough_pixels_mostly_vegetated() {
     assert!(figures.texels.delta_e.unwrap().mean > 1.0);
     // Too small for one 5 × 5 block: no block figures, not a perfect 0.
     assert_eq!((figures.blocks.counted, figures.blocks.delta_e), (0, None));
-    assert_eq!((figures.vegetated_px, figures.changed_px), (6, 1));
+    assert_eq!((figures.wooded_px, figures.changed_px), (6, 1));
 }
 
 #[test]
-fn blocks_need_half_their_pixels_vegetated() {
+fn blocks_need_half_their_pixels_wooded() {
     let photo = frame(10, 5, |_, _| [40, 60, 30]);
     let mut keys = grid_keys(10, 5, 1);
-    // The left block keeps 13 of 25 vegetated (counts), the right 12 (does not).
-    for (i, v) in keys.vegetated.iter_mut().enumerate() {
+    // The left block keeps 13 of 25 wooded (counts), the right 12 (does not).
+    for (i, v) in keys.wooded.iter_mut().enumerate() {
         let (x, y) = (i % 10, i / 10);
         *v = if x < 5 { y * 5 + x < 13 } else { y * 5 + (x - 5) < 12 };
     }
