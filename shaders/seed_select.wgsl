@@ -59,6 +59,7 @@ struct SeedUniforms {
     height_levels: array<vec4<u32>, MAX_LEVELS>,
     lcc_levels: array<vec4<u32>, 4>,
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
+    vegetation: vec4<f32>,
 }
 
 struct SeedCell {
@@ -263,9 +264,48 @@ fn ground_colour(p: GridPos, hash: u32) -> u32 {
         let offset = vec2<f32>(mul(unit(h) * 2.0 - 1.0, u.ground_radius_texels),
                                mul(unit(pcg(h)) * 2.0 - 1.0, u.ground_radius_texels));
         let texel = clamp(p.texel + vec2<i32>(floor(p.frac + offset)), vec2<i32>(0), last);
-        sum += imagery_texel(vec2<u32>(texel));
+        var colour = imagery_texel(vec2<u32>(texel));
+        if u.vegetation.x != 0.0 {
+            colour.a = vegetation_coverage(colour.a);
+        }
+        sum += colour;
     }
     return pack4x8unorm(sum * (1.0 / f32(GROUND_SAMPLES)));
+}
+
+// Whether the imagery's vegetation index lets seed `hash` grow at `p` (level-0 imagery texels):
+// the coded alpha of the four texels around it, bilinear, as an index, against the ramp
+// `seeds.vegetation_*`, by a hash of the seed's own. Where the imagery has no index or no data
+// there, the land cover alone decides.
+fn vegetation_grows(p: GridPos, hash: u32) -> bool {
+    if u.vegetation.x == 0.0 {
+        return true;
+    }
+    // Texel centres lie half a texel in: the texel below-left of p's centre, and p's weights.
+    let q = p.frac - vec2<f32>(0.5);
+    let below = floor(q);
+    let f = q - below;
+    let base = p.texel + vec2<i32>(below);
+    let last = vec2<i32>(u.imagery_size) - 1;
+    var alpha = 0.0;
+    var weight = 0.0;
+    for (var k = 0u; k < 4u; k += 1u) {
+        let d = vec2<i32>(i32(k & 1u), i32(k >> 1u));
+        let t = clamp(base + d, vec2<i32>(0), last);
+        let w = mul(select(1.0 - f.x, f.x, d.x == 1), select(1.0 - f.y, f.y, d.y == 1));
+        let a = imagery_texel(vec2<u32>(t)).a;
+        if a > 0.0 {
+            alpha += mul(w, a);
+            weight += w;
+        }
+    }
+    if weight <= 0.0 {
+        return true;
+    }
+    // `vegetation_index`, product by product.
+    let index = mul(mul(alpha / weight, 255.0) - 1.0, 2.0 / f32(VEGETATION_CODE_STEPS)) - 1.0;
+    let growth = clamp(mul(index - u.vegetation.y, u.vegetation.z), 0.0, 1.0);
+    return unit(pcg(hash ^ VEGETATION_SALT)) < growth;
 }
 
 // Pixel column holding clip-space x at distance w (x / w in NDC): a first guess by division,
@@ -328,6 +368,11 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     }
 
     let hash = seed_hash(cell.address, rank);
+    // The photograph's vegetation index: a rule of where plants grow, as altitude and slope are.
+    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
+    if !vegetation_grows(imagery, hash) {
+        return out;
+    }
     let height_m = species.height_m.x + mul(species.height_m.y - species.height_m.x, unit(hash));
     let rel_xy = cell.rel_m + vec2<f32>(mul(pos_unit.x, u.cell_m), mul(pos_unit.y, u.cell_m));
     let ground_rel_m = ground.height_m - u.camera_z_m;
@@ -407,7 +452,6 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     out.count = COUNT_SELECTED;
     let drawn = species_index + seed_variant(hash, species.variants);
     out.key = seed_group(drawn, lod);
-    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     out.record = SeedRecord(
         vec3<f32>(rel_xy, base_rel_m),
         height_m,

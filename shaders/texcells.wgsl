@@ -180,7 +180,11 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     let texel = in.grid_m * (tu.inv_cell_m / f32(TEXCELL_REFERENCE_CELLS) * tu.texels);
     let footprint = max(length(dpdx(texel)), length(dpdy(texel)));
     let normal = normalize(in.normal);
-    let ground = ground_albedo(imagery_albedo(in.grid_m), in.rel_m.z + u.camera_grid_m.z, normal);
+    let photo = imagery_sample(in.grid_m);
+    let coverage = select(photo.a, vegetation_coverage(photo.a), u.imagery_texels == IMAGERY_VEGETATION);
+    let ground = ground_albedo(vec4<f32>(photo.rgb, coverage), in.rel_m.z + u.camera_grid_m.z, normal);
+    // Where the photograph's vegetation index says bare ground, the forest thins out.
+    let growth = vegetation_growth(photo);
 
     let distance_m = length(in.rel_m);
     let fade = clamp((distance_m - tu.fade_m.x) / tu.fade_m.y, 0.0, 1.0)
@@ -201,7 +205,7 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
         if bayer4(pixel, 5u) < regular {
             discard;
         }
-        return silhouette(in.rel_m, in.kind_node.y, view, distance_m, ground);
+        return silhouette(in.rel_m, in.kind_node.y, view, distance_m, ground) * growth;
     }
     let forest = forest_at(in.grid_m);
     if forest.coverage <= 0.0 || bayer4(pixel, 5u) >= regular {
@@ -210,7 +214,7 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     let lod = max(log2(max(footprint, 1e-6)), f32(in.slice.y));
     let layer = i32(forest.sample * tu.finest_slices + in.slice.x);
     let sampled = textureSampleLevel(forest_slices, forest_sampler, forest_uv(in.grid_m), layer, lod);
-    let alpha = sampled.a * forest.coverage;
+    let alpha = sampled.a * forest.coverage * growth;
     if alpha <= 0.0 {
         discard;
     }

@@ -40,7 +40,7 @@ use terramp::reference::seed_select::SeedComparison;
 use terramp::seeds::cell_pattern;
 use terramp_testkit::camera::posed;
 
-use support::{build_nc, build_zion};
+use support::{build_nc, build_nc_ndvi, build_zion};
 use terramp_testkit::{TempDir, shared_data};
 
 /// Named camera poses: grid x, y, height above the ground, yaw, pitch.
@@ -105,6 +105,14 @@ fn nc_and_zion_gpu_equals_twin() {
             ("nc oblique", [6000.0, 5000.0, 120.0, 40.0, -12.0]),
             ("nc low", [9000.0, 8000.0, 4.0, 200.0, 0.0]),
             ("nc high", [3000.0, 3000.0, 900.0, 60.0, -35.0]),
+        ],
+    );
+    // The imagery's vegetation index thins the seeds (`seeds.vegetation_*`).
+    gpu_equals_twin(
+        build_nc_ndvi(&tmp.path().join("nc_ndvi")),
+        &[
+            ("nc ndvi oblique", [6000.0, 5000.0, 120.0, 40.0, -12.0]),
+            ("nc ndvi high", [3000.0, 3000.0, 900.0, 60.0, -35.0]),
         ],
     );
     gpu_equals_twin(

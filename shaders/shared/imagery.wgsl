@@ -29,6 +29,24 @@ fn ground_albedo(imagery: vec4<f32>, height_m: f32, normal: vec3<f32>) -> vec3<f
 
 // Linear RGB, and in alpha the imagery's coverage (0 where the source had no data).
 fn imagery_albedo(grid_m: vec2<f32>) -> vec4<f32> {
+    let sampled = imagery_sample(grid_m);
+    if u.imagery_texels == IMAGERY_VEGETATION {
+        return vec4<f32>(sampled.rgb, vegetation_coverage(sampled.a));
+    }
+    return sampled;
+}
+
+// How densely plants grow at an imagery sample (`imagery_sample`) by its vegetation index, 0 to 1
+// (`seeds.vegetation_*`); 1 where the imagery carries none.
+fn vegetation_growth(sampled: vec4<f32>) -> f32 {
+    if u.imagery_texels != IMAGERY_VEGETATION || sampled.a <= 0.0 {
+        return 1.0;
+    }
+    return clamp((vegetation_index(sampled.a) - u.vegetation.x) * u.vegetation.y, 0.0, 1.0);
+}
+
+// Linear RGB and alpha as the imagery stores it (`IMAGERY_VEGETATION`: coded), filtered.
+fn imagery_sample(grid_m: vec2<f32>) -> vec4<f32> {
     // Level-0 texel coordinates, continuous across tiles: their derivatives are the footprint.
     let texel0 = (grid_m - u.imagery_frame.xy) / u.imagery_frame.z;
     let ddx0 = dpdx(texel0);

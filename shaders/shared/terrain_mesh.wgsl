@@ -24,9 +24,8 @@ struct TerrainUniforms {
     cloud_shift: vec4<f32>,
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
     imagery_level_count: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    _pad: u32,
+    vegetation: vec2<f32>,
 }
 
 struct TerrainNode {

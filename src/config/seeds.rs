@@ -37,8 +37,22 @@ pub struct SeedSettings {
     /// Radius around a seed in which its ground colour is sampled from the imagery, metres; 0
     /// samples the seed's own point.
     pub ground_colour_radius_m: f64,
+    /// Where the imagery carries a vegetation index (`dataset::vegetation`): the index at and
+    /// below which seeds and texcells grow none...
+    pub vegetation_bare: f64,
+    /// ... and at and above which they grow as densely as the class table says (linear between).
+    pub vegetation_full: f64,
     /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
     pub class_table: String,
+}
+
+impl SeedSettings {
+    /// The vegetation index's ramp for the shaders: where growth starts, and 1 / the span to full
+    /// growth (`vegetation_bare`, `vegetation_full`; validated: the span is positive).
+    pub fn vegetation_ramp(&self) -> [f32; 2] {
+        let span = (self.vegetation_full - self.vegetation_bare).max(f64::EPSILON);
+        [self.vegetation_bare as f32, (1.0 / span) as f32]
+    }
 }
 
 /// How far behind the terrain's depth something must lie to count as hidden: `m` plus `per_km`
@@ -78,6 +92,14 @@ impl SeedSettings {
         if !(steps == 0 || steps.is_power_of_two() && steps <= 65536) {
             let (key, rule) = ("seeds.occlusion_refine_steps", "0 or a power of two up to 65536");
             return Err(SettingsError::OutOfRange { key, value: steps.to_string(), rule });
+        }
+        let ramp_ok = (-1.0..1.0).contains(&s.vegetation_bare)
+            && s.vegetation_bare < s.vegetation_full
+            && s.vegetation_full <= 1.0;
+        if !ramp_ok {
+            let value = format!("{} to {}", s.vegetation_bare, s.vegetation_full);
+            let rule = "−1 ≤ seeds.vegetation_bare < seeds.vegetation_full ≤ 1 (vegetation index)";
+            return Err(SettingsError::OutOfRange { key: "seeds.vegetation_bare", value, rule });
         }
         let ranges: [(&'static str, f64, f64, f64, &'static str); 9] = [
             ("seeds.seeds_per_pattern", s.seeds_per_pattern.into(), 64.0, 65536.0, "64 to 65536 seeds"),

@@ -60,6 +60,10 @@ fn seed_settings_are_range_checked() {
         ("reference_height_m = 0.0", "seeds.reference_height_m"),
         ("sink_fraction = 0.6", "seeds.sink_fraction"),
         ("ground_colour_radius_m = -2.0", "seeds.ground_colour_radius_m"),
+        ("vegetation_bare = 0.5", "seeds.vegetation_bare"),
+        ("vegetation_full = -0.2", "seeds.vegetation_bare"),
+        ("vegetation_bare = -1.5", "seeds.vegetation_bare"),
+        ("vegetation_full = 1.5", "seeds.vegetation_bare"),
         ("class_table = 3", "seeds.class_table"),
     ] {
         let err = with(&format!("[seeds]\n{bad}\n")).unwrap_err().to_string();

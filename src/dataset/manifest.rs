@@ -36,6 +36,21 @@ pub struct Manifest {
     /// The land cover; absent in a dataset built without it (the ground is then bare everywhere).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub landcover: Option<LandcoverLayer>,
+    /// The imagery's vegetation index, carried in its alpha (`dataset::vegetation`); absent where
+    /// the alpha is the imagery's coverage alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vegetation: Option<Vegetation>,
+}
+
+/// A vegetation index computed at build time at the imagery's resolution and stored in its alpha
+/// channel (`dataset::vegetation`): seeds and texcells thin out where it says bare ground.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Vegetation {
+    /// Which index: "ndvi", (NIR − red) / (NIR + red).
+    pub index: String,
+    /// Where it came from, for the record (the bands and the file).
+    pub source: String,
 }
 
 /// The dataset's coordinate reference system, metric, and where it came from.

@@ -26,6 +26,7 @@ pub mod partition;
 pub mod pyramid;
 pub mod staging;
 pub mod surface;
+pub mod vegetation;
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +41,7 @@ pub use layer_pack::{LayerPack, ValueCheck};
 pub use layer_writer::{LayerError, LayerSpec, Reduce, Texel, Window, write_layer};
 pub use manifest::{
     CellLayer, ClassName, Crs, FORMAT_VERSION, HeightLayer, LandcoverLayer, MANIFEST_FILE, Manifest,
+    Vegetation,
 };
 pub use pack::{Codec, Damage, PACK_VERSION, Pack, PackError, Predictor};
 pub use pyramid::{Pyramid, Sampling, TileId};

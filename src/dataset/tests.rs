@@ -236,6 +236,7 @@ fn manifest_for(spec: &LayerSpec) -> Manifest {
         },
         imagery: None,
         landcover: None,
+        vegetation: None,
     }
 }
 

@@ -63,6 +63,9 @@ wgsl_constants! { dataset_constants:
     /// Imagery texels without data are transparent black (BC1's punch-through): a filtered texel
     /// is the covered texels' colour times their coverage, so the shader divides by alpha.
     pub const IMAGERY_PUNCHED: u32 = 2;
+    /// Imagery texels hold their colour as it is, alpha the coverage and the vegetation index
+    /// (`dataset::vegetation`: 0 no data, else 1 + the index coded).
+    pub const IMAGERY_VEGETATION: u32 = 3;
 }
 
 /// A page-table entry: the tile's cache slot (texture-array layer) + 1, or `PAGE_EMPTY`.
@@ -188,6 +191,12 @@ wgsl_constants! { seed_constants:
     pub const OCCLUSION_FOOTPRINT_PX: i32 = 1;
     /// Imagery texels averaged into a seed's ground colour.
     pub const GROUND_SAMPLES: u32 = 4;
+    /// Salt of the hash that thins a seed by the imagery's vegetation index (`seeds.vegetation_*`),
+    /// apart from every other use of the seed's hash.
+    pub const VEGETATION_SALT: u32 = 0x5eed_0e91;
+    /// A vegetation-coded imagery alpha (`dataset::vegetation`): 0 where the imagery has no data,
+    /// else 1 + the index mapped from [−1, 1] onto 0 to this.
+    pub const VEGETATION_CODE_STEPS: u32 = 254;
     /// Mixed into the seed hash so it never equals the pattern hash of the same cell.
     pub const SEED_SALT: u32 = 0x5eed_5eed;
     /// Mixed into a seed's hash to pick its species' variant, so the pick is independent of the
@@ -391,11 +400,33 @@ fn tlm_visibility(pattern: u32) -> u32 {
     return TLM_FIRST_PATTERN + pattern;
 }
 
+// The vegetation index of a vegetation-coded imagery alpha in [0, 1], filtered or not (Rust:
+// `vegetation_index`).
+fn vegetation_index(alpha: f32) -> f32 {
+    return (alpha * 255.0 - 1.0) / f32(VEGETATION_CODE_STEPS) * 2.0 - 1.0;
+}
+
+// The imagery's coverage from a vegetation-coded alpha: any code above 0 is data (Rust:
+// `vegetation_coverage`).
+fn vegetation_coverage(alpha: f32) -> f32 {
+    return min(alpha * 255.0, 1.0);
+}
+
 // The draw group of a seed (Rust: `seed_group`).
 fn seed_group(species: u32, lod: u32) -> u32 {
     return species * SEED_LODS + lod;
 }
 ";
+
+/// The vegetation index of a vegetation-coded imagery alpha in [0, 1] (WGSL: `vegetation_index`).
+pub fn vegetation_index(alpha: f32) -> f32 {
+    (alpha * 255.0 - 1.0) / VEGETATION_CODE_STEPS as f32 * 2.0 - 1.0
+}
+
+/// The imagery's coverage from a vegetation-coded alpha (WGSL: `vegetation_coverage`).
+pub fn vegetation_coverage(alpha: f32) -> f32 {
+    (alpha * 255.0).min(1.0)
+}
 
 /// Every constant the prelude declares: name, WGSL type, literal.
 pub fn wgsl_constants() -> Vec<(&'static str, &'static str, String)> {

@@ -1,7 +1,8 @@
 //! How it works: the exact oracle of seed visibility, what the accuracy of pass 3 is measured
 //! against (CPU, f64, full resolution, no tolerance). It owes the GPU nothing: it enumerates the
 //! seeds itself, every seed of every ring-0 cell within reach of the camera, and judges each in the
-//! GPU pass's order of culls (class, rule, distance, frustum, occlusion), but exactly. The seeded
+//! GPU pass's order of culls (class, rule: altitude, slope and the imagery's vegetation index,
+//! `vegetation`; distance, frustum, occlusion), but exactly. The seeded
 //! world (patterns, hashes, rank thinning, sizes) is the shared definition in `crate::seeds`.
 //!
 //! The ground is the surface the finest terrain mesh draws over the level-0 height samples (sample
@@ -24,6 +25,7 @@
 //! deterministic: visible seeds sorted by (cell address, rank), counts summed.
 
 mod ground;
+mod vegetation;
 
 use glam::{DMat4, DVec2, DVec3, DVec4};
 use rayon::prelude::*;
@@ -37,6 +39,7 @@ use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::wind::Wind;
 use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, seed_variant, species_of_rank};
 use ground::{DemWindow, LandcoverTiles};
+use vegetation::Vegetation;
 
 /// The fraction of an eye→summit segment, at the summit's end, the occlusion test ignores.
 pub const SEGMENT_END_SKIP: f64 = 1e-6;
@@ -275,6 +278,7 @@ impl ViewFrame {
         let dataset = inputs.dataset;
         let dem = DemWindow::load(dataset, region_min, region_max)?;
         let landcover = LandcoverTiles::load(dataset, region_min, region_max)?;
+        let vegetation = Vegetation::load(dataset, inputs.settings, region_min, region_max)?;
         let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= extent_m[0] && p.y <= extent_m[1];
         // An eye below the ground sees nothing (every seed reaching the occlusion test is hidden).
         let eye_underground = inside(eye.truncate()) && eye.z < dem.ground(eye.truncate()).0;
@@ -284,6 +288,7 @@ impl ViewFrame {
             culls,
             dem,
             landcover,
+            vegetation,
             planes,
             eye,
             eye_underground,
@@ -347,6 +352,7 @@ struct View<'a> {
     culls: Culls,
     dem: DemWindow,
     landcover: LandcoverTiles,
+    vegetation: Vegetation,
     planes: [DVec4; 5],
     eye: DVec3,
     eye_underground: bool,
@@ -414,6 +420,9 @@ impl View<'_> {
         }
         let seeds = &settings.seeds;
         let hash = seed_hash(i32_address, rank, settings.tlm.seed);
+        if !self.vegetation.grows(p, hash) {
+            return Ok(Fate::Rule);
+        }
         let height_m = f64::from(seed_height_m(species, hash));
         let rel = DVec3::new(p.x, p.y, ground_m) - self.eye;
         let distance_m = rel.length();

@@ -17,7 +17,7 @@ use crate::gpu::layout::{
     COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_OVERFLOW, COUNT_RULE,
     COUNT_SELECTED, GROUND_SAMPLES, IMAGERY_BORDER, IMAGERY_TILE_TEXELS, LCC_LEVELS, LCC_PACKED_LEVEL,
     LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS, SEED_LODS, SEED_WORKGROUP,
-    SpeciesLod, page_slot, seed_group,
+    SpeciesLod, VEGETATION_CODE_STEPS, VEGETATION_SALT, page_slot, seed_group, vegetation_coverage,
 };
 use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
 use crate::passes::seed_select::march::{block_max_m, height_tile_max_m};
@@ -300,6 +300,37 @@ fn imagery_texel(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, t: [u32; 2]) ->
     [0.0; 4]
 }
 
+/// Whether the imagery's vegetation index lets seed `hash` grow at `p` (the shader's
+/// `vegetation_grows`, step by step).
+fn vegetation_grows(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, hash: u32) -> bool {
+    if u.vegetation[0] == 0.0 {
+        return true;
+    }
+    let q = p.frac.map(|f| f - 0.5);
+    let below = q.map(f32::floor);
+    let f = [q[0] - below[0], q[1] - below[1]];
+    let last = u.imagery_size.map(|n| n as i32 - 1);
+    let (mut alpha, mut weight) = (0.0f32, 0.0f32);
+    for k in 0..4u32 {
+        let d = [(k & 1) as i32, (k >> 1) as i32];
+        let t: [u32; 2] =
+            std::array::from_fn(|a| (p.texel[a] + below[a] as i32 + d[a]).clamp(0, last[a]) as u32);
+        let side = |a: usize| if d[a] == 1 { f[a] } else { 1.0 - f[a] };
+        let w = side(0) * side(1);
+        let a = imagery_texel(u, imagery, t)[3];
+        if a > 0.0 {
+            alpha += w * a;
+            weight += w;
+        }
+    }
+    if weight <= 0.0 {
+        return true;
+    }
+    let index = ((alpha / weight) * 255.0 - 1.0) * (2.0 / VEGETATION_CODE_STEPS as f32) - 1.0;
+    let growth = ((index - u.vegetation[1]) * u.vegetation[2]).clamp(0.0, 1.0);
+    unit(pcg(hash ^ VEGETATION_SALT)) < growth
+}
+
 fn ground_colour(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, hash: u32) -> u32 {
     if u.imagery_level_count == 0 {
         return 0;
@@ -316,7 +347,10 @@ fn ground_colour(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, ha
         let texel: [u32; 2] = std::array::from_fn(|a| {
             (p.texel[a] + (p.frac[a] + offset[a]).floor() as i32).clamp(0, last[a]) as u32
         });
-        let colour = imagery_texel(u, imagery, texel);
+        let mut colour = imagery_texel(u, imagery, texel);
+        if u.vegetation[0] != 0.0 {
+            colour[3] = vegetation_coverage(colour[3]);
+        }
         for c in 0..4 {
             sum[c] += colour[c];
         }
@@ -370,6 +404,10 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
     }
 
     let hash = seed_hash(cell.address, rank, u.seed);
+    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
+    if !vegetation_grows(u, inputs.imagery, &imagery, hash) {
+        return Err(COUNT_RULE);
+    }
     let height_m = species.height_m[0] + (species.height_m[1] - species.height_m[0]) * unit(hash);
     let rel_xy = [cell.rel_m[0] + pos_unit[0] * u.cell_m, cell.rel_m[1] + pos_unit[1] * u.cell_m];
     let ground_rel_m = ground.height_m - u.camera_z_m;
@@ -434,7 +472,6 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
     }
 
     let drawn = species_index + seed_variant(hash, species.variants);
-    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     Ok(SeedRecord {
         position_rel_m: [rel_xy[0], rel_xy[1], base_rel_m],
         height_m,

@@ -150,6 +150,7 @@ impl Layers {
                 scheme: table.scheme,
                 nodata_code: LANDCOVER_NODATA,
             }),
+            vegetation: None,
         })
     }
 }

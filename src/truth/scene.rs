@@ -118,7 +118,12 @@ impl<'a> ImageryTexels<'a> {
         let at = 4 * (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize;
         let rgba = bytes.get(at..at + 4).unwrap_or(&[0; 4]);
         let linear = super::srgb_to_linear;
-        Ok([linear(rgba[0]), linear(rgba[1]), linear(rgba[2]), f64::from(rgba[3]) / 255.0])
+        // A vegetation-coded alpha (`dataset::vegetation`): any code above 0 is data.
+        let coverage = match self.dataset.manifest.vegetation {
+            Some(_) => f64::from(rgba[3].min(1)),
+            None => f64::from(rgba[3]) / 255.0,
+        };
+        Ok([linear(rgba[0]), linear(rgba[1]), linear(rgba[2]), coverage])
     }
 
     /// Pass 3's ground colour, from level 0: the mean of `GROUND_SAMPLES` texels at hashed

@@ -163,6 +163,11 @@ pub static CLAIMS: &[Claim] = &[
         values: &[(Source::Value(MIN_PIXELS_PER_TEXEL as f64), plain)],
     },
     Claim {
+        doc: "docs/photo.md",
+        quote: "(`seeds.vegetation_bare` {}: none, `vegetation_full` {}: the class table's density)",
+        values: &[(default("seeds.vegetation_bare"), plain), (default("seeds.vegetation_full"), plain)],
+    },
+    Claim {
         doc: "docs/texcells.md",
         quote: "(from {} to {} m a pixel, `TEXCELL_DETAIL_*_PX_M`)",
         values: &[

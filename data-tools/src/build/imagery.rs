@@ -16,7 +16,9 @@ use anyhow::{Context, Result, ensure};
 use gdal::raster::{ColorInterpretation, GdalDataType};
 use indicatif::ProgressBar;
 use serde::{Deserialize, Serialize};
-use terramp::dataset::{CellLayer, IMAGERY_MIPS, LayerSpec, Staging, Window, write_layer};
+use terramp::dataset::{
+    CellLayer, IMAGERY_MIPS, LayerSpec, Staging, Vegetation, Window, vegetation, write_layer,
+};
 
 use super::frame::{Frame, Grid};
 use super::raster::{Access, GridRaster, Resampling, SourceRaster};
@@ -87,6 +89,9 @@ pub struct Imagery {
     /// The colour of texels without data: the mean of the valid ones.
     fill_rgb: [u8; 3],
     pub bands: Vec<usize>,
+    /// The near-infrared band read after `bands`, whose NDVI against the red band (the first of
+    /// `bands`) the alpha carries (`terramp::dataset::vegetation`).
+    nir_band: Option<usize>,
 }
 
 impl Imagery {
@@ -94,12 +99,21 @@ impl Imagery {
     /// `look` (a plan's) when given.
     pub fn open(
         path: &Path,
-        bands: Option<&[usize]>,
+        (bands, nir_band): (Option<&[usize]>, Option<usize>),
         frame: &Frame,
         look: Option<&ImageryLook>,
     ) -> Result<Self> {
         let source = SourceRaster::open(path, "imagery")?;
         let bands = choose_bands(&source, bands).with_context(|| format!("imagery {}", path.display()))?;
+        if let Some(nir) = nir_band {
+            let count = source.dataset.raster_count();
+            ensure!(
+                bands.len() == 3 && (1..=count).contains(&nir),
+                "imagery {}: --nir-band {nir} needs three colour bands (the first is red) and a band \
+                 that exists (the raster has {count})",
+                path.display()
+            );
+        }
         let grid = frame.cell_grid(&source)?;
         let (colour, fill_rgb) = match look {
             Some(look) => (colour_planned(&source, &bands, look)?, look.fill_rgb),
@@ -113,8 +127,9 @@ impl Imagery {
             Colour::Palette(_) => Resampling::Nearest,
             Colour::Bands(_) => Resampling::Bilinear,
         };
-        let raster = GridRaster::new(source, &grid, &frame.srs, &bands, resampling, true)?;
-        Ok(Self { raster, colour, fill_rgb, bands })
+        let read: Vec<usize> = bands.iter().copied().chain(nir_band).collect();
+        let raster = GridRaster::new(source, &grid, &frame.srs, &read, resampling, true)?;
+        Ok(Self { raster, colour, fill_rgb, bands, nir_band })
     }
 
     /// The look this imagery's colours were made with.
@@ -146,11 +161,32 @@ impl Imagery {
             .map(|k| {
                 values.iter_mut().zip(&bands).for_each(|(v, band)| *v = band[k]);
                 match self.colour.rgb(&values) {
-                    Some([r, g, b]) => [r, g, b, 255],
+                    Some([r, g, b]) => [r, g, b, self.alpha(&values)],
                     None => [self.fill_rgb[0], self.fill_rgb[1], self.fill_rgb[2], 0],
                 }
             })
             .collect())
+    }
+
+    /// A texel's alpha, where it has data: full coverage, or the vegetation index coded
+    /// (`vegetation::encode`; an index the bands do not define is 0, neither bare nor green).
+    fn alpha(&self, values: &[f64]) -> u8 {
+        match (self.nir_band, values.first(), values.get(self.bands.len())) {
+            (Some(_), Some(&red), Some(&nir)) => {
+                vegetation::encode(vegetation::ndvi(nir, red).unwrap_or(0.0))
+            }
+            _ => 255,
+        }
+    }
+
+    /// What the manifest says of the vegetation index in the alpha, if any.
+    pub fn vegetation(&self) -> Option<Vegetation> {
+        let nir = self.nir_band?;
+        let red = self.bands.first()?;
+        Some(Vegetation {
+            index: vegetation::NDVI.to_owned(),
+            source: format!("bands {nir} (near infrared) and {red} (red) of {}", self.raster.path.display()),
+        })
     }
 
     /// The manifest's imagery layer, as written in plain texels.

@@ -48,6 +48,11 @@ pub struct InputArgs {
     /// Imagery bands (1-based) to use as red,green,blue, e.g. `3,2,1`; one band gives grey.
     #[arg(long, value_delimiter = ',', requires = "imagery")]
     pub bands: Option<Vec<usize>>,
+    /// The imagery's near-infrared band (1-based, e.g. 4 for Landsat 7): its NDVI against the red
+    /// band (the first of `--bands`) is stored in the imagery's alpha, and seeds and texcells thin
+    /// out where it says bare ground (`seeds.vegetation_*`). Needs three bands, rgba8 or bc7.
+    #[arg(long, requires = "imagery")]
+    pub nir_band: Option<usize>,
     /// A land-cover classification raster.
     #[arg(long, requires = "classes")]
     pub landcover: Option<PathBuf>,
@@ -127,8 +132,18 @@ impl Inputs {
             None => HeightStep::default_for(&dem_source)?,
         };
         let frame = Frame::from_dem(&dem_source)?;
-        let imagery =
-            args.imagery.as_deref().map(|path| Imagery::open(path, args.bands.as_deref(), &frame, look));
+        let imagery = args.imagery.as_deref().map(|path| {
+            let bands = (args.bands.as_deref(), args.nir_band);
+            Imagery::open(path, bands, &frame, look)
+        });
+        if args.nir_band.is_some() {
+            anyhow::ensure!(
+                !imagery_format.holes_are_transparent(),
+                "--nir-band stores the vegetation index in the imagery's alpha, which {} cannot hold \
+                 (one bit): build with --imagery-format rgba8 or bc7",
+                imagery_format.name()
+            );
+        }
         let landcover = match (&args.landcover, &args.classes) {
             (Some(path), Some(classes)) => Some(Landcover::open(path, classes, &frame)?),
             _ => None,
@@ -196,6 +211,7 @@ fn write_layers(
         crs: inputs.frame.crs.clone(),
         origin_m: inputs.frame.origin_m(),
         height,
+        vegetation: inputs.imagery.as_ref().and_then(Imagery::vegetation),
         imagery,
         landcover,
     };

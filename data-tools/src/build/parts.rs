@@ -96,6 +96,9 @@ fn is_virtual(path: &Path) -> bool {
 pub struct PlannedImagery {
     pub file: InputFile,
     pub bands: Vec<usize>,
+    /// The near-infrared band whose NDVI the alpha carries (`--nir-band`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nir_band: Option<usize>,
     pub look: ImageryLook,
 }
 
@@ -155,6 +158,7 @@ impl GeotiffSource {
             (Some(imagery), Some(path)) => Some(PlannedImagery {
                 file: InputFile::measure(path)?,
                 bands: imagery.bands.clone(),
+                nir_band: args.nir_band,
                 look: imagery.look(),
             }),
             _ => None,
@@ -187,6 +191,7 @@ impl GeotiffSource {
             dem: Some(self.dem.path.clone()),
             imagery: self.imagery.as_ref().map(|i| i.file.path.clone()),
             bands: self.imagery.as_ref().map(|i| i.bands.clone()),
+            nir_band: self.imagery.as_ref().and_then(|i| i.nir_band),
             landcover: self.landcover.as_ref().map(|l| l.file.path.clone()),
             classes: self.landcover.as_ref().map(|l| l.classes.clone()),
             height_step_m: Some(self.height_step_m),
@@ -359,6 +364,7 @@ impl GeotiffParts {
             crs: self.inputs.frame.crs.clone(),
             origin_m: self.inputs.frame.origin_m(),
             height,
+            vegetation: self.inputs.imagery.as_ref().and_then(super::Imagery::vegetation),
             imagery,
             landcover,
         };

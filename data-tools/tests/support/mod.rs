@@ -50,6 +50,17 @@ pub fn build(out: &Path, args: &[&str]) -> (Dataset, String) {
 
 /// Builds `nc/`'s co-registered trio (DEM, Landsat true colour, land use) into `out`.
 pub fn build_nc(out: &Path) -> Dataset {
+    build_nc_with(out, &[])
+}
+
+/// Builds `nc/` as `build_nc` does, with the imagery's NDVI (Landsat band 4 against band 3) in
+/// its alpha (`--nir-band 4`).
+pub fn build_nc_ndvi(out: &Path) -> Dataset {
+    build_nc_with(out, &["--nir-band", "4"])
+}
+
+/// `nc/`'s DEM, Landsat bands 3, 2, 1 and land use, built into `out` with `extra` arguments.
+fn build_nc_with(out: &Path, extra: &[&str]) -> Dataset {
     let nc = shared_data().expect("../shared/data").join("nc");
     let arg = |f: &str| nc.join(f).to_str().unwrap().to_owned();
     let args = [
@@ -59,7 +70,9 @@ pub fn build_nc(out: &Path) -> Dataset {
         ["--landcover", &arg("landuse_r.tif")],
         ["--classes", "nc"],
     ];
-    build(out, &args.concat()).0
+    let mut all = args.concat();
+    all.extend_from_slice(extra);
+    build(out, &all).0
 }
 
 /// Builds `zion/`'s reprojected DEM and NLCD land cover (no imagery) into `out`.

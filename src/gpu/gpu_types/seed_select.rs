@@ -94,6 +94,10 @@ gpu_struct! {
         pub lcc_levels: [[u32; 4]; 4],
         /// The imagery page table per level, laid out as `height_levels` (0 without imagery).
         pub imagery_levels: [[u32; 4]; MAX_LEVELS as usize],
+        /// The imagery's vegetation index (`dataset::vegetation`): 1 where its alpha carries it,
+        /// else 0 (x); where growth starts (`seeds.vegetation_bare`, y) and 1 / the span to full
+        /// growth (z); w unused.
+        pub vegetation: [f32; 4],
     }
 }
 

@@ -24,7 +24,7 @@ gpu_struct! {
         /// vertices, its skirt ring included.
         pub node_cells: u32,
         /// How the dataset's imagery texels carry coverage: `IMAGERY_NONE` (no imagery: the relief
-        /// tint shows), `IMAGERY_STRAIGHT` or `IMAGERY_PUNCHED`.
+        /// tint shows), `IMAGERY_STRAIGHT`, `IMAGERY_PUNCHED` or `IMAGERY_VEGETATION`.
         pub imagery_texels: u32,
         /// Imagery: grid-space position of texel (0, 0)'s south-west corner (xy), level-0 texel edge
         /// in metres (z), level-of-detail bias in log2 texels (w).
@@ -41,7 +41,10 @@ gpu_struct! {
         /// Imagery levels stored, then padding.
         pub imagery_level_count: u32,
         /// Padding to the WGSL struct's alignment (always 0).
-        pub _pad: [u32; 3],
+        pub _pad: u32,
+        /// With `IMAGERY_VEGETATION`: the index where growth starts (`seeds.vegetation_bare`) and
+        /// 1 / the span to full growth (`seeds.vegetation_full`); the texcells thin by it.
+        pub vegetation: [f32; 2],
     }
 }
 

@@ -159,6 +159,7 @@ impl SeedFrame {
             height_levels: page_levels(&dataset.height.pyramid),
             lcc_levels: [[0; 4]; 4],
             imagery_levels: [[0; 4]; MAX_LEVELS as usize],
+            vegetation: [0.0; 4],
         };
         // Level-1 land-cover texels are twice the level-0 ones (the level that duplicates them).
         let lcc_texel_m = match (&dataset.landcover, &manifest.landcover) {
@@ -179,6 +180,10 @@ impl SeedFrame {
                 u.imagery_level_count = layer.pyramid.levels.min(MAX_LEVELS);
                 u.imagery_size = layer.pyramid.size;
                 u.imagery_levels = page_levels(&layer.pyramid);
+                if manifest.vegetation.is_some() {
+                    let [bare, inv_span] = seeds.vegetation_ramp();
+                    u.vegetation = [1.0, bare, inv_span, 0.0];
+                }
                 Some(meta.texel_m)
             }
             _ => None,

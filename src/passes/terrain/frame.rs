@@ -10,7 +10,7 @@ use crate::config::Settings;
 use crate::dataset::surface::diagonal_rises;
 use crate::dataset::{Dataset, ImageryFormat, TileId};
 use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
-use crate::gpu::layout::{IMAGERY_NONE, IMAGERY_PUNCHED, IMAGERY_STRAIGHT, MAX_LEVELS};
+use crate::gpu::layout::{IMAGERY_NONE, IMAGERY_PUNCHED, IMAGERY_STRAIGHT, IMAGERY_VEGETATION, MAX_LEVELS};
 use crate::light::{CloudShadowFrame, sun_dir};
 use crate::streaming::{TileCache, page_levels};
 
@@ -93,14 +93,16 @@ pub fn terrain_uniforms(
             Some(layer) if layer.block_format.is_some_and(ImageryFormat::holes_are_transparent) => {
                 IMAGERY_PUNCHED
             }
+            Some(_) if manifest.vegetation.is_some() => IMAGERY_VEGETATION,
             Some(_) => IMAGERY_STRAIGHT,
         },
+        vegetation: settings.seeds.vegetation_ramp(),
         imagery_frame: [0.0; 4],
         cloud_field: clouds.field,
         cloud_shift: clouds.shift,
         imagery_levels: [[0; 4]; MAX_LEVELS as usize],
         imagery_level_count: 1,
-        _pad: [0; 3],
+        _pad: 0,
     };
     if let (Some(layer), Some(meta)) = (&dataset.imagery, &manifest.imagery) {
         let p = &layer.pyramid;
