@@ -273,6 +273,13 @@ fn ground_colour(p: GridPos, hash: u32) -> u32 {
     return pack4x8unorm(sum * (1.0 / f32(GROUND_SAMPLES)));
 }
 
+// How far a seed's land-cover read moves, texels, each way in [-0.5, 0.5) (Rust: the twin's and
+// the oracle's `class_offset`).
+fn class_offset(address: vec2<i32>, rank: u32) -> vec2<f32> {
+    let h = pcg(seed_hash(address, rank) ^ CLASS_EDGE_SALT);
+    return vec2<f32>(unit(h) - 0.5, unit(pcg(h)) - 0.5);
+}
+
 // Whether the imagery's vegetation index lets seed `hash` grow at `p` (level-0 imagery texels):
 // the coded alpha of the four texels around it, bilinear, as an index, against the ramp
 // `seeds.vegetation_*`, by a hash of the seed's own. Where the imagery has no index or no data
@@ -343,7 +350,12 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
         return out;
     }
     let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);
-    let q = vec2<u32>(clamp(lcc.texel, vec2<i32>(0), vec2<i32>(u.lcc_size) - 1));
+    // A class boundary, dithered: the class is read up to half a texel away from the seed, by a
+    // hash of its own, so a seed near a boundary takes the neighbour's class with the share
+    // bilinear interpolation gives it, and a forest's edge is as smooth as its seeds are dense,
+    // not a staircase of the land cover's cells.
+    let moved = lcc.frac + class_offset(cell.address, rank);
+    let q = vec2<u32>(clamp(lcc.texel + vec2<i32>(floor(moved)), vec2<i32>(0), vec2<i32>(u.lcc_size) - 1));
     let found = class_at(q, cell.lcc_level);
     if found.x >= arrayLength(&class_table) {
         return out;

@@ -13,7 +13,7 @@ use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::SeedRecord;
 use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP, SpeciesLod, seed_group};
 use terramp::passes::seed_select::march::BLOCKS_PER_TILE;
-use terramp::reference::seed_select::{SeedComparison, occlusion_march, seed_select};
+use terramp::reference::seed_select::{SeedComparison, class_offset, occlusion_march, seed_select};
 use terramp::reference::worst::max_or_nan;
 use terramp_testkit::camera::over_fraction;
 
@@ -450,8 +450,11 @@ fn classes_missing_from_the_table_grow_nothing() {
     let (texel_m, half) = (2.0 * landcover.layer.texel_m, 0.5 * m.height.spacing_m);
     let camera_grid = camera.position_m - DVec3::new(m.origin_m[0], m.origin_m[1], 0.0);
     for s in &records {
-        let p =
-            [camera_grid.x + f64::from(s.position_rel_m[0]), camera_grid.y + f64::from(s.position_rel_m[1])];
+        // Each seed's class is read where its hash moves it, up to half a texel (`class_offset`).
+        let offset = class_offset(s.address, s.rank, r.settings.tlm.seed);
+        let p: [f64; 2] = std::array::from_fn(|a| {
+            camera_grid[a] + f64::from(s.position_rel_m[a]) + f64::from(offset[a]) * texel_m
+        });
         let q = p.map(|v| ((v + half) / texel_m).floor() as u32);
         let code = landcover.coding.code_of(r.dataset.landcover_index(1, q).unwrap());
         assert_eq!(code, Some(3), "a seed grew on class {code:?}");

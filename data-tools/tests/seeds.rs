@@ -36,7 +36,7 @@ use terramp::gpu::layout::SpeciesLod;
 use terramp::passes::seed_select::frame::SeedCellRef;
 use terramp::reference::accuracy::{HeightError, SeedAgreement, SeedId, record_id};
 use terramp::reference::oracle::{OracleInputs, visible_seeds};
-use terramp::reference::seed_select::SeedComparison;
+use terramp::reference::seed_select::{SeedComparison, class_offset};
 use terramp::seeds::cell_pattern;
 use terramp_testkit::camera::posed;
 
@@ -267,7 +267,12 @@ fn nc_species_follow_the_land_cover() {
     };
     let mut seeds_per_code = std::collections::BTreeMap::<u8, u64>::new();
     for s in &records {
-        let code = code_at(c.x + f64::from(s.position_rel_m[0]), c.y + f64::from(s.position_rel_m[1]));
+        // Its class is read where its hash moves it, up to half a texel (`class_offset`).
+        let offset = class_offset(s.address, s.rank, r.settings.tlm.seed).map(|v| f64::from(v) * texel_m);
+        let code = code_at(
+            c.x + f64::from(s.position_rel_m[0]) + offset[0],
+            c.y + f64::from(s.position_rel_m[1]) + offset[1],
+        );
         let species = &table.species[SpeciesLod::unpack(s.species_lod).species as usize];
         assert!(
             !(species.kind == SpeciesKind::Tree && (code == 1 || code == 6)),

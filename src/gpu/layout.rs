@@ -194,6 +194,9 @@ wgsl_constants! { seed_constants:
     /// Salt of the hash that thins a seed by the imagery's vegetation index (`seeds.vegetation_*`),
     /// apart from every other use of the seed's hash.
     pub const VEGETATION_SALT: u32 = 0x5eed_0e91;
+    /// Salt of the hash that moves a seed's land-cover read by up to half a texel each way (a
+    /// forest's edge dithered, `seed_select.wgsl` `class_offset`).
+    pub const CLASS_EDGE_SALT: u32 = 0xed9e_5eed;
     /// A vegetation-coded imagery alpha (`dataset::vegetation`): 0 where the imagery has no data,
     /// else 1 + the index mapped from [−1, 1] onto 0 to this.
     pub const VEGETATION_CODE_STEPS: u32 = 254;

@@ -35,6 +35,7 @@ use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::{Dataset, PackError};
 use crate::gpu::gpu_types::SeedSpecies;
+use crate::reference::seed_select::class_offset;
 use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::wind::Wind;
 use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, seed_variant, species_of_rank};
@@ -404,7 +405,9 @@ impl View<'_> {
         if !(p.x >= 0.0 && p.y >= 0.0 && p.x <= self.extent_m[0] && p.y <= self.extent_m[1]) {
             return Ok(Fate::Class);
         }
-        let index = self.landcover.index(dataset, p)?;
+        // Pass 3's dithered class boundary: the read moved by up to half a level-1 texel.
+        let offset = class_offset(i32_address, rank, settings.tlm.seed).map(f64::from);
+        let index = self.landcover.index(dataset, p + DVec2::from(offset) * self.landcover.texel_m())?;
         let class = tables.classes.get(index as usize);
         let found = class.and_then(|class| species_of_rank(class, rank));
         let Some((species_index, species)) = found.and_then(|k| Some((k, tables.species.get(k as usize)?)))

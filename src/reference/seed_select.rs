@@ -14,10 +14,10 @@ use crate::classes::MAX_SPECIES_PER_CLASS;
 use crate::dataset::{Dataset, PackError, TileId};
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{
-    COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION, COUNT_OVERFLOW, COUNT_RULE,
-    COUNT_SELECTED, GROUND_SAMPLES, IMAGERY_BORDER, IMAGERY_TILE_TEXELS, LCC_LEVELS, LCC_PACKED_LEVEL,
-    LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS, SEED_LODS, SEED_WORKGROUP,
-    SpeciesLod, VEGETATION_CODE_STEPS, VEGETATION_SALT, page_slot, seed_group, vegetation_coverage,
+    CLASS_EDGE_SALT, COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION,
+    COUNT_OVERFLOW, COUNT_RULE, COUNT_SELECTED, GROUND_SAMPLES, IMAGERY_BORDER, IMAGERY_TILE_TEXELS,
+    LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS,
+    SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group, vegetation_coverage,
 };
 use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
 use crate::passes::seed_select::march::{block_max_m, height_tile_max_m};
@@ -27,7 +27,7 @@ use crate::streaming::TileCache;
 mod compare;
 mod ground;
 
-use ground::ground_at;
+use ground::{ground_at, vegetation_grows};
 
 pub use compare::SeedComparison;
 pub use ground::{OcclusionMarch, occlusion_march};
@@ -300,35 +300,11 @@ fn imagery_texel(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, t: [u32; 2]) ->
     [0.0; 4]
 }
 
-/// Whether the imagery's vegetation index lets seed `hash` grow at `p` (the shader's
-/// `vegetation_grows`, step by step).
-fn vegetation_grows(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, hash: u32) -> bool {
-    if u.vegetation[0] == 0.0 {
-        return true;
-    }
-    let q = p.frac.map(|f| f - 0.5);
-    let below = q.map(f32::floor);
-    let f = [q[0] - below[0], q[1] - below[1]];
-    let last = u.imagery_size.map(|n| n as i32 - 1);
-    let (mut alpha, mut weight) = (0.0f32, 0.0f32);
-    for k in 0..4u32 {
-        let d = [(k & 1) as i32, (k >> 1) as i32];
-        let t: [u32; 2] =
-            std::array::from_fn(|a| (p.texel[a] + below[a] as i32 + d[a]).clamp(0, last[a]) as u32);
-        let side = |a: usize| if d[a] == 1 { f[a] } else { 1.0 - f[a] };
-        let w = side(0) * side(1);
-        let a = imagery_texel(u, imagery, t)[3];
-        if a > 0.0 {
-            alpha += w * a;
-            weight += w;
-        }
-    }
-    if weight <= 0.0 {
-        return true;
-    }
-    let index = ((alpha / weight) * 255.0 - 1.0) * (2.0 / VEGETATION_CODE_STEPS as f32) - 1.0;
-    let growth = ((index - u.vegetation[1]) * u.vegetation[2]).clamp(0.0, 1.0);
-    unit(pcg(hash ^ VEGETATION_SALT)) < growth
+/// How far a seed's land-cover read moves, texels, each way in [−0.5, 0.5): a class boundary
+/// dithered (the shader's `class_offset`).
+pub fn class_offset(address: [i32; 2], rank: u32, seed: u32) -> [f32; 2] {
+    let h = pcg(seed_hash(address, rank, seed) ^ CLASS_EDGE_SALT);
+    [unit(h) - 0.5, unit(pcg(h)) - 0.5]
 }
 
 fn ground_colour(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, hash: u32) -> u32 {
@@ -387,7 +363,11 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         return Err(COUNT_CLASS);
     }
     let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);
-    let q: [u32; 2] = std::array::from_fn(|a| lcc.texel[a].clamp(0, u.lcc_size[a] as i32 - 1) as u32);
+    let offset = class_offset(cell.address, rank, u.seed);
+    let q: [u32; 2] = std::array::from_fn(|a| {
+        let moved = lcc.frac[a] + offset[a];
+        (lcc.texel[a] + moved.floor() as i32).clamp(0, u.lcc_size[a] as i32 - 1) as u32
+    });
     let (index, lcc_level) = class_at(u, inputs.landcover, q, cell.lcc_level).ok_or(COUNT_CLASS)?;
     let seeds = inputs.tables.classes.get(index as usize).ok_or(COUNT_CLASS)?;
     let k = (0..MAX_SPECIES_PER_CLASS).find(|&k| (rank as f32) < seeds.rank_limit[k]).ok_or(COUNT_CLASS)?;

@@ -192,6 +192,11 @@ impl LandcoverTiles {
         Ok(tiles)
     }
 
+    /// A level-1 texel's edge, metres (1 without land cover).
+    pub(super) fn texel_m(&self) -> f64 {
+        self.grid.map_or(1.0, |(texel_m, ..)| texel_m)
+    }
+
     /// The level-1 texel holding grid point `p`, clamped to the layer.
     fn texel(&self, p: DVec2) -> [u32; 2] {
         let Some((texel_m, half_spacing_m, size)) = self.grid else { return [0; 2] };
