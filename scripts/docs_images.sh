@@ -301,9 +301,10 @@ make_texcells() {
     compose --columns 1 --scale 0.75 --gap 4 --out docs/texcells_zion_rim.png "${shots[@]}"
 }
 
-# The photograph, before the colour follow-up and after it: nc's forest from 3 km straight down,
-# 1.5 km at 45° and 300 m at 30°. "Before" is the release build of c1e844b (the last commit before
-# it), built once in a worktree of its own (long: a second release build), or BEFORE_BIN if given.
+# The photograph, before the colour follow-up, after it, and after it on nc built with its
+# vegetation index (--nir-band 4): nc's forest from 3 km straight down, 1.5 km at 45° and 300 m at
+# 30°. "Before" is the release build of c1e844b (the last commit before it), built once in a
+# worktree of its own (long: a second release build), or BEFORE_BIN if given.
 make_photo() {
     forest
     local trees before_bin="${BEFORE_BIN:-}"
@@ -314,6 +315,11 @@ make_photo() {
         (cd "$tree" && CARGO_TARGET_DIR="$out/before-target" cargo build --release -q --bin terramp)
         before_bin="$out/before-target/release/terramp"
     fi
+    if [[ ! -f "$data/nc_ndvi/manifest.toml" ]]; then
+        "$terramp_data" build --dem "$shared/nc/elev_ned_30m.tif" --imagery "$shared/nc/landsat_multiband.tif" \
+            --bands 3,2,1 --nir-band 4 --landcover "$shared/nc/landuse_r.tif" --classes nc --out "$data/nc_ndvi" \
+            >/dev/null
+    fi
     local rows=() view name pose
     for view in 3km:637500,221750,3000,0,-89 1500m_45:637500,221750,1600,0,-45 300m_30:637500,221750,400,0,-30; do
         name=${view%%:*} pose=${view#*:}
@@ -321,10 +327,12 @@ make_photo() {
             --out "$out/photo_before_$name.png" >/dev/null
         "$terramp" photo --dataset "$data/nc" --camera "$pose" --width 640 --height 640 --settings "$trees" \
             --out "$out/photo_after_$name" >/dev/null
+        "$terramp" photo --dataset "$data/nc_ndvi" --camera "$pose" --width 640 --height 640 --settings "$trees" \
+            --out "$out/photo_ndvi_$name" >/dev/null
         rows+=("$out/photo_after_$name/photograph.png" "$out/photo_before_$name.png" \
-            "$out/photo_after_$name/amplified.png")
+            "$out/photo_after_$name/amplified.png" "$out/photo_ndvi_$name/amplified.png")
     done
-    compose --columns 3 --scale 0.5 --gap 4 --out docs/photo_nc.png "${rows[@]}"
+    compose --columns 4 --scale 0.5 --gap 4 --out docs/photo_nc.png "${rows[@]}"
 }
 
 make_trees_health() {

@@ -353,9 +353,18 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     // A class boundary, dithered: the class is read up to half a texel away from the seed, by a
     // hash of its own, so a seed near a boundary takes the neighbour's class with the share
     // bilinear interpolation gives it, and a forest's edge is as smooth as its seeds are dense,
-    // not a staircase of the land cover's cells.
-    let moved = lcc.frac + class_offset(cell.address, rank);
-    let q = vec2<u32>(clamp(lcc.texel + vec2<i32>(floor(moved)), vec2<i32>(0), vec2<i32>(u.lcc_size) - 1));
+    // not a staircase of the land cover's cells. Only between classes that grow: a seed whose own
+    // cell grows nothing (water, no data, a class without rules) stays bare, so shores and the
+    // data's edge stay where the land cover puts them.
+    let step = vec2<i32>(floor(lcc.frac + class_offset(cell.address, rank)));
+    let last_lcc = vec2<i32>(u.lcc_size) - 1;
+    if any(step != vec2<i32>(0)) {
+        let own = class_at(vec2<u32>(clamp(lcc.texel, vec2<i32>(0), last_lcc)), cell.lcc_level);
+        if own.x >= arrayLength(&class_table) || !(class_table[own.x].rank_limit[0] > 0.0) {
+            return out;
+        }
+    }
+    let q = vec2<u32>(clamp(lcc.texel + step, vec2<i32>(0), last_lcc));
     let found = class_at(q, cell.lcc_level);
     if found.x >= arrayLength(&class_table) {
         return out;

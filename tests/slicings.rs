@@ -11,7 +11,7 @@ use terramp::bake::{BakeOptions, SlicingOptions, bake_models};
 use terramp::impostor::slicing::orientation;
 use terramp::impostor::{Impostor, MipChain, Plane, load};
 use terramp::reference::slicing::{BlendError, blend_views};
-use terramp_testkit::{TempDir, shared_data};
+use terramp_testkit::{TempDir, nc_table_with, shared_data};
 
 const OPTIONS: SlicingOptions = SlicingOptions { orientations: 6, slices: 5 };
 
@@ -109,9 +109,12 @@ fn crowns_are_sliced_trunks_stay_meshes_and_every_crown_vertex_shows_in_a_slicin
 }
 
 /// A frame of the synthetic forest from 30 m up, with every seed near enough drawn as LOD 1 (no
-/// meshes), by `impostors` (or none), with slicings on or off.
+/// meshes), by `impostors` (or none), with slicings on or off, in the models' own colours (the
+/// colour follow-up off: following the photograph, a tree's pixel may match the ground's, and
+/// which pixels the trees cover is what these frames compare).
 fn lod1_frame(dir: &std::path::Path, impostors: &str, slicings: bool, brightness: f64) -> image::RgbaImage {
     let mut s = terramp_testkit::small_settings(LOD1_FRAME_PX[0] as u32, LOD1_FRAME_PX[1] as u32);
+    s.seeds.class_table = nc_table_with("slicings-own-colours", "ground_blend = 0.0").display().to_string();
     s.draw_seeds.impostors = impostors.to_owned();
     s.draw_seeds.reach_m = [0.0, 1000.0, 1400.0, 3000.0];
     s.draw_seeds.slicings = slicings;
@@ -180,10 +183,11 @@ fn slicings_draw_lod_1_where_the_clouds_would_with_their_trunks() {
 /// Side of the frames of `lod1_frame`, pixels.
 const LOD1_FRAME_PX: [usize; 2] = [320, 180];
 /// The share of the clouds' tree pixels the slicings may cover, and of either's they must share
-/// (measured 0.950 and 0.895; the margins are in the test).
-const MIN_COVERAGE_OF_CLOUDS: f64 = 0.93;
-const MAX_COVERAGE_OF_CLOUDS: f64 = 0.97;
-const MIN_SHARED_WITH_CLOUDS: f64 = 0.88;
+/// (measured 0.929 and 0.878 since 95e0171 dithered the class edges, which changed the trees in
+/// view; 0.950 and 0.895 before; the margins are in the test).
+const MIN_COVERAGE_OF_CLOUDS: f64 = 0.91;
+const MAX_COVERAGE_OF_CLOUDS: f64 = 0.95;
+const MIN_SHARED_WITH_CLOUDS: f64 = 0.865;
 
 /// `mask` (a `LOD1_FRAME_PX` frame's pixels, row by row) grown by a pixel all round.
 fn grown(mask: &[bool]) -> Vec<bool> {

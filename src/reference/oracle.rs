@@ -405,9 +405,17 @@ impl View<'_> {
         if !(p.x >= 0.0 && p.y >= 0.0 && p.x <= self.extent_m[0] && p.y <= self.extent_m[1]) {
             return Ok(Fate::Class);
         }
-        // Pass 3's dithered class boundary: the read moved by up to half a level-1 texel.
+        // Pass 3's dithered class boundary: the read moved by up to half a level-1 texel, between
+        // classes that grow (a seed whose own texel grows nothing stays bare).
         let offset = class_offset(i32_address, rank, settings.tlm.seed).map(f64::from);
-        let index = self.landcover.index(dataset, p + DVec2::from(offset) * self.landcover.texel_m())?;
+        let moved = p + DVec2::from(offset) * self.landcover.texel_m();
+        if !self.landcover.same_texel(p, moved) {
+            let own = self.landcover.index(dataset, p)?;
+            if !tables.classes.get(own as usize).is_some_and(|c| c.rank_limit[0] > 0.0) {
+                return Ok(Fate::Class);
+            }
+        }
+        let index = self.landcover.index(dataset, moved)?;
         let class = tables.classes.get(index as usize);
         let found = class.and_then(|class| species_of_rank(class, rank));
         let Some((species_index, species)) = found.and_then(|k| Some((k, tables.species.get(k as usize)?)))

@@ -364,10 +364,17 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
     }
     let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);
     let offset = class_offset(cell.address, rank, u.seed);
-    let q: [u32; 2] = std::array::from_fn(|a| {
-        let moved = lcc.frac[a] + offset[a];
-        (lcc.texel[a] + moved.floor() as i32).clamp(0, u.lcc_size[a] as i32 - 1) as u32
-    });
+    let step: [i32; 2] = std::array::from_fn(|a| (lcc.frac[a] + offset[a]).floor() as i32);
+    let clamped = |a: usize, t: i32| t.clamp(0, u.lcc_size[a] as i32 - 1) as u32;
+    if step != [0, 0] {
+        let own = std::array::from_fn(|a| clamped(a, lcc.texel[a]));
+        let (own, _) = class_at(u, inputs.landcover, own, cell.lcc_level).ok_or(COUNT_CLASS)?;
+        let grows = inputs.tables.classes.get(own as usize).is_some_and(|c| c.rank_limit[0] > 0.0);
+        if !grows {
+            return Err(COUNT_CLASS);
+        }
+    }
+    let q: [u32; 2] = std::array::from_fn(|a| clamped(a, lcc.texel[a] + step[a]));
     let (index, lcc_level) = class_at(u, inputs.landcover, q, cell.lcc_level).ok_or(COUNT_CLASS)?;
     let seeds = inputs.tables.classes.get(index as usize).ok_or(COUNT_CLASS)?;
     let k = (0..MAX_SPECIES_PER_CLASS).find(|&k| (rank as f32) < seeds.rank_limit[k]).ok_or(COUNT_CLASS)?;

@@ -192,6 +192,11 @@ impl LandcoverTiles {
         Ok(tiles)
     }
 
+    /// Whether grid points `a` and `b` lie in the same level-1 texel.
+    pub(super) fn same_texel(&self, a: DVec2, b: DVec2) -> bool {
+        self.texel(a) == self.texel(b)
+    }
+
     /// A level-1 texel's edge, metres (1 without land cover).
     pub(super) fn texel_m(&self) -> f64 {
         self.grid.map_or(1.0, |(texel_m, ..)| texel_m)
