@@ -60,6 +60,10 @@ struct SeedUniforms {
     lcc_levels: array<vec4<u32>, 4>,
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
     vegetation: vec4<f32>,
+    class_edge_dither: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct SeedCell {
@@ -356,7 +360,10 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     // not a staircase of the land cover's cells. Only between classes that grow: a seed whose own
     // cell grows nothing (water, no data, a class without rules) stays bare, so shores and the
     // data's edge stay where the land cover puts them.
-    let step = vec2<i32>(floor(lcc.frac + class_offset(cell.address, rank)));
+    var step = vec2<i32>(0);
+    if u.class_edge_dither != 0u {
+        step = vec2<i32>(floor(lcc.frac + class_offset(cell.address, rank)));
+    }
     let last_lcc = vec2<i32>(u.lcc_size) - 1;
     if any(step != vec2<i32>(0)) {
         let own = class_at(vec2<u32>(clamp(lcc.texel, vec2<i32>(0), last_lcc)), cell.lcc_level);
@@ -390,8 +397,8 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
 
     let hash = seed_hash(cell.address, rank);
     // The photograph's vegetation index: a rule of where plants grow, as altitude and slope are.
-    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
-    if !vegetation_grows(imagery, hash) {
+    if u.vegetation.x != 0.0
+        && !vegetation_grows(grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels), hash) {
         return out;
     }
     let height_m = species.height_m.x + mul(species.height_m.y - species.height_m.x, unit(hash));
@@ -473,6 +480,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     out.count = COUNT_SELECTED;
     let drawn = species_index + seed_variant(hash, species.variants);
     out.key = seed_group(drawn, lod);
+    let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     out.record = SeedRecord(
         vec3<f32>(rel_xy, base_rel_m),
         height_m,

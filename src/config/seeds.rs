@@ -42,6 +42,9 @@ pub struct SeedSettings {
     pub vegetation_bare: f64,
     /// ... and at and above which they grow as densely as the class table says (linear between).
     pub vegetation_full: f64,
+    /// A seed reads its class up to half a land-cover texel away, by a hash of its own, so class
+    /// edges are dithered rather than a staircase of the land cover's cells.
+    pub class_edge_dither: bool,
     /// "" = the table named by the dataset's land-cover scheme; else a built-in name or a path.
     pub class_table: String,
 }

@@ -408,7 +408,8 @@ impl View<'_> {
         // Pass 3's dithered class boundary: the read moved by up to half a level-1 texel, between
         // classes that grow (a seed whose own texel grows nothing stays bare).
         let offset = class_offset(i32_address, rank, settings.tlm.seed).map(f64::from);
-        let moved = p + DVec2::from(offset) * self.landcover.texel_m();
+        let dither = if settings.seeds.class_edge_dither { 1.0 } else { 0.0 };
+        let moved = p + DVec2::from(offset) * self.landcover.texel_m() * dither;
         if !self.landcover.same_texel(p, moved) {
             let own = self.landcover.index(dataset, p)?;
             if !tables.classes.get(own as usize).is_some_and(|c| c.rank_limit[0] > 0.0) {

@@ -364,7 +364,10 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
     }
     let lcc = grid_pos(cell.lcc_texel, cell.lcc_frac, pos_unit, u.cell_in_lcc_texels);
     let offset = class_offset(cell.address, rank, u.seed);
-    let step: [i32; 2] = std::array::from_fn(|a| (lcc.frac[a] + offset[a]).floor() as i32);
+    let step: [i32; 2] = match u.class_edge_dither {
+        0 => [0, 0],
+        _ => std::array::from_fn(|a| (lcc.frac[a] + offset[a]).floor() as i32),
+    };
     let clamped = |a: usize, t: i32| t.clamp(0, u.lcc_size[a] as i32 - 1) as u32;
     if step != [0, 0] {
         let own = std::array::from_fn(|a| clamped(a, lcc.texel[a]));

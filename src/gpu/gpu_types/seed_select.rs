@@ -98,6 +98,11 @@ gpu_struct! {
         /// else 0 (x); where growth starts (`seeds.vegetation_bare`, y) and 1 / the span to full
         /// growth (z); w unused.
         pub vegetation: [f32; 4],
+        /// 1: a seed reads its class up to half a texel away (`seeds.class_edge_dither`); 0: at its
+        /// own point.
+        pub class_edge_dither: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
+        pub _pad: [u32; 3],
     }
 }
 

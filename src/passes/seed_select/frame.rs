@@ -160,6 +160,8 @@ impl SeedFrame {
             lcc_levels: [[0; 4]; 4],
             imagery_levels: [[0; 4]; MAX_LEVELS as usize],
             vegetation: [0.0; 4],
+            class_edge_dither: u32::from(seeds.class_edge_dither),
+            _pad: [0; 3],
         };
         // Level-1 land-cover texels are twice the level-0 ones (the level that duplicates them).
         let lcc_texel_m = match (&dataset.landcover, &manifest.landcover) {
