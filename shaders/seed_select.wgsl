@@ -284,14 +284,11 @@ fn class_offset(address: vec2<i32>, rank: u32) -> vec2<f32> {
     return vec2<f32>(unit(h) - 0.5, unit(pcg(h)) - 0.5);
 }
 
-// Whether the imagery's vegetation index lets seed `hash` grow at `p` (level-0 imagery texels):
-// the coded alpha of the four texels around it, bilinear, as an index, against the ramp
-// `seeds.vegetation_*`, by a hash of the seed's own. Where the imagery has no index or no data
-// there, the land cover alone decides.
+// Whether the imagery's vegetation index lets seed `hash` grow at `p` (level-0 imagery texels),
+// where the imagery carries one (the caller asks): the coded alpha of the four texels around it,
+// bilinear, as an index, against the ramp `seeds.vegetation_*`, by a hash of the seed's own.
+// Where the imagery has no data there, the land cover alone decides.
 fn vegetation_grows(p: GridPos, hash: u32) -> bool {
-    if u.vegetation.x == 0.0 {
-        return true;
-    }
     // Texel centres lie half a texel in: the texel below-left of p's centre, and p's weights.
     let q = p.frac - vec2<f32>(0.5);
     let below = floor(q);

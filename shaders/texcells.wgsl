@@ -181,8 +181,7 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     let footprint = max(length(dpdx(texel)), length(dpdy(texel)));
     let normal = normalize(in.normal);
     let photo = imagery_sample(in.grid_m);
-    let coverage = select(photo.a, vegetation_coverage(photo.a), u.imagery_texels == IMAGERY_VEGETATION);
-    let ground = ground_albedo(vec4<f32>(photo.rgb, coverage), in.rel_m.z + u.camera_grid_m.z, normal);
+    let ground = ground_albedo(imagery_coverage(photo), in.rel_m.z + u.camera_grid_m.z, normal);
     // Where the photograph's vegetation index says bare ground, the forest thins out.
     let growth = vegetation_growth(photo);
 

@@ -29,7 +29,12 @@ fn ground_albedo(imagery: vec4<f32>, height_m: f32, normal: vec3<f32>) -> vec3<f
 
 // Linear RGB, and in alpha the imagery's coverage (0 where the source had no data).
 fn imagery_albedo(grid_m: vec2<f32>) -> vec4<f32> {
-    let sampled = imagery_sample(grid_m);
+    return imagery_coverage(imagery_sample(grid_m));
+}
+
+// An imagery sample (`imagery_sample`) with its alpha as coverage alone (decoded where it also
+// carries the vegetation index).
+fn imagery_coverage(sampled: vec4<f32>) -> vec4<f32> {
     if u.imagery_texels == IMAGERY_VEGETATION {
         return vec4<f32>(sampled.rgb, vegetation_coverage(sampled.a));
     }

@@ -286,5 +286,14 @@ impl Dataset {
     }
 }
 
+/// Where level-0 imagery texel `t` lies: the tile holding it and the texel's index within that
+/// tile's stored texels (its border included), as `LayerPack::tile_texels` returns them.
+pub fn imagery_texel_at(t: [u32; 2]) -> (TileId, usize) {
+    use crate::gpu::layout::{IMAGERY_TILE_EXTENT, IMAGERY_TILE_TEXELS};
+    let tile = t.map(|v| v / IMAGERY_TILE_TEXELS);
+    let local = [0, 1].map(|a| t[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
+    (TileId::new(0, tile[0], tile[1]), (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize)
+}
+
 #[cfg(test)]
 mod tests;

@@ -21,9 +21,8 @@ use super::measure::{NO_TEXEL, PixelKeys, texel_key};
 use crate::camera::Camera;
 use crate::classes::{ClassTable, SpeciesKind};
 use crate::dataset::lcc::{LCC_BARE_INDEX, LCC_SOURCE_LEVEL};
-use crate::dataset::{Dataset, TileId};
+use crate::dataset::{Dataset, TileId, imagery_texel_at};
 use crate::frame::Renderer;
-use crate::gpu::layout::{IMAGERY_BORDER, IMAGERY_TILE_EXTENT, IMAGERY_TILE_TEXELS};
 
 /// The keys of the view `renderer` last settled from `camera` (its terrain depth read back).
 pub fn pixel_keys(renderer: &Renderer, camera: &Camera) -> Result<PixelKeys, PhotoError> {
@@ -91,14 +90,12 @@ struct Coverage<'a> {
 impl Coverage<'_> {
     fn has_data(&mut self, t: [u32; 2]) -> Result<bool, PhotoError> {
         let Some(layer) = &self.dataset.imagery else { return Ok(false) };
-        let tile = t.map(|v| v / IMAGERY_TILE_TEXELS);
-        let texels = match self.tiles.entry(tile) {
+        let (tile, index) = imagery_texel_at(t);
+        let texels = match self.tiles.entry([tile.x, tile.y]) {
             Entry::Occupied(e) => e.into_mut(),
-            Entry::Vacant(e) => e.insert(layer.tile_texels(TileId::new(0, tile[0], tile[1]))?),
+            Entry::Vacant(e) => e.insert(layer.tile_texels(tile)?),
         };
-        let local = [0, 1].map(|a| t[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
-        let alpha = 4 * (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize + 3;
-        Ok(texels.get(alpha).is_some_and(|&a| a > 0))
+        Ok(texels.get(4 * index + 3).is_some_and(|&a| a > 0))
     }
 }
 

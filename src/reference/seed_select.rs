@@ -395,7 +395,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
 
     let hash = seed_hash(cell.address, rank, u.seed);
     let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
-    if !vegetation_grows(u, inputs.imagery, &imagery, hash) {
+    if u.vegetation[0] != 0.0 && !vegetation_grows(u, inputs.imagery, &imagery, hash) {
         return Err(COUNT_RULE);
     }
     let height_m = species.height_m[0] + (species.height_m[1] - species.height_m[0]) * unit(hash);

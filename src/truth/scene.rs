@@ -15,11 +15,10 @@ use glam::DVec3;
 
 use crate::camera::Camera;
 use crate::config::Settings;
-use crate::dataset::{Dataset, PackError, TileId};
+use crate::dataset::vegetation::vegetation_coverage;
+use crate::dataset::{Dataset, PackError, imagery_texel_at};
 use crate::gpu::gpu_types::SeedRecord;
-use crate::gpu::layout::{
-    GROUND_SAMPLES, IMAGERY_BORDER, IMAGERY_TILE_EXTENT, IMAGERY_TILE_TEXELS, SpeciesLod,
-};
+use crate::gpu::layout::{GROUND_SAMPLES, SpeciesLod};
 use crate::reference::oracle::OracleSeed;
 use crate::seeds::{SeedTables, pcg, seed_hash, unit};
 
@@ -112,16 +111,15 @@ impl<'a> ImageryTexels<'a> {
     /// Linear RGB and coverage of level-0 texel `t`.
     fn texel(&self, t: [u32; 2]) -> Result<[f64; 4], PackError> {
         let Some(layer) = &self.dataset.imagery else { return Ok([0.0; 4]) };
-        let tile = t.map(|v| v / IMAGERY_TILE_TEXELS);
-        let bytes = layer.tile_texels(TileId { level: 0, x: tile[0], y: tile[1] })?;
-        let local = [0, 1].map(|a| t[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
-        let at = 4 * (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize;
+        let (tile, index) = imagery_texel_at(t);
+        let bytes = layer.tile_texels(tile)?;
+        let at = 4 * index;
         let rgba = bytes.get(at..at + 4).unwrap_or(&[0; 4]);
         let linear = super::srgb_to_linear;
-        // A vegetation-coded alpha (`dataset::vegetation`): any code above 0 is data.
+        let alpha = f32::from(rgba[3]) / 255.0;
         let coverage = match self.dataset.manifest.vegetation {
-            Some(_) => f64::from(rgba[3].min(1)),
-            None => f64::from(rgba[3]) / 255.0,
+            Some(_) => f64::from(vegetation_coverage(alpha)),
+            None => f64::from(alpha),
         };
         Ok([linear(rgba[0]), linear(rgba[1]), linear(rgba[2]), coverage])
     }

@@ -10,10 +10,8 @@ use std::collections::HashMap;
 use glam::DVec2;
 
 use crate::config::Settings;
-use crate::dataset::{Dataset, PackError, TileId};
-use crate::gpu::layout::{
-    IMAGERY_BORDER, IMAGERY_TILE_EXTENT, IMAGERY_TILE_TEXELS, VEGETATION_CODE_STEPS, VEGETATION_SALT,
-};
+use crate::dataset::{Dataset, PackError, TileId, imagery_texel_at};
+use crate::gpu::layout::{IMAGERY_TILE_TEXELS, VEGETATION_CODE_STEPS, VEGETATION_SALT};
 use crate::seeds::{pcg, unit};
 
 /// The coded alphas of the level-0 imagery tiles under a region, with the ramp.
@@ -58,10 +56,8 @@ impl Vegetation {
     }
 
     fn alpha(&self, t: [u32; 2]) -> u8 {
-        let tile = t.map(|v| v / IMAGERY_TILE_TEXELS);
-        let local = [0, 1].map(|a| t[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
-        let at = (local[1] * IMAGERY_TILE_EXTENT + local[0]) as usize;
-        self.tiles.get(&tile).and_then(|alphas| alphas.get(at)).copied().unwrap_or(0)
+        let (tile, index) = imagery_texel_at(t);
+        self.tiles.get(&[tile.x, tile.y]).and_then(|alphas| alphas.get(index)).copied().unwrap_or(0)
     }
 
     /// Whether seed `hash` grows at grid point `p` by the vegetation index.

@@ -181,17 +181,14 @@ pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMa
     OcclusionMarch { hidden: false, samples_read }
 }
 
-/// Whether the imagery's vegetation index lets seed `hash` grow at `p` (the shader's
-/// `vegetation_grows`, step by step).
+/// Whether the imagery's vegetation index lets seed `hash` grow at `p`, where the imagery
+/// carries one (the caller asks; the shader's `vegetation_grows`, step by step).
 pub(super) fn vegetation_grows(
     u: &SeedUniforms,
     imagery: &TwinCache<[u8; 4]>,
     p: &GridPos,
     hash: u32,
 ) -> bool {
-    if u.vegetation[0] == 0.0 {
-        return true;
-    }
     let q = p.frac.map(|f| f - 0.5);
     let below = q.map(f32::floor);
     let f = [q[0] - below[0], q[1] - below[1]];
