@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use terramp::dataset::Dataset;
 use terramp::path::CameraPath;
-use terramp::truth::compare::flip_map;
+use terramp::reference::image_metrics::flip_map;
 use terramp_testkit::images::psnr;
 use terramp_testkit::{ground_settings, renderer, settled_colour};
 

@@ -13,8 +13,8 @@
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
+use terramp::reference::image_metrics::flip_map;
 use terramp::reference::image_metrics::{psnr_db, ssim};
-use terramp::truth::compare::flip_map;
 use terramp::truth::{TruthOptions, render_truth};
 use terramp_testkit::{camera, gpu, renderer, small_settings, synth_dataset};
 

@@ -109,7 +109,7 @@ fn read_picture(path: &Path) -> Result<RgbaImage> {
 
 /// The FLIP error map of `test` against `reference` in FLIP's magma colours, and its mean.
 fn flip_picture(reference: &RgbaImage, test: &RgbaImage) -> Result<(RgbaImage, f64)> {
-    let errors = terramp::truth::compare::flip_map(reference, test)?;
+    let errors = terramp::reference::image_metrics::flip_map(reference, test)?;
     let mean = errors.iter().map(|&e| f64::from(e)).sum::<f64>() / errors.len().max(1) as f64;
     let map = nv_flip::FlipImageFloat::with_data(test.width(), test.height(), &errors);
     let rgb = map.apply_color_lut(&nv_flip::magma_lut()).to_vec();

@@ -10,18 +10,16 @@
 
 mod support;
 
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::path::Path;
 
 use terramp::camera::Camera;
-use terramp::classes::ClassTable;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::passes::texcells::frame::Band;
 use terramp::reference::frame_change::{BLOCK_PX, block_changes};
 use terramp_testkit::{TempDir, shared_data};
 
-use support::texcells::{Frame, SIZE, changed, own_colours, render_from, samples};
+use support::texcells::{Frame, SIZE, changed, own_colours, render_from, samples, trees_and_forest};
 use support::{FOREST, PixelGround, WATER, build_nc, code_at, ground_under_pixels};
 
 /// The camera's height above the ground at the map's centre, and its pitch.
@@ -29,26 +27,6 @@ const VIEW: [f64; 2] = [350.0, -4.0];
 /// Where the view looks for water: inside the texcell band.
 const WATER_AT_M: [f64; 2] = [3500.0, 6500.0];
 const REACH_M: f64 = 8000.0;
-
-/// The nc table's species as impostors and its forest sample beside them, baked once per test
-/// process through the command line (`terramp-data bake --model ... --classes nc`).
-fn trees_and_forest() -> &'static Path {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("texcells-trees-and-forest");
-        let models = shared_data().expect("../shared/data").join("models");
-        let table = ClassTable::load("nc").unwrap();
-        let mut bake = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data"));
-        bake.arg("bake");
-        for s in &table.species {
-            bake.arg("--model").arg(models.join(format!("{}.glb", s.model)));
-        }
-        bake.args(["--classes", "nc", "--texels", "256", "--models"]).arg(&models).arg("--out").arg(&out);
-        let output = bake.output().unwrap();
-        assert!(output.status.success(), "bake failed:\n{}", String::from_utf8_lossy(&output.stderr));
-        out
-    })
-}
 
 /// The map's centre, and the heading (degrees, of 36) whose sight line crosses the most water
 /// within `WATER_AT_M` of it.

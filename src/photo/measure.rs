@@ -11,6 +11,8 @@
 //!   is a pixel or less and footprints do not form: a block counts when at least half its pixels
 //!   are wooded.
 //! - **changed share**: of the wooded pixels, those whose bytes differ between the frames.
+//! - **edges** (filled in by `measure_view`, which has the seeds): whether the trees' edges
+//!   follow the land cover's cells (`edges`).
 //!
 //! A grouping with nothing counted has no ΔE figures (`None`), rather than a 0 that would read as
 //! a perfect match.
@@ -22,6 +24,7 @@ use serde::Serialize;
 
 use super::PhotoError;
 use super::colour::{Lab, delta_e_2000, lab_of_linear, linear_table, luminance};
+use super::edges::Edges;
 use crate::reference::worst::worst;
 
 /// A pixel whose terrain point lies in no imagery texel: sky, or beyond the imagery.
@@ -52,6 +55,19 @@ pub struct PixelKeys {
     pub texel: Vec<u64>,
     /// Per pixel, whether the land cover there grows trees (`keys`).
     pub wooded: Vec<bool>,
+    /// Per pixel, the bilinear share of tree-growing cells around its terrain point (0 to 1).
+    pub wooded_fraction: Vec<f32>,
+    /// Per pixel, whether the four cells around its terrain point all grow seeds: seed selection
+    /// dithers the class edges between such cells, and keeps the others (shores, the data's
+    /// edge) on the land cover's cells.
+    pub seeded_around: Vec<bool>,
+    /// Per pixel, the horizontal area of ground it shows, m² (0 for the sky).
+    pub ground_area_m2: Vec<f32>,
+    /// Per pixel, the horizontal distance from the camera to its terrain point, m (infinite for
+    /// the sky).
+    pub ground_distance_m: Vec<f32>,
+    /// Per pixel, the view depth of its terrain point, m (infinite for the sky).
+    pub ground_depth_m: Vec<f32>,
 }
 
 /// CIEDE2000 over a grouping's members.
@@ -131,6 +147,9 @@ pub struct PhotoFigures {
     pub changed_px: usize,
     /// `changed_px` / `wooded_px` (`None` without wooded pixels).
     pub changed_share: Option<f64>,
+    /// Whether the trees' edges follow the land cover's cells (`edges`; `None` where the
+    /// amplified frame's seeds are not at hand: a frame given as an image, or no land cover).
+    pub edges: Option<Edges>,
 }
 
 /// A footprint's or block's pixels, summed in linear light.
@@ -181,6 +200,11 @@ pub fn measure(
         || keys.size_px != size_px
         || keys.texel.len() != pixels
         || keys.wooded.len() != pixels
+        || keys.wooded_fraction.len() != pixels
+        || keys.seeded_around.len() != pixels
+        || keys.ground_area_m2.len() != pixels
+        || keys.ground_distance_m.len() != pixels
+        || keys.ground_depth_m.len() != pixels
     {
         return Err(PhotoError::Size {
             amplified: size_px,
@@ -274,6 +298,7 @@ pub fn measure(
         wooded_px,
         changed_px,
         changed_share: (wooded_px > 0).then(|| changed_px as f64 / wooded_px as f64),
+        edges: None,
     })
 }
 

@@ -16,11 +16,15 @@
 //! Each pixel is keyed by the terrain point it shows (`keys`: the level-0 imagery texel, and
 //! whether its land cover grows trees), and `measure` compares the frames per texel footprint,
 //! per 5 × 5 block and per pixel (CIEDE2000 of mean colours, `colour`; the amplified frame's
-//! detail within footprints; the share of wooded pixels changed).
+//! detail within footprints; the share of wooded pixels changed); `edges` tells from the
+//! amplified frame's seeds whether the forest's edges follow the land cover's cells.
 
 pub mod colour;
+pub mod descent;
+pub mod edges;
 pub mod keys;
 pub mod measure;
+pub mod truth;
 
 use std::sync::Arc;
 
@@ -60,6 +64,21 @@ pub enum PhotoError {
         /// The keys' size.
         keys: [u32; 2],
     },
+    /// A descent that does not go down.
+    #[error(
+        "photo: a descent from {top_m} m to {bottom_m} m above the ground by {step} a frame: the top must be above the bottom, the bottom above 0 and the step within (0, 1)"
+    )]
+    Descent {
+        /// The first camera's height above the ground below it, metres.
+        top_m: f64,
+        /// Where the descent ends, metres above that ground.
+        bottom_m: f64,
+        /// The share of its height the camera sinks each frame.
+        step: f64,
+    },
+    /// A truth image could not be compared (its size differs from the frame's).
+    #[error("photo: against the truth: {0}")]
+    Truth(crate::reference::image_metrics::ImageMetricError),
     /// A colour difference came out NaN or infinite.
     #[error("photo: a colour difference is {0}")]
     NotFinite(f64),
@@ -101,6 +120,8 @@ pub struct PhotoReport {
     pub adapter: String,
     /// The figures.
     pub figures: PhotoFigures,
+    /// Against a truth image of the same view, when one was given.
+    pub truth: Option<truth::TruthFlip>,
 }
 
 /// Renders the view from `camera` (at `settings.render`'s size) with `settings` and with
@@ -122,13 +143,17 @@ pub fn measure_view(
         let image = renderer.read_colour()?;
         Ok((renderer, image))
     };
-    let amplified = match amplified {
-        Some(image) => image,
-        None => settle(settings.clone())?.1,
+    let (amplified, trees) = match amplified {
+        Some(image) => (image, None),
+        None => {
+            let (renderer, image) = settle(settings.clone())?;
+            (image, edges::tree_shares(&renderer, camera)?)
+        }
     };
     let (photo_renderer, photograph) = settle(photograph_settings(settings))?;
     let keys = pixel_keys(&photo_renderer, camera)?;
-    let figures = measure(&amplified, &photograph, &keys)?;
+    let mut figures = measure(&amplified, &photograph, &keys)?;
+    figures.edges = trees.map(|trees| edges::edges(&keys, &trees));
     Ok(PhotoView { amplified, photograph, keys, figures })
 }
 
@@ -182,5 +207,15 @@ pub fn table(figures: &PhotoFigures) -> String {
         figures.changed_px,
         figures.wooded_px
     ));
+    if let Some(e) = &figures.edges {
+        let stair = |s: &edges::Staircase| {
+            format!("{} ({} trees, {} px near an edge)", num(s.step_share, 3), s.trees, s.pixels)
+        };
+        out.push_str(&format!(
+            "trees' edges, step share (0 filtered, 1 on the cells): between seeded classes {}; all {}\n",
+            stair(&e.between_seeded),
+            stair(&e.all)
+        ));
+    }
     out
 }

@@ -1,5 +1,6 @@
-//! How it works: the two image errors the speed trade is measured with, between two same-sized
-//! sRGB images (8 bits per channel, alpha ignored).
+//! How it works: the image errors the speed trade is measured with, between two same-sized sRGB
+//! images (8 bits per channel, alpha ignored); FLIP's map (with the `flip` feature) is NVIDIA's
+//! reference implementation, described where the trade pools it (`truth::compare`).
 //!
 //! - **PSNR** over the R, G and B channels: 10·log10(255² / MSE), the MSE taken over every channel
 //!   of every pixel. Identical images have an infinite PSNR; `capped_psnr_db` clamps it to
@@ -171,6 +172,19 @@ pub fn squared_errors(a: &image::RgbaImage, b: &image::RgbaImage) -> Result<Vec<
         .zip(b.pixels())
         .map(|(p, q)| (0..3).map(|c| (f64::from(p[c]) - f64::from(q[c])).powi(2)).sum::<f64>() / 3.0)
         .collect())
+}
+
+#[cfg(feature = "flip")]
+/// The FLIP error map of `test` against `reference` (sRGB, alpha ignored), one value per pixel.
+pub fn flip_map(reference: &image::RgbaImage, test: &image::RgbaImage) -> Result<Vec<f32>, ImageMetricError> {
+    if reference.dimensions() != test.dimensions() {
+        return Err(ImageMetricError::SizeMismatch { a: reference.dimensions(), b: test.dimensions() });
+    }
+    let rgb = |image: &image::RgbaImage| {
+        let bytes: Vec<u8> = image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
+        nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &bytes)
+    };
+    Ok(nv_flip::flip(rgb(reference), rgb(test), nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec())
 }
 
 #[cfg(test)]

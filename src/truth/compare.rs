@@ -30,7 +30,7 @@ use serde::Serialize;
 use super::Truth;
 use crate::config::Settings;
 use crate::reference::image_metrics::{
-    ImageMetricError, capped_psnr_db, psnr_of_mse, squared_errors, ssim_map,
+    ImageMetricError, capped_psnr_db, flip_map, psnr_of_mse, squared_errors, ssim_map,
 };
 
 /// A distance band, metres from the camera.
@@ -184,18 +184,6 @@ pub fn pixel_distances_m(truth: &Truth, near_m: f64) -> Vec<f64> {
         let nearest = samples.map(|i| truth.depth.get(i).copied().unwrap_or(0.0)).fold(0.0f32, f32::max);
         if nearest > 0.0 { near_m / f64::from(nearest) } else { f64::INFINITY }
     })
-}
-
-/// The FLIP error map of `test` against `reference` (sRGB, alpha ignored), one value per pixel.
-pub fn flip_map(reference: &image::RgbaImage, test: &image::RgbaImage) -> Result<Vec<f32>, ImageMetricError> {
-    if reference.dimensions() != test.dimensions() {
-        return Err(ImageMetricError::SizeMismatch { a: reference.dimensions(), b: test.dimensions() });
-    }
-    let rgb = |image: &image::RgbaImage| {
-        let bytes: Vec<u8> = image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
-        nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &bytes)
-    };
-    Ok(nv_flip::flip(rgb(reference), rgb(test), nv_flip::DEFAULT_PIXELS_PER_DEGREE).to_vec())
 }
 
 /// Several views' errors as one: squared errors, SSIM windows and FLIP pooled over all their

@@ -79,3 +79,23 @@ pub fn changed(bare: &image::RgbaImage, forest: &image::RgbaImage, i: usize) -> 
     let (a, b) = (&bare.as_raw()[4 * i..4 * i + 3], &forest.as_raw()[4 * i..4 * i + 3]);
     a.iter().zip(b).any(|(a, b)| a.abs_diff(*b) > 2)
 }
+
+/// The nc table's species as impostors and its forest sample beside them, baked once per test
+/// process through the command line (`terramp-data bake --model ... --classes nc`).
+pub fn trees_and_forest() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("texcells-trees-and-forest");
+        let models = shared_data().expect("../shared/data").join("models");
+        let table = ClassTable::load("nc").unwrap();
+        let mut bake = terramp_testkit::command(env!("CARGO_BIN_EXE_terramp-data"));
+        bake.arg("bake");
+        for s in &table.species {
+            bake.arg("--model").arg(models.join(format!("{}.glb", s.model)));
+        }
+        bake.args(["--classes", "nc", "--texels", "256", "--models"]).arg(&models).arg("--out").arg(&out);
+        let output = bake.output().unwrap();
+        assert!(output.status.success(), "bake failed:\n{}", String::from_utf8_lossy(&output.stderr));
+        out
+    })
+}
