@@ -14,6 +14,7 @@ pub mod camera;
 pub mod classes;
 pub mod config;
 pub mod dataset;
+pub mod earth;
 pub mod frame;
 pub mod gpu;
 pub mod impostor;

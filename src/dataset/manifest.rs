@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::pyramid::{Pyramid, Sampling};
 use crate::dataset::lcc::LccCoding;
+use crate::earth::EarthFrame;
 
 /// Version 2: land cover is the LCC quadtree of palette indices (`crate::dataset::lcc`).
 pub const FORMAT_VERSION: u32 = 2;
@@ -40,6 +41,10 @@ pub struct Manifest {
     /// the alpha is the imagery's coverage alone.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vegetation: Option<Vegetation>,
+    /// Where the CRS's points lie on the Earth (`earth`); absent for a CRS the builder could not
+    /// place (and for datasets built before it did).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub earth: Option<EarthFrame>,
 }
 
 /// A vegetation index computed at build time at the imagery's resolution and stored in its alpha

@@ -237,6 +237,7 @@ fn manifest_for(spec: &LayerSpec) -> Manifest {
         imagery: None,
         landcover: None,
         vegetation: None,
+        earth: None,
     }
 }
 

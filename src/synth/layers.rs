@@ -151,6 +151,7 @@ impl Layers {
                 nodata_code: LANDCOVER_NODATA,
             }),
             vegetation: None,
+            earth: None,
         })
     }
 }

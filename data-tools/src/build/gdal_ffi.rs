@@ -101,3 +101,13 @@ pub fn set_block_cache_bytes(bytes: i64) {
     // SAFETY: a plain setter of a global, callable at any time.
     unsafe { gdal_sys::GDALSetCacheMax64(bytes) };
 }
+
+/// The CRS's TOWGS84 Helmert parameters (translation m, rotation ″, scale ppm; position vector),
+/// or `None` where its datum carries none.
+pub fn towgs84(srs: &SpatialRef) -> Option<[f64; 7]> {
+    let mut params = [0.0f64; 7];
+    // SAFETY: `srs` is a live spatial reference for the call; GDAL writes at most the 7 doubles
+    // the count allows into the array, which outlives the call.
+    let err = unsafe { gdal_sys::OSRGetTOWGS84(srs.to_c_hsrs(), params.as_mut_ptr(), 7) };
+    (err == gdal_sys::OGRErr::OGRERR_NONE).then_some(params)
+}

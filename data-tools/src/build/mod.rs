@@ -9,6 +9,7 @@
 //! finds its codes, hence its LCC palette). The manifest is written last and the folder published
 //! atomically, so `--out` never holds half a dataset.
 
+mod earth;
 mod fill;
 mod frame;
 mod gdal_ffi;
@@ -205,6 +206,7 @@ fn write_layers(
         None => None,
     };
     let (landcover, landcover_scan) = landcover.unzip();
+    let earth = earth::place(&inputs.frame, &height)?;
     let manifest = Manifest {
         format_version: FORMAT_VERSION,
         name,
@@ -214,6 +216,7 @@ fn write_layers(
         vegetation: inputs.imagery.as_ref().and_then(Imagery::vegetation),
         imagery,
         landcover,
+        earth,
     };
     Ok((manifest, Scans { height: scan, landcover: landcover_scan }))
 }

@@ -358,6 +358,7 @@ impl GeotiffParts {
             planned.source_voids + planned.beyond_edge,
             self.fill.is_some(),
         );
+        let earth = super::earth::place(&self.inputs.frame, &height)?;
         let manifest = Manifest {
             format_version: FORMAT_VERSION,
             name: self.source.name.clone(),
@@ -367,6 +368,7 @@ impl GeotiffParts {
             vegetation: self.inputs.imagery.as_ref().and_then(super::Imagery::vegetation),
             imagery,
             landcover,
+            earth,
         };
         staging.commit(&manifest).with_context(|| format!("publishing {}", out.display()))
     }

@@ -56,6 +56,7 @@ fn dem(name: &str, size: u32, spacing_m: f64, height: impl Fn(u32, u32) -> f32 +
         imagery: None,
         landcover: None,
         vegetation: None,
+        earth: None,
     };
     Dataset::open(&staging.commit(&manifest).unwrap()).unwrap()
 }
