@@ -2,8 +2,9 @@
 //! projection, ellipsoid and datum step in the manifest (`terramp::earth::EarthFrame`), and the
 //! runtime's Earth-centred position (WGS 84, EPSG:4978) of a dataset point equals PROJ's (through
 //! GDAL, here) within a centimetre at 10,000 random points of nc (NAD83 / North Carolina, Lambert
-//! Conformal Conic) and of zion (NAD83 / UTM zone 12N, Transverse Mercator), at random heights
-//! between the DEM's lowest and highest.
+//! Conformal Conic), of zion (NAD83 / UTM zone 12N, Transverse Mercator), and of rainier and GLOBE's
+//! tile G (geographic DEMs, which the builder moves to a local azimuthal equidistant frame), at
+//! random heights between the DEM's lowest and highest.
 
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
@@ -14,7 +15,8 @@ use terramp::dataset::Dataset;
 use terramp::earth::{DatumShift, Projection};
 use terramp_testkit::TempDir;
 
-use support::{build_nc, build_zion};
+use support::{build, build_nc, build_zion};
+use terramp_testkit::shared_data;
 
 const POINTS: usize = 10_000;
 const TOLERANCE_M: f64 = 0.01;
@@ -73,4 +75,23 @@ fn nc_and_zion_lie_where_proj_puts_them() {
     let worst = worst_against_proj(&zion, 0x5eed_0002);
     eprintln!("zion: {earth:?}\n  worst against PROJ over {POINTS} points: {worst:.3e} m");
     assert!(worst < TOLERANCE_M, "zion: {worst} m");
+}
+
+#[test]
+fn geographic_dems_lie_where_proj_puts_them() {
+    let Some(data) = shared_data() else { return };
+    let tmp = TempDir::new("earth-geographic");
+    for (name, file, seed) in [
+        ("rainier", "rainier/mt_rainier_90m.tif", 0x5eed_0003),
+        ("globe", "globe/globe_g_30arcsec.tif", 0x5eed_0004),
+    ] {
+        let dem = data.join(file);
+        let (dataset, _) = build(&tmp.path().join(name), &["--dem", dem.to_str().unwrap()]);
+        let earth = dataset.manifest.earth.as_ref().unwrap();
+        assert!(matches!(earth.projection, Projection::AzimuthalEquidistant { .. }), "{earth:?}");
+        let worst = worst_against_proj(&dataset, seed);
+        eprintln!("{name}: {earth:?}\n  worst against PROJ over {POINTS} points: {worst:.3e} m");
+        assert!(worst < TOLERANCE_M, "{name}: {worst} m");
+        std::fs::remove_dir_all(tmp.path().join(name)).unwrap();
+    }
 }

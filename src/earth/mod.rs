@@ -15,6 +15,7 @@
 //! points of nc and zion.
 
 pub mod ellipsoid;
+pub mod geodesic;
 pub mod projection;
 
 use glam::DVec3;

@@ -9,6 +9,9 @@
 //!   as Karney gives them (the conformal latitude via `τ′`, then the series in `ξ′ + iη′`); the way
 //!   back inverts the series and solves `τ′ → τ` by Newton's method. Within a UTM zone it is exact
 //!   to well under a millimetre, as PROJ's default `tmerc` (the same series) is.
+//! - **Azimuthal Equidistant** (EPSG 1125 oblique; the builder's local frame of a geographic DEM):
+//!   a point's distance and azimuth from the centre along the geodesic (`geodesic`), as PROJ's
+//!   ellipsoidal `aeqd` takes them.
 //!
 //! Angles are radians inside and degrees in the stored parameters.
 
@@ -17,6 +20,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 use serde::{Deserialize, Serialize};
 
 use super::ellipsoid::Ellipsoid;
+use super::geodesic;
 
 /// A map projection and its parameters (angles in degrees, lengths in metres).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -50,6 +54,17 @@ pub enum Projection {
         /// Northing at the natural origin.
         false_northing_m: f64,
     },
+    /// Azimuthal Equidistant, on the ellipsoid's geodesics.
+    AzimuthalEquidistant {
+        /// Latitude of the centre.
+        lat_origin_deg: f64,
+        /// Longitude of the centre.
+        lon_origin_deg: f64,
+        /// Easting at the centre.
+        false_easting_m: f64,
+        /// Northing at the centre.
+        false_northing_m: f64,
+    },
 }
 
 /// `angle` brought into (−π, π].
@@ -76,6 +91,17 @@ impl Projection {
                     false_northing_m + scale * tm.a_rect * (xi - tm.xi_origin),
                 ]
             }
+            Self::AzimuthalEquidistant {
+                lat_origin_deg,
+                lon_origin_deg,
+                false_easting_m,
+                false_northing_m,
+            } => {
+                let (lat0, lon0) = (lat_origin_deg.to_radians(), lon_origin_deg.to_radians());
+                // Nearly antipodal to the centre the geodesic is not found: no position.
+                let (s, az) = geodesic::inverse(ellipsoid, lat0, lon0, lat, lon).unwrap_or((f64::NAN, 0.0));
+                [false_easting_m + s * az.sin(), false_northing_m + s * az.cos()]
+            }
         }
     }
 
@@ -97,6 +123,17 @@ impl Projection {
                 let eta = (x_m - false_easting_m) / (scale * tm.a_rect);
                 let (lat, dlon) = tm.inverse(xi, eta);
                 (lat, wrap(dlon + lon_origin_deg.to_radians()))
+            }
+            Self::AzimuthalEquidistant {
+                lat_origin_deg,
+                lon_origin_deg,
+                false_easting_m,
+                false_northing_m,
+            } => {
+                let (lat0, lon0) = (lat_origin_deg.to_radians(), lon_origin_deg.to_radians());
+                let (dx, dy) = (x_m - false_easting_m, y_m - false_northing_m);
+                let (lat, lon) = geodesic::direct(ellipsoid, lat0, lon0, dx.atan2(dy), dx.hypot(dy));
+                (lat, wrap(lon))
             }
         }
     }
@@ -304,6 +341,43 @@ mod tests {
         assert!((x - 577_274.99).abs() < 0.01 && (y - 69_740.49).abs() < 0.01, "{x} {y}");
         let (lat2, lon2) = p.inverse(&airy, x, y);
         assert!((lat2 - lat).abs() < 1e-13 && (lon2 - lon).abs() < 1e-13, "{lat2} {lon2}");
+    }
+
+    #[test]
+    fn azimuthal_equidistant_keeps_distances_from_its_centre() {
+        let p = Projection::AzimuthalEquidistant {
+            lat_origin_deg: 25.0,
+            lon_origin_deg: 45.0,
+            false_easting_m: 0.0,
+            false_northing_m: 0.0,
+        };
+        let e = Ellipsoid::WGS84;
+        // Due north along the meridian: y is the meridian arc from 25° N to 26° N, the integral of
+        // the meridian's radius of curvature a (1 − e²) / (1 − e² sin² φ)^1.5 (Simpson's rule).
+        let radius = |lat: f64| e.a_m * (1.0 - e.e2()) / (1.0 - e.e2() * lat.sin().powi(2)).powf(1.5);
+        let (lo, hi, steps) = (25f64.to_radians(), 26f64.to_radians(), 100);
+        let h = (hi - lo) / f64::from(steps);
+        let arc = (0..=steps)
+            .map(|k| {
+                let w = if k == 0 || k == steps {
+                    1.0
+                } else if k % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * radius(lo + f64::from(k) * h)
+            })
+            .sum::<f64>()
+            * h
+            / 3.0;
+        let [x, y] = p.forward(&e, hi, 45f64.to_radians());
+        assert!(x.abs() < 1e-6 && (y - arc).abs() < 1e-4, "{x} {y} against {arc}");
+        for (x, y) in [(0.0, 0.0), (1.0e3, -2.0e3), (-4.0e6, 3.0e6), (5.0e6, 1.0e5)] {
+            let (lat, lon) = p.inverse(&e, x, y);
+            let [x2, y2] = p.forward(&e, lat, lon);
+            assert!((x2 - x).abs() < 1e-4 && (y2 - y).abs() < 1e-4, "{x} {y}: {x2} {y2}");
+        }
     }
 
     #[test]

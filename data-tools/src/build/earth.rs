@@ -112,6 +112,12 @@ fn projection(srs: &SpatialRef) -> Result<Option<Projection>> {
             false_easting_m: param("false_easting")?,
             false_northing_m: param("false_northing")?,
         },
+        "Azimuthal_Equidistant" => Projection::AzimuthalEquidistant {
+            lat_origin_deg: param("latitude_of_center")?,
+            lon_origin_deg: param("longitude_of_center")?,
+            false_easting_m: param("false_easting")?,
+            false_northing_m: param("false_northing")?,
+        },
         _ => return Ok(None),
     }))
 }
