@@ -7,8 +7,10 @@
 //! 2. the datum's step to WGS 84 (`DatumShift`) as PROJ takes it for this CRS: none (the
 //!    coordinates are taken as WGS 84's, as PROJ's default NAD83 → WGS 84 step, EPSG:1188, does),
 //!    or a seven-parameter Helmert transformation of the datum's own Earth-centred positions;
-//! 3. the height along the ellipsoid's normal (`ellipsoid`), as the DEM gives it: the builder
-//!    records what its heights are above (`heights`); no geoid is applied yet.
+//! 3. the height along the ellipsoid's normal (`ellipsoid`): the DEM's height plus the geoid's
+//!    height above the ellipsoid there (`GeoidLattice`, sampled by the builder from PROJ's EGM96
+//!    grid on a lattice over the dataset and interpolated bilinearly); the builder records what
+//!    the heights are above (`heights`).
 //!
 //! The builder checks the frame it records against PROJ on a lattice over the dataset before it
 //! writes it; `data-tools/tests/earth.rs` holds it within a centimetre of PROJ at 10,000 random
@@ -74,9 +76,57 @@ pub struct EarthFrame {
     pub to_wgs84: DatumShift,
     /// What the step is, for the record: the datum, and the operation PROJ chose for it.
     pub datum_note: String,
-    /// What the dataset's heights are above, for the record (e.g. "NAVD88 heights taken as
-    /// heights above the ellipsoid: no geoid applied").
+    /// What the dataset's heights are above, for the record.
     pub heights: String,
+    /// The geoid the heights are above, over the dataset; absent: they are taken as heights
+    /// above the ellipsoid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geoid: Option<GeoidLattice>,
+}
+
+/// A geoid's height above the ellipsoid (its undulation) over a dataset: the nodes of the
+/// geoid's own geographic grid that cover it, interpolated bilinearly in latitude and longitude as
+/// PROJ interpolates the grid, so that within the dataset the two agree to the values' rounding.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeoidLattice {
+    /// Which geoid, and from where.
+    pub name: String,
+    /// Latitude and longitude of node (0, 0), the south-west one, degrees (the longitude may lie
+    /// outside ±180 where the dataset crosses the antimeridian).
+    pub south_west_deg: [f64; 2],
+    /// Distance between nodes, degrees, in latitude and longitude alike.
+    pub step_deg: f64,
+    /// Nodes along a parallel and along a meridian (at least 2 each).
+    pub size: [u32; 2],
+    /// Undulation at each node, metres, rows from the south.
+    pub undulation_m: Vec<f32>,
+    /// The largest difference the builder found between the lattice's interpolation and PROJ's
+    /// at its check points, metres.
+    pub interpolation_error_m: f64,
+}
+
+impl GeoidLattice {
+    /// The undulation at latitude `lat` and longitude `lon` (radians), metres: bilinear between
+    /// the four nodes around it (the nearest edge's beyond the lattice).
+    pub fn undulation_at(&self, lat: f64, lon: f64) -> f64 {
+        let [w, h] = self.size.map(|n| n.max(2) as usize);
+        let at = |c: usize, r: usize| f64::from(self.undulation_m.get(r * w + c).copied().unwrap_or(0.0));
+        let [south, west] = self.south_west_deg;
+        let span_deg = (w - 1) as f64 * self.step_deg;
+        let mut east_of_west = (lon.to_degrees() - west).rem_euclid(360.0);
+        // West of the lattice (nearer its west edge than its east one, going round): its west edge.
+        if east_of_west > span_deg + 0.5 * (360.0 - span_deg) {
+            east_of_west = 0.0;
+        }
+        let u = (east_of_west / self.step_deg).clamp(0.0, (w - 1) as f64);
+        let v = ((lat.to_degrees() - south) / self.step_deg).clamp(0.0, (h - 1) as f64);
+        let (c, r) = ((u as usize).min(w - 2), (v as usize).min(h - 2));
+        let (fu, fv) = (u - c as f64, v - r as f64);
+        let s = at(c, r) * (1.0 - fu) + at(c + 1, r) * fu;
+        let n = at(c, r + 1) * (1.0 - fu) + at(c + 1, r + 1) * fu;
+        s * (1.0 - fv) + n * fv
+    }
 }
 
 impl EarthFrame {
@@ -89,6 +139,7 @@ impl EarthFrame {
     /// `height_m` along the normal.
     pub fn ecef_m(&self, x_m: f64, y_m: f64, height_m: f64) -> DVec3 {
         let (lat, lon) = self.geodetic(x_m, y_m);
+        let height_m = height_m + self.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon));
         match self.to_wgs84 {
             // PROJ's null step takes the coordinates as WGS 84's: on WGS 84's ellipsoid.
             DatumShift::None => Ellipsoid::WGS84.ecef_m(lat, lon, height_m),
@@ -116,5 +167,25 @@ mod tests {
             DatumShift::Helmert { translation_m: [0.0; 3], rotation_arcsec: [0.0; 3], scale_ppm: 1.0 };
         assert!((scale.apply(p).x - p.x * 1.000_001).abs() < 1e-6);
         assert_eq!(DatumShift::None.apply(p), p);
+    }
+
+    #[test]
+    fn a_geoid_lattice_interpolates_between_its_nodes_and_holds_beyond_them() {
+        let g = GeoidLattice {
+            name: "test".into(),
+            south_west_deg: [10.0, 179.5],
+            step_deg: 0.25,
+            size: [3, 2],
+            undulation_m: vec![0.0, 1.0, 2.0, 10.0, 11.0, 12.0],
+            interpolation_error_m: 0.0,
+        };
+        let at = |lat: f64, lon: f64| g.undulation_at(lat.to_radians(), lon.to_radians());
+        assert!(at(10.0, 179.5).abs() < 1e-9);
+        assert!((at(10.25, -180.0) - 12.0).abs() < 1e-9, "across the antimeridian");
+        assert!((at(10.0625, 179.875) - (1.5 + 2.5)).abs() < 1e-9);
+        // Beyond the lattice: its edge.
+        assert!(at(0.0, 179.5).abs() < 1e-9);
+        assert!((at(20.0, -170.0) - 12.0).abs() < 1e-9);
+        assert!((at(10.25, 170.0) - 10.0).abs() < 1e-9, "west of it: its west edge");
     }
 }

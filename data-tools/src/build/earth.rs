@@ -6,18 +6,31 @@
 //! within `AGREE_M` on a lattice over the grid's extent, at the DEM's lowest and highest heights,
 //! is kept. A CRS whose projection the runtime does not know, or whose step PROJ makes otherwise
 //! (a grid shift), gets no frame: the dataset is still built, flat, and the reason is printed.
+//!
+//! Heights: a DEM's heights are taken to be above EGM96 (SRTM's and GLOBE's are; NED's NAVD88
+//! lies within about a metre of it across the conterminous US; a GeoTIFF rarely says), and the
+//! frame carries EGM96's undulation over the dataset (`GeoidLattice`): the nodes of PROJ's 15′
+//! EGM96 grid that cover it (PROJ's values at them), interpolated as PROJ does, checked against
+//! PROJ at `GEOID_CHECKS` points and the largest difference recorded. Where PROJ has no EGM96 grid, heights stay ellipsoidal and
+//! the frame says so.
 
 use anyhow::{Context, Result};
 use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
 use glam::DVec3;
 use terramp::dataset::HeightLayer;
-use terramp::earth::{DatumShift, EarthFrame, Ellipsoid, Projection};
+use terramp::earth::{DatumShift, EarthFrame, Ellipsoid, GeoidLattice, Projection};
 
 use super::frame::Grid;
 use super::gdal_ffi;
 
 /// How far the recorded frame may lie from PROJ at any lattice point, metres.
 pub const AGREE_M: f64 = 0.001;
+/// The geoid heights are taken to be above: EGM96 height (EPSG:5773) on WGS 84.
+pub const GEOID_CRS: &str = "EPSG:4326+5773";
+/// EGM96's grid step in PROJ (`us_nga_egm96_15`), degrees: the lattice copies its nodes.
+const GEOID_STEP_DEG: f64 = 0.25;
+/// Random points at which the geoid lattice is checked against PROJ.
+const GEOID_CHECKS: usize = 500;
 /// Lattice points per axis over the grid's extent.
 const LATTICE: u32 = 9;
 
@@ -60,7 +73,8 @@ pub fn earth_frame(srs: &SpatialRef, grid: &Grid, heights_m: [f64; 2]) -> Result
             ellipsoid,
             to_wgs84,
             datum_note: String::new(),
-            heights: "the DEM's heights, taken as heights above the ellipsoid: no geoid applied".to_owned(),
+            heights: String::new(),
+            geoid: None,
         };
         let worst_m = points
             .iter()
@@ -77,7 +91,19 @@ pub fn earth_frame(srs: &SpatialRef, grid: &Grid, heights_m: [f64; 2]) -> Result
                  largest difference {worst_m:.1e} m",
                 points.len()
             );
-            return Ok(Ok(EarthFrame { datum_note, ..frame }));
+            let geoid = geoid_lattice(&frame, grid)?;
+            let heights = match &geoid {
+                Some(g) => format!(
+                    "the DEM's heights, taken as above {}: the frame adds its undulation ({} × {} nodes \
+                     every {}°, within {:.1e} m of PROJ at {GEOID_CHECKS} points)",
+                    g.name, g.size[0], g.size[1], g.step_deg, g.interpolation_error_m
+                ),
+                None => {
+                    "the DEM's heights, taken as heights above the ellipsoid: PROJ has no EGM96 grid here"
+                        .to_owned()
+                }
+            };
+            return Ok(Ok(EarthFrame { datum_note, heights, geoid, ..frame }));
         }
     }
     Ok(Err(format!(
@@ -150,4 +176,76 @@ pub fn to_ecef(srs: &SpatialRef, points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
     );
     transform.transform_coords(&mut xs, &mut ys, &mut zs).context("transforming to EPSG:4978")?;
     Ok((0..points.len()).map(|i| [xs[i], ys[i], zs[i]]).collect())
+}
+
+/// EGM96's undulation (metres) at each (latitude, longitude) in degrees, by PROJ; `None` where
+/// PROJ has no EGM96 grid (it then leaves every height unchanged).
+pub fn egm96_undulations(lat_lon_deg: &[[f64; 2]]) -> Result<Option<Vec<f64>>> {
+    let mut geoid = SpatialRef::from_definition(GEOID_CRS).context(GEOID_CRS)?;
+    geoid.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    let mut ellipsoidal = SpatialRef::from_epsg(4979).context("EPSG:4979")?;
+    ellipsoidal.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    let Ok(transform) = CoordTransform::new(&geoid, &ellipsoidal) else { return Ok(None) };
+    let mut xs: Vec<f64> = lat_lon_deg.iter().map(|p| p[1]).collect();
+    let mut ys: Vec<f64> = lat_lon_deg.iter().map(|p| p[0]).collect();
+    let mut zs = vec![0.0; lat_lon_deg.len()];
+    if transform.transform_coords(&mut xs, &mut ys, &mut zs).is_err() || zs.iter().all(|&z| z == 0.0) {
+        return Ok(None);
+    }
+    Ok(Some(zs))
+}
+
+/// EGM96's grid nodes covering `grid` (a node's margin all round), by PROJ, checked against PROJ
+/// at `GEOID_CHECKS` points; `None` without the grid.
+fn geoid_lattice(frame: &EarthFrame, grid: &Grid) -> Result<Option<GeoidLattice>> {
+    let extent = [grid.east_m() - grid.corner_m[0], grid.north_m() - grid.corner_m[1]];
+    let lat_lon = |x: f64, y: f64| {
+        let (lat, lon) = frame.geodetic(x, y);
+        [lat.to_degrees(), lon.to_degrees()]
+    };
+    // The dataset's geographic bounds, from its edges densified: longitudes unwrapped about the
+    // centre's, so that a dataset across the antimeridian has one west and one east.
+    let centre_lon = lat_lon(grid.corner_m[0] + 0.5 * extent[0], grid.corner_m[1] + 0.5 * extent[1])[1];
+    let (mut south, mut north, mut west, mut east) = (90.0f64, -90.0f64, f64::MAX, f64::MIN);
+    let edge = 64;
+    for k in 0..=edge {
+        let f = f64::from(k) / f64::from(edge);
+        for (u, v) in [(f, 0.0), (f, 1.0), (0.0, f), (1.0, f)] {
+            let [lat, lon] = lat_lon(grid.corner_m[0] + u * extent[0], grid.corner_m[1] + v * extent[1]);
+            let lon = centre_lon + (lon - centre_lon + 180.0).rem_euclid(360.0) - 180.0;
+            (south, north, west, east) = (south.min(lat), north.max(lat), west.min(lon), east.max(lon));
+        }
+    }
+    let step = GEOID_STEP_DEG;
+    let (s, w) = ((south / step).floor() - 1.0, (west / step).floor() - 1.0);
+    let (n, e) = ((north / step).ceil() + 1.0, (east / step).ceil() + 1.0);
+    let (s, n) = (s.max(-90.0 / step), n.min(90.0 / step));
+    let size = [(e - w) as u32 + 1, (n - s) as u32 + 1];
+    let nodes: Vec<[f64; 2]> = (0..size[1])
+        .flat_map(|r| (0..size[0]).map(move |c| [(s + f64::from(r)) * step, (w + f64::from(c)) * step]))
+        .collect();
+    let Some(undulation) = egm96_undulations(&nodes)? else { return Ok(None) };
+    let mut lattice = GeoidLattice {
+        name: "EGM96 (PROJ's 15′ grid)".to_owned(),
+        south_west_deg: [s * step, w * step],
+        step_deg: step,
+        size,
+        undulation_m: undulation.iter().map(|&v| v as f32).collect(),
+        interpolation_error_m: 0.0,
+    };
+    // Check points spread by a fixed additive recurrence (deterministic, no two alike).
+    let checks: Vec<[f64; 2]> = (1..=GEOID_CHECKS)
+        .map(|k| {
+            let (u, v) =
+                ((k as f64 * 0.754_877_666_246_692_7).fract(), (k as f64 * 0.569_840_290_998_053_3).fract());
+            lat_lon(grid.corner_m[0] + u * extent[0], grid.corner_m[1] + v * extent[1])
+        })
+        .collect();
+    let Some(truth) = egm96_undulations(&checks)? else { return Ok(None) };
+    lattice.interpolation_error_m = checks
+        .iter()
+        .zip(&truth)
+        .map(|(&[lat, lon], &n)| (lattice.undulation_at(lat.to_radians(), lon.to_radians()) - n).abs())
+        .fold(0.0, f64::max);
+    Ok(Some(lattice))
 }
