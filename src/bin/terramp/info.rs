@@ -22,6 +22,33 @@ pub fn run(dataset_dir: &Path) -> Result<()> {
         w / 1000.0,
         h / 1000.0
     );
+    match &m.earth {
+        Some(earth) => {
+            let (lat, lon) = earth.geodetic(corner[0] + 0.5 * w, corner[1] + 0.5 * h);
+            let (lat, lon) = (lat.to_degrees(), lon.to_degrees());
+            let geoid = earth.geoid.as_ref().map_or_else(
+                || "heights above the ellipsoid".to_owned(),
+                |g| {
+                    format!(
+                        "heights above {}, {:.2} m above the ellipsoid there",
+                        g.name,
+                        g.undulation_at(lat.to_radians(), lon.to_radians())
+                    )
+                },
+            );
+            println!(
+                "  on the Earth: centre {:.5}° {}, {:.5}° {}; {geoid}; {}",
+                lat.abs(),
+                if lat >= 0.0 { "N" } else { "S" },
+                lon.abs(),
+                if lon >= 0.0 { "E" } else { "W" },
+                earth.datum_note
+            );
+        }
+        None => {
+            println!("  on the Earth: not placed (built before placement, or a CRS the builder cannot map)")
+        }
+    }
     let p = &m.height.pyramid;
     println!(
         "  heights: {}×{} samples at {} m, {} levels, {:.1} .. {:.1} m, {} filled",
