@@ -26,7 +26,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use super::colour::{delta_e_2000, lab_of_linear, linear_table};
-use super::measure::{BLOCK_PX, NO_TEXEL, PixelKeys};
+use super::measure::{BLOCK_PX, NO_TEXEL, PixelKeys, Sums, key_texel, linear_at, texel_key};
 use super::{PhotoError, photograph_settings, pixel_keys};
 use crate::camera::Camera;
 use crate::config::Settings;
@@ -155,15 +155,12 @@ pub fn descend(
     Ok(DescentFigures { frames: cameras.len(), pairs })
 }
 
-/// A block's pixels in one frame: count, amplified and photograph sums in linear light, and
-/// whether any lies on the frame's border.
+/// A block's pixels in one frame: their sums (`measure::Sums`), the sum of their columns and
+/// rows, and whether any lies on the frame's border.
 #[derive(Debug, Default, Clone, Copy)]
 struct BlockSums {
-    pixels: u32,
-    /// Sum of its pixels' columns and rows.
+    sums: Sums,
     at_px: [u64; 2],
-    amplified: [f64; 3],
-    photograph: [f64; 3],
     on_border: bool,
 }
 
@@ -176,19 +173,12 @@ fn block_sums(frame: &Frame, block_texels: u32) -> HashMap<u64, BlockSums> {
         if key == NO_TEXEL {
             continue;
         }
-        let (column, row) = ((key & 0xffff_ffff) as u32 / block_texels, (key >> 32) as u32 / block_texels);
-        let s = blocks.entry((u64::from(row) << 32) | u64::from(column)).or_default();
+        let s = blocks.entry(texel_key(key_texel(key).map(|t| t / block_texels))).or_default();
         let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
         s.on_border |= x == 0 || y == 0 || x + 1 == w || y + 1 == h;
-        s.pixels += 1;
         s.at_px[0] += u64::from(x);
         s.at_px[1] += u64::from(y);
-        let (a, p) =
-            (&frame.amplified.as_raw()[4 * i..4 * i + 3], &frame.photograph.as_raw()[4 * i..4 * i + 3]);
-        for c in 0..3 {
-            s.amplified[c] += table[a[c] as usize];
-            s.photograph[c] += table[p[c] as usize];
-        }
+        s.sums.add(linear_at(&frame.amplified, i, &table), linear_at(&frame.photograph, i, &table), false);
     }
     blocks
 }
@@ -196,21 +186,19 @@ fn block_sums(frame: &Frame, block_texels: u32) -> HashMap<u64, BlockSums> {
 /// The pair's figures over the blocks both frames show whole.
 fn compare(before: &Frame, after: &Frame, block_texels: u32) -> PairFigures {
     let (b0, b1) = (block_sums(before, block_texels), block_sums(after, block_texels));
-    let least = BLOCK_PX * BLOCK_PX;
-    let mean = |sum: [f64; 3], n: u32| sum.map(|v| v / f64::from(n));
+    let least = (BLOCK_PX * BLOCK_PX) as usize;
     let de = |a: [f64; 3], b: [f64; 3]| delta_e_2000(lab_of_linear(a), lab_of_linear(b));
     let (mut blocks, mut largest, mut own_at_px) = (0, [None::<f64>; 3], None);
     for (key, s0) in &b0 {
         let Some(s1) = b1.get(key) else { continue };
-        if s0.on_border || s1.on_border || s0.pixels < least || s1.pixels < least {
+        if s0.on_border || s1.on_border || s0.sums.pixels < least || s1.sums.pixels < least {
             continue;
         }
-        let (a0, p0) = (mean(s0.amplified, s0.pixels), mean(s0.photograph, s0.pixels));
-        let (a1, p1) = (mean(s1.amplified, s1.pixels), mean(s1.photograph, s1.pixels));
+        let ((a0, p0), (a1, p1)) = (s0.sums.means(), s1.sums.means());
         let carried: [f64; 3] = std::array::from_fn(|c| (p1[c] + a0[c] - p0[c]).max(0.0));
         let own = de(carried, a1);
         if largest[2].is_none_or(|v| own > v) {
-            own_at_px = Some(s1.at_px.map(|v| (v / u64::from(s1.pixels)) as u32));
+            own_at_px = Some(s1.at_px.map(|v| (v / s1.sums.pixels as u64) as u32));
         }
         for (slot, value) in largest.iter_mut().zip([de(a0, a1), de(p0, p1), own]) {
             *slot = Some(slot.map_or(value, |v: f64| v.max(value)));
@@ -241,18 +229,8 @@ mod tests {
                 image::Rgba([v, v, v, 255])
             })
         };
-        let texel = (0..n * n).map(|i| crate::photo::measure::texel_key([i % n / 5, i / n / 5])).collect();
-        let pixels = (n * n) as usize;
-        let keys = PixelKeys {
-            size_px: [n, n],
-            texel,
-            wooded: vec![true; pixels],
-            wooded_fraction: vec![1.0; pixels],
-            seeded_around: vec![true; pixels],
-            ground_area_m2: vec![1.0; pixels],
-            ground_distance_m: vec![1.0; pixels],
-            ground_depth_m: vec![1.0; pixels],
-        };
+        let texel = (0..n * n).map(|i| texel_key([i % n / 5, i / n / 5])).collect();
+        let keys = PixelKeys::forest([n, n], texel);
         Frame { height_m: 100.0, amplified: grey(&amplified), photograph: grey(&photograph), keys }
     }
 

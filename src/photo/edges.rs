@@ -179,8 +179,7 @@ mod tests {
     use super::*;
 
     /// A strip of cells 16 pixels wide (a pixel 1 m²), every other pair wooded: its keys, and the
-    /// trees `keep(bilinear, nearest)` keeps of candidates at every other pixel's centre... and
-    /// between, so trees do not stand on pixel centres only.
+    /// trees `keep(bilinear, nearest)` keeps of candidates four to a pixel, off its centre.
     fn strip(mut keep: impl FnMut(f64, bool) -> bool) -> Edges {
         let w = 256usize;
         let cell_wooded = |c: i64| f64::from(u8::from(c.rem_euclid(4) < 2));
@@ -192,16 +191,9 @@ mod tests {
             let bilinear = (1.0 - f) * cell_wooded(base as i64) + f * cell_wooded(base as i64 + 1);
             (cell_wooded(u.floor() as i64) > 0.0, bilinear)
         };
-        let mut keys = PixelKeys {
-            size_px: [w as u32, 1],
-            texel: vec![0; w],
-            wooded: vec![false; w],
-            wooded_fraction: vec![0.0; w],
-            seeded_around: vec![true; w],
-            ground_area_m2: vec![1.0; w],
-            ground_distance_m: vec![0.0; w],
-            ground_depth_m: vec![0.0; w],
-        };
+        // Every pixel at the trees' distance (0), so all lie within their reach.
+        let mut keys =
+            PixelKeys { ground_distance_m: vec![0.0; w], ..PixelKeys::forest([w as u32, 1], vec![0; w]) };
         for x in 0..w {
             let (nearest, bilinear) = shares(x as f64 + 0.5);
             keys.wooded[x] = nearest;

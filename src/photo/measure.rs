@@ -46,6 +46,17 @@ pub fn texel_key(texel: [u32; 2]) -> u64 {
     (u64::from(texel[1]) << 32) | u64::from(texel[0])
 }
 
+/// The texel (column, row) of a `texel_key`.
+pub fn key_texel(key: u64) -> [u32; 2] {
+    [(key & 0xffff_ffff) as u32, (key >> 32) as u32]
+}
+
+/// Pixel `i`'s RGB of sRGB `image` in linear light, by `table` (`colour::linear_table`).
+pub(super) fn linear_at(image: &RgbaImage, i: usize, table: &[f64; 256]) -> [f64; 3] {
+    let p = &image.as_raw()[4 * i..4 * i + 3];
+    [table[p[0] as usize], table[p[1] as usize], table[p[2] as usize]]
+}
+
 /// What each pixel of a view stands on, top row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PixelKeys {
@@ -154,15 +165,15 @@ pub struct PhotoFigures {
 
 /// A footprint's or block's pixels, summed in linear light.
 #[derive(Debug, Default, Clone, Copy)]
-struct Sums {
-    pixels: usize,
+pub(super) struct Sums {
+    pub(super) pixels: usize,
     wooded: usize,
     amplified: [f64; 3],
     photograph: [f64; 3],
 }
 
 impl Sums {
-    fn add(&mut self, amplified: [f64; 3], photograph: [f64; 3], wooded: bool) {
+    pub(super) fn add(&mut self, amplified: [f64; 3], photograph: [f64; 3], wooded: bool) {
         self.pixels += 1;
         self.wooded += usize::from(wooded);
         for c in 0..3 {
@@ -175,7 +186,8 @@ impl Sums {
         2 * self.wooded >= self.pixels && self.pixels > 0
     }
 
-    fn means(&self) -> ([f64; 3], [f64; 3]) {
+    /// The amplified and the photograph's mean colours, linear.
+    pub(super) fn means(&self) -> ([f64; 3], [f64; 3]) {
         let n = self.pixels.max(1) as f64;
         (self.amplified.map(|v| v / n), self.photograph.map(|v| v / n))
     }
@@ -213,10 +225,7 @@ pub fn measure(
         });
     }
     let table = linear_table();
-    let linear = |image: &RgbaImage, i: usize| {
-        let p = &image.as_raw()[4 * i..4 * i + 3];
-        [table[p[0] as usize], table[p[1] as usize], table[p[2] as usize]]
-    };
+    let linear = |image: &RgbaImage, i: usize| linear_at(image, i, &table);
 
     // Footprints: sums, then the luminance spread about each one's mean (a second pass, so a flat
     // footprint's spread is exactly 0).
@@ -300,6 +309,25 @@ pub fn measure(
         changed_share: (wooded_px > 0).then(|| changed_px as f64 / wooded_px as f64),
         edges: None,
     })
+}
+
+#[cfg(test)]
+impl PixelKeys {
+    /// Keys of a `size_px` view whose pixels stand on `texel` (one key each), all wooded, inside
+    /// forest (share 1, every cell seeded), each on 1 m² of ground 1 m away.
+    pub(super) fn forest(size_px: [u32; 2], texel: Vec<u64>) -> Self {
+        let n = texel.len();
+        Self {
+            size_px,
+            texel,
+            wooded: vec![true; n],
+            wooded_fraction: vec![1.0; n],
+            seeded_around: vec![true; n],
+            ground_area_m2: vec![1.0; n],
+            ground_distance_m: vec![1.0; n],
+            ground_depth_m: vec![1.0; n],
+        }
+    }
 }
 
 #[cfg(test)]

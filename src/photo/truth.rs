@@ -109,3 +109,65 @@ pub fn truth_flip(
         detail: mean(&detail),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::photo::measure::texel_key;
+
+    /// An 8 × 8 frame of texels 4 × 4 pixels, its pixels' linear greys from `f(x, y)`.
+    fn frame(f: impl Fn(u32, u32) -> f64) -> (RgbaImage, PixelKeys) {
+        let image = RgbaImage::from_fn(8, 8, |x, y| {
+            let v = encode_srgb(f(x, y) as f32);
+            image::Rgba([v, v, v, 255])
+        });
+        let texel = (0..64u32).map(|i| texel_key([i % 8 / 4, i / 8 / 4])).collect();
+        (image, PixelKeys::forest([8, 8], texel))
+    }
+
+    #[test]
+    fn grey_is_the_luminance_in_srgb() {
+        let colours = RgbaImage::from_fn(3, 1, |x, _| {
+            let [r, g, b] = [[0, 0, 0], [255, 255, 255], [0, 255, 0]][x as usize];
+            image::Rgba([r, g, b, 255])
+        });
+        let g = grey(&colours);
+        assert_eq!([g.get_pixel(0, 0).0, g.get_pixel(1, 0).0], [[0, 0, 0, 255], [255, 255, 255, 255]]);
+        // Pure green's luminance is its weight in CIE Y.
+        let v = encode_srgb(0.715_152_2);
+        assert_eq!(g.get_pixel(2, 0).0, [v, v, v, 255]);
+    }
+
+    #[test]
+    fn detail_ignores_each_footprint_s_brightness_and_a_flat_paint_has_none() {
+        let pattern = |x: u32, y: u32| 0.05 + 0.1 * f64::from((x * 3 + y * 5) % 4);
+        let (a, keys) = frame(pattern);
+        // The same pattern, each footprint made brighter or darker by its own factor.
+        let (b, _) = frame(|x, y| pattern(x, y) * [0.5, 2.0, 1.5, 0.8][(x / 4 + 2 * (y / 4)) as usize]);
+        let (da, db) = (detail(&a, &keys), detail(&b, &keys));
+        let most = da.as_raw().iter().zip(db.as_raw()).map(|(p, q)| p.abs_diff(*q)).max().unwrap();
+        assert!(most <= 2, "the bytes' rounding only: {most}");
+        let (flat, _) = frame(|x, y| [0.1, 0.3, 0.02, 0.6][(x / 4 + 2 * (y / 4)) as usize]);
+        let mid = encode_srgb(MID_GREY_Y as f32);
+        assert!(detail(&flat, &keys).pixels().all(|p| p[0].abs_diff(mid) <= 1));
+        assert!(da.pixels().any(|p| p[0].abs_diff(mid) > 20), "the pattern's detail shows");
+    }
+
+    #[cfg(feature = "flip")]
+    #[test]
+    fn a_frame_against_itself_is_zero_over_the_band_and_the_band_is_its_near_pixels() {
+        let (a, mut keys) = frame(|x, y| 0.05 + 0.1 * f64::from((x + y) % 3));
+        for (i, d) in keys.ground_depth_m.iter_mut().enumerate() {
+            *d = if i < 24 { 100.0 } else { 900.0 };
+        }
+        let same = truth_flip(&a, &a, &keys, 800.0).unwrap();
+        assert_eq!(
+            (same.pixels, same.colour, same.luminance, same.detail),
+            (24, Some(0.0), Some(0.0), Some(0.0))
+        );
+        let (b, _) = frame(|x, y| 0.4 + 0.1 * f64::from((x + 2 * y) % 3));
+        let other = truth_flip(&a, &b, &keys, 800.0).unwrap();
+        assert!(other.colour.unwrap() > 0.05 && other.luminance.unwrap() > 0.05, "{other:?}");
+        assert_eq!(truth_flip(&a, &a, &keys, 50.0).unwrap().colour, None, "no pixels, no figure");
+    }
+}

@@ -24,9 +24,9 @@ use super::frame::Grid;
 use super::gdal_ffi;
 
 /// How far the recorded frame may lie from PROJ at any lattice point, metres.
-pub const AGREE_M: f64 = 0.001;
+const AGREE_M: f64 = 0.001;
 /// The geoid heights are taken to be above: EGM96 height (EPSG:5773) on WGS 84.
-pub const GEOID_CRS: &str = "EPSG:4326+5773";
+const GEOID_CRS: &str = "EPSG:4326+5773";
 /// EGM96's grid step in PROJ (`us_nga_egm96_15`), degrees: the lattice copies its nodes.
 const GEOID_STEP_DEG: f64 = 0.25;
 /// Random points at which the geoid lattice is checked against PROJ.
@@ -48,7 +48,7 @@ pub fn place(frame: &super::frame::Frame, height: &HeightLayer) -> Result<Option
 
 /// The frame of `srs` over `grid` with heights `heights_m` (lowest, highest), or why there is
 /// none.
-pub fn earth_frame(srs: &SpatialRef, grid: &Grid, heights_m: [f64; 2]) -> Result<Result<EarthFrame, String>> {
+fn earth_frame(srs: &SpatialRef, grid: &Grid, heights_m: [f64; 2]) -> Result<Result<EarthFrame, String>> {
     let Some(projection) = projection(srs)? else {
         let method = srs.get_attr_value("PROJECTION", 0).ok().flatten().unwrap_or_else(|| "none".to_owned());
         return Ok(Err(format!("its projection {method} has no mapping to the Earth yet")));
@@ -162,37 +162,35 @@ fn lattice(grid: &Grid, heights_m: [f64; 2]) -> Vec<[f64; 3]> {
     points
 }
 
+/// `points` (x, y, z in `from`, traditional GIS order) in `to`, by PROJ; `None` where PROJ has no
+/// operation between them.
+fn proj_transform(from: &SpatialRef, to: &SpatialRef, points: &[[f64; 3]]) -> Result<Option<Vec<[f64; 3]>>> {
+    let (mut from, mut to) = (from.clone(), to.clone());
+    from.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    to.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    let Ok(transform) = CoordTransform::new(&from, &to) else { return Ok(None) };
+    let [mut xs, mut ys, mut zs] = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).collect::<Vec<f64>>());
+    transform.transform_coords(&mut xs, &mut ys, &mut zs).context("transforming by PROJ")?;
+    Ok(Some((0..points.len()).map(|i| [xs[i], ys[i], zs[i]]).collect()))
+}
+
 /// PROJ's WGS 84 Earth-centred positions (EPSG:4978) of `points` (x, y in `srs`, height).
-pub fn to_ecef(srs: &SpatialRef, points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
-    let mut source = srs.clone();
-    source.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
-    let mut ecef = SpatialRef::from_epsg(4978).context("EPSG:4978")?;
-    ecef.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
-    let transform = CoordTransform::new(&source, &ecef).context("transforming to EPSG:4978")?;
-    let (mut xs, mut ys, mut zs): (Vec<f64>, Vec<f64>, Vec<f64>) = (
-        points.iter().map(|p| p[0]).collect(),
-        points.iter().map(|p| p[1]).collect(),
-        points.iter().map(|p| p[2]).collect(),
-    );
-    transform.transform_coords(&mut xs, &mut ys, &mut zs).context("transforming to EPSG:4978")?;
-    Ok((0..points.len()).map(|i| [xs[i], ys[i], zs[i]]).collect())
+fn to_ecef(srs: &SpatialRef, points: &[[f64; 3]]) -> Result<Vec<[f64; 3]>> {
+    let ecef = SpatialRef::from_epsg(4978).context("EPSG:4978")?;
+    proj_transform(srs, &ecef, points)?.context("PROJ has no operation to EPSG:4978")
 }
 
 /// EGM96's undulation (metres) at each (latitude, longitude) in degrees, by PROJ; `None` where
 /// PROJ has no EGM96 grid (it then leaves every height unchanged).
-pub fn egm96_undulations(lat_lon_deg: &[[f64; 2]]) -> Result<Option<Vec<f64>>> {
-    let mut geoid = SpatialRef::from_definition(GEOID_CRS).context(GEOID_CRS)?;
-    geoid.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
-    let mut ellipsoidal = SpatialRef::from_epsg(4979).context("EPSG:4979")?;
-    ellipsoidal.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
-    let Ok(transform) = CoordTransform::new(&geoid, &ellipsoidal) else { return Ok(None) };
-    let mut xs: Vec<f64> = lat_lon_deg.iter().map(|p| p[1]).collect();
-    let mut ys: Vec<f64> = lat_lon_deg.iter().map(|p| p[0]).collect();
-    let mut zs = vec![0.0; lat_lon_deg.len()];
-    if transform.transform_coords(&mut xs, &mut ys, &mut zs).is_err() || zs.iter().all(|&z| z == 0.0) {
-        return Ok(None);
-    }
-    Ok(Some(zs))
+fn egm96_undulations(lat_lon_deg: &[[f64; 2]]) -> Result<Option<Vec<f64>>> {
+    let geoid = SpatialRef::from_definition(GEOID_CRS).context(GEOID_CRS)?;
+    let ellipsoidal = SpatialRef::from_epsg(4979).context("EPSG:4979")?;
+    let points: Vec<[f64; 3]> = lat_lon_deg.iter().map(|&[lat, lon]| [lon, lat, 0.0]).collect();
+    let heights = proj_transform(&geoid, &ellipsoidal, &points)
+        .ok()
+        .flatten()
+        .map(|p| p.iter().map(|q| q[2]).collect());
+    Ok(heights.filter(|h: &Vec<f64>| h.iter().any(|&z| z != 0.0)))
 }
 
 /// EGM96's grid nodes covering `grid` (a node's margin all round), by PROJ, checked against PROJ

@@ -17,17 +17,7 @@ fn frame(w: u32, h: u32, colour: impl Fn(u32, u32) -> [u8; 3]) -> RgbaImage {
 /// Keys of a `w` × `h` view over texels `texel_px` pixels wide, every pixel wooded.
 fn grid_keys(w: u32, h: u32, texel_px: u32) -> PixelKeys {
     let texel = (0..h).flat_map(|y| (0..w).map(move |x| texel_key([x / texel_px, y / texel_px]))).collect();
-    let n = (w * h) as usize;
-    PixelKeys {
-        size_px: [w, h],
-        texel,
-        wooded: vec![true; n],
-        wooded_fraction: vec![1.0; n],
-        seeded_around: vec![true; n],
-        ground_area_m2: vec![1.0; n],
-        ground_distance_m: vec![1.0; n],
-        ground_depth_m: vec![1.0; n],
-    }
+    PixelKeys::forest([w, h], texel)
 }
 
 fn lab_of_bytes(rgb: [u8; 3]) -> Lab {
@@ -91,16 +81,7 @@ fn footprints_count_only_with_enough_pixels_mostly_wooded() {
     let texel = [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, NO_TEXEL]
         .map(|t| if t == NO_TEXEL { t } else { texel_key([t as u32, 0]) });
     let wooded = [true, true, false, false, true, false, false, false, true, true, true, false];
-    let keys = PixelKeys {
-        size_px: [12, 1],
-        texel: texel.to_vec(),
-        wooded: wooded.to_vec(),
-        wooded_fraction: wooded.iter().map(|&w| f32::from(u8::from(w))).collect(),
-        seeded_around: vec![true; 12],
-        ground_area_m2: vec![1.0; 12],
-        ground_distance_m: vec![1.0; 12],
-        ground_depth_m: vec![1.0; 12],
-    };
+    let keys = PixelKeys { wooded: wooded.to_vec(), ..PixelKeys::forest([12, 1], texel.to_vec()) };
     let photo = frame(12, 1, |_, _| [50, 70, 30]);
     let amplified = frame(12, 1, |x, _| if x == 0 { [20, 30, 10] } else { [50, 70, 30] });
     let figures = measure(&amplified, &photo, &keys).unwrap();
