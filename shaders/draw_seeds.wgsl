@@ -9,9 +9,10 @@
 // under the seed (foliage, by its species' `ground_blend`; bark keeps its own: the colour
 // follow-up, a ratio transfer, `photo_scale`), are varied by the seed's colour variation and by
 // the luminosity of their place in the plant (`crown_luminosity`), lit (the sun through the
-// clouds, `shared/clouds.wgsl`) and hazed like the ground.
+// clouds, `shared/clouds.wgsl`) and hazed like the ground. A seed a few pixels tall seen from
+// above shows its mean colour instead of one sample of its detail a pixel (`small_seed_mean`).
 //
-// Continuous LOD (`draw_seeds.continuous_lod`, `u.focal_px` > 0): a mesh whose materials say how
+// Continuous LOD (`draw_seeds.continuous_lod`, `u.continuous_lod`): a mesh whose materials say how
 // they shed detail thins its leaves and its thin stems as they shrink on screen, per seed
 // (`detail_position`), and serves LOD 1 too: its materials' `last_lod`.
 //
@@ -35,6 +36,10 @@ struct DrawSeedsUniforms {
     wind_wave: vec4<f32>,
     cloud_field: vec4<f32>,
     cloud_shift: vec4<f32>,
+    continuous_lod: u32,
+    prefilter_small: u32,
+    _pad0: u32,
+    _pad1: u32,
     photo_scale: array<vec4<f32>, SEED_GROUPS>,
 }
 
@@ -102,6 +107,9 @@ struct VertexOut {
     @location(8) luminosity: f32,
     // The dither range a slice keeps of the slicings' blend (`slice_blend`); [0, 2) elsewhere.
     @location(9) @interpolate(flat) blend: vec2<f32>,
+    // The seed's mean albedo seen from above, in units of flat ground's light (rgb), and how much
+    // of it the foliage shows in place of its own detail (w, `small_seed_mean`).
+    @location(10) @interpolate(flat) far: vec4<f32>,
 }
 
 // Model space (x, y up, z) to world (x east, y north, z up), turned by `angle` about the vertical.
@@ -285,7 +293,7 @@ fn vs_main(
         }
     }
     var position_model_m = in.position_model_m;
-    if u.focal_px > 0.0 {
+    if u.continuous_lod != 0u {
         let detailed = detail_position(in, vertex, scale, distance_m, record.jitter);
         if detailed.w == 0.0 {
             out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
@@ -331,8 +339,25 @@ fn vs_main(
         follow = 0.0;
     }
     out.follow = mix(vec3<f32>(1.0), ground.rgb * photo_scale, follow);
+    out.far = vec4<f32>(mix(1.0 / max(photo_scale, vec3<f32>(1e-4)), ground.rgb, follow) * out.tint, 0.0);
+    if u.prefilter_small != 0u && (material.flags & MATERIAL_BARK) == 0u && photo_scale.g > 0.0 {
+        out.far.w = small_seed_mean(record, distance_m);
+    }
     out.luminosity = crown_luminosity(shape, position_model_m, angle);
     return out;
+}
+
+// How much of a seed's foliage shows its mean colour seen from above rather than its own detail
+// (`draw_seeds.prefilter_small`): all of it where the seed stands `SEED_DETAIL_NONE_PX` tall on
+// screen or less, none from `SEED_DETAIL_FULL_PX`, and only for views from above (the follow-up's
+// `PHOTO_DETAIL_*`), whose mean the photograph shows. A crown of a pixel or two shows one sample
+// of its shading and gaps a pixel, which changes as the view moves by a fraction of a pixel; its
+// mean is what a pixel over it would average (the truth supersamples to it).
+fn small_seed_mean(record: SeedRecord, distance_m: f32) -> f32 {
+    let tall_px = record.height_m * u.focal_px / max(distance_m, 1e-3);
+    let down = -record.position_rel_m.z / max(length(record.position_rel_m), 1e-3);
+    let from_above = smoothstep(PHOTO_DETAIL_GRAZING_SIN, PHOTO_DETAIL_STEEP_SIN, down);
+    return (1.0 - smoothstep(SEED_DETAIL_NONE_PX, SEED_DETAIL_FULL_PX, tall_px)) * from_above;
 }
 
 // A fragment of a seed, before the alpha test: its lit, hazed colour, its alpha and how fast that
@@ -370,10 +395,14 @@ fn surface(in: VertexOut) -> Surface {
     if dot(normal, in.rel_m) > 0.0 {
         normal = -normal;
     }
-    let sun = (FOLIAGE_SUN * max(dot(normal, u.sun_dir.xyz), 0.0) + FOLIAGE_SUN_WRAP * max(u.sun_dir.z, 0.0))
-        * sun_through_clouds(u.cloud_field, u.cloud_shift, in.rel_m);
-    let sky = FOLIAGE_SKY;
-    let lit = albedo * (sun + sky);
+    let clouds = sun_through_clouds(u.cloud_field, u.cloud_shift, in.rel_m);
+    let sun = (FOLIAGE_SUN * max(dot(normal, u.sun_dir.xyz), 0.0) + FOLIAGE_SUN_WRAP * max(u.sun_dir.z, 0.0)) * clouds;
+    var lit = albedo * (sun + FOLIAGE_SKY);
+    if in.far.w > 0.0 {
+        // Its mean seen from above, lit as flat ground (`photo_scale`'s yardstick).
+        let ground_light = GROUND_SUN * max(u.sun_dir.z, 0.0) * clouds + GROUND_SKY;
+        lit = mix(lit, in.far.rgb * ground_light, in.far.w);
+    }
     let haze = 1.0 - exp2(-length(in.rel_m) / u.haze.w);
     return Surface(vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0), texel.a, fwidth(texel.a));
 }

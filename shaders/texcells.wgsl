@@ -257,7 +257,7 @@ fn shade(surface: Surface, ground: vec3<f32>, rel_m: vec3<f32>, view: vec3<f32>,
         let followed = ground * surface.albedo / surface.sample_mean * ground_light;
         lit = mix(own, followed, tu.ground_blend);
         let px_m = distance_m * tu.metres_per_px_at_1m;
-        let from_above = smoothstep(TEXCELL_DETAIL_GRAZING_SIN, TEXCELL_DETAIL_STEEP_SIN, -view.z);
+        let from_above = smoothstep(PHOTO_DETAIL_GRAZING_SIN, PHOTO_DETAIL_STEEP_SIN, -view.z);
         let flat = smoothstep(TEXCELL_DETAIL_FULL_PX_M, TEXCELL_DETAIL_NONE_PX_M, px_m) * from_above;
         opacity *= 1.0 - flat * tu.ground_blend;
     }

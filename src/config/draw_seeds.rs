@@ -30,6 +30,10 @@ pub struct DrawSeedsSettings {
     /// a pixel wide on a share of the seeds as they shrink on screen, and the thinned mesh also
     /// takes the 17-plane cloud's place (LOD 1).
     pub continuous_lod: bool,
+    /// A seed a few pixels tall seen from above shows its mean colour seen from above (the
+    /// photograph's under it, where it follows the photograph) instead of one sample of its
+    /// shading and gaps a pixel (`SEED_DETAIL_*`, `small_seed_mean` in `shaders/draw_seeds.wgsl`).
+    pub prefilter_small: bool,
     /// Species whose impostor carries slicings (`terramp-data bake --slicings`) draw them in
     /// LOD 1's place (Jakulin 2000): the mesh's trunk and limbs, and the crown's two slicings
     /// nearest the view, blended.

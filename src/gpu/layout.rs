@@ -312,6 +312,21 @@ wgsl_constants! { light_constants:
     pub const FOLIAGE_SUN_WRAP: f32 = 0.35;
     /// Foliage's sky light.
     pub const FOLIAGE_SKY: f32 = 0.3;
+    /// The follow-up's fades of detail (the texcells' by pixel size, `TEXCELL_DETAIL_*`, a seed's
+    /// by its own size on screen, `SEED_DETAIL_*`) apply to views from above, which the
+    /// photograph was taken from: none where the eye looks down at the forest less steeply than
+    /// this (sine of the angle below the horizon, 20°), where the canopy's side and the ground it
+    /// hides are what the photograph cannot show...
+    pub const PHOTO_DETAIL_GRAZING_SIN: f32 = 0.342;
+    /// ... all where it looks down more steeply than this (45°).
+    pub const PHOTO_DETAIL_STEEP_SIN: f32 = 0.707;
+    /// A seed keeps all its own detail (texture, shading, gaps' colours) where it stands at least
+    /// this many pixels tall...
+    pub const SEED_DETAIL_FULL_PX: f32 = 8.0;
+    /// ... and shows only its mean colour seen from above (the photograph's under it, by its
+    /// colour variation) where it stands at most this many: a crown of a pixel or two cannot show
+    /// its shading, and one sample of it a pixel makes the pixel flicker as it moves.
+    pub const SEED_DETAIL_NONE_PX: f32 = 2.0;
 }
 
 // --- Wind (`seeds::wind`) ---
@@ -355,13 +370,6 @@ wgsl_constants! { texcell_constants:
     /// ... none where it spans this many: a tree is then smaller than a pixel, and the forest
     /// shows the photograph's colour alone, which already holds what the trees look like there.
     pub const TEXCELL_DETAIL_NONE_PX_M: f32 = 8.0;
-    /// That fade applies to views from above, which the photograph was taken from: none where
-    /// the eye looks down at the forest less steeply than this (sine of the angle below the
-    /// horizon, 20°), where the canopy's side and the ground it hides are what the photograph
-    /// cannot show...
-    pub const TEXCELL_DETAIL_GRAZING_SIN: f32 = 0.342;
-    /// ... all where it looks down more steeply than this (45°).
-    pub const TEXCELL_DETAIL_STEEP_SIN: f32 = 0.707;
     /// Points per workgroup of the shader's probe of its tiling (`passes::texcells::gpu::probe`).
     pub const TEXCELL_PROBE_WORKGROUP: u32 = 64;
     /// `TexcellSlice::kind`: a regular slice of a patch drawn with regular slices only.

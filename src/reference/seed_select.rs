@@ -15,9 +15,9 @@ use crate::dataset::{Dataset, PackError, TileId};
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{
     CLASS_EDGE_SALT, COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION,
-    COUNT_OVERFLOW, COUNT_RULE, COUNT_SELECTED, GROUND_SAMPLES, IMAGERY_BORDER, IMAGERY_TILE_TEXELS,
-    LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL, LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS,
-    SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot, seed_group, vegetation_coverage,
+    COUNT_OVERFLOW, COUNT_RULE, COUNT_SELECTED, LCC_LEVELS, LCC_PACKED_LEVEL, LCC_SOURCE_LEVEL,
+    LCC_TILE_TEXELS, OCCLUSION_FOOTPRINT_PX, SEED_COUNTERS, SEED_LODS, SEED_WORKGROUP, SpeciesLod, page_slot,
+    seed_group,
 };
 use crate::passes::seed_select::frame::{SeedFrame, SeedOutput};
 use crate::passes::seed_select::march::{block_max_m, height_tile_max_m};
@@ -26,8 +26,10 @@ use crate::streaming::TileCache;
 
 mod compare;
 mod ground;
+mod imagery;
 
-use ground::{ground_at, vegetation_grows};
+use ground::ground_at;
+use imagery::{ground_colour, vegetation_grows};
 
 pub use compare::SeedComparison;
 pub use ground::{OcclusionMarch, occlusion_march};
@@ -272,70 +274,11 @@ fn class_at(u: &SeedUniforms, landcover: &TwinCache<u32>, q: [u32; 2], wanted: u
     })
 }
 
-/// sRGB-encoded byte to linear, as the GPU decodes an sRGB texel.
-fn srgb_to_linear(byte: u8) -> f32 {
-    let c = f64::from(byte) / 255.0;
-    (if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }) as f32
-}
-
-fn imagery_texel(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, t: [u32; 2]) -> [f32; 4] {
-    for level in 0..u.imagery_level_count {
-        let info = u.imagery_levels[level as usize];
-        let texel = t.map(|v| v >> level);
-        let tile = [
-            (texel[0] / IMAGERY_TILE_TEXELS).min(info[1] - 1),
-            (texel[1] / IMAGERY_TILE_TEXELS).min(info[2] - 1),
-        ];
-        if let Some(slot) = page_slot(imagery.page_table[(info[0] + tile[1] * info[1] + tile[0]) as usize]) {
-            let local = [0, 1].map(|a| texel[a] - tile[a] * IMAGERY_TILE_TEXELS + IMAGERY_BORDER);
-            let rgba = imagery.load(slot, local[0], local[1]);
-            return [
-                srgb_to_linear(rgba[0]),
-                srgb_to_linear(rgba[1]),
-                srgb_to_linear(rgba[2]),
-                f32::from(rgba[3]) / 255.0,
-            ];
-        }
-    }
-    [0.0; 4]
-}
-
 /// How far a seed's land-cover read moves, texels, each way in [−0.5, 0.5): a class boundary
 /// dithered (the shader's `class_offset`).
 pub fn class_offset(address: [i32; 2], rank: u32, seed: u32) -> [f32; 2] {
     let h = pcg(seed_hash(address, rank, seed) ^ CLASS_EDGE_SALT);
     [unit(h) - 0.5, unit(pcg(h)) - 0.5]
-}
-
-fn ground_colour(u: &SeedUniforms, imagery: &TwinCache<[u8; 4]>, p: &GridPos, hash: u32) -> u32 {
-    if u.imagery_level_count == 0 {
-        return 0;
-    }
-    let mut sum = [0.0f32; 4];
-    let mut h = hash;
-    let last = u.imagery_size.map(|n| n as i32 - 1);
-    for _ in 0..GROUND_SAMPLES {
-        h = pcg(h);
-        let offset = [
-            (unit(h) * 2.0 - 1.0) * u.ground_radius_texels,
-            (unit(pcg(h)) * 2.0 - 1.0) * u.ground_radius_texels,
-        ];
-        let texel: [u32; 2] = std::array::from_fn(|a| {
-            (p.texel[a] + (p.frac[a] + offset[a]).floor() as i32).clamp(0, last[a]) as u32
-        });
-        let mut colour = imagery_texel(u, imagery, texel);
-        if u.vegetation[0] != 0.0 {
-            colour[3] = vegetation_coverage(colour[3]);
-        }
-        for c in 0..4 {
-            sum[c] += colour[c];
-        }
-    }
-    let mean = sum.map(|c| c * (1.0 / GROUND_SAMPLES as f32));
-    // WGSL's pack4x8unorm.
-    mean.iter()
-        .enumerate()
-        .fold(0, |word, (c, v)| word | (((v.clamp(0.0, 1.0) * 255.0).round() as u32) << (8 * c)))
 }
 
 /// Pixel column holding clip-space x at distance w: the shader's `pixel_of`.

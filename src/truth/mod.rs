@@ -316,6 +316,8 @@ fn draw_seeds(
         let (draw, pipeline) = meshes.get(gpu, &table.species)?;
         let mut uniforms = draw_uniforms(settings, canvas.terrain, &renderer.wind_frame(camera));
         uniforms.draw_reach_m = [NO_FADE_REACH_M; 4];
+        // Its samples average a small seed's detail themselves: no shortcut to its mean.
+        uniforms.prefilter_small = 0;
         draw.prepare(&gpu.queue, &uniforms);
         let mut draws = Vec::new();
         for (species, range) in &scene.species_ranges {

@@ -4,8 +4,9 @@
 //! drawn as LOD 0 whatever its distance, culled only when its bounding sphere lies outside the
 //! view; occlusion is for the image to say. Each becomes the `SeedRecord` pass 4 draws: its anchor
 //! camera-relative (subtracted in f64, then rounded once), its jitter from the seed's hash as pass
-//! 3 makes it, and its ground colour as pass 3 samples it (the same `GROUND_SAMPLES` hashed
-//! offsets within `seeds.ground_colour_radius_m`), but from the finest imagery level, read
+//! 3 makes it, and its ground colour as pass 3 samples it (the bilinear imagery at the same
+//! `GROUND_SAMPLES` hashed offsets within `seeds.ground_colour_radius_m`), but from the finest
+//! imagery level, read
 //! straight from the pack. Records are grouped by species (then address, rank) so each species is
 //! one instanced draw.
 
@@ -124,8 +125,8 @@ impl<'a> ImageryTexels<'a> {
         Ok([linear(rgba[0]), linear(rgba[1]), linear(rgba[2]), coverage])
     }
 
-    /// Pass 3's ground colour, from level 0: the mean of `GROUND_SAMPLES` texels at hashed
-    /// offsets around grid point `p`, packed as unorm8 (WGSL's `pack4x8unorm`).
+    /// Pass 3's ground colour, from level 0: the mean of the bilinear imagery at `GROUND_SAMPLES`
+    /// hashed points around grid point `p`, packed as unorm8 (WGSL's `pack4x8unorm`).
     fn ground_colour(&self, p: [f64; 2], hash: u32) -> Result<u32, PackError> {
         let (Some((texel_m, offset_m)), Some(layer)) = (self.frame, &self.dataset.imagery) else {
             return Ok(0);
@@ -137,10 +138,18 @@ impl<'a> ImageryTexels<'a> {
         for _ in 0..GROUND_SAMPLES {
             h = pcg(h);
             let offset = [h, pcg(h)].map(|v| (f64::from(unit(v)) * 2.0 - 1.0) * self.radius_texels);
-            let t: [u32; 2] =
-                std::array::from_fn(|a| ((centre[a] + offset[a]).floor() as i64).clamp(0, last[a]) as u32);
-            for (s, c) in sum.iter_mut().zip(self.texel(t)?) {
-                *s += c;
+            // Texel centres lie half a texel in.
+            let q = [0, 1].map(|a| centre[a] + offset[a] - 0.5);
+            let below = q.map(f64::floor);
+            for k in 0..4 {
+                let d = [k & 1, k >> 1];
+                let t: [u32; 2] = std::array::from_fn(|a| (below[a] as i64 + d[a]).clamp(0, last[a]) as u32);
+                let w: f64 = (0..2)
+                    .map(|a| if d[a] == 1 { q[a] - below[a] } else { 1.0 - (q[a] - below[a]) })
+                    .product();
+                for (s, c) in sum.iter_mut().zip(self.texel(t)?) {
+                    *s += w * c;
+                }
             }
         }
         Ok(sum.iter().enumerate().fold(0, |word, (c, v)| {

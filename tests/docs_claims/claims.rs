@@ -4,7 +4,9 @@
 
 use terramp::camera::{MAX_COORDINATE_M, MIN_FOV_DEG};
 use terramp::classes::{DEFAULT_GROUND_BLEND, MAX_SPECIES};
-use terramp::gpu::layout::{TEXCELL_DETAIL_FULL_PX_M, TEXCELL_DETAIL_NONE_PX_M};
+use terramp::gpu::layout::{
+    SEED_DETAIL_FULL_PX, SEED_DETAIL_NONE_PX, TEXCELL_DETAIL_FULL_PX_M, TEXCELL_DETAIL_NONE_PX_M,
+};
 use terramp::photo::measure::{BLOCK_PX, MIN_PIXELS_PER_TEXEL};
 use terramp::seeds::wind::{GUST_WAVELENGTH_M, LEAN_PER_SPEED_SQ, MAX_LEAN};
 use terramp::truth::DEFAULT_REACH_M;
@@ -181,6 +183,24 @@ pub static CLAIMS: &[Claim] = &[
         values: &[
             (Source::Value(TEXCELL_DETAIL_FULL_PX_M as f64), plain),
             (Source::Value(TEXCELL_DETAIL_NONE_PX_M as f64), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/light.md",
+        quote: "`SEED_DETAIL_FULL_PX` ({}) pixels tall or less",
+        values: &[(Source::Value(SEED_DETAIL_FULL_PX as f64), plain)],
+    },
+    Claim {
+        doc: "docs/light.md",
+        quote: "all of it at `SEED_DETAIL_NONE_PX` ({}) pixels and below",
+        values: &[(Source::Value(SEED_DETAIL_NONE_PX as f64), plain)],
+    },
+    Claim {
+        doc: "config/default.toml",
+        quote: "(SEED_DETAIL_FULL_PX {} down to SEED_DETAIL_NONE_PX {})",
+        values: &[
+            (Source::Value(SEED_DETAIL_FULL_PX as f64), plain),
+            (Source::Value(SEED_DETAIL_NONE_PX as f64), plain),
         ],
     },
     Claim {

@@ -26,8 +26,7 @@ gpu_struct! {
         pub sink_fraction: f32,
         /// The outer part of each LOD band over which a seed dithers out, as a fraction of its reach.
         pub fade_fraction: f32,
-        /// The lens's focal length, pixels: what a metre one metre away covers on screen, for the
-        /// continuous LOD (`impostor::detail`); 0 turns it off (`draw_seeds.continuous_lod`).
+        /// The lens's focal length, pixels: what a metre one metre away covers on screen.
         pub focal_px: f32,
         /// The wind (`seeds::wind::WindFrame::wind`): downwind unit vector (xy), a top's mean lean
         /// and sway per metre of height (zw); lean 0: still air, no vertex moves.
@@ -38,6 +37,14 @@ gpu_struct! {
         pub cloud_field: [f32; 4],
         /// See `cloud_field`.
         pub cloud_shift: [f32; 4],
+        /// 1: meshes that say how shed detail as they shrink on screen (`impostor::detail`,
+        /// `draw_seeds.continuous_lod`); 0: they do not.
+        pub continuous_lod: u32,
+        /// 1: a seed a few pixels tall shows its mean colour seen from above (`SEED_DETAIL_*`,
+        /// `draw_seeds.prefilter_small`); 0: always its own detail (the truth, which supersamples).
+        pub prefilter_small: u32,
+        /// Padding to the WGSL struct's alignment (always 0).
+        pub _pad: [u32; 2],
         /// The colour follow-up, per (species, draw LOD) group (`species · SEED_LODS + lod`): the
         /// factor per channel (xyz) that turns the group's geometry's mean lit colour seen from
         /// above into that of flat ground of albedo 1 under this sun (`draw_seeds::from_above`);

@@ -62,11 +62,10 @@ pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &Wind
         cloud_shift: terrain.cloud_shift,
         // The pass fills it in from its geometry (`DrawSeedsPass::prepare`).
         photo_scale: [[0.0; 4]; SEED_GROUPS as usize],
-        focal_px: if settings.draw_seeds.continuous_lod {
-            focal_px(terrain, settings.render.height)
-        } else {
-            0.0
-        },
+        focal_px: focal_px(terrain, settings.render.height),
+        continuous_lod: settings.draw_seeds.continuous_lod.into(),
+        prefilter_small: settings.draw_seeds.prefilter_small.into(),
+        _pad: [0; 2],
     }
 }
 

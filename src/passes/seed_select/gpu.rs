@@ -32,6 +32,7 @@ pub const SHADER: WgslSource = WgslSource {
         TERRAIN_SURFACE,
         LANDCOVER,
         include_str!("../../../shaders/seed_select.wgsl"),
+        include_str!("../../../shaders/seed_select_imagery.wgsl"),
         include_str!("../../../shaders/seed_select_march.wgsl"),
         include_str!("../../../shaders/seed_select_blocks.wgsl"),
     ],

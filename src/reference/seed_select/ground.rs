@@ -5,8 +5,7 @@
 //! (`height_tile_max_m`) or of a block of the resident tile drawing the sample (`block_max_m`), it
 //! leaps to the last sample still in that square and over that top, found by bisection. A leap
 //! takes the decision visiting every sample would (the shader's comment says why); with every top
-//! +∞ the march never leaps, which is how the tests check that. And the imagery's vegetation index
-//! under a seed (`vegetation_grows`), pass 3's rule beside altitude and slope.
+//! +∞ the march never leaps, which is how the tests check that.
 
 use crate::dataset::surface::drawn_height;
 use crate::gpu::gpu_types::SeedUniforms;
@@ -14,9 +13,7 @@ use crate::gpu::layout::{
     HEIGHT_BLOCK_CELLS, HEIGHT_BLOCK_LEVELS, HEIGHT_BORDER, HEIGHT_TILE_BLOCKS, HEIGHT_TILE_CELLS, page_slot,
 };
 
-use super::{GridPos, SeedTwinInputs, TwinCache, grid_pos, imagery_texel};
-use crate::gpu::layout::{VEGETATION_CODE_STEPS, VEGETATION_SALT};
-use crate::seeds::{pcg, unit};
+use super::{GridPos, SeedTwinInputs, TwinCache, grid_pos};
 
 pub(super) struct Ground {
     pub height_m: f32,
@@ -179,37 +176,4 @@ pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMa
         k += 1;
     }
     OcclusionMarch { hidden: false, samples_read }
-}
-
-/// Whether the imagery's vegetation index lets seed `hash` grow at `p`, where the imagery
-/// carries one (the caller asks; the shader's `vegetation_grows`, step by step).
-pub(super) fn vegetation_grows(
-    u: &SeedUniforms,
-    imagery: &TwinCache<[u8; 4]>,
-    p: &GridPos,
-    hash: u32,
-) -> bool {
-    let q = p.frac.map(|f| f - 0.5);
-    let below = q.map(f32::floor);
-    let f = [q[0] - below[0], q[1] - below[1]];
-    let last = u.imagery_size.map(|n| n as i32 - 1);
-    let (mut alpha, mut weight) = (0.0f32, 0.0f32);
-    for k in 0..4u32 {
-        let d = [(k & 1) as i32, (k >> 1) as i32];
-        let t: [u32; 2] =
-            std::array::from_fn(|a| (p.texel[a] + below[a] as i32 + d[a]).clamp(0, last[a]) as u32);
-        let side = |a: usize| if d[a] == 1 { f[a] } else { 1.0 - f[a] };
-        let w = side(0) * side(1);
-        let a = imagery_texel(u, imagery, t)[3];
-        if a > 0.0 {
-            alpha += w * a;
-            weight += w;
-        }
-    }
-    if weight <= 0.0 {
-        return true;
-    }
-    let index = ((alpha / weight) * 255.0 - 1.0) * (2.0 / VEGETATION_CODE_STEPS as f32) - 1.0;
-    let growth = ((index - u.vegetation[1]) * u.vegetation[2]).clamp(0.0, 1.0);
-    unit(pcg(hash ^ VEGETATION_SALT)) < growth
 }
