@@ -77,6 +77,11 @@ frame showing its trees (`draw_seeds.impostors` set by a settings layer over eac
     seed's summit: pass 3's own rule, done exactly): *recall / precision (summit oracle)* say how
     well pass 3 does what it means to do; the *seed height error* is |ground height of each kept
     seed − the drawn ground (the finest mesh's triangles) under it|.
+  - the **photograph** (issue 43, docs/photo.md): each settled frame against the point's own
+    photograph frame (its settings with nothing grown: the imagery on the terrain alone), both
+    in linear light; *ΔE2000 vs photograph* is the CIEDE2000 of 5 × 5 pixel blocks' means over the
+    wooded pixels, pooled over the poses (mean / p95): how far the amplified forest departs from the
+    imagery it grows from, where a dataset has imagery (zion/ has none: no figure).
   Image errors pool the poses' pixels. No figure here compares a point with itself.
 - **Popping**: along a slow flight ({flight.get('frames')} frames {flight.get('step_m')} m apart along
   the path, from t = {flight.get('from_t')}), the largest change of a 4 × 4 block's mean luma between
