@@ -15,10 +15,13 @@
 
 #[path = "docs_claims/claims.rs"]
 mod claims;
+#[path = "docs_claims/presets.rs"]
+mod presets;
 
 use std::path::PathBuf;
 
-use claims::{CLAIMS, Claim, Format, PRESET_ROWS, Source};
+use claims::{CLAIMS, Claim, Format, Source};
+use presets::PRESET_ROWS;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
