@@ -14,10 +14,13 @@
 //!
 //! The builder checks the frame it records against PROJ on a lattice over the dataset before it
 //! writes it; `data-tools/tests/earth.rs` holds it within a centimetre of PROJ at 10,000 random
-//! points of nc and zion.
+//! points of nc and zion. `local` turns those positions into the camera's local frame, exactly in
+//! f64 and node by node as an f32 polynomial for the GPU.
 
 pub mod ellipsoid;
 pub mod geodesic;
+pub mod gpu;
+pub mod local;
 pub mod projection;
 
 use glam::DVec3;
@@ -130,6 +133,19 @@ impl GeoidLattice {
 }
 
 impl EarthFrame {
+    /// A frame with `projection` on `ellipsoid`, its datum taken as WGS 84's (no step) and its
+    /// heights as heights above the ellipsoid (no geoid).
+    pub fn ellipsoidal(projection: Projection, ellipsoid: Ellipsoid, datum_note: &str) -> Self {
+        Self {
+            projection,
+            ellipsoid,
+            to_wgs84: DatumShift::None,
+            datum_note: datum_note.to_owned(),
+            heights: "the ellipsoid".to_owned(),
+            geoid: None,
+        }
+    }
+
     /// Geodetic latitude and longitude (radians) in the CRS's datum of CRS point (`x_m`, `y_m`).
     pub fn geodetic(&self, x_m: f64, y_m: f64) -> (f64, f64) {
         self.projection.inverse(&self.ellipsoid, x_m, y_m)

@@ -329,6 +329,12 @@ wgsl_constants! { light_constants:
     pub const SEED_DETAIL_NONE_PX: f32 = 2.0;
 }
 
+// --- The Earth (`earth`) ---
+wgsl_constants! { earth_constants:
+    /// Points per workgroup of the Earth mapping's probe (`earth::gpu::probe_positions`).
+    pub const EARTH_PROBE_WORKGROUP: u32 = 64;
+}
+
 // --- Wind (`seeds::wind`) ---
 wgsl_constants! { wind_constants:
     /// Share of a plant's mean lean that gusts take away between their crests (0: no gusts).
@@ -451,6 +457,7 @@ pub fn wgsl_constants() -> Vec<(&'static str, &'static str, String)> {
         wind_constants(),
         cloud_constants(),
         light_constants(),
+        earth_constants(),
     ]
     .concat()
 }

@@ -30,7 +30,7 @@ pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 /// The depth target: reversed-Z (1 at the near plane, 0 at infinity), written by the terrain.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Every pass's shader, in frame order.
+/// Every pass's shader, in frame order, then the Earth mapping's probe (`earth::gpu`).
 pub const SHADERS: &[&WgslSource] = &[
     &terrain::gpu::SHADER,
     &depth_pyramid::gpu::SHADER,
@@ -40,11 +40,18 @@ pub const SHADERS: &[&WgslSource] = &[
     &seed_select::gpu::SHADER,
     &compact::gpu::SHADER,
     &draw_seeds::gpu::SHADER,
+    &crate::earth::gpu::SHADER,
 ];
 
 /// Every pipeline's bind group and the shader entry points it serves: what the binding-table test
 /// checks against the WGSL.
 pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
+    PipelineBindings {
+        shader: &crate::earth::gpu::SHADER,
+        entry_points: &["probe_earth_positions"],
+        group: 0,
+        bindings: &crate::earth::gpu::PROBE_BINDINGS.bindings,
+    },
     PipelineBindings {
         shader: &terrain::gpu::SHADER,
         entry_points: &["vs_main"],

@@ -6,6 +6,7 @@
 
 mod compact;
 mod draw_seeds;
+mod earth;
 mod seed_select;
 mod terrain;
 mod texcells;
@@ -13,6 +14,7 @@ mod tile_load_map;
 
 pub use compact::{CompactParams, SeedBlock, SeedDrawArgs};
 pub use draw_seeds::{DrawSeedsUniforms, SeedMaterial, SeedShape, SeedVertex};
+pub use earth::{EarthNode, EarthProbePoint};
 pub use seed_select::{SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSettle, SeedSpecies, SeedUniforms};
 pub use terrain::{TerrainNode, TerrainUniforms};
 pub use texcells::{TexcellRecord, TexcellUniforms};
@@ -44,6 +46,8 @@ pub fn layouts() -> Vec<StructLayout> {
         SeedShape::layout(),
         TexcellUniforms::layout(),
         TexcellRecord::layout(),
+        EarthNode::layout(),
+        EarthProbePoint::layout(),
     ]
 }
 
