@@ -186,6 +186,11 @@ pub static CLAIMS: &[Claim] = &[
         ],
     },
     Claim {
+        doc: "docs/earth.md",
+        quote: "the test allows {} roundings of the largest term",
+        values: &[(test_const("tests/earth.rs", "ROUNDINGS"), plain)],
+    },
+    Claim {
         doc: "docs/light.md",
         quote: "`SEED_DETAIL_FULL_PX` ({}) pixels tall or less",
         values: &[(Source::Value(SEED_DETAIL_FULL_PX as f64), plain)],
