@@ -339,9 +339,11 @@ fn vs_main(
         follow = 0.0;
     }
     out.follow = mix(vec3<f32>(1.0), ground.rgb * photo_scale, follow);
-    out.far = vec4<f32>(mix(1.0 / max(photo_scale, vec3<f32>(1e-4)), ground.rgb, follow) * out.tint, 0.0);
+    out.far = vec4<f32>(0.0);
     if u.prefilter_small != 0u && (material.flags & MATERIAL_BARK) == 0u && photo_scale.g > 0.0 {
-        out.far.w = small_seed_mean(record, distance_m);
+        // The model's own mean is the photograph's yardstick over its factor.
+        let mean = mix(1.0 / max(photo_scale, vec3<f32>(1e-4)), ground.rgb, follow) * out.tint;
+        out.far = vec4<f32>(mean, small_seed_mean(record, distance_m));
     }
     out.luminosity = crown_luminosity(shape, position_model_m, angle);
     return out;

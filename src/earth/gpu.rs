@@ -66,7 +66,8 @@ pub fn probe_positions(
     use wgpu::BufferUsages as U;
     let nodes = buffer_init(device, "earth probe nodes", bytemuck::cast_slice(nodes), U::STORAGE);
     let input = buffer_init(device, "earth probe points", bytemuck::cast_slice(points), U::STORAGE);
-    let output = buffer(device, "earth probe positions", 16 * points.len() as u64, U::STORAGE | U::COPY_SRC);
+    let bytes = (size_of::<[f32; 4]>() * points.len()) as u64;
+    let output = buffer(device, "earth probe positions", bytes, U::STORAGE | U::COPY_SRC);
     let bind_group = PROBE_BINDINGS.bind_group(
         device,
         &group,
