@@ -46,6 +46,7 @@ docs/truth_vs_accurate.png                truth_vs_accurate  -        short
 docs/viewer_nc.png                        viewer             shared   short
 docs/wind_strip.png                       wind               shared   short
 docs/photo_nc.png                         photo              shared   long
+docs/earth_globe_12km.png                 earth              shared   short
 docs/flight_0.png                         streaming          -        long
 docs/flight_1.png                         streaming          -        long
 docs/flight_2.png                         streaming          -        long
@@ -333,6 +334,22 @@ make_photo() {
             "$out/photo_after_$name/amplified.png" "$out/photo_ndvi_$name/amplified.png")
     done
     compose --columns 4 --scale 0.5 --gap 4 --out docs/photo_nc.png "${rows[@]}"
+}
+
+# GLOBE's tile from 12 km up over its centre, looking 3° down: on the Earth, then as the flat
+# sheet (docs/earth.md). Built into DATA_DIR/globe (as scripts/soak.sh does) where that build
+# predates the manifest's [earth].
+make_earth() {
+    local globe="$data/globe" flat
+    if ! grep -q '^\[earth\]' "$globe/manifest.toml" 2>/dev/null; then
+        "$terramp_data" build --dem "$shared/globe/globe_g_30arcsec.tif" --out "$globe" >/dev/null
+    fi
+    flat=$(layer earth_flat '[render]' 'curved_earth = false')
+    "$terramp" render --dataset "$globe" --camera 0,0,12000,0,-3 --width 640 --height 360 \
+        --out "$out/earth_round.png" >/dev/null
+    "$terramp" render --dataset "$globe" --camera 0,0,12000,0,-3 --width 640 --height 360 --settings "$flat" \
+        --out "$out/earth_flat.png" >/dev/null
+    compose --columns 1 --gap 4 --out docs/earth_globe_12km.png "$out/earth_round.png" "$out/earth_flat.png"
 }
 
 make_trees_health() {

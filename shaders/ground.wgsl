@@ -7,7 +7,7 @@
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
-    let height_m = in.rel_m.z + u.camera_grid_m.z;
+    let height_m = in.height_m;
     // Where the imagery has no data (or no tile is resident yet), the relief tint shows.
     var imagery = vec4<f32>(0.0);
     if u.imagery_texels != IMAGERY_NONE {

@@ -71,6 +71,10 @@ struct TexcellOut {
     @location(3) @interpolate(flat) slice: vec2<u32>,
     // The record's kind (`TEXCELL_REGULAR`, ...) and its terrain node.
     @location(4) @interpolate(flat) kind_node: vec2<u32>,
+    // The position on the flat sheet (the silhouettes march their node's ground there), and the
+    // ground's height under it above the datum, metres.
+    @location(5) flat_rel_m: vec3<f32>,
+    @location(6) height_m: f32,
 }
 
 @vertex
@@ -91,10 +95,13 @@ fn vs_texcell(@builtin(vertex_index) vertex: u32, @builtin(instance_index) insta
     }
 
     var out: TexcellOut;
-    out.rel_m = vec3<f32>(surface.xy, surface.z + lift);
+    // Lifted along the ground's vertical: on the Earth, the node's up.
+    out.rel_m = placed_m(record.node, surface.offset_m, surface.height_m + lift);
     out.clip = u.clip_from_view_world * vec4<f32>(out.rel_m, 1.0);
     out.grid_m = u.camera_grid_m.xy + surface.xy;
-    out.normal = surface.normal;
+    out.normal = placed_normal(record.node, surface.offset_m, surface.height_m, surface.normal);
+    out.flat_rel_m = vec3<f32>(surface.xy, surface.z + lift);
+    out.height_m = surface.height_m;
     out.slice = vec2<u32>(s.index << s.level, s.level);
     out.kind_node = vec2<u32>(s.kind, record.node);
     return out;
@@ -181,7 +188,7 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
     let footprint = max(length(dpdx(texel)), length(dpdy(texel)));
     let normal = normalize(in.normal);
     let photo = imagery_sample(in.grid_m);
-    let ground = ground_albedo(imagery_coverage(photo), in.rel_m.z + u.camera_grid_m.z, normal);
+    let ground = ground_albedo(imagery_coverage(photo), in.height_m, normal);
     // Where the photograph's vegetation index says bare ground, the forest thins out.
     let growth = vegetation_growth(photo);
 
@@ -204,7 +211,7 @@ fn fs_texcell(in: TexcellOut) -> @location(0) vec4<f32> {
         if bayer4(pixel, 5u) < regular {
             discard;
         }
-        return silhouette(in.rel_m, in.kind_node.y, view, distance_m, ground) * growth;
+        return silhouette(in.flat_rel_m, in.kind_node.y, view, distance_m, ground) * growth;
     }
     let forest = forest_at(in.grid_m);
     if forest.coverage <= 0.0 || bayer4(pixel, 5u) >= regular {
@@ -270,9 +277,12 @@ fn shade(surface: Surface, ground: vec3<f32>, rel_m: vec3<f32>, view: vec3<f32>,
 // or is opaque. The first half of `silhouette_steps` are one voxel of the 3D level the pixel's cone
 // needs apart (the paper's slicing rate: where the ray enters the canopy, which draws the skyline);
 // the rest grow apart evenly so that all of them span the ray's path through a flat slab
-// (slab / sin of the ray's descent), each read at the level its spacing needs.
-fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f32, ground: vec3<f32>) -> vec4<f32> {
+// (slab / sin of the ray's descent), each read at the level its spacing needs. The ray is
+// marched on the flat sheet, from the fragment's place there (`flat_rel_m`) along the view turned
+// into the node's own frame: within a slab the Earth's bend is far below a voxel.
+fn silhouette(flat_rel_m: vec3<f32>, node_index: u32, camera_view: vec3<f32>, distance_m: f32, ground: vec3<f32>) -> vec4<f32> {
     let node = nodes[node_index];
+    let view = normalize(earth_flat_direction(node_earth[node_index], camera_view));
     let slab_m = tu.slab_height_m;
     let texel_m = f32(TEXCELL_REFERENCE_CELLS) / (tu.inv_cell_m * tu.texels);
     let slice_m = slab_m / f32(tu.finest_slices);
@@ -285,7 +295,7 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
     // The slices lie at odd multiples of half a base step along the view from the node's origin,
     // so they stay put as the eye moves.
     let origin = vec3<f32>(node.origin_rel_m, -u.camera_grid_m.z);
-    let along = dot(rel_m - origin, view);
+    let along = dot(flat_rel_m - origin, view);
     var t = (ceil(along / base_m - 0.5) + 0.5) * base_m - along;
 
     var colour = vec3<f32>(0.0);
@@ -295,7 +305,7 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
     var hit_m = distance_m;
     for (var k = 0u; k < tu.silhouette_steps; k += 1u) {
         let step_m = base_m * (1.0 + growth * f32(max(k + 1u, even) - even));
-        let p = rel_m + view * t;
+        let p = flat_rel_m + view * t;
         let p_along_m = t;
         t += step_m;
         let above_m = p.z - (height_at(node, (p.xy - node.origin_rel_m) / node.cell_m) - u.camera_grid_m.z);
@@ -346,7 +356,7 @@ fn silhouette(rel_m: vec3<f32>, node_index: u32, view: vec3<f32>, distance_m: f3
     // The forest's colour follows the photograph by the first sample the ray met; the ground's
     // normal is taken as up (the ray crosses the slab, not one point of the ground).
     let surface = Surface(colour / opacity, sample_mean, vec3<f32>(0.0, 0.0, 1.0));
-    return shade(surface, ground, view * hit_m, view, hit_m, opacity);
+    return shade(surface, ground, camera_view * hit_m, camera_view, hit_m, opacity);
 }
 
 // --- For the test that holds `forest_uv` equal to its twin (`passes::texcells::gpu::probe`) ---

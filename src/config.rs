@@ -169,6 +169,9 @@ pub struct RenderSettings {
     pub sun_elevation_deg: f64,
     /// Distance at which haze hides half of the ground colour, metres.
     pub haze_half_distance_m: f64,
+    /// Draw the dataset on the Earth's ellipsoid where its manifest says where it lies; false
+    /// draws its grid as a flat sheet.
+    pub curved_earth: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -181,6 +184,8 @@ pub struct TerrainSettings {
     pub triangle_px: f64,
     /// Fraction of each LOD ring over which vertices morph into the next coarser grid (0 < f < 1).
     pub morph_fraction: f64,
+    /// Cull the nodes the Earth hides behind the horizon (on the Earth only).
+    pub horizon_culling: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]

@@ -75,7 +75,7 @@ fn ground_and_seeds_are_shaded_alike_where_the_field_says() {
             if d <= 0.0 {
                 continue;
             }
-            let rel = (rays.point(x, y, d, r.settings.render.near_m) - rays.eye_grid_m).as_vec3().to_array();
+            let rel = rays.point_rel(x, y, d, r.settings.render.near_m).as_vec3().to_array();
             let density = clouds.density_at(rel);
             let side = if density > threshold + CLOUD_EDGE + MARGIN {
                 0

@@ -222,7 +222,7 @@ fn trees_stand_on_forest_not_on_water(
     trees: &image::RgbaImage,
 ) {
     let [w, h] = size;
-    let ground: Vec<Option<(u8, f64)>> = ground_under_pixels(dataset, camera, size, bare_depth)
+    let ground: Vec<Option<(u8, f64)>> = ground_under_pixels(dataset, camera, size, bare_depth, true)
         .into_iter()
         .map(|g| g.map(|g| (g.code, g.distance_m)))
         .collect();

@@ -122,7 +122,9 @@ fn zion_seeds_grow_up_to_the_nodata_border_and_never_on_it() {
     let dem = Dem::load(&r.dataset);
     let spacing_m = dem.spacing_m;
     let b = [f64::from(border) * spacing_m, f64::from(row) * spacing_m];
-    let tol = Tolerance { height_m: 0.05, coarse_height_m: 50.0, margin_m: 3.0 * spacing_m };
+    // The coarse levels' worst error over the judged pixels: 46.9 m flat, 50.9 m on the Earth
+    // (the far pixels fall on other points of the same coarse mesh, 30 m lower at 20 km).
+    let tol = Tolerance { height_m: 0.05, coarse_height_m: 60.0, margin_m: 3.0 * spacing_m };
     let views = [
         ("inside, towards the border", camera_at(&r, &dem, [b[0] + 250.0, b[1]], 30.0, 270.0, -12.0)),
         ("over the border, looking in", camera_at(&r, &dem, [b[0] - 150.0, b[1] + 50.0], 20.0, 80.0, -10.0)),

@@ -76,13 +76,19 @@ fn texcells_at_grazing_incidence_and_inside_the_canopy_leave_no_gaps() {
             fov_deg,
             ..terramp_testkit::camera::over(r, [300.0, north_m / 2.0], above_m, 90.0, pitch)
         };
-        let none = |_: &mut Settings| {};
+        // On the flat sheet: the view's geometry (a flat forest, the crossings by similar
+        // triangles) is the sheet's; on the Earth the canopy falls 2 m below the eye's
+        // horizontal 5 km out. The bend is tested in tests/earth_terrain.rs.
+        let none = |s: &mut Settings| s.render.curved_earth = false;
         let (_, bare, depth, _, camera) =
             render_from(Dataset::open(&path).unwrap(), samples(), 0.0, &none, &camera_of);
-        let kind = |s: &mut Settings| s.texcells.silhouette_deg = silhouette_deg;
+        let kind = |s: &mut Settings| {
+            none(s);
+            s.texcells.silhouette_deg = silhouette_deg;
+        };
         let (_, forest, _, report, _) =
             render_from(Dataset::open(&path).unwrap(), samples(), FAR_M, &kind, &camera_of);
-        let ground = ground_under_pixels(&dataset, &camera, SIZE, &depth);
+        let ground = ground_under_pixels(&dataset, &camera, SIZE, &depth, false);
         // Rays through the crowns (the canopy's upper half) within the band's inside.
         let inside =
             |d: f64| d > band.fade_in_m + band.fade_in_width_m && d < band.reach_m - band.fade_out_width_m;
@@ -161,7 +167,10 @@ fn a_forested_skyline_seen_edge_on_has_no_gaps() {
     let (_, bare, ..) = render_from(Dataset::open(&path).unwrap(), samples(), 0.0, &none, &camera_of);
     let [w, h] = SIZE.map(|v| v as usize);
     for silhouette_deg in [0.0, SILHOUETTE_DEG] {
-        let kind = |s: &mut Settings| s.texcells.silhouette_deg = silhouette_deg;
+        let kind = |s: &mut Settings| {
+            none(s);
+            s.texcells.silhouette_deg = silhouette_deg;
+        };
         let (_, forest, _, report, _) =
             render_from(Dataset::open(&path).unwrap(), samples(), 12_000.0, &kind, &camera_of);
         let skyline: Vec<f64> = (0..w)

@@ -127,7 +127,7 @@ fn nc_texcells_cover_the_far_forest_and_no_water() {
     assert!(t.patches > 0 && t.slices > t.patches, "{t:?}");
 
     let reopened = Dataset::open(&path).unwrap();
-    let ground = ground_under_pixels(&reopened, &camera, SIZE, &depth);
+    let ground = ground_under_pixels(&reopened, &camera, SIZE, &depth, true);
     // Where texcells are drawn is judged in their models' own colours: following the photograph,
     // their mean is the ground's (`own_colours`).
     let (_, own, ..) = render_tuned(Dataset::open(&path).unwrap(), samples(), REACH_M, VIEW, &own_colours);
@@ -204,7 +204,7 @@ fn the_switch_from_clouds_to_texcells_pops_no_more_than_the_cloud_switches() {
     build_nc(&path);
     let (mut r, first, depth, _, camera) =
         render(Dataset::open(&path).unwrap(), trees_and_forest(), REACH_M, VIEW);
-    let ground = ground_under_pixels(&Dataset::open(&path).unwrap(), &camera, SIZE, &depth);
+    let ground = ground_under_pixels(&Dataset::open(&path).unwrap(), &camera, SIZE, &depth, true);
     // The forest's colour and cover either side of the switch, in the first frame: the mean
     // colour of the forest pixels (land cover) within 3–15 % of the switch's distance, and the
     // share of them the trees or texcells change from the ground.

@@ -28,3 +28,34 @@ fn earth_position_m(node: EarthNode, offset_m: vec3<f32>) -> vec3<f32> {
     let linear = node.d_x.xyz * dx + node.d_y.xyz * dy + node.d_h.xyz * dh;
     return node.origin_m.xyz + (linear + (curved + turned));
 }
+
+// The mapping's derivatives at `offset_m` from `node`'s origin: how the point there moves per
+// metre of x, of y and of height (the polynomial's Jacobian, its columns).
+fn earth_jacobian(node: EarthNode, offset_m: vec3<f32>) -> mat3x3<f32> {
+    let dx = offset_m.x;
+    let dy = offset_m.y;
+    let dh = offset_m.z;
+    let along_x = node.d_x.xyz + (2.0 * dx) * node.d_xx.xyz + dy * node.d_xy.xyz + dh * node.d_xh.xyz;
+    let along_y = node.d_y.xyz + dx * node.d_xy.xyz + (2.0 * dy) * node.d_yy.xyz + dh * node.d_yh.xyz;
+    let up = node.d_h.xyz + dx * node.d_xh.xyz + dy * node.d_yh.xyz;
+    return mat3x3<f32>(along_x, along_y, up);
+}
+
+// The normal, not unit, of a surface whose normal on the flat sheet is `normal`, where it passes
+// `offset_m` from `node`'s origin: tangents move by the Jacobian J, so normals by its cofactor
+// matrix det(J) J⁻ᵀ. The identity's is the identity, term by term.
+fn earth_normal(node: EarthNode, offset_m: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+    let j = earth_jacobian(node, offset_m);
+    return normal.x * cross(j[1], j[2]) + normal.y * cross(j[2], j[0]) + normal.z * cross(j[0], j[1]);
+}
+
+// The flat sheet's direction, not unit, of camera-frame direction `direction` at `node`'s origin
+// (J⁻¹ times det J: the rows of the cofactor matrix).
+fn earth_flat_direction(node: EarthNode, direction: vec3<f32>) -> vec3<f32> {
+    let j = earth_jacobian(node, vec3<f32>(0.0));
+    return vec3<f32>(
+        dot(cross(j[1], j[2]), direction),
+        dot(cross(j[2], j[0]), direction),
+        dot(cross(j[0], j[1]), direction),
+    );
+}

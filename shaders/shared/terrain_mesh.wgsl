@@ -7,9 +7,12 @@
 // the camera recedes (Strugar 2010), reaching it exactly at the node's outer range, so nodes of
 // neighbouring LODs meet without cracks. While a node's own tile streams in it reads its finest
 // resident ancestor (at 1/2^k samples per cell); the skirts hide the seams that leaves against
-// neighbours reading finer tiles, so the view is coarser there, never holed. Positions are
-// camera-relative: the CPU subtracts in f64 and hands small f32 offsets to the GPU. Both passes compute positions with this same code and
-// `@invariant`, so the ground pass can shade exactly the fragments the depth pass kept.
+// neighbours reading finer tiles, so the view is coarser there, never holed. The grid is laid out
+// on the flat sheet (the morph, the heights, the normals); each vertex is then placed by its
+// node's Earth mapping (`shared/earth.wgsl`, origin the node's centre at height 0: on the ellipsoid
+// from the camera's frame, or the identity on a flat dataset), camera-relative: the CPU subtracts
+// in f64 and hands small f32 offsets to the GPU. Both passes compute positions with this same code
+// and `@invariant`, so the ground pass can shade exactly the fragments the depth pass kept.
 
 struct TerrainUniforms {
     clip_from_view_world: mat4x4<f32>,
@@ -43,6 +46,8 @@ struct TerrainNode {
 @group(0) @binding(0) var<uniform> u: TerrainUniforms;
 @group(0) @binding(1) var<storage, read> nodes: array<TerrainNode>;
 @group(0) @binding(2) var height_tiles: texture_2d_array<f32>;
+// Each node's Earth mapping, by the node's index.
+@group(0) @binding(6) var<storage, read> node_earth: array<EarthNode>;
 
 struct VertexOut {
     @builtin(position) @invariant clip: vec4<f32>,
@@ -51,6 +56,8 @@ struct VertexOut {
     // Grid-space position (for imagery lookup), metres.
     @location(1) grid_m: vec2<f32>,
     @location(2) normal: vec3<f32>,
+    // The ground's height above the datum, metres.
+    @location(3) height_m: f32,
 }
 
 fn height_sample(node: TerrainNode, s: vec2<i32>) -> f32 {
@@ -73,12 +80,18 @@ fn height_at(node: TerrainNode, g: vec2<f32>) -> f32 {
     return mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);
 }
 
-// A vertex of the drawn surface: node grid position `g`, morphed as the camera recedes.
+// A vertex of the drawn surface on the flat sheet: node grid position `g`, morphed as the camera
+// recedes.
 struct SurfaceVertex {
-    // Camera-relative horizontal position and the ground's height under it, metres.
+    // Camera-relative horizontal position on the flat sheet and the ground's height under it less
+    // the camera's, metres.
     xy: vec2<f32>,
     z: f32,
+    // The flat sheet's normal.
     normal: vec3<f32>,
+    // The (morphed) grid offset from the node's south-west corner, and the ground's height, metres.
+    offset_m: vec2<f32>,
+    height_m: f32,
 }
 
 fn surface_vertex(node: TerrainNode, g: vec2<f32>) -> SurfaceVertex {
@@ -89,11 +102,30 @@ fn surface_vertex(node: TerrainNode, g: vec2<f32>) -> SurfaceVertex {
     // Central differences one (level) sample apart; the tile border makes them valid at the edges.
     let dx = height_at(node, g_morphed + vec2<f32>(1.0, 0.0)) - height_at(node, g_morphed - vec2<f32>(1.0, 0.0));
     let dy = height_at(node, g_morphed + vec2<f32>(0.0, 1.0)) - height_at(node, g_morphed - vec2<f32>(0.0, 1.0));
+    let offset_m = g_morphed * node.cell_m;
+    let height_m = height_at(node, g_morphed);
     return SurfaceVertex(
-        node.origin_rel_m + g_morphed * node.cell_m,
-        height_at(node, g_morphed) - u.camera_grid_m.z,
+        node.origin_rel_m + offset_m,
+        height_m - u.camera_grid_m.z,
         normalize(vec3<f32>(-dx, -dy, 2.0 * node.cell_m)),
+        offset_m,
+        height_m,
     );
+}
+
+// Where node `index` draws the point at grid offset `offset_m` from its south-west corner,
+// `height_m` above the datum: camera-relative, on the Earth.
+fn placed_m(index: u32, offset_m: vec2<f32>, height_m: f32) -> vec3<f32> {
+    let node = nodes[index];
+    let centre_m = vec2<f32>(0.5 * f32(u.node_cells) * node.cell_m);
+    return earth_position_m(node_earth[index], vec3<f32>(offset_m - centre_m, height_m));
+}
+
+// The drawn surface's unit normal there, of the flat sheet's `normal`.
+fn placed_normal(index: u32, offset_m: vec2<f32>, height_m: f32, normal: vec3<f32>) -> vec3<f32> {
+    let node = nodes[index];
+    let centre_m = vec2<f32>(0.5 * f32(u.node_cells) * node.cell_m);
+    return normalize(earth_normal(node_earth[index], vec3<f32>(offset_m - centre_m, height_m), normal));
 }
 
 @vertex
@@ -109,13 +141,14 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance
     // Skirts hang `skirt_m` below the edge, but never lower than a cell under the dataset's lowest
     // ground: still below both sides of any seam, and nothing dangles under the terrain for a view
     // past its edge to see.
-    let floor = u.height_range_m.x - node.cell_m - u.camera_grid_m.z;
-    let z = select(surface.z, max(surface.z - node.skirt_m, floor), skirt);
+    let floor_m = u.height_range_m.x - node.cell_m;
+    let height_m = select(surface.height_m, max(surface.height_m - node.skirt_m, floor_m), skirt);
 
     var out: VertexOut;
-    out.rel_m = vec3<f32>(surface.xy, z);
+    out.rel_m = placed_m(instance, surface.offset_m, height_m);
     out.clip = u.clip_from_view_world * vec4<f32>(out.rel_m, 1.0);
     out.grid_m = u.camera_grid_m.xy + surface.xy;
-    out.normal = surface.normal;
+    out.normal = placed_normal(instance, surface.offset_m, surface.height_m, surface.normal);
+    out.height_m = surface.height_m;
     return out;
 }

@@ -5,25 +5,10 @@
 use glam::{DVec3, Vec3};
 
 use super::*;
-use crate::earth::Projection;
+use crate::earth::test_frames::nc;
 
 /// nc's centre, CRS metres.
 const CENTRE_M: [f64; 2] = [637_500.0, 221_750.0];
-
-fn nc() -> EarthFrame {
-    EarthFrame::ellipsoidal(
-        Projection::LambertConformalConic2Sp {
-            lat_origin_deg: 33.75,
-            lon_origin_deg: -79.0,
-            parallel_1_deg: 36.0 + 10.0 / 60.0,
-            parallel_2_deg: 34.0 + 20.0 / 60.0,
-            false_easting_m: 609_601.22,
-            false_northing_m: 0.0,
-        },
-        Ellipsoid::GRS80,
-        "NAD83 (EPSG:32119), taken as WGS 84",
-    )
-}
 
 /// The radius of curvature of the ellipsoid at latitude `lat` in the direction `azimuth` (Euler).
 fn euler_radius_m(lat: f64, azimuth: f64) -> f64 {

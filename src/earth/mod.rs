@@ -21,6 +21,7 @@ pub mod ellipsoid;
 pub mod geodesic;
 pub mod gpu;
 pub mod local;
+pub mod placing;
 pub mod projection;
 
 use glam::DVec3;
@@ -161,6 +162,29 @@ impl EarthFrame {
             DatumShift::None => Ellipsoid::WGS84.ecef_m(lat, lon, height_m),
             shift => shift.apply(self.ellipsoid.ecef_m(lat, lon, height_m)),
         }
+    }
+}
+
+/// Frames the unit tests place points with.
+#[cfg(test)]
+pub(crate) mod test_frames {
+    use super::{EarthFrame, Ellipsoid, Projection};
+
+    /// nc's State Plane (EPSG:32119: Lambert Conformal Conic on GRS 80), NAD83 taken as WGS 84 as
+    /// PROJ's default step does, heights above the ellipsoid (the ground's shape the ellipsoid's).
+    pub(crate) fn nc() -> EarthFrame {
+        EarthFrame::ellipsoidal(
+            Projection::LambertConformalConic2Sp {
+                lat_origin_deg: 33.75,
+                lon_origin_deg: -79.0,
+                parallel_1_deg: 36.0 + 10.0 / 60.0,
+                parallel_2_deg: 34.0 + 20.0 / 60.0,
+                false_easting_m: 609_601.22,
+                false_northing_m: 0.0,
+            },
+            Ellipsoid::GRS80,
+            "NAD83 (EPSG:32119), taken as WGS 84",
+        )
     }
 }
 

@@ -13,6 +13,7 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
+use crate::earth::placing::EarthPlacing;
 use crate::gpu::fragments::{CountedPass, FragmentCounter, PassFragments};
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
@@ -156,6 +157,8 @@ pub struct Renderer {
     targets: Targets,
     /// Height ranges of terrain nodes, read from the packs once and kept.
     bounds: NodeBounds,
+    /// Where the dataset's points are drawn: on the Earth, or flat.
+    placing: EarthPlacing,
     /// The latest TLM's load maps; they drive the streaming of the next frames.
     load_maps: Option<LoadMaps>,
     last: Option<LastFrame>,
@@ -207,6 +210,8 @@ impl Renderer {
         };
         let h = &dataset.manifest.height;
         let bounds = NodeBounds::new([h.min_m, h.max_m]);
+        let m = &dataset.manifest;
+        let placing = EarthPlacing::new(m.earth.as_ref(), m.origin_m, settings.render.curved_earth);
         let profiler = Profiler::new(&gpu, settings.gpu.timestamps);
         let counted = [("texcells", texcells.is_some()), ("draw_seeds", seeds.is_some())];
         let labels: Vec<_> =
@@ -236,6 +241,7 @@ impl Renderer {
             loader,
             targets,
             bounds,
+            placing,
             load_maps: None,
             last: None,
             frame: 0,

@@ -67,8 +67,11 @@ impl Renderer {
     fn select_nodes(&mut self, view: &View) -> Vec<Selected> {
         let frustum = Frustum::from_clip(view.clip_from_view_world);
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
+        let mut placed = self.placing.view(view.grid_m);
+        let horizon =
+            self.settings.terrain.horizon_culling.then_some(f64::from(dataset.manifest.height.min_m));
         self.profiler.cpu("terrain_select", || {
-            select(&view.lods, view.grid_m, &frustum, &mut |node| {
+            select(&view.lods, &mut placed, &frustum, horizon, &mut |node| {
                 bounds.get(&view.lods, node, |tile| dataset.height_tile(tile).ok())
             })
         })
@@ -150,8 +153,9 @@ impl Renderer {
     ) -> (PreparedNodes, TerrainUniforms) {
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
         let floor_m = dataset.manifest.height.min_m;
+        let mut placed = self.placing.view(view.grid_m);
         let (batches, dropped) =
-            node_batches(&view.lods, selected, view.grid_m, &self.caches.heights, floor_m, &mut |node| {
+            node_batches(&view.lods, selected, &mut placed, &self.caches.heights, floor_m, &mut |node| {
                 bounds.get(&view.lods, node, |tile| dataset.height_tile(tile).ok())
             });
         report.nodes_drawn = batches.len();

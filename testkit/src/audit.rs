@@ -16,10 +16,14 @@
 use glam::{DMat4, DVec3, DVec4};
 use terramp::camera::Camera;
 use terramp::dataset::{Dataset, TileId};
+use terramp::earth::placing::{EarthPlacing, ExactPlacing};
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::{SeedCounters, SeedRecord, TlmCell};
 use terramp::gpu::layout::{LevelRange, RADIAL_INACTIVE, SpeciesLod, TLM_CULLED, TLM_FIRST_PATTERN};
 use terramp::passes::terrain::select::Lods;
+
+#[path = "audit_round.rs"]
+pub mod round;
 
 /// The level-0 DEM of a dataset, whole, in f64: the oracle's ground.
 pub struct Dem {
@@ -120,7 +124,7 @@ impl Tolerance {
 
 /// The vertical slack `tol` allows at distance `distance_m`, with the finest LOD drawn out to
 /// `fine_within_m`.
-fn slack_m(tol: &Tolerance, fine_within_m: f64, distance_m: f64) -> f64 {
+pub(crate) fn slack_m(tol: &Tolerance, fine_within_m: f64, distance_m: f64) -> f64 {
     if distance_m < fine_within_m { tol.height_m } else { tol.coarse_height_m }
 }
 
@@ -132,26 +136,33 @@ pub enum Expect {
     Unknown,
 }
 
-/// The ray through a pixel's centre, from the camera (grid space, unit direction).
+/// The ray through a pixel's centre, from the camera (camera-relative, unit direction), and where
+/// the renderer's placing (`terramp::earth::placing`) puts the grid.
 pub struct Rays {
     pub eye_grid_m: DVec3,
     pub forward: DVec3,
     world_from_clip: DMat4,
     pub width: u32,
     pub height: u32,
+    /// The renderer's placing from this camera: flat, or on the Earth.
+    pub exact: ExactPlacing,
 }
 
 impl Rays {
     pub fn new(r: &Renderer, camera: &Camera) -> Self {
         let (width, height) = (r.settings.render.width, r.settings.render.height);
         let clip = camera.clip_from_view(width, height).unwrap() * camera.view_from_world();
-        let o = r.dataset.manifest.origin_m;
+        let m = &r.dataset.manifest;
+        let o = m.origin_m;
+        let eye_grid_m = camera.position_m - DVec3::new(o[0], o[1], 0.0);
+        let placing = EarthPlacing::new(m.earth.as_ref(), o, r.settings.render.curved_earth);
         Self {
-            eye_grid_m: camera.position_m - DVec3::new(o[0], o[1], 0.0),
+            eye_grid_m,
             forward: camera.forward(),
             world_from_clip: clip.inverse(),
             width,
             height,
+            exact: placing.exact(eye_grid_m),
         }
     }
 
@@ -163,11 +174,18 @@ impl Rays {
         (p.truncate() / p.w).normalize()
     }
 
-    /// The grid-space point a reversed-Z depth puts on the ray through pixel (x, y).
-    pub fn point(&self, x: u32, y: u32, depth: f32, near_m: f64) -> DVec3 {
+    /// The camera-relative point a reversed-Z depth puts on the ray through pixel (x, y).
+    pub fn point_rel(&self, x: u32, y: u32, depth: f32, near_m: f64) -> DVec3 {
         let dir = self.dir(x, y);
         let along_forward_m = near_m / f64::from(depth);
-        self.eye_grid_m + dir * (along_forward_m / dir.dot(self.forward))
+        dir * (along_forward_m / dir.dot(self.forward))
+    }
+
+    /// The grid-space point (x, y and a height) a reversed-Z depth puts on the ray through pixel
+    /// (x, y), where the renderer's placing puts it.
+    pub fn point(&self, x: u32, y: u32, depth: f32, near_m: f64) -> DVec3 {
+        let rel_m = self.point_rel(x, y, depth, near_m);
+        if self.exact.is_round() { self.exact.grid_m(rel_m) } else { self.eye_grid_m + rel_m }
     }
 }
 
@@ -309,8 +327,12 @@ pub fn audit(r: &Renderer, camera: &Camera, dem: &Dem, tol: Tolerance, ray_step_
             a.rays += 1;
             let d = at(x, y);
             let dir = rays.dir(x, y);
-            match expect(dem, rays.eye_grid_m, dir, camera.near_m / dir.dot(rays.forward), tol, fine_within_m)
-            {
+            let t_near = camera.near_m / dir.dot(rays.forward);
+            let expected = match rays.exact.is_round() {
+                true => round::expect(dem, &rays.exact, dir, t_near, tol, fine_within_m),
+                false => expect(dem, rays.eye_grid_m, dir, t_near, tol, fine_within_m),
+            };
+            match expected {
                 Expect::Ground => {
                     a.expect_ground += 1;
                     a.holes += usize::from(d == 0.0);

@@ -12,6 +12,7 @@ pub mod audit;
 pub mod camera;
 pub mod data;
 pub mod datasets;
+pub mod earth;
 pub mod images;
 pub mod impostors;
 pub mod memory;

@@ -191,6 +191,11 @@ pub static CLAIMS: &[Claim] = &[
         values: &[(test_const("tests/earth.rs", "ROUNDINGS"), plain)],
     },
     Claim {
+        doc: "docs/earth.md",
+        quote: "(the test allows {} pixel)",
+        values: &[(test_const("data-tools/tests/earth_horizon.rs", "MISS_PX"), plain)],
+    },
+    Claim {
         doc: "docs/light.md",
         quote: "`SEED_DETAIL_FULL_PX` ({}) pixels tall or less",
         values: &[(Source::Value(SEED_DETAIL_FULL_PX as f64), plain)],

@@ -12,6 +12,7 @@ use gdal::raster::{Buffer, GdalType};
 use gdal::spatial_ref::SpatialRef;
 use gdal::{DriverManager, GeoTransform};
 use terramp::dataset::{Dataset, Pyramid, Sampling, TileId};
+use terramp::earth::placing::EarthPlacing;
 use terramp_testkit::shared_data;
 
 pub mod texcells;
@@ -181,12 +182,14 @@ pub fn code_at(dataset: &Dataset, q: [u32; 2]) -> Option<u8> {
 }
 
 /// The ground under each pixel of a `size` frame seen from `camera`, read back from its
-/// reversed-Z `depth` (`None`: sky, or off the map).
+/// reversed-Z `depth` (`None`: sky, or off the map), drawn on the Earth where the manifest says
+/// where (`curved`: `render.curved_earth`) or flat.
 pub fn ground_under_pixels(
     dataset: &Dataset,
     camera: &terramp::camera::Camera,
     size: [u32; 2],
     depth: &[f32],
+    curved: bool,
 ) -> Vec<Option<PixelGround>> {
     let [w, h] = size;
     let clip_from_world = camera.clip_from_view(w, h).unwrap() * camera.view_from_world();
@@ -195,6 +198,8 @@ pub fn ground_under_pixels(
     let texel_m = 2.0 * meta.layer.texel_m;
     let origin = dataset.manifest.origin_m;
     let half = 0.5 * dataset.manifest.height.spacing_m;
+    let eye_grid_m = camera.position_m - glam::DVec3::new(origin[0], origin[1], 0.0);
+    let exact = EarthPlacing::new(dataset.manifest.earth.as_ref(), origin, curved).exact(eye_grid_m);
     let mut codes = std::collections::HashMap::new();
     (0..w * h)
         .map(|i| {
@@ -208,7 +213,7 @@ pub fn ground_under_pixels(
             ];
             let p = world_from_clip * glam::DVec4::new(ndc[0], ndc[1], d, 1.0);
             let rel = p.truncate() / p.w;
-            let grid = [camera.position_m.x + rel.x - origin[0], camera.position_m.y + rel.y - origin[1]];
+            let grid = exact.grid_m(rel);
             // Cell layers tile the extent from half a height spacing south-west of the grid.
             let q = [((grid[0] + half) / texel_m).floor(), ((grid[1] + half) / texel_m).floor()];
             if q[0] < 0.0 || q[1] < 0.0 {

@@ -1,6 +1,7 @@
 //! The ground pass's GPU half: the pipeline over the terrain's bind group, and the recorded draw.
 
 use crate::config::Settings;
+use crate::earth::gpu::EARTH;
 use crate::gpu::resources::{frame_pass, pipeline_layout};
 use crate::gpu::shaders::{CLOUDS, HASH, IMAGERY, TERRAIN_MESH, WgslSource};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
@@ -10,7 +11,7 @@ use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 /// `terrain::gpu::BINDINGS`).
 pub const SHADER: WgslSource = WgslSource {
     name: "ground",
-    parts: &[TERRAIN_MESH, IMAGERY, HASH, CLOUDS, include_str!("../../../shaders/ground.wgsl")],
+    parts: &[TERRAIN_MESH, EARTH, IMAGERY, HASH, CLOUDS, include_str!("../../../shaders/ground.wgsl")],
 };
 
 /// Pass 2 on the GPU: its pipeline (depth-equal, no depth write) and imagery sampler built once in

@@ -9,7 +9,8 @@ use glam::DVec3;
 use crate::config::Settings;
 use crate::dataset::surface::diagonal_rises;
 use crate::dataset::{Dataset, ImageryFormat, TileId};
-use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
+use crate::earth::placing::PlacedView;
+use crate::gpu::gpu_types::{EarthNode, TerrainNode, TerrainUniforms};
 use crate::gpu::layout::{IMAGERY_NONE, IMAGERY_PUNCHED, IMAGERY_STRAIGHT, IMAGERY_VEGETATION, MAX_LEVELS};
 use crate::light::{CloudShadowFrame, sun_dir};
 use crate::streaming::{TileCache, page_levels};
@@ -22,6 +23,9 @@ pub struct NodeBatches {
     /// Each quadrant's instances (south-west, south-east, north-west, north-east: the grid's index
     /// ranges' order); a node drawing several quadrants appears in each.
     pub by_quadrant: [Vec<TerrainNode>; 4],
+    /// Each of those instances' Earth mapping (origin the node's centre at height 0), in the same
+    /// order.
+    pub earth: [Vec<EarthNode>; 4],
     /// The box each of those instances draws (its quadrant of the node), in the same order.
     pub boxes: [Vec<QuadrantBox>; 4],
 }
@@ -118,7 +122,7 @@ pub fn terrain_uniforms(
     uniforms
 }
 
-/// The instances drawing `selected` from a camera at `camera_grid_m` (grid space). A node reads its
+/// The instances drawing `selected` from the camera `placed` sees from. A node reads its
 /// own height tile, or while that streams in, its finest resident ancestor; a node with neither
 /// (only before the pinned levels load) is dropped and counted. `bounds` gives node height ranges
 /// (the skirt depth). Nodes on the dataset's boundary hang their skirts down to `floor_m`, the
@@ -127,13 +131,14 @@ pub fn terrain_uniforms(
 pub fn node_batches(
     lods: &Lods,
     selected: &[Selected],
-    camera_grid_m: DVec3,
+    placed: &mut PlacedView,
     heights: &TileCache,
     floor_m: f32,
     bounds: &mut dyn FnMut(NodeId) -> [f32; 2],
 ) -> (NodeBatches, usize) {
     let mut batches = NodeBatches::default();
     let mut dropped = 0;
+    let camera_grid_m = placed.camera_grid_m();
     for s in selected {
         let Some((source, slot)) = heights.resident_ancestor(lods.tile_of(s.node)) else {
             dropped += 1;
@@ -164,12 +169,14 @@ pub fn node_batches(
             skirt_m: (f64::from(high_m - low_m) + cell_m) as f32,
         };
         let origin = [f64::from(s.node.x) * size, f64::from(s.node.y) * size];
+        let earth = placed.node(DVec3::new(origin[0] + 0.5 * size, origin[1] + 0.5 * size, 0.0));
         let half_cells = f64::from(lods.cells / 2);
         for q in 0..4 {
             if s.quadrants & (1 << q) == 0 {
                 continue;
             }
             batches.by_quadrant[q].push(node);
+            batches.earth[q].push(earth);
             // The quadrant's cells, cut to the node's cells inside the dataset.
             let first = [(q & 1) as f64 * half_cells, (q >> 1) as f64 * half_cells];
             let last = [0, 1].map(|a| (first[a] + half_cells).min(f64::from(inside[a])).max(first[a]));

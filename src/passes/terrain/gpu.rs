@@ -6,8 +6,9 @@ use std::ops::Range;
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::config::Settings;
+use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
-use crate::gpu::gpu_types::{TerrainNode, TerrainUniforms};
+use crate::gpu::gpu_types::{EarthNode, TerrainNode, TerrainUniforms};
 use crate::gpu::resources::{buffer, buffer_init, pipeline_layout};
 use crate::gpu::shaders::{TERRAIN_MESH, WgslSource};
 use crate::passes::DEPTH_FORMAT;
@@ -19,12 +20,15 @@ use super::frame::{NodeBatches, grid_indices};
 pub const MAX_NODES: u32 = 16384;
 
 /// The terrain pass's shader (the mesh alone: depth only).
-pub const SHADER: WgslSource =
-    WgslSource { name: "terrain", parts: &[TERRAIN_MESH, include_str!("../../../shaders/terrain.wgsl")] };
+pub const SHADER: WgslSource = WgslSource {
+    name: "terrain",
+    parts: &[TERRAIN_MESH, EARTH, include_str!("../../../shaders/terrain.wgsl")],
+};
 
 /// The bind group both terrain passes use: uniforms, nodes and the height cache (the mesh), then
-/// the imagery cache with its sampler and page table (the ground's shading).
-pub const BINDINGS: BindingTable<6> = BindingTable {
+/// the imagery cache with its sampler and page table (the ground's shading), and the nodes' Earth
+/// mappings (the mesh).
+pub const BINDINGS: BindingTable<7> = BindingTable {
     label: "terrain",
     bindings: [
         Binding::uniform::<TerrainUniforms>(0, "u", Stage::VERTEX_FRAGMENT),
@@ -46,6 +50,8 @@ pub const BINDINGS: BindingTable<6> = BindingTable {
         ),
         Binding::sampler(4, "imagery_sampler", Stage::FRAGMENT, wgpu::SamplerBindingType::Filtering),
         Binding::storage_array::<u32>(5, "imagery_page_table", Stage::FRAGMENT, Access::Read),
+        // The texcells' silhouettes turn their rays into their node's frame in the fragment stage.
+        Binding::storage_array::<EarthNode>(6, "node_earth", Stage::VERTEX_FRAGMENT, Access::Read),
     ],
 };
 
@@ -56,6 +62,7 @@ pub struct TerrainPass {
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     nodes: wgpu::Buffer,
+    node_earth: wgpu::Buffer,
     indices: wgpu::Buffer,
     quadrant_indices: [Range<u32>; 4],
 }
@@ -137,9 +144,11 @@ impl TerrainPass {
             buffer(device, "terrain uniforms", size_of::<TerrainUniforms>() as u64, U::UNIFORM | U::COPY_DST);
         let nodes_bytes = u64::from(MAX_NODES) * size_of::<TerrainNode>() as u64;
         let nodes = buffer(device, "terrain nodes", nodes_bytes, U::STORAGE | U::COPY_DST);
+        let earth_bytes = u64::from(MAX_NODES) * size_of::<EarthNode>() as u64;
+        let node_earth = buffer(device, "terrain nodes' earth", earth_bytes, U::STORAGE | U::COPY_DST);
         let (index_data, quadrant_indices) = grid_indices(settings.terrain.node_cells);
         let indices = buffer_init(device, "terrain grid", bytemuck::cast_slice(&index_data), U::INDEX);
-        Self { pipeline, layout, uniforms, nodes, indices, quadrant_indices }
+        Self { pipeline, layout, uniforms, nodes, node_earth, indices, quadrant_indices }
     }
 
     /// The bind group both terrain passes use (`BINDINGS`) over the height and imagery caches;
@@ -162,12 +171,13 @@ impl TerrainPass {
                 R::TextureView(&imagery.view),
                 R::Sampler(imagery_sampler),
                 imagery.page_table.as_entire_binding(),
+                self.node_earth.as_entire_binding(),
             ],
         )
     }
 
-    /// Uploads the frame's uniforms and node instances (at most `MAX_NODES`; the rest are dropped,
-    /// coarse quadrants last, and counted by the caller).
+    /// Uploads the frame's uniforms and node instances with their Earth mappings (at most
+    /// `MAX_NODES`; the rest are dropped, coarse quadrants last, and counted by the caller).
     pub fn prepare(
         &self,
         queue: &wgpu::Queue,
@@ -175,14 +185,17 @@ impl TerrainPass {
         batches: &NodeBatches,
     ) -> PreparedNodes {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
-        let mut all = Vec::with_capacity(batches.len());
-        let ranges = batches.by_quadrant.each_ref().map(|nodes| {
+        let (mut all, mut earth) = (Vec::with_capacity(batches.len()), Vec::with_capacity(batches.len()));
+        let ranges = std::array::from_fn(|q| {
             let start = all.len().min(MAX_NODES as usize);
-            all.extend_from_slice(&nodes[..nodes.len().min(MAX_NODES as usize - start)]);
+            let kept = batches.by_quadrant[q].len().min(MAX_NODES as usize - start);
+            all.extend_from_slice(&batches.by_quadrant[q][..kept]);
+            earth.extend_from_slice(&batches.earth[q][..kept]);
             start as u32..all.len() as u32
         });
         if !all.is_empty() {
             queue.write_buffer(&self.nodes, 0, bytemuck::cast_slice(&all));
+            queue.write_buffer(&self.node_earth, 0, bytemuck::cast_slice(&earth));
         }
         PreparedNodes { ranges }
     }

@@ -16,6 +16,7 @@ use glam::DVec3;
 use crate::camera::{Camera, Frustum};
 use crate::config::TerrainSettings;
 use crate::dataset::{Dataset, HEIGHT_BORDER, HEIGHT_TILE_CELLS, Pyramid, TileId};
+use crate::earth::placing::PlacedView;
 
 /// A node of the terrain quadtree: LOD `lod`, position (`x`, `y`) in nodes of that LOD.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -167,61 +168,81 @@ fn distance_to_box(p: DVec3, (min, max): (DVec3, DVec3)) -> f64 {
     (p.clamp(min, max) - p).length()
 }
 
-/// Selects the nodes to draw for a camera at `camera_grid_m` (grid space). `frustum` is in
-/// camera-relative space. `bounds` gives a node's height range.
+/// Selects the nodes to draw for the camera `placed` sees from. `frustum` is in camera-relative
+/// space: a node is culled by the box that holds what it draws (`PlacedView::box_rel_m`: on the
+/// Earth, bent), its LOD chosen by its distance on the flat sheet (as the shader's morph measures
+/// it; the bend changes a distance by less than the drop over it, 785 m in 100 km). `bounds`
+/// gives a node's height range. With `horizon` (the dataset's lowest ground, metres), a node the
+/// Earth hides from the camera is culled too (`PlacedView::hidden_by_earth`).
 pub fn select(
     lods: &Lods,
-    camera_grid_m: DVec3,
+    placed: &mut PlacedView,
     frustum: &Frustum,
+    horizon: Option<f64>,
     bounds: &mut dyn FnMut(NodeId) -> [f32; 2],
 ) -> Vec<Selected> {
     let mut out = Vec::new();
+    let camera_grid_m = placed.camera_grid_m();
+    let mut search = Search { lods, camera: camera_grid_m, placed, frustum, horizon, bounds };
     let top = lods.pyramid.levels - 1;
     let [nx, ny] = lods.nodes_at(top);
     for y in 0..ny {
         for x in 0..nx {
-            visit(lods, NodeId { lod: top, x, y }, camera_grid_m, frustum, bounds, &mut out);
+            search.visit(NodeId { lod: top, x, y }, &mut out);
         }
     }
     out
 }
 
-/// Returns false when `node` lies beyond its own range: its parent draws that area instead.
-fn visit(
-    lods: &Lods,
-    node: NodeId,
+/// One selection's walk down the quadtree.
+struct Search<'a, 'p> {
+    lods: &'a Lods,
     camera: DVec3,
-    frustum: &Frustum,
-    bounds: &mut dyn FnMut(NodeId) -> [f32; 2],
-    out: &mut Vec<Selected>,
-) -> bool {
-    let (min, max) = lods.node_box(node, bounds(node));
-    if distance_to_box(camera, (min, max)) > lods.range_m[node.lod as usize] {
-        return false;
-    }
-    if !frustum.intersects_box(min - camera, max - camera) {
-        return true;
-    }
-    if node.lod == 0 || distance_to_box(camera, (min, max)) > lods.range_m[node.lod as usize - 1] {
-        out.push(Selected { node, quadrants: ALL_QUADRANTS });
-        return true;
-    }
-    let [nx, ny] = lods.nodes_at(node.lod - 1);
-    let mut parent_draws = 0u8;
-    for q in 0..4u8 {
-        let child =
-            NodeId { lod: node.lod - 1, x: node.x * 2 + u32::from(q & 1), y: node.y * 2 + u32::from(q >> 1) };
-        if child.x >= nx || child.y >= ny {
-            continue;
+    placed: &'a mut PlacedView<'p>,
+    frustum: &'a Frustum,
+    horizon: Option<f64>,
+    bounds: &'a mut dyn FnMut(NodeId) -> [f32; 2],
+}
+
+impl Search<'_, '_> {
+    /// Returns false when `node` lies beyond its own range: its parent draws that area instead.
+    fn visit(&mut self, node: NodeId, out: &mut Vec<Selected>) -> bool {
+        let lods = self.lods;
+        let (min, max) = lods.node_box(node, (self.bounds)(node));
+        let distance_m = distance_to_box(self.camera, (min, max));
+        if distance_m > lods.range_m[node.lod as usize] {
+            return false;
         }
-        if !visit(lods, child, camera, frustum, bounds, out) {
-            parent_draws |= 1 << q;
+        let (lo, hi) = self.placed.box_rel_m(min, max);
+        if !self.frustum.intersects_box(lo, hi)
+            || self.horizon.is_some_and(|h| self.placed.hidden_by_earth(lo, hi, h))
+        {
+            return true;
         }
+        if node.lod == 0 || distance_m > lods.range_m[node.lod as usize - 1] {
+            out.push(Selected { node, quadrants: ALL_QUADRANTS });
+            return true;
+        }
+        let [nx, ny] = lods.nodes_at(node.lod - 1);
+        let mut parent_draws = 0u8;
+        for q in 0..4u8 {
+            let child = NodeId {
+                lod: node.lod - 1,
+                x: node.x * 2 + u32::from(q & 1),
+                y: node.y * 2 + u32::from(q >> 1),
+            };
+            if child.x >= nx || child.y >= ny {
+                continue;
+            }
+            if !self.visit(child, out) {
+                parent_draws |= 1 << q;
+            }
+        }
+        if parent_draws != 0 {
+            out.push(Selected { node, quadrants: parent_draws });
+        }
+        true
     }
-    if parent_draws != 0 {
-        out.push(Selected { node, quadrants: parent_draws });
-    }
-    true
 }
 
 /// Height ranges of nodes, computed once per node from its tile's samples.

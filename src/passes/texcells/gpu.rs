@@ -7,6 +7,7 @@
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::dataset::surface::diagonal_rises;
+use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{TexcellRecord, TexcellUniforms};
@@ -27,6 +28,7 @@ pub const SHADER: WgslSource = WgslSource {
     name: "texcells",
     parts: &[
         TERRAIN_MESH,
+        EARTH,
         IMAGERY,
         HASH,
         CLOUDS,

@@ -1,0 +1,276 @@
+//! How it works: where a renderer draws its dataset's grid points, frame by frame. A dataset whose
+//! manifest records where it lies on the Earth (`EarthFrame`) is drawn on WGS 84's ellipsoid, seen
+//! from the camera's frame (`LocalFrame::grid_aligned`: up along the ellipsoid's normal, the
+//! grid's x direction turned into the horizontal); one without (a synthetic world, a local CRS),
+//! or a renderer told `render.curved_earth = false`, is drawn as the flat sheet of its grid. Both
+//! hand the GPU the same thing, a node's `EarthNode`: on the flat sheet the mapping is the
+//! identity (first derivatives the axes, no second ones), which the shader's polynomial turns into
+//! exactly the sum the flat sheet formed (the origin plus the offset; the zero terms add nothing).
+//!
+//! A node's mapping in Earth-centred axes (`EcefNode`) depends on the node alone, so it is formed
+//! once (13 exact mappings) and kept, keyed by the node's origin; each frame only turns it into
+//! the camera's frame. The CPU's culling asks `box_rel_m` for a camera-relative box that holds
+//! what the GPU draws of a grid box: its lattice of corners and mid-points placed by the node's
+//! polynomial, widened by what a quadratic can bulge between them and by the polynomial's third
+//! order.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::local::{EcefNode, LocalFrame};
+use super::{EarthFrame, Ellipsoid};
+use crate::gpu::gpu_types::EarthNode;
+
+/// Nodes whose mappings are kept; past this the keep is emptied and refilled as frames ask.
+pub const MAX_KEPT_NODES: usize = 1 << 16;
+
+/// The smallest radius of curvature WGS 84 has (the meridian's, at the equator), metres: the
+/// bound on how fast its ground bends.
+const SMALLEST_RADIUS_M: f64 = 6_335_439.0;
+
+/// How a renderer places its dataset: on the ellipsoid, or flat.
+#[derive(Debug, Clone)]
+pub struct EarthPlacing {
+    round: Option<Round>,
+    /// Mappings formed so far, by their origin's grid position's bits.
+    kept: HashMap<[u64; 3], EcefNode>,
+}
+
+#[derive(Debug, Clone)]
+struct Round {
+    earth: Arc<EarthFrame>,
+    /// The grid's origin, CRS metres (`Manifest::origin_m`).
+    origin_m: [f64; 2],
+    /// The geoid's lowest undulation over the dataset (0 without one), metres.
+    lowest_undulation_m: f64,
+}
+
+/// How far below the datum's lowest point the horizon's ellipsoid is lowered beyond the geoid's
+/// lowest undulation, metres: a datum step's metres, and the parallel surface's departure from
+/// a scaled ellipsoid (h e², centimetres).
+const HORIZON_MARGIN_M: f64 = 10.0;
+
+impl EarthPlacing {
+    /// Placing on `earth` (when given and `curved`) for a grid whose origin is CRS point
+    /// `origin_m`; flat otherwise.
+    pub fn new(earth: Option<&EarthFrame>, origin_m: [f64; 2], curved: bool) -> Self {
+        let round = earth.filter(|_| curved).map(|earth| {
+            let lowest =
+                earth.geoid.as_ref().map_or(0.0, |g| g.undulation_m.iter().copied().fold(0.0f32, f32::min));
+            Round { earth: Arc::new(earth.clone()), origin_m, lowest_undulation_m: f64::from(lowest) }
+        });
+        Self { round, kept: HashMap::new() }
+    }
+
+    /// Whether the grid is drawn on the ellipsoid.
+    pub fn is_round(&self) -> bool {
+        self.round.is_some()
+    }
+
+    /// The exact placing (f64) seen from a camera at grid point `camera_grid_m`.
+    pub fn exact(&self, camera_grid_m: DVec3) -> ExactPlacing {
+        let round = self.round.as_ref().map(|round| {
+            let [x, y] = [camera_grid_m.x + round.origin_m[0], camera_grid_m.y + round.origin_m[1]];
+            let frame = LocalFrame::grid_aligned(&round.earth, x, y, camera_grid_m.z);
+            (frame, Arc::clone(&round.earth), round.origin_m, round.lowest_undulation_m)
+        });
+        ExactPlacing { camera_grid_m, round }
+    }
+
+    /// The placing seen from a camera at grid point `camera_grid_m`, for a frame's GPU work.
+    pub fn view(&mut self, camera_grid_m: DVec3) -> PlacedView<'_> {
+        PlacedView { exact: self.exact(camera_grid_m), kept: &mut self.kept }
+    }
+}
+
+/// The placing from one camera, exact (f64): for the CPU, and for tests that judge the GPU.
+#[derive(Debug, Clone)]
+pub struct ExactPlacing {
+    camera_grid_m: DVec3,
+    /// The camera's frame, the dataset's frame, the grid's CRS origin and the geoid's lowest
+    /// undulation; `None` flat.
+    round: Option<(LocalFrame, Arc<EarthFrame>, [f64; 2], f64)>,
+}
+
+impl ExactPlacing {
+    /// The camera's grid position.
+    pub fn camera_grid_m(&self) -> DVec3 {
+        self.camera_grid_m
+    }
+
+    /// Whether the grid is placed on the ellipsoid.
+    pub fn is_round(&self) -> bool {
+        self.round.is_some()
+    }
+
+    /// The camera-relative position of grid point `grid_m` (x, y and a height).
+    pub fn position_rel_m(&self, grid_m: DVec3) -> DVec3 {
+        match &self.round {
+            Some((frame, earth, origin_m, _)) => {
+                frame.position_m(earth, grid_m.x + origin_m[0], grid_m.y + origin_m[1], grid_m.z)
+            }
+            None => grid_m - self.camera_grid_m,
+        }
+    }
+
+    /// The grid point (x, y and a height) placed at camera-relative `rel_m`: `position_rel_m`'s
+    /// inverse, by fixed-point steps (the mapping is the identity turned by the Earth's bend
+    /// between the camera and the point, d / R: each step divides the miss by about that).
+    pub fn grid_m(&self, rel_m: DVec3) -> DVec3 {
+        let mut grid_m = self.camera_grid_m + rel_m;
+        if self.round.is_some() {
+            for _ in 0..MAX_INVERSE_STEPS {
+                let miss = rel_m - self.position_rel_m(grid_m);
+                grid_m += miss;
+                if miss.length_squared() < 1e-18 {
+                    break;
+                }
+            }
+        }
+        grid_m
+    }
+}
+
+/// The most steps `ExactPlacing::grid_m` takes (it stops at a nanometre): enough for points
+/// 3,000 km away (a bend of 0.5 a step).
+const MAX_INVERSE_STEPS: usize = 48;
+
+/// One frame's placing: the camera's frame, and the dataset's mappings.
+pub struct PlacedView<'a> {
+    exact: ExactPlacing,
+    kept: &'a mut HashMap<[u64; 3], EcefNode>,
+}
+
+/// The mapping of a node whose origin is grid point `origin_grid_m`, formed once.
+fn kept_node<'k>(
+    kept: &'k mut HashMap<[u64; 3], EcefNode>,
+    earth: &EarthFrame,
+    origin_m: [f64; 2],
+    origin_grid_m: DVec3,
+) -> &'k EcefNode {
+    if kept.len() >= MAX_KEPT_NODES {
+        kept.clear();
+    }
+    let key = origin_grid_m.to_array().map(f64::to_bits);
+    kept.entry(key)
+        .or_insert_with(|| EcefNode::at(earth, origin_grid_m + DVec3::new(origin_m[0], origin_m[1], 0.0)))
+}
+
+impl PlacedView<'_> {
+    /// The camera's grid position.
+    pub fn camera_grid_m(&self) -> DVec3 {
+        self.exact.camera_grid_m
+    }
+
+    /// Whether this frame is drawn on the ellipsoid.
+    pub fn is_round(&self) -> bool {
+        self.exact.is_round()
+    }
+
+    /// The exact placing this view hands the GPU a node at a time.
+    pub fn exact(&self) -> &ExactPlacing {
+        &self.exact
+    }
+
+    /// The mapping of a node whose origin is grid point `origin_grid_m` (x, y and a height), for
+    /// the GPU: offsets from that point go in, camera-relative positions come out.
+    pub fn node(&mut self, origin_grid_m: DVec3) -> EarthNode {
+        match &self.exact.round {
+            Some((frame, earth, origin_m, _)) => {
+                EarthNode::from(&frame.place(kept_node(self.kept, earth, *origin_m, origin_grid_m)))
+            }
+            None => {
+                let axis = |a: usize| {
+                    let mut v = [0.0; 4];
+                    v[a] = 1.0;
+                    v
+                };
+                EarthNode {
+                    origin_m: (origin_grid_m - self.exact.camera_grid_m).as_vec3().extend(0.0).to_array(),
+                    d_x: axis(0),
+                    d_y: axis(1),
+                    d_h: axis(2),
+                    ..EarthNode::default()
+                }
+            }
+        }
+    }
+
+    /// The exact camera-relative position of grid point `grid_m` (f64).
+    pub fn position_rel_m(&self, grid_m: DVec3) -> DVec3 {
+        self.exact.position_rel_m(grid_m)
+    }
+
+    /// Whether the Earth hides every point of the camera-relative box `lo`..`hi` from the camera
+    /// (horizon culling): the ellipsoid lowered below `lowest_height_m` (the dataset's lowest
+    /// ground) by the geoid's lowest undulation and `HORIZON_MARGIN_M` hides a point that lies inside the cone of its tangents
+    /// from the eye and beyond the plane of their points of contact, a convex region: a box whose
+    /// eight corners lie in it lies in it whole. Worked in the ellipsoid's scaled space (Cesium's
+    /// horizon culling), where the ellipsoid is the unit sphere and the test is exact. Flat, or
+    /// with the eye below that ellipsoid, nothing is hidden.
+    pub fn hidden_by_earth(&self, lo: DVec3, hi: DVec3, lowest_height_m: f64) -> bool {
+        let Some((frame, _, _, undulation_m)) = &self.exact.round else { return false };
+        let lowest_m = lowest_height_m + undulation_m - HORIZON_MARGIN_M;
+        let e = Ellipsoid::WGS84;
+        let scale = DVec3::new(e.a_m + lowest_m, e.a_m + lowest_m, e.b_m() + lowest_m).recip();
+        let eye = frame.eye_ecef_m * scale;
+        let eye_sq = eye.length_squared();
+        if eye_sq <= 1.0 {
+            return false;
+        }
+        // The cone of tangents from the eye: cos² of its half-angle is 1 − 1 / |eye|²; the plane
+        // of contact lies (|eye|² − 1) / |eye| along the axis towards the centre.
+        let (axis, tangent_sq) = (-eye, eye_sq - 1.0);
+        let ecef_from_local = frame.local_from_ecef.transpose();
+        (0..8).all(|k| {
+            let corner = DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            let p = (ecef_from_local * corner) * scale;
+            let along = p.dot(axis);
+            // Beyond the plane (along > tangent², |axis| folded in) and inside the cone
+            // (along² ≥ |p|² |axis|² cos²: cos² = tangent² / |axis|²).
+            along > tangent_sq && along * along >= p.length_squared() * tangent_sq
+        })
+    }
+
+    /// A camera-relative box holding everything the GPU draws of the grid box `min_m`..`max_m`
+    /// when its mapping's origin is the box's centre at height 0 (`node`).
+    pub fn box_rel_m(&mut self, min_m: DVec3, max_m: DVec3) -> (DVec3, DVec3) {
+        let camera_grid_m = self.exact.camera_grid_m;
+        let Some((frame, earth, origin_m, _)) = &self.exact.round else {
+            return (min_m - camera_grid_m, max_m - camera_grid_m);
+        };
+        let centre = DVec3::new(0.5 * (min_m.x + max_m.x), 0.5 * (min_m.y + max_m.y), 0.0);
+        let node = *kept_node(self.kept, earth, *origin_m, centre);
+        let half = 0.5 * (max_m - min_m);
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for j in -1..=1 {
+            for i in -1..=1 {
+                for h in [min_m.z, max_m.z] {
+                    let offset = DVec3::new(f64::from(i) * half.x, f64::from(j) * half.y, h);
+                    let p = frame.turn(node.position_m(offset) - frame.eye_ecef_m);
+                    (lo, hi) = (lo.min(p), hi.max(p));
+                }
+            }
+        }
+        // Between lattice points half a side apart a quadratic strays from the chord by a quarter
+        // of its second-order term there; the polynomial itself misses the ellipsoid by its third
+        // order (about r³ / 6R² at half-diagonal r: doubled).
+        let (a, b) = (half.x, half.y);
+        let quadratic =
+            0.25 * (node.d_xx.length() * a * a + node.d_xy.length() * a * b + node.d_yy.length() * b * b);
+        let r = f64::hypot(a, b);
+        let third = r.powi(3) / (3.0 * SMALLEST_RADIUS_M * SMALLEST_RADIUS_M);
+        let margin = DVec3::splat(quadratic + third);
+        (lo - margin, hi + margin)
+    }
+}
+
+#[cfg(test)]
+#[path = "placing_tests.rs"]
+mod tests;
