@@ -3,11 +3,12 @@
 //! depth, unprojected, is held to the exact mapping (f64, `PlacedView::position_rel_m`) of the
 //! finest mesh's ground under it; the flat sheet misses it by the Earth's drop (196 m at 50 km),
 //! which shows the measure can tell. A frame over the default LOD rings has no hole below its
-//! horizon.
+//! horizon. Cameras written in longitude and latitude land where they are.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::DVec3;
 use terramp::dataset::Dataset;
+use terramp::dataset::pose::CameraPoseError;
 use terramp::earth::placing::EarthPlacing;
 use terramp::frame::Renderer;
 use terramp::synth::SynthParams;
@@ -131,4 +132,38 @@ fn a_curved_frame_has_no_hole_below_its_horizon() {
             assert!(hole.is_none(), "yaw {yaw}: hole at column {column}, row {}", first + hole.unwrap_or(0));
         }
     }
+}
+
+/// A camera written on the Earth lands in the dataset's CRS where the pose is: `lonlat:` at its
+/// height above the ellipsoid, `lonlat-ground:` that far above the ground there; the CRS form is
+/// read as before, and a dataset that does not say where it lies refuses the Earth's forms.
+#[test]
+fn cameras_are_placed_from_longitude_and_latitude() {
+    let dataset = placed_dataset();
+    let earth = dataset.manifest.earth.clone().unwrap();
+    let [ox, oy] = dataset.manifest.origin_m;
+    let (lat, lon) = earth.geodetic(ox + 30_000.0, oy + 20_000.0);
+    let (lon_deg, lat_deg) = (lon.to_degrees(), lat.to_degrees());
+    let on_earth =
+        dataset.camera_from(&format!("lonlat:{lon_deg},{lat_deg},2500,90,-30"), 60.0, 0.1).unwrap();
+    let p = on_earth.position_m;
+    assert!((p.x - ox - 30_000.0).abs() < 1e-4 && (p.y - oy - 20_000.0).abs() < 1e-4, "{p}");
+    let wanted = terramp::earth::Ellipsoid::WGS84.ecef_m(lat, lon, 2_500.0);
+    assert!((earth.ecef_m(p.x, p.y, p.z) - wanted).length() < 1e-5, "{p}");
+    assert_eq!(on_earth.pitch_deg, -30.0);
+    let above =
+        dataset.camera_from(&format!("lonlat-ground:{lon_deg},{lat_deg},40,90,-30"), 60.0, 0.1).unwrap();
+    let ground_m = dataset.height_at(30_000.0, 20_000.0, 0).unwrap();
+    assert!((above.position_m.z - ground_m - 40.0).abs() < 1e-3, "{} over {ground_m}", above.position_m);
+    // The grid's north, taken 2.5 km higher, turns by under 10⁻⁶°.
+    assert!((above.yaw_deg - on_earth.yaw_deg).abs() < 1e-5, "{} {}", above.yaw_deg, on_earth.yaw_deg);
+    let crs = dataset.camera_from("630000,200000,900,10,-20", 60.0, 0.1).unwrap();
+    assert_eq!((crs.position_m, crs.yaw_deg), (DVec3::new(630_000.0, 200_000.0, 900.0), 10.0));
+    for bad in ["lonlat:1,2,3", "lonlat:a,2,3,4,5", "geo:1,2,3,4,5", "1,2,3"] {
+        assert!(matches!(dataset.camera_from(bad, 60.0, 0.1), Err(CameraPoseError::Parse(_))), "{bad}");
+    }
+    let mut flat = placed_dataset();
+    flat.manifest.earth = None;
+    let refused = flat.camera_from("lonlat:-78.6,35.7,900,0,-20", 60.0, 0.1);
+    assert!(matches!(refused, Err(CameraPoseError::NotOnEarth(_))), "{refused:?}");
 }

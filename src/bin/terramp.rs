@@ -66,7 +66,10 @@ struct ViewArgs {
     #[arg(long)]
     dataset: PathBuf,
     /// X,Y,Z,YAW,PITCH: position in the dataset CRS (metres; Z above the datum), compass
-    /// heading and pitch above the horizon (degrees). E.g. `--camera 636000,214000,900,0,-20`.
+    /// heading from the grid's north and pitch above the horizon (degrees). E.g. `--camera
+    /// 636000,214000,900,0,-20`. Or on the Earth (datasets whose manifest records where they
+    /// lie): `lonlat:LON,LAT,H,HEADING,PITCH` (WGS 84 degrees, H metres above its ellipsoid,
+    /// heading from true north), `lonlat-ground:LON,LAT,H,HEADING,PITCH` (H above the ground).
     #[arg(long, allow_hyphen_values = true)]
     camera: String,
     /// Vertical field of view, degrees.
@@ -92,7 +95,7 @@ impl ViewArgs {
         r.fov_deg = self.fov.unwrap_or(r.fov_deg);
         r.width = self.width.unwrap_or(r.width);
         r.height = self.height.unwrap_or(r.height);
-        let camera = Camera::parse_pose(&self.camera, r.fov_deg, r.near_m)?;
+        let camera = Dataset::open(&self.dataset)?.camera_from(&self.camera, r.fov_deg, r.near_m)?;
         Ok((settings, camera))
     }
 }

@@ -23,6 +23,7 @@ pub mod lcc;
 pub mod manifest;
 pub mod pack;
 pub mod partition;
+pub mod pose;
 pub mod pyramid;
 pub mod staging;
 pub mod surface;

@@ -22,6 +22,7 @@ pub mod geodesic;
 pub mod gpu;
 pub mod local;
 pub mod placing;
+pub mod pose;
 pub mod projection;
 
 use glam::DVec3;
