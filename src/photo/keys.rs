@@ -2,7 +2,8 @@
 //! 0 for the sky; `Renderer::terrain_depth`, the terrain pass alone, so a tree's pixel is keyed by
 //! the ground behind it, the ground the photograph shows there) is unprojected through the inverse
 //! of the camera's clip-from-camera-relative-world matrix (in f64) at each pixel's centre, then
-//! moved into grid space (the camera's CRS position less the dataset's origin). The imagery's
+//! moved into grid space where the renderer placed it: the camera's grid position plus the offset
+//! on the flat sheet, or the exact placing's inverse on the Earth (`ExactPlacing::grid_m`). The imagery's
 //! level-0 texel there is `floor((p + ½ height spacing) / texel_m)`, as the ground truth's seeds
 //! find it (`truth::scene`): cell layers cover the DEM's pixel-area extent, half a spacing beyond
 //! grid space. The pixel is wooded when the land cover's class there (its source level, which
@@ -25,27 +26,43 @@ use crate::camera::Camera;
 use crate::classes::{ClassTable, SpeciesKind};
 use crate::dataset::lcc::{LCC_BARE_INDEX, LCC_SOURCE_LEVEL};
 use crate::dataset::{Dataset, TileId, imagery_texel_at};
+use crate::earth::placing::EarthPlacing;
 use crate::frame::Renderer;
 
 /// The keys of the view `renderer` last settled from `camera` (its terrain depth read back).
 pub fn pixel_keys(renderer: &Renderer, camera: &Camera) -> Result<PixelKeys, PhotoError> {
     let depth = renderer.terrain_depth()?;
     let r = &renderer.settings.render;
-    keys_of_depth(&renderer.dataset, renderer.class_table(), camera, [r.width, r.height], &depth)
+    let view = View { camera, size_px: [r.width, r.height], curved_earth: r.curved_earth };
+    keys_of_depth(&renderer.dataset, renderer.class_table(), &view, &depth)
 }
 
-/// The keys of a view `size_px` from `camera` whose terrain depth is `depth` (top row first).
+/// The view whose keys are formed: its camera, its size, and whether the renderer drew the
+/// dataset on the Earth (`render.curved_earth`).
+pub struct View<'a> {
+    /// The camera.
+    pub camera: &'a Camera,
+    /// The frame's size, pixels.
+    pub size_px: [u32; 2],
+    /// Whether the ground was drawn on the Earth where the manifest says where it lies.
+    pub curved_earth: bool,
+}
+
+/// The keys of `view` whose terrain depth is `depth` (top row first).
 pub fn keys_of_depth(
     dataset: &Dataset,
     table: Option<&ClassTable>,
-    camera: &Camera,
-    size_px: [u32; 2],
+    view: &View,
     depth: &[f32],
 ) -> Result<PixelKeys, PhotoError> {
+    let (camera, size_px) = (view.camera, view.size_px);
     let [w, h] = size_px;
     let world_from_clip = (camera.clip_from_view(w, h)? * camera.view_from_world()).inverse();
     let manifest = &dataset.manifest;
     let eye_grid_m = camera.position_m - DVec3::new(manifest.origin_m[0], manifest.origin_m[1], 0.0);
+    // Back from the camera's frame to the grid as the renderer placed it (flat: the eye plus).
+    let placing = EarthPlacing::new(manifest.earth.as_ref(), manifest.origin_m, view.curved_earth);
+    let exact = placing.exact(eye_grid_m);
     let half_spacing_m = 0.5 * manifest.height.spacing_m;
     let imagery = match (&manifest.imagery, &dataset.imagery) {
         (Some(meta), Some(layer)) => Some((meta.texel_m, layer.pyramid.size)),
@@ -78,7 +95,7 @@ pub fn keys_of_depth(
         );
         let rel = world_from_clip * ndc;
         let from_eye_m = rel.truncate() / rel.w;
-        let p = eye_grid_m + from_eye_m;
+        let p = exact.grid_m(from_eye_m);
         ground_m[i] = Some([p.x, p.y]);
         keys.ground_distance_m[i] = from_eye_m.truncate().length() as f32;
         // Reversed-Z with an infinite far plane: depth is near / view depth.
