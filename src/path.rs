@@ -1,5 +1,7 @@
 //! How it works: a camera path is a list of keyframes in the dataset CRS (metres, height above the
-//! datum; compass heading and pitch in degrees), read from TOML (`config/paths/*.toml`). Positions
+//! datum; compass heading and pitch in degrees), read from TOML (`config/paths/*.toml`); a
+//! keyframe may instead be given on the Earth (`lonlat`, `heading_deg`), which the dataset places
+//! in its CRS as the path is read (`CameraPath::load_placed`). Positions
 //! follow a uniform Catmull-Rom spline through the keys, so the flight passes
 //! exactly through each key with a continuous velocity; headings turn the short way round. A
 //! flight of `n` frames samples the path at `n` evenly spaced parameters from the first key to
@@ -46,7 +48,20 @@ pub enum PathError {
         /// The keyframe's position in the file, from 0.
         index: usize,
     },
+    /// A keyframe given on the Earth could not be placed in the dataset's CRS.
+    #[error("{path}: keyframe {index}: {message}")]
+    Place {
+        /// The file, as in `Parse`.
+        path: String,
+        /// The keyframe's position in the file, from 0.
+        index: usize,
+        /// Why.
+        message: String,
+    },
 }
+
+/// Why a keyframe on the Earth is refused where no dataset places it.
+const ON_EARTH: &str = "given on the Earth (`lonlat`): only a dataset that records where it lies places it";
 
 /// Spline samples per key when `CameraPath::walk` measures the arc length.
 const WALK_SAMPLES_PER_KEY: f64 = 4096.0;
@@ -63,37 +78,109 @@ pub struct Keyframe {
     pub pitch_deg: f64,
 }
 
-/// A camera flight: keyframes joined by a Catmull-Rom spline, sampled by `camera_at`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+/// A keyframe given on the Earth (`lonlat`, `heading_deg`, `pitch_deg`, `above_ground`), before a
+/// dataset places it in its CRS (`CameraPath::parse_placed`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EarthKey {
+    /// WGS 84 longitude and latitude, degrees, and a height, metres: above the ellipsoid, or
+    /// above the ground with `above_ground`.
+    pub lonlat: [f64; 3],
+    /// Compass heading from true north, degrees.
+    pub heading_deg: f64,
+    /// Elevation of the view above the horizon, degrees.
+    pub pitch_deg: f64,
+    /// Whether the height is above the dataset's ground rather than the ellipsoid.
+    pub above_ground: bool,
+}
+
+/// A keyframe as the file writes it: in the dataset CRS (`at`, `yaw_deg`) or on the Earth
+/// (`lonlat`, `heading_deg`, and `above_ground`, false by default).
+#[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(deny_unknown_fields)]
+struct KeyOnFile {
+    at: Option<[f64; 3]>,
+    yaw_deg: Option<f64>,
+    lonlat: Option<[f64; 3]>,
+    heading_deg: Option<f64>,
+    #[serde(default)]
+    above_ground: bool,
+    pitch_deg: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PathFile {
+    key: Vec<KeyOnFile>,
+}
+
+/// A camera flight: keyframes joined by a Catmull-Rom spline, sampled by `camera_at`.
+#[derive(Debug, Clone, PartialEq)]
 pub struct CameraPath {
     /// The keyframes in flight order, at least one; equally spaced in the path's parameter.
-    #[serde(rename = "key")]
     pub keys: Vec<Keyframe>,
 }
 
+/// Places a keyframe given on the Earth in the dataset's CRS, or says why it cannot.
+pub type PlaceKey<'a> = &'a mut dyn FnMut(&EarthKey) -> Result<Keyframe, String>;
+
 impl CameraPath {
-    /// Reads and checks a path file (`config/paths/*.toml`).
+    /// Reads and checks a path file (`config/paths/*.toml`) of keyframes in the dataset CRS.
     pub fn load(path: &Path) -> Result<Self, PathError> {
+        Self::load_placed(path, &mut |_| Err(ON_EARTH.to_owned()))
+    }
+
+    /// Reads and checks a path file whose keyframes may be given on the Earth, each placed by
+    /// `place`.
+    pub fn load_placed(path: &Path, place: PlaceKey) -> Result<Self, PathError> {
         let name = path.display().to_string();
         let text =
             std::fs::read_to_string(path).map_err(|source| PathError::Read { path: name.clone(), source })?;
-        Self::parse(&text, &name)
+        Self::parse_placed(&text, &name, place)
     }
 
-    /// Parses and checks a path's TOML text; `name` labels the errors.
+    /// Parses and checks a path's TOML text of keyframes in the dataset CRS; `name` labels the
+    /// errors.
     pub fn parse(text: &str, name: &str) -> Result<Self, PathError> {
-        let path: CameraPath = toml::from_str(text)
+        Self::parse_placed(text, name, &mut |_| Err(ON_EARTH.to_owned()))
+    }
+
+    /// Parses and checks a path's TOML text, keyframes given on the Earth placed by `place`.
+    pub fn parse_placed(text: &str, name: &str, place: PlaceKey) -> Result<Self, PathError> {
+        let file: PathFile = toml::from_str(text)
             .map_err(|e| PathError::Parse { path: name.to_owned(), message: e.to_string() })?;
-        if path.keys.is_empty() {
+        if file.key.is_empty() {
             return Err(PathError::Empty { path: name.to_owned() });
         }
-        if let Some(index) = path.keys.iter().position(|k| {
-            !(k.at.iter().all(|v| v.is_finite()) && k.yaw_deg.is_finite() && k.pitch_deg.is_finite())
-        }) {
-            return Err(PathError::NotFinite { path: name.to_owned(), index });
+        let mut keys = Vec::with_capacity(file.key.len());
+        for (index, k) in file.key.into_iter().enumerate() {
+            let numbers = k.at.into_iter().chain(k.lonlat).flatten().chain(k.yaw_deg).chain(k.heading_deg);
+            if !numbers.chain([k.pitch_deg]).all(f64::is_finite) {
+                return Err(PathError::NotFinite { path: name.to_owned(), index });
+            }
+            let key = match (k.at, k.yaw_deg, k.lonlat, k.heading_deg, k.above_ground) {
+                (Some(at), Some(yaw_deg), None, None, false) => {
+                    Keyframe { at, yaw_deg, pitch_deg: k.pitch_deg }
+                }
+                (None, None, Some(lonlat), Some(heading_deg), above_ground) => {
+                    let earth = EarthKey { lonlat, heading_deg, pitch_deg: k.pitch_deg, above_ground };
+                    place(&earth).map_err(|message| PathError::Place {
+                        path: name.to_owned(),
+                        index,
+                        message,
+                    })?
+                }
+                _ => {
+                    let message = format!(
+                        "keyframe {index}: give `at` and `yaw_deg` (the dataset CRS) or `lonlat` and \
+                         `heading_deg` (on the Earth, with `above_ground` if the height is above the ground), \
+                         and `pitch_deg`"
+                    );
+                    return Err(PathError::Parse { path: name.to_owned(), message });
+                }
+            };
+            keys.push(key);
         }
-        Ok(path)
+        Ok(Self { keys })
     }
 
     /// The camera at `t` in [0, 1] along the path (clamped).
@@ -204,6 +291,47 @@ mod tests {
         let path = CameraPath::parse(one, "one").unwrap();
         assert_eq!(path.camera_at(0.7, 60.0, 0.1).position_m, DVec3::new(5.0, 6.0, 7.0));
         assert_eq!(path.walk(0.2, 1.0, 8, 60.0, 0.1).len(), 1);
+    }
+
+    #[test]
+    fn keys_on_the_earth_are_placed_by_the_dataset() {
+        let text = "[[key]]\nat = [5.0, 6.0, 7.0]\nyaw_deg = 10.0\npitch_deg = 0.0\n\
+                    [[key]]\nlonlat = [-78.6, 35.7, 900.0]\nheading_deg = 90.0\npitch_deg = -5.0\nabove_ground = true\n";
+        let mut seen = Vec::new();
+        let path = CameraPath::parse_placed(text, "earth", &mut |key| {
+            seen.push(*key);
+            Ok(Keyframe {
+                at: [1.0, 2.0, key.lonlat[2]],
+                yaw_deg: key.heading_deg - 1.0,
+                pitch_deg: key.pitch_deg,
+            })
+        })
+        .unwrap();
+        assert_eq!(
+            seen,
+            [EarthKey {
+                lonlat: [-78.6, 35.7, 900.0],
+                heading_deg: 90.0,
+                pitch_deg: -5.0,
+                above_ground: true
+            }]
+        );
+        assert_eq!(path.keys[1], Keyframe { at: [1.0, 2.0, 900.0], yaw_deg: 89.0, pitch_deg: -5.0 });
+        assert_eq!(path.keys[0].at, [5.0, 6.0, 7.0]);
+        // Without a dataset to place them, refused with the keyframe named.
+        let refused = CameraPath::parse(text, "earth").unwrap_err();
+        assert!(matches!(refused, PathError::Place { index: 1, .. }), "{refused}");
+        let failed =
+            CameraPath::parse_placed(text, "earth", &mut |_| Err("beyond the CRS".into())).unwrap_err();
+        assert!(failed.to_string().contains("keyframe 1: beyond the CRS"), "{failed}");
+        // Both forms at once, or half of one, is neither.
+        let both =
+            "[[key]]\nat = [0.0, 0.0, 0.0]\nyaw_deg = 0.0\nlonlat = [0.0, 0.0, 0.0]\npitch_deg = 0.0\n";
+        let half = "[[key]]\nlonlat = [0.0, 0.0, 0.0]\npitch_deg = 0.0\n";
+        for text in [both, half] {
+            let e = CameraPath::parse_placed(text, "mixed", &mut |_| unreachable!()).unwrap_err();
+            assert!(e.to_string().contains("give `at` and `yaw_deg`"), "{e}");
+        }
     }
 
     #[test]

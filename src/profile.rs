@@ -31,7 +31,7 @@ pub mod summary;
 pub mod table;
 pub mod trace;
 
-pub use session::{Session, default_path, fly, orbit_path, timing_of};
+pub use session::{Session, default_path, fly, load_path, orbit_path, timing_of};
 pub use summary::{Meta, Summary};
 
 /// Why a profiled flight, or writing what it measured, failed.

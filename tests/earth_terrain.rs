@@ -167,3 +167,35 @@ fn cameras_are_placed_from_longitude_and_latitude() {
     let refused = flat.camera_from("lonlat:-78.6,35.7,900,0,-20", 60.0, 0.1);
     assert!(matches!(refused, Err(CameraPoseError::NotOnEarth(_))), "{refused:?}");
 }
+
+/// A camera path whose keyframes are given on the Earth lands, key by key, where the cameras
+/// written the same way land.
+#[test]
+fn camera_paths_on_the_earth_are_placed_in_the_dataset() {
+    let dataset = placed_dataset();
+    let earth = dataset.manifest.earth.clone().unwrap();
+    let [ox, oy] = dataset.manifest.origin_m;
+    let (lat, lon) = earth.geodetic(ox + 10_000.0, oy + 40_000.0);
+    let (lon_deg, lat_deg) = (lon.to_degrees(), lat.to_degrees());
+    let dir = terramp_testkit::TempDir::new("earth-path");
+    let file = dir.path().join("path.toml");
+    let text = format!(
+        "[[key]]\nlonlat = [{lon_deg}, {lat_deg}, 3000.0]\nheading_deg = 45.0\npitch_deg = -20.0\n\
+         [[key]]\nlonlat = [{lon_deg}, {lat_deg}, 50.0]\nheading_deg = 0.0\npitch_deg = -5.0\nabove_ground = true\n"
+    );
+    std::fs::write(&file, text).unwrap();
+    let path = terramp::profile::load_path(&dataset, &file).unwrap();
+    for (key, written) in path.keys.iter().zip([
+        format!("lonlat:{lon_deg},{lat_deg},3000,45,-20"),
+        format!("lonlat-ground:{lon_deg},{lat_deg},50,0,-5"),
+    ]) {
+        let camera = dataset.camera_from(&written, 60.0, 0.1).unwrap();
+        assert_eq!(
+            (DVec3::from(key.at), key.yaw_deg, key.pitch_deg),
+            (camera.position_m, camera.yaw_deg, camera.pitch_deg)
+        );
+    }
+    let mut flat = placed_dataset();
+    flat.manifest.earth = None;
+    assert!(terramp::profile::load_path(&flat, &file).unwrap_err().to_string().contains("keyframe 0"));
+}

@@ -17,7 +17,6 @@ use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::frame::Renderer;
 use terramp::gpu::{Gpu, PassTiming};
-use terramp::path::CameraPath;
 use terramp::profile::{Meta, Summary};
 
 // Crate roots look for modules beside themselves: this one keeps its own in src/bin/terramp/.
@@ -243,7 +242,7 @@ fn main() -> Result<()> {
             let mut settings = settings.load()?;
             settings.render.width = width.unwrap_or(settings.render.width);
             settings.render.height = height.unwrap_or(settings.render.height);
-            fly(&dataset, &CameraPath::load(&path)?, frames, &out, save_every, settings)
+            fly(&dataset, &path, frames, &out, save_every, settings)
         }
         Command::Profile { dataset, path, frames, warmup, width, height, json, trace, log, settings } => {
             let outputs = ProfileOutputs { json, trace, log };
@@ -281,7 +280,7 @@ fn profile(
     settings.render.height = height.unwrap_or(settings.render.height);
     let dataset = Dataset::open(dataset_dir)?;
     let (path, path_name) = match path {
-        Some(file) => (CameraPath::load(file)?, file.display().to_string()),
+        Some(file) => (terramp::profile::load_path(&dataset, file)?, file.display().to_string()),
         None => terramp::profile::default_path(&dataset)?,
     };
     let gpu = Gpu::new(settings.gpu.adapter)?;
@@ -391,7 +390,7 @@ fn print_timings(timings: &[PassTiming]) {
 
 fn fly(
     dataset_dir: &Path,
-    path: &CameraPath,
+    path_file: &Path,
     frames: u32,
     out: &Path,
     save_every: u32,
@@ -401,6 +400,7 @@ fn fly(
         bail!("--frames must be at least 1");
     }
     let mut renderer = open_renderer(dataset_dir, settings)?;
+    let path = terramp::profile::load_path(&renderer.dataset, path_file)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let log_path = out.join("log.jsonl");
     let mut log = std::io::BufWriter::new(

@@ -11,7 +11,7 @@ use thiserror::Error;
 use super::Dataset;
 use super::pack::PackError;
 use crate::camera::{Camera, CameraError};
-use crate::earth::pose::{GeoPose, PoseError};
+use crate::earth::pose::{CrsPose, GeoPose, PoseError};
 
 /// Why a camera cannot be placed in a dataset.
 #[derive(Debug, Error)]
@@ -61,26 +61,33 @@ impl Dataset {
         let [lon_deg, lat_deg, height_m, heading_deg, pitch_deg] = values[..] else {
             return Err(parse_error());
         };
+        let crs = self
+            .place_on_earth(&GeoPose { lon_deg, lat_deg, height_m, heading_deg, pitch_deg }, above_ground)?;
+        let camera = Camera {
+            position_m: crs.position_m,
+            yaw_deg: crs.yaw_deg,
+            pitch_deg: crs.pitch_deg,
+            fov_deg,
+            near_m,
+        };
+        camera.validate()?;
+        Ok(camera)
+    }
+
+    /// `pose` in this dataset's CRS, its height taken above the ground there when `above_ground`
+    /// (else above WGS 84's ellipsoid).
+    pub fn place_on_earth(&self, pose: &GeoPose, above_ground: bool) -> Result<CrsPose, CameraPoseError> {
         let earth = self
             .manifest
             .earth
             .as_ref()
             .ok_or_else(|| CameraPoseError::NotOnEarth(self.manifest.name.clone()))?;
-        let pose = GeoPose {
-            lon_deg,
-            lat_deg,
-            height_m: if above_ground { 0.0 } else { height_m },
-            heading_deg,
-            pitch_deg,
-        };
-        let crs = pose.in_crs(earth)?;
-        let mut position_m = crs.position_m;
+        let at = GeoPose { height_m: if above_ground { 0.0 } else { pose.height_m }, ..*pose };
+        let mut crs = at.in_crs(earth)?;
         if above_ground {
             let [x, y] = self.manifest.origin_m;
-            position_m.z = self.height_at(position_m.x - x, position_m.y - y, 0)? + height_m;
+            crs.position_m.z = self.height_at(crs.position_m.x - x, crs.position_m.y - y, 0)? + pose.height_m;
         }
-        let camera = Camera { position_m, yaw_deg: crs.yaw_deg, pitch_deg: crs.pitch_deg, fov_deg, near_m };
-        camera.validate()?;
-        Ok(camera)
+        Ok(crs)
     }
 }

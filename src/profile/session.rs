@@ -14,15 +14,17 @@
 //! centre.
 
 use std::collections::{HashMap, VecDeque};
+use std::path::Path;
 
 use glam::DVec3;
 
 use super::{ProfileError, Recording, SeedSample};
 use crate::camera::Camera;
 use crate::dataset::{Dataset, PackError};
+use crate::earth::pose::GeoPose;
 use crate::frame::{FrameReport, Renderer};
 use crate::gpu::{GpuError, TimeSource};
-use crate::path::{CameraPath, Keyframe};
+use crate::path::{CameraPath, EarthKey, Keyframe, PathError};
 
 /// Frames that may be queued on the GPU at once.
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -189,6 +191,17 @@ pub fn timing_of(renderer: &Renderer) -> (TimeSource, String) {
         "the timestamp profiler could not start"
     };
     (TimeSource::CpuWait, format!("CPU waits, one per pass, which serialise the frame ({why})"))
+}
+
+/// The camera path in `file`, its keyframes given on the Earth placed in `dataset`'s CRS.
+pub fn load_path(dataset: &Dataset, file: &Path) -> Result<CameraPath, PathError> {
+    CameraPath::load_placed(file, &mut |key: &EarthKey| {
+        let [lon_deg, lat_deg, height_m] = key.lonlat;
+        let pose =
+            GeoPose { lon_deg, lat_deg, height_m, heading_deg: key.heading_deg, pitch_deg: key.pitch_deg };
+        let crs = dataset.place_on_earth(&pose, key.above_ground).map_err(|e| e.to_string())?;
+        Ok(Keyframe { at: crs.position_m.to_array(), yaw_deg: crs.yaw_deg, pitch_deg: crs.pitch_deg })
+    })
 }
 
 /// The path to profile `dataset` along when none is given, and its description.

@@ -46,7 +46,6 @@ use thiserror::Error;
 use crate::camera::Camera;
 use crate::config::{Settings, SettingsError};
 use crate::dataset::{Dataset, DatasetError};
-use crate::path::CameraPath;
 use crate::profile::ProfileError;
 use crate::truth::TruthOptions;
 pub use knobs::{Knob, Point, points};
@@ -206,7 +205,7 @@ pub fn run(options: &SweepOptions, progress: &mut dyn FnMut(Progress)) -> Result
 
     let dataset = Dataset::open(&options.dataset)?;
     let (path, path_name) = match &options.path {
-        Some(file) => (CameraPath::load(file)?, file.display().to_string()),
+        Some(file) => (crate::profile::load_path(&dataset, file)?, file.display().to_string()),
         None => crate::profile::default_path(&dataset)?,
     };
     let r = &reference_settings.render;

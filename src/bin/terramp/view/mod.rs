@@ -86,7 +86,13 @@ pub fn run(args: ViewArgs) -> Result<()> {
         }
         None => None,
     };
-    let path = args.path.as_deref().map(terramp::path::CameraPath::load).transpose()?;
+    // Keyframes on the Earth are placed in the dataset given (the embedded default does not say
+    // where it lies: they are refused there).
+    let path = match (args.path.as_deref(), &given) {
+        (Some(file), Some((dataset, _))) => Some(terramp::profile::load_path(dataset, file)?),
+        (Some(file), None) => Some(terramp::path::CameraPath::load(file)?),
+        (None, _) => None,
+    };
     // The window's needs first: the embedded default is minutes of work, no use without them.
     Gpu::probe(settings.gpu.adapter).context("terramp view needs a GPU adapter")?;
     let event_loop = EventLoop::new().map_err(|e| {
