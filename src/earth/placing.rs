@@ -73,8 +73,12 @@ impl EarthPlacing {
     pub fn exact(&self, camera_grid_m: DVec3) -> ExactPlacing {
         let round = self.round.as_ref().map(|round| {
             let [x, y] = [camera_grid_m.x + round.origin_m[0], camera_grid_m.y + round.origin_m[1]];
-            let frame = LocalFrame::grid_aligned(&round.earth, x, y, camera_grid_m.z);
-            (frame, Arc::clone(&round.earth), round.origin_m, round.lowest_undulation_m)
+            RoundView {
+                frame: LocalFrame::grid_aligned(&round.earth, x, y, camera_grid_m.z),
+                earth: Arc::clone(&round.earth),
+                origin_m: round.origin_m,
+                lowest_undulation_m: round.lowest_undulation_m,
+            }
         });
         ExactPlacing { camera_grid_m, round }
     }
@@ -89,9 +93,20 @@ impl EarthPlacing {
 #[derive(Debug, Clone)]
 pub struct ExactPlacing {
     camera_grid_m: DVec3,
-    /// The camera's frame, the dataset's frame, the grid's CRS origin and the geoid's lowest
-    /// undulation; `None` flat.
-    round: Option<(LocalFrame, Arc<EarthFrame>, [f64; 2], f64)>,
+    /// `None` flat.
+    round: Option<RoundView>,
+}
+
+/// The Earth seen from one camera.
+#[derive(Debug, Clone)]
+struct RoundView {
+    /// The camera's frame (`LocalFrame::grid_aligned`).
+    frame: LocalFrame,
+    earth: Arc<EarthFrame>,
+    /// The grid's origin, CRS metres.
+    origin_m: [f64; 2],
+    /// The geoid's lowest undulation over the dataset, metres.
+    lowest_undulation_m: f64,
 }
 
 impl ExactPlacing {
@@ -108,7 +123,7 @@ impl ExactPlacing {
     /// The camera-relative position of grid point `grid_m` (x, y and a height).
     pub fn position_rel_m(&self, grid_m: DVec3) -> DVec3 {
         match &self.round {
-            Some((frame, earth, origin_m, _)) => {
+            Some(RoundView { frame, earth, origin_m, .. }) => {
                 frame.position_m(earth, grid_m.x + origin_m[0], grid_m.y + origin_m[1], grid_m.z)
             }
             None => grid_m - self.camera_grid_m,
@@ -117,7 +132,8 @@ impl ExactPlacing {
 
     /// The grid point (x, y and a height) placed at camera-relative `rel_m`: `position_rel_m`'s
     /// inverse, by fixed-point steps (the mapping is the identity turned by the Earth's bend
-    /// between the camera and the point, d / R: each step divides the miss by about that).
+    /// between the camera and the point, d / R radians: each step leaves about that share of the
+    /// miss).
     pub fn grid_m(&self, rel_m: DVec3) -> DVec3 {
         let mut grid_m = self.camera_grid_m + rel_m;
         if self.round.is_some() {
@@ -178,7 +194,7 @@ impl PlacedView<'_> {
     /// the GPU: offsets from that point go in, camera-relative positions come out.
     pub fn node(&mut self, origin_grid_m: DVec3) -> EarthNode {
         match &self.exact.round {
-            Some((frame, earth, origin_m, _)) => {
+            Some(RoundView { frame, earth, origin_m, .. }) => {
                 EarthNode::from(&frame.place(kept_node(self.kept, earth, *origin_m, origin_grid_m)))
             }
             None => {
@@ -211,7 +227,9 @@ impl PlacedView<'_> {
     /// horizon culling), where the ellipsoid is the unit sphere and the test is exact. Flat, or
     /// with the eye below that ellipsoid, nothing is hidden.
     pub fn hidden_by_earth(&self, lo: DVec3, hi: DVec3, lowest_height_m: f64) -> bool {
-        let Some((frame, _, _, undulation_m)) = &self.exact.round else { return false };
+        let Some(RoundView { frame, lowest_undulation_m: undulation_m, .. }) = &self.exact.round else {
+            return false;
+        };
         let lowest_m = lowest_height_m + undulation_m - HORIZON_MARGIN_M;
         let e = Ellipsoid::WGS84;
         let scale = DVec3::new(e.a_m + lowest_m, e.a_m + lowest_m, e.b_m() + lowest_m).recip();
@@ -242,7 +260,7 @@ impl PlacedView<'_> {
     /// when its mapping's origin is the box's centre at height 0 (`node`).
     pub fn box_rel_m(&mut self, min_m: DVec3, max_m: DVec3) -> (DVec3, DVec3) {
         let camera_grid_m = self.exact.camera_grid_m;
-        let Some((frame, earth, origin_m, _)) = &self.exact.round else {
+        let Some(RoundView { frame, earth, origin_m, .. }) = &self.exact.round else {
             return (min_m - camera_grid_m, max_m - camera_grid_m);
         };
         let centre = DVec3::new(0.5 * (min_m.x + max_m.x), 0.5 * (min_m.y + max_m.y), 0.0);

@@ -66,8 +66,9 @@ fn the_camera_frame_follows_the_grid_and_the_vertical() {
     assert!((along.x / 10_000.0 - 1.0).abs() < 1e-3, "{along}");
 }
 
-/// Every point of a box, placed exactly, lies in the box `box_rel_m` gives, for boxes 1 km to
-/// 300 km across, beside the camera and 250 km from it; and that box is not much larger.
+/// Every point of a 17 × 17 × 3 lattice over a box, placed exactly, lies in the box `box_rel_m`
+/// gives, for boxes 1 km to 300 km across, beside the camera and 250 km from it; and that box is
+/// not much larger.
 #[test]
 fn a_box_holds_what_its_ground_becomes() {
     let mut placing = EarthPlacing::new(Some(&nc()), ORIGIN_M, true);
