@@ -1,6 +1,6 @@
 //! The terrain drawn on the Earth: a synthetic dataset 60 km across placed on nc's State Plane
 //! (its manifest given an `[earth]`), seen from 800 m up looking across it. Each ground pixel's
-//! depth, unprojected, is held to the exact mapping (f64, `PlacedView::position_rel_m`) of the
+//! depth, unprojected, is held to the exact mapping (f64, `ExactPlacing::position_rel_m`) of the
 //! finest mesh's ground under it; the flat sheet misses it by the Earth's drop (196 m at 50 km),
 //! which shows the measure can tell. A frame over the default LOD rings has no hole below its
 //! horizon. Cameras written in longitude and latitude land where they are.
@@ -32,14 +32,20 @@ fn placed_dataset() -> Dataset {
     dataset
 }
 
+/// The longitude and latitude, degrees, of `dataset`'s grid point `grid_m`.
+fn lon_lat_deg(dataset: &Dataset, [x, y]: [f64; 2]) -> [f64; 2] {
+    let [ox, oy] = dataset.manifest.origin_m;
+    let (lat, lon) = dataset.manifest.earth.as_ref().unwrap().geodetic(ox + x, oy + y);
+    [lon.to_degrees(), lat.to_degrees()]
+}
+
 /// Per ground pixel (every 4th row and column), the distance from the camera and how far the
 /// drawn ground lies above the exact mapping's ground under it, metres.
 fn vertical_misses(r: &Renderer, camera: &terramp::camera::Camera, dem: &Dem) -> Vec<(f64, f64)> {
     let rays = Rays::new(r, camera);
     let depth = r.read_depth().unwrap();
     let m = &r.dataset.manifest;
-    let mut placing = EarthPlacing::new(m.earth.as_ref(), m.origin_m, true);
-    let placed = placing.view(rays.eye_grid_m);
+    let placed = EarthPlacing::new(m.earth.as_ref(), m.origin_m, true).exact(rays.eye_grid_m);
     let span = dem.span_m();
     let mut misses = Vec::new();
     for y in (0..rays.height).step_by(4) {
@@ -142,8 +148,8 @@ fn cameras_are_placed_from_longitude_and_latitude() {
     let dataset = placed_dataset();
     let earth = dataset.manifest.earth.clone().unwrap();
     let [ox, oy] = dataset.manifest.origin_m;
-    let (lat, lon) = earth.geodetic(ox + 30_000.0, oy + 20_000.0);
-    let (lon_deg, lat_deg) = (lon.to_degrees(), lat.to_degrees());
+    let [lon_deg, lat_deg] = lon_lat_deg(&dataset, [30_000.0, 20_000.0]);
+    let (lat, lon) = (lat_deg.to_radians(), lon_deg.to_radians());
     let on_earth =
         dataset.camera_from(&format!("lonlat:{lon_deg},{lat_deg},2500,90,-30"), 60.0, 0.1).unwrap();
     let p = on_earth.position_m;
@@ -173,10 +179,7 @@ fn cameras_are_placed_from_longitude_and_latitude() {
 #[test]
 fn camera_paths_on_the_earth_are_placed_in_the_dataset() {
     let dataset = placed_dataset();
-    let earth = dataset.manifest.earth.clone().unwrap();
-    let [ox, oy] = dataset.manifest.origin_m;
-    let (lat, lon) = earth.geodetic(ox + 10_000.0, oy + 40_000.0);
-    let (lon_deg, lat_deg) = (lon.to_degrees(), lat.to_degrees());
+    let [lon_deg, lat_deg] = lon_lat_deg(&dataset, [10_000.0, 40_000.0]);
     let dir = terramp_testkit::TempDir::new("earth-path");
     let file = dir.path().join("path.toml");
     let text = format!(

@@ -116,16 +116,18 @@ fn surface_vertex(node: TerrainNode, g: vec2<f32>) -> SurfaceVertex {
 // Where node `index` draws the point at grid offset `offset_m` from its south-west corner,
 // `height_m` above the datum: camera-relative, on the Earth.
 fn placed_m(index: u32, offset_m: vec2<f32>, height_m: f32) -> vec3<f32> {
-    let node = nodes[index];
-    let centre_m = vec2<f32>(0.5 * f32(u.node_cells) * node.cell_m);
-    return earth_position_m(node_earth[index], vec3<f32>(offset_m - centre_m, height_m));
+    return earth_position_m(node_earth[index], from_mapping_origin_m(index, offset_m, height_m));
 }
 
 // The drawn surface's unit normal there, of the flat sheet's `normal`.
 fn placed_normal(index: u32, offset_m: vec2<f32>, height_m: f32, normal: vec3<f32>) -> vec3<f32> {
-    let node = nodes[index];
-    let centre_m = vec2<f32>(0.5 * f32(u.node_cells) * node.cell_m);
-    return normalize(earth_normal(node_earth[index], vec3<f32>(offset_m - centre_m, height_m), normal));
+    return normalize(earth_normal(node_earth[index], from_mapping_origin_m(index, offset_m, height_m), normal));
+}
+
+// That point's offset from the origin of node `index`'s mapping: the node's centre at height 0.
+fn from_mapping_origin_m(index: u32, offset_m: vec2<f32>, height_m: f32) -> vec3<f32> {
+    let centre_m = vec2<f32>(0.5 * f32(u.node_cells) * nodes[index].cell_m);
+    return vec3<f32>(offset_m - centre_m, height_m);
 }
 
 @vertex

@@ -57,11 +57,7 @@ impl LocalFrame {
     /// heading and pitch given in the grid mean what they meant on the flat sheet.
     pub fn grid_aligned(earth: &EarthFrame, x_m: f64, y_m: f64, height_m: f64) -> Self {
         let local = Self::at(earth, x_m, y_m, height_m);
-        let s = DIFFERENCE_STEP_M;
-        let along_x =
-            local.position_m(earth, x_m + s, y_m, height_m) - local.position_m(earth, x_m - s, y_m, height_m);
-        // The grid's x turned from east by the meridians' convergence (and the projection's skew).
-        let (sin, cos) = along_x.y.atan2(along_x.x).sin_cos();
+        let (sin, cos) = grid_turn_rad(earth, x_m, y_m, height_m).sin_cos();
         let unturn = DMat3::from_cols(DVec3::new(cos, -sin, 0.0), DVec3::new(sin, cos, 0.0), DVec3::Z);
         Self { eye_ecef_m: local.eye_ecef_m, local_from_ecef: unturn * local.local_from_ecef }
     }
@@ -160,6 +156,17 @@ impl EcefNode {
         let turned = (self.d_xh * dx + self.d_yh * dy) * dh;
         self.origin_m + (self.d_x * dx + self.d_y * dy + self.d_h * dh + (curved + turned))
     }
+}
+
+/// How far the CRS's x direction at CRS point (`x_m`, `y_m`), `height_m` up, turns from east in
+/// the horizontal, anticlockwise seen from above, radians: the meridians' convergence there (and
+/// the projection's skew where it has one).
+pub fn grid_turn_rad(earth: &EarthFrame, x_m: f64, y_m: f64, height_m: f64) -> f64 {
+    let local = LocalFrame::at(earth, x_m, y_m, height_m);
+    let s = DIFFERENCE_STEP_M;
+    let along_x =
+        local.position_m(earth, x_m + s, y_m, height_m) - local.position_m(earth, x_m - s, y_m, height_m);
+    along_x.y.atan2(along_x.x)
 }
 
 /// East, north and up at geodetic latitude `lat` and longitude `lon` (radians) as the rows of

@@ -83,9 +83,10 @@ impl EarthPlacing {
         ExactPlacing { camera_grid_m, round }
     }
 
-    /// The placing seen from a camera at grid point `camera_grid_m`, for a frame's GPU work.
-    pub fn view(&mut self, camera_grid_m: DVec3) -> PlacedView<'_> {
-        PlacedView { exact: self.exact(camera_grid_m), kept: &mut self.kept }
+    /// The placing `exact` (this placing's, from the frame's camera) with the node mappings kept,
+    /// for a frame's GPU work: one frame's passes share one camera frame.
+    pub fn view<'a>(&'a mut self, exact: &'a ExactPlacing) -> PlacedView<'a> {
+        PlacedView { exact, kept: &mut self.kept }
     }
 }
 
@@ -110,11 +111,6 @@ struct RoundView {
 }
 
 impl ExactPlacing {
-    /// The camera's grid position.
-    pub fn camera_grid_m(&self) -> DVec3 {
-        self.camera_grid_m
-    }
-
     /// Whether the grid is placed on the ellipsoid.
     pub fn is_round(&self) -> bool {
         self.round.is_some()
@@ -155,7 +151,7 @@ const MAX_INVERSE_STEPS: usize = 48;
 
 /// One frame's placing: the camera's frame, and the dataset's mappings.
 pub struct PlacedView<'a> {
-    exact: ExactPlacing,
+    exact: &'a ExactPlacing,
     kept: &'a mut HashMap<[u64; 3], EcefNode>,
 }
 
@@ -180,16 +176,6 @@ impl PlacedView<'_> {
         self.exact.camera_grid_m
     }
 
-    /// Whether this frame is drawn on the ellipsoid.
-    pub fn is_round(&self) -> bool {
-        self.exact.is_round()
-    }
-
-    /// The exact placing this view hands the GPU a node at a time.
-    pub fn exact(&self) -> &ExactPlacing {
-        &self.exact
-    }
-
     /// The mapping of a node whose origin is grid point `origin_grid_m` (x, y and a height), for
     /// the GPU: offsets from that point go in, camera-relative positions come out.
     pub fn node(&mut self, origin_grid_m: DVec3) -> EarthNode {
@@ -212,11 +198,6 @@ impl PlacedView<'_> {
                 }
             }
         }
-    }
-
-    /// The exact camera-relative position of grid point `grid_m` (f64).
-    pub fn position_rel_m(&self, grid_m: DVec3) -> DVec3 {
-        self.exact.position_rel_m(grid_m)
     }
 
     /// Whether the Earth hides every point of the camera-relative box `lo`..`hi` from the camera

@@ -31,7 +31,8 @@ fn flat_placing_is_the_flat_sheet_to_the_bit() {
     let mut placing = EarthPlacing::new(Some(&nc()), ORIGIN_M, false);
     assert!(!placing.is_round());
     let camera = DVec3::new(37_512.3, 41_007.9, 1_733.25);
-    let mut view = placing.view(camera);
+    let exact = placing.exact(camera);
+    let mut view = placing.view(&exact);
     let origin = DVec3::new(36_480.0, 40_960.0, 0.0);
     let node = mapping(&view.node(origin));
     let origin_rel = (origin - camera).as_vec3();
@@ -46,10 +47,10 @@ fn flat_placing_is_the_flat_sheet_to_the_bit() {
 /// frame's first axis (no north turn left), the drop along it the Earth's.
 #[test]
 fn the_camera_frame_follows_the_grid_and_the_vertical() {
-    let mut placing = EarthPlacing::new(Some(&nc()), ORIGIN_M, true);
+    let placing = EarthPlacing::new(Some(&nc()), ORIGIN_M, true);
     let camera = DVec3::new(40_000.0, 40_000.0, 2_000.0);
-    let view = placing.view(camera);
-    assert!(view.is_round());
+    assert!(placing.is_round());
+    let view = placing.exact(camera);
     let below = view.position_rel_m(DVec3::new(camera.x, camera.y, 150.0));
     assert!((below - DVec3::new(0.0, 0.0, -1_850.0)).length() < 1e-6, "{below}");
     // The grid's line y = const bends away from the frame's axis only in the second order (the
@@ -73,7 +74,8 @@ fn the_camera_frame_follows_the_grid_and_the_vertical() {
 fn a_box_holds_what_its_ground_becomes() {
     let mut placing = EarthPlacing::new(Some(&nc()), ORIGIN_M, true);
     let camera = DVec3::new(40_000.0, 40_000.0, 3_000.0);
-    let mut view = placing.view(camera);
+    let placement = placing.exact(camera);
+    let mut view = placing.view(&placement);
     for side_m in [1_000.0, 20_000.0, 300_000.0] {
         for (ox, oy) in [(0.0, 0.0), (60_000.0, -20_000.0), (-200_000.0, 150_000.0)] {
             let min = DVec3::new(camera.x + ox - 0.5 * side_m, camera.y + oy - 0.3 * side_m, 50.0);
@@ -84,7 +86,7 @@ fn a_box_holds_what_its_ground_becomes() {
                 for i in 0..=16 {
                     for k in 0..=2 {
                         let f = DVec3::new(f64::from(i) / 16.0, f64::from(j) / 16.0, f64::from(k) / 2.0);
-                        let p = view.position_rel_m(min + (max - min) * f);
+                        let p = placement.position_rel_m(min + (max - min) * f);
                         assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{side_m} m at ({ox}, {oy}): {p}");
                         exact = (exact.0.min(p), exact.1.max(p));
                     }
@@ -102,14 +104,18 @@ fn a_box_holds_what_its_ground_becomes() {
 fn a_kept_mapping_serves_every_camera() {
     let mut placing = EarthPlacing::new(Some(&nc()), ORIGIN_M, true);
     let origin = DVec3::new(52_000.0, 38_000.0, 0.0);
-    let first = placing.view(DVec3::new(40_000.0, 40_000.0, 2_000.0)).node(origin);
+    let node_from = |placing: &mut EarthPlacing, camera: DVec3| {
+        let exact = placing.exact(camera);
+        placing.view(&exact).node(origin)
+    };
+    let first = node_from(&mut placing, DVec3::new(40_000.0, 40_000.0, 2_000.0));
     let camera = DVec3::new(70_000.0, 20_000.0, 900.0);
-    let kept = placing.view(camera).node(origin);
+    let kept = node_from(&mut placing, camera);
     assert_ne!(first, kept);
     let mut fresh = EarthPlacing::new(Some(&nc()), ORIGIN_M, true);
     let frame = LocalFrame::grid_aligned(&nc(), camera.x + ORIGIN_M[0], camera.y + ORIGIN_M[1], camera.z);
     let own = frame.node(&nc(), origin + DVec3::new(ORIGIN_M[0], ORIGIN_M[1], 0.0));
-    assert_eq!(kept, fresh.view(camera).node(origin));
+    assert_eq!(kept, node_from(&mut fresh, camera));
     assert_eq!(mapping(&kept), own);
 }
 

@@ -15,7 +15,7 @@
 use glam::{DMat3, DVec3};
 use thiserror::Error;
 
-use super::local::{EcefNode, LocalFrame};
+use super::local::{EcefNode, grid_turn_rad};
 use super::{EarthFrame, Ellipsoid};
 
 /// A pose on the Earth.
@@ -99,14 +99,10 @@ impl GeoPose {
         if !crs.is_finite() || (earth.ecef_m(crs.x, crs.y, crs.z) - target).length() > 1e3 * CLOSE_M {
             return Err(unreachable);
         }
-        // The grid's x direction at the point, as a compass azimuth: the grid's north lies 90°
-        // anticlockwise of it.
-        let enu = LocalFrame::at(earth, crs.x, crs.y, crs.z);
-        let s = super::local::DIFFERENCE_STEP_M;
-        let along_x =
-            enu.position_m(earth, crs.x + s, crs.y, crs.z) - enu.position_m(earth, crs.x - s, crs.y, crs.z);
-        let grid_north_deg = along_x.x.atan2(along_x.y).to_degrees() - 90.0;
-        let yaw_deg = (self.heading_deg - grid_north_deg).rem_euclid(360.0);
+        // The grid's north lies as far anticlockwise of true north as its x direction does of
+        // east: a heading from true north is that much more from the grid's.
+        let turn_deg = grid_turn_rad(earth, crs.x, crs.y, crs.z).to_degrees();
+        let yaw_deg = (self.heading_deg + turn_deg).rem_euclid(360.0);
         Ok(CrsPose { position_m: crs, yaw_deg, pitch_deg: self.pitch_deg })
     }
 }

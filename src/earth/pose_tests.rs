@@ -3,6 +3,7 @@
 use glam::DVec3;
 
 use super::*;
+use crate::earth::local::LocalFrame;
 use crate::earth::test_frames::nc;
 use crate::earth::{GeoidLattice, Projection};
 

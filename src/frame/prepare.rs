@@ -7,6 +7,7 @@
 use glam::DVec3;
 
 use crate::camera::{Camera, Frustum};
+use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms};
 use crate::passes::terrain::gpu::PreparedNodes;
@@ -38,6 +39,8 @@ struct View<'a> {
     grid_m: DVec3,
     clip_from_view_world: glam::DMat4,
     lods: Lods,
+    /// Where this frame draws the dataset (on the Earth, or flat), from this camera.
+    placing: ExactPlacing,
 }
 
 impl Renderer {
@@ -49,11 +52,13 @@ impl Renderer {
     ) -> Result<FramePlan, RenderError> {
         let (width, height) = (self.settings.render.width, self.settings.render.height);
         let origin = self.dataset.manifest.origin_m;
+        let grid_m = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
         let view = View {
             camera,
-            grid_m: camera.position_m - DVec3::new(origin[0], origin[1], 0.0),
+            grid_m,
             clip_from_view_world: camera.clip_from_view(width, height)? * camera.view_from_world(),
             lods: Lods::for_view(&self.dataset, &self.settings.terrain, camera, height),
+            placing: self.placing.exact(grid_m),
         };
         let selected = self.select_nodes(&view);
         self.stream(&view, &selected, report);
@@ -67,7 +72,7 @@ impl Renderer {
     fn select_nodes(&mut self, view: &View) -> Vec<Selected> {
         let frustum = Frustum::from_clip(view.clip_from_view_world);
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
-        let mut placed = self.placing.view(view.grid_m);
+        let mut placed = self.placing.view(&view.placing);
         let horizon =
             self.settings.terrain.horizon_culling.then_some(f64::from(dataset.manifest.height.min_m));
         self.profiler.cpu("terrain_select", || {
@@ -153,7 +158,7 @@ impl Renderer {
     ) -> (PreparedNodes, TerrainUniforms) {
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
         let floor_m = dataset.manifest.height.min_m;
-        let mut placed = self.placing.view(view.grid_m);
+        let mut placed = self.placing.view(&view.placing);
         let (batches, dropped) =
             node_batches(&view.lods, selected, &mut placed, &self.caches.heights, floor_m, &mut |node| {
                 bounds.get(&view.lods, node, |tile| dataset.height_tile(tile).ok())

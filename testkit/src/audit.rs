@@ -184,8 +184,7 @@ impl Rays {
     /// The grid-space point (x, y and a height) a reversed-Z depth puts on the ray through pixel
     /// (x, y), where the renderer's placing puts it.
     pub fn point(&self, x: u32, y: u32, depth: f32, near_m: f64) -> DVec3 {
-        let rel_m = self.point_rel(x, y, depth, near_m);
-        if self.exact.is_round() { self.exact.grid_m(rel_m) } else { self.eye_grid_m + rel_m }
+        self.exact.grid_m(self.point_rel(x, y, depth, near_m))
     }
 }
 
