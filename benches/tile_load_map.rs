@@ -58,6 +58,7 @@ fn bench(mut r: terramp::frame::Renderer) {
             lods: &warm.lods,
             imagery,
             hiz_mips: hiz.mips(),
+            earth: r.tlm_earth(&camera),
         };
         let prepare_start = Instant::now();
         pass.prepare(&r.gpu.queue, &inputs).unwrap();

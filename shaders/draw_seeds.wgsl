@@ -36,6 +36,9 @@ struct DrawSeedsUniforms {
     wind_wave: vec4<f32>,
     cloud_field: vec4<f32>,
     cloud_shift: vec4<f32>,
+    seed_up: vec4<f32>,
+    seed_up_per_x_m: vec4<f32>,
+    seed_up_per_y_m: vec4<f32>,
     continuous_lod: u32,
     prefilter_small: u32,
     _pad0: u32,
@@ -112,7 +115,14 @@ struct VertexOut {
     @location(10) @interpolate(flat) far: vec4<f32>,
 }
 
-// Model space (x, y up, z) to world (x east, y north, z up), turned by `angle` about the vertical.
+// The local vertical at camera-relative `rel_m` (pass 3's `up_at`, from the camera's mapping):
+// straight up on the flat sheet.
+fn seed_up(rel_m: vec3<f32>) -> vec3<f32> {
+    return u.seed_up.xyz + u.seed_up_per_x_m.xyz * rel_m.x + u.seed_up_per_y_m.xyz * rel_m.y;
+}
+
+// Model space (x, y up, z) to world (x east, y north, z up), turned by `angle` about the vertical:
+// the seed's own frame, which `earth_stand` stands on its place.
 fn model_to_world(v: vec3<f32>, angle: f32) -> vec3<f32> {
     let w = vec3<f32>(v.x, -v.z, v.y);
     let c = cos(angle);
@@ -145,13 +155,14 @@ fn crown_luminosity(shape: SeedShape, position_model_m: vec3<f32>, angle: f32) -
 // past 1 a pixel shows both, and no sort is needed; and by azimuth rather than by role, so each
 // slicing keeps its pixels when the two trade roles half-way. Empty (x ≥ y) in the other
 // slicings. The slice's own slicing is its normal's.
-fn slice_blend(material: SeedMaterial, normal_model: vec3<f32>, record: SeedRecord, angle: f32) -> vec2<f32> {
+fn slice_blend(material: SeedMaterial, normal_model: vec3<f32>, record: SeedRecord, angle: f32, up: vec3<f32>) -> vec2<f32> {
     let tau = 6.2831853;
     let n = max(material.slicings, 1u);
     let step = tau / f32(n);
-    let centre_rel = record.position_rel_m + vec3<f32>(0.0, 0.0, record.height_m * (u.sink_fraction + 0.5));
-    // World to model space: undo the turn about the vertical, then model_to_world's axes.
-    let eye = -centre_rel;
+    let centre_rel = record.position_rel_m + up * (record.height_m * (u.sink_fraction + 0.5));
+    // World to model space: into the seed's own frame, undo the turn about the vertical, then
+    // model_to_world's axes.
+    let eye = earth_unstand(-centre_rel, up);
     let c = cos(angle);
     let s = sin(angle);
     let w = vec2<f32>(c * eye.x + s * eye.y, c * eye.y - s * eye.x);
@@ -188,8 +199,8 @@ fn slice_blend(material: SeedMaterial, normal_model: vec3<f32>, record: SeedReco
 }
 
 // How far the seed's foot is from the eye (its anchor was sunk by pass 3), metres.
-fn seed_distance_m(record: SeedRecord) -> f32 {
-    let ground_rel = record.position_rel_m + vec3<f32>(0.0, 0.0, record.height_m * u.sink_fraction);
+fn seed_distance_m(record: SeedRecord, up: vec3<f32>) -> f32 {
+    let ground_rel = record.position_rel_m + up * (record.height_m * u.sink_fraction);
     return length(ground_rel);
 }
 
@@ -258,7 +269,8 @@ fn vs_main(
     let species = seed.species;
     let lod = seed.lod;
     let material = materials[in.material];
-    let distance_m = seed_distance_m(record);
+    let up = seed_up(record.position_rel_m);
+    let distance_m = seed_distance_m(record, up);
     var fade = band_fade(record, lod, distance_m);
     // In its class's last LOD a seed fades out to nothing, as in the last band: no next LOD.
     let last = seed.last != 0u;
@@ -285,7 +297,7 @@ fn vs_main(
     let scale = record.height_m * shape.inv_model_height_m;
     out.blend = vec2<f32>(0.0, 2.0);
     if (material.flags & MATERIAL_SLICE) != 0u {
-        out.blend = slice_blend(material, in.normal_model, record, angle);
+        out.blend = slice_blend(material, in.normal_model, record, angle, up);
         if out.blend.x >= out.blend.y {
             // A slicing the view does not blend: every vertex at one point outside the view.
             out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
@@ -304,7 +316,7 @@ fn vs_main(
     // Still air (or a rock) leaves every vertex where it was, bit for bit: this expression is
     // the one the pass had before the wind, and nothing else uses its products (a compiler may
     // fuse a product into the add only where the product has no other use).
-    var rel_m = record.position_rel_m + model_to_world(position_model_m * scale, angle);
+    var rel_m = record.position_rel_m + earth_stand(model_to_world(position_model_m * scale, angle), up);
     // In wind, a leaf turns about where it hangs, then the whole plant bends.
     if u.wind.z > 0.0 && shape.wind_bend > 0.0 {
         // (A stem's pivot names it for the continuous LOD: stems do not flutter.)
@@ -317,11 +329,11 @@ fn vs_main(
         let fluttered = wind_flutter(u.wind, u.wind_wave, leaf_m, pivot_model_m, record.height_m);
         let top_m = wind_top_m(u.wind, u.wind_wave, record.position_rel_m, record.height_m, record.jitter);
         let bent = wind_bend(pivot_m + fluttered, top_m * shape.wind_bend, record.height_m);
-        rel_m = record.position_rel_m + bent;
+        rel_m = record.position_rel_m + earth_stand(bent, up);
     }
     out.clip = u.clip_from_view_world * vec4<f32>(rel_m, 1.0);
     out.rel_m = rel_m;
-    out.normal = model_to_world(in.normal_model, angle);
+    out.normal = earth_stand(model_to_world(in.normal_model, angle), up);
     out.uv = in.uv;
     // Colour variation: brightness ±15 % and a slight shift between yellow-green and blue-green.
     let variation = f32(jitter.colour) / 65535.0 - 0.5;
@@ -343,7 +355,7 @@ fn vs_main(
     if u.prefilter_small != 0u && (material.flags & MATERIAL_BARK) == 0u && photo_scale.g > 0.0 {
         // The model's own mean is the photograph's yardstick over its factor.
         let mean = mix(1.0 / max(photo_scale, vec3<f32>(1e-4)), ground.rgb, follow) * out.tint;
-        out.far = vec4<f32>(mean, small_seed_mean(record, distance_m));
+        out.far = vec4<f32>(mean, small_seed_mean(record, distance_m, up));
     }
     out.luminosity = crown_luminosity(shape, position_model_m, angle);
     return out;
@@ -355,9 +367,9 @@ fn vs_main(
 // `PHOTO_DETAIL_*`), whose mean the photograph shows. A crown of a pixel or two shows one sample
 // of its shading and gaps a pixel, which changes as the view moves by a fraction of a pixel; its
 // mean is what a pixel over it would average (the truth supersamples to it).
-fn small_seed_mean(record: SeedRecord, distance_m: f32) -> f32 {
+fn small_seed_mean(record: SeedRecord, distance_m: f32, up: vec3<f32>) -> f32 {
     let tall_px = record.height_m * u.focal_px / max(distance_m, 1e-3);
-    let down = -record.position_rel_m.z / max(length(record.position_rel_m), 1e-3);
+    let down = -dot(record.position_rel_m, up) / max(length(record.position_rel_m), 1e-3);
     let from_above = smoothstep(PHOTO_DETAIL_GRAZING_SIN, PHOTO_DETAIL_STEEP_SIN, down);
     return (1.0 - smoothstep(SEED_DETAIL_NONE_PX, SEED_DETAIL_FULL_PX, tall_px)) * from_above;
 }

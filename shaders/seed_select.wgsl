@@ -61,9 +61,9 @@ struct SeedUniforms {
     imagery_levels: array<vec4<u32>, MAX_LEVELS>,
     vegetation: vec4<f32>,
     class_edge_dither: u32,
+    chord_sag_per_m2: f32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 struct SeedCell {
@@ -78,6 +78,7 @@ struct SeedCell {
     pattern: u32,
     lcc_level: u32,
     _pad: vec2<u32>,
+    earth: EarthNode,
 }
 
 struct SeedSpecies {
@@ -152,6 +153,30 @@ fn grid_pos(corner: vec2<i32>, corner_frac: vec2<f32>, pos_unit: vec2<f32>, cell
     let t = corner_frac + vec2<f32>(mul(pos_unit.x, cell_in_texels), mul(pos_unit.y, cell_in_texels));
     let whole = floor(t);
     return GridPos(corner + vec2<i32>(whole), t - whole);
+}
+
+fn mul3(v: vec3<f32>, s: f32) -> vec3<f32> {
+    return vec3<f32>(mul(v.x, s), mul(v.y, s), mul(v.z, s));
+}
+
+// Where the point at grid offset `offset_m.xy` from `e`'s origin (a cell's corner) and height
+// `offset_m.z` stands, camera-relative: `earth_position_m` (`shared/earth.wgsl`), product by
+// product. Flat: the corner's offset from the camera plus the point's, the height less the
+// camera's.
+fn placed_m(e: EarthNode, offset_m: vec3<f32>) -> vec3<f32> {
+    let dx = offset_m.x;
+    let dy = offset_m.y;
+    let dh = offset_m.z;
+    let curved = mul3(e.d_xx.xyz, mul(dx, dx)) + mul3(e.d_xy.xyz, mul(dx, dy)) + mul3(e.d_yy.xyz, mul(dy, dy));
+    let turned = mul3(mul3(e.d_xh.xyz, dx) + mul3(e.d_yh.xyz, dy), dh);
+    let linear = mul3(e.d_x.xyz, dx) + mul3(e.d_y.xyz, dy) + mul3(e.d_h.xyz, dh);
+    return e.origin_m.xyz + (linear + (curved + turned));
+}
+
+// The local vertical (not unit: within 1e-6 of it) at grid offset `offset_m` from `e`'s origin:
+// the mapping's ∂p/∂h there. Straight up on the flat sheet.
+fn up_at(e: EarthNode, offset_m: vec2<f32>) -> vec3<f32> {
+    return e.d_h.xyz + mul3(e.d_xh.xyz, offset_m.x) + mul3(e.d_yh.xyz, offset_m.y);
 }
 
 // Clip position of camera-relative `p`, product by product.
@@ -325,13 +350,16 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
         return out;
     }
     let height_m = species.height_m.x + mul(species.height_m.y - species.height_m.x, unit(hash));
-    let rel_xy = cell.rel_m + vec2<f32>(mul(pos_unit.x, u.cell_m), mul(pos_unit.y, u.cell_m));
-    let ground_rel_m = ground.height_m - u.camera_z_m;
+    // The seed's grid offset from its cell's corner and from the camera; its foot on the ground,
+    // placed.
+    let in_cell = vec2<f32>(mul(pos_unit.x, u.cell_m), mul(pos_unit.y, u.cell_m));
+    let rel_xy = cell.rel_m + in_cell;
+    let foot = placed_m(cell.earth, vec3<f32>(in_cell, ground.height_m));
 
     // Radial LOD: thresholds shrink with the seed's size below the reference height; a class
     // stops at its own last LOD.
     out.count = COUNT_DISTANCE;
-    let distance_sq = mul(rel_xy.x, rel_xy.x) + mul(rel_xy.y, rel_xy.y) + mul(ground_rel_m, ground_rel_m);
+    let distance_sq = mul(foot.x, foot.x) + mul(foot.y, foot.y) + mul(foot.z, foot.z);
     let size_scale = min(1.0, mul(height_m, u.inv_reference_height_m));
     let lods = min(seeds.lods, SEED_LODS);
     var lod = 0u;
@@ -347,13 +375,15 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     }
 
     // Frustum: the bounding sphere, centred half-way up, against the NDC square grown by ε.
+    // A plant stands along the local vertical, its anchor sunk along it.
     out.count = COUNT_FRUSTUM;
     let sink_m = mul(height_m, u.sink_fraction);
-    let base_rel_m = ground_rel_m - sink_m;
+    let up = up_at(cell.earth, in_cell);
+    let base = foot - mul3(up, sink_m);
     // The wind moves no point of a plant farther than this (`seeds::wind`): its bounds grow by it.
     let sway_m = mul(height_m, mul(species.wind_bend, u.wind_reach_per_height));
     let radius_m = mul(height_m, species.radius_per_height) + sway_m;
-    let centre = to_clip(vec3<f32>(rel_xy, base_rel_m + mul(height_m, 0.5)));
+    let centre = to_clip(base + mul3(up, mul(height_m, 0.5)));
     if centre.w < -radius_m {
         return out;
     }
@@ -367,8 +397,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     // pixels when it is off screen), with the tolerance the coarse far mesh needs.
     out.count = COUNT_OCCLUSION;
     // Swaying, the summit may rise into view by as much (and come as much nearer).
-    let summit_rel_z = base_rel_m + height_m + sway_m;
-    let summit = to_clip(vec3<f32>(rel_xy, summit_rel_z));
+    let summit = to_clip(base + mul3(up, height_m) + mul3(up, sway_m));
     if summit.w > u.near_m {
         let px = vec2<i32>(i32(pixel_of(summit.x, summit.w, u.screen_px.x, u.ndc_per_px.x)),
                            i32(pixel_of(-summit.y, summit.w, u.screen_px.y, u.ndc_per_px.y)));
@@ -392,6 +421,8 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
             if u.refine_max_steps == 0u {
                 hidden = mul(behind_m, textureLoad(depth, px, 0)) > u.near_m;
             } else {
+                // The march walks the grid: the summit's offset and height, from the camera's.
+                let summit_rel_z = ground.height_m - u.camera_z_m - sink_m + height_m + sway_m;
                 hidden = dem_blocks(vec3<f32>(rel_xy, summit_rel_z));
             }
         }
@@ -405,7 +436,7 @@ fn select_seed(cell: SeedCell, rank: u32) -> Outcome {
     out.key = seed_group(drawn, lod);
     let imagery = grid_pos(cell.imagery_texel, cell.imagery_frac, pos_unit, u.cell_in_imagery_texels);
     out.record = SeedRecord(
-        vec3<f32>(rel_xy, base_rel_m),
+        base,
         height_m,
         cell.address,
         rank,

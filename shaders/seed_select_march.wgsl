@@ -19,17 +19,31 @@
 // by bisection: positions are monotone in the sample number (rounding is monotone), so those
 // samples are a run from the first.
 
-// Sample `k` of the march towards camera-relative `summit_rel` (`dt` apart in its parameter): the
-// point, camera-relative, and where it lies in the height grid.
+// Sample `k` of the march towards `summit_rel` (grid offset from the camera and height above it;
+// `dt` apart in its parameter): where it lies in the height grid, the segment's height there
+// above the datum, and a floor under that height linear in k. On the Earth the straight segment
+// sags below the line between its ends' heights by t (1 − t) times `sag_m`, (L² + 2 Δz²) / 2R:
+// the Earth's fall under it, and the verticals' convergence, which puts its higher points over
+// nearer grid points (L its length over the grid, Δz its rise, t the grid's fraction); the floor
+// drops the whole t `sag_m`. A leap is judged against the floor: linear, so where it holds at
+// two samples it holds between them (the sagging height is convex, and could dip between), and
+// under the height, so a leap never skips a sample whose ground the segment passes below.
 struct MarchPoint {
-    rel_m: vec3<f32>,
     sample: GridPos,
+    z_m: f32,
+    floor_m: f32,
 }
 
-fn march_point(summit_rel: vec3<f32>, k: u32, dt: f32) -> MarchPoint {
+fn march_point(summit_rel: vec3<f32>, sag_m: f32, k: u32, dt: f32) -> MarchPoint {
     let t = mul(f32(k), dt);
     let p = vec3<f32>(mul(summit_rel.x, t), mul(summit_rel.y, t), mul(summit_rel.z, t));
-    return MarchPoint(p, grid_pos(u.camera_sample, u.camera_sample_frac, p.xy, u.inv_spacing_m));
+    let line_m = p.z + u.camera_z_m;
+    let sag_t = mul(sag_m, t);
+    return MarchPoint(
+        grid_pos(u.camera_sample, u.camera_sample_frac, p.xy, u.inv_spacing_m),
+        line_m - (sag_t - mul(sag_t, t)),
+        line_m - sag_t,
+    );
 }
 
 fn in_dataset(sample: GridPos) -> bool {
@@ -52,16 +66,16 @@ struct Leap {
 
 fn leap_holds(leap: Leap, m: MarchPoint) -> bool {
     let square = (vec2<u32>(m.sample.texel) >> vec2<u32>(leap.level)) / leap.cells;
-    return in_dataset(m.sample) && all(square == leap.square) && leap.top_m <= m.rel_m.z + u.camera_z_m;
+    return in_dataset(m.sample) && all(square == leap.square) && leap.top_m <= m.floor_m;
 }
 
 // The last sample from `k` (where `leap` holds) to `steps` where it still holds.
-fn leap_end(summit_rel: vec3<f32>, k: u32, steps: u32, dt: f32, leap: Leap) -> u32 {
+fn leap_end(summit_rel: vec3<f32>, sag_m: f32, k: u32, steps: u32, dt: f32, leap: Leap) -> u32 {
     var clear = k;
     var beyond = steps;
     while beyond - clear > 1u {
         let mid = clear + (beyond - clear) / 2u;
-        if leap_holds(leap, march_point(summit_rel, mid, dt)) {
+        if leap_holds(leap, march_point(summit_rel, sag_m, mid, dt)) {
             clear = mid;
         } else {
             beyond = mid;
@@ -72,6 +86,7 @@ fn leap_end(summit_rel: vec3<f32>, k: u32, steps: u32, dt: f32, leap: Leap) -> u
 
 fn dem_blocks(summit_rel: vec3<f32>) -> bool {
     let length_sq = mul(summit_rel.x, summit_rel.x) + mul(summit_rel.y, summit_rel.y);
+    let sag_m = mul(u.chord_sag_per_m2, length_sq + mul(2.0, mul(summit_rel.z, summit_rel.z)));
     let wanted_sq = mul(mul(length_sq, 4.0), mul(u.inv_spacing_m, u.inv_spacing_m));
     var steps = 2u;
     while steps < u.refine_max_steps && f32(steps * steps) < wanted_sq {
@@ -81,17 +96,17 @@ fn dem_blocks(summit_rel: vec3<f32>) -> bool {
     let tile_level = leap_level();
     var k = 1u;
     while k < steps {
-        let m = march_point(summit_rel, k, dt);
+        let m = march_point(summit_rel, sag_m, k, dt);
         if !in_dataset(m.sample) {
             k += 1u;
             continue;
         }
         let s0 = vec2<u32>(m.sample.texel);
-        let z_m = m.rel_m.z + u.camera_z_m;
         let tile_top_m = height_tile_max_m[height_tile_at(s0, tile_level).z];
-        if tile_top_m <= z_m {
+        if tile_top_m <= m.floor_m {
             let square = (s0 >> vec2<u32>(tile_level)) / HEIGHT_TILE_CELLS;
-            k = leap_end(summit_rel, k, steps, dt, Leap(tile_level, HEIGHT_TILE_CELLS, square, tile_top_m)) + 1u;
+            let leap = Leap(tile_level, HEIGHT_TILE_CELLS, square, tile_top_m);
+            k = leap_end(summit_rel, sag_m, k, steps, dt, leap) + 1u;
             continue;
         }
         let hit = height_tile(s0);
@@ -102,14 +117,15 @@ fn dem_blocks(summit_rel: vec3<f32>) -> bool {
             if all(local < vec2<u32>(HEIGHT_TILE_BLOCKS)) {
                 let slot_blocks = u32(page_layer(hit.slot)) * HEIGHT_TILE_BLOCKS * HEIGHT_TILE_BLOCKS;
                 let block_top_m = height_block_max_m[slot_blocks + local.y * HEIGHT_TILE_BLOCKS + local.x];
-                if block_top_m <= z_m {
-                    k = leap_end(summit_rel, k, steps, dt, Leap(hit.level, HEIGHT_BLOCK_CELLS, block, block_top_m)) + 1u;
+                if block_top_m <= m.floor_m {
+                    let leap = Leap(hit.level, HEIGHT_BLOCK_CELLS, block, block_top_m);
+                    k = leap_end(summit_rel, sag_m, k, steps, dt, leap) + 1u;
                     continue;
                 }
             }
         }
         let ground = ground_in(hit, m.sample);
-        if ground.found && ground.height_m > z_m {
+        if ground.found && ground.height_m > m.z_m {
             return true;
         }
         k += 1u;

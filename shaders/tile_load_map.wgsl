@@ -8,6 +8,7 @@
 // `mul`, which ORs a uniform zero into its bits: no compiler can fuse it with the following add
 // into an FMA (fusing rounds once instead of twice, which the CPU would not reproduce).
 // Everything large is subtracted on the CPU in f64: the cell extents arrive camera-relative.
+// On the Earth a cell's grid box is bent onto it (`bent_box`) and culled by the horizon too.
 
 struct TlmRing {
     origin_cell: vec2<i32>,
@@ -37,6 +38,8 @@ struct TlmUniforms {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
+    earth_bend: vec4<f32>,
+    horizon: array<vec4<f32>, 4>,
     height_lod_range_m: array<vec4<f32>, MAX_LEVELS / 4u>,
     height_levels: array<vec4<u32>, MAX_LEVELS>,
     rings_info: array<TlmRing, TLM_MAX_RINGS>,
@@ -86,6 +89,51 @@ fn height_range(ring: u32, tiles_x: u32, tiles_y: u32) -> vec2<f32> {
         }
     }
     return range;
+}
+
+// A camera-relative box.
+struct CellBox {
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+}
+
+// The grid box `lo`..`hi` bent onto the Earth (`earth::horizon::EarthBend`): each corner falls by
+// d² / 2R at its horizontal distance d (the low face by its farthest, the high by its nearest),
+// and every face moves out by the mapping's other terms' bound. Flat, the box as it came.
+fn bent_box(lo: vec3<f32>, hi: vec3<f32>) -> CellBox {
+    let e = u.earth_bend;
+    let far = max(abs(lo.xy), abs(hi.xy));
+    let near = clamp(vec2<f32>(0.0), lo.xy, hi.xy);
+    let far_sq = mul(far.x, far.x) + mul(far.y, far.y);
+    let near_sq = mul(near.x, near.x) + mul(near.y, near.y);
+    let l1 = far.x + far.y;
+    let margin = vec3<f32>(mul(e.y, l1) + mul(e.z, far_sq) + mul(e.w, mul(l1, far_sq)));
+    return CellBox(lo - margin - vec3<f32>(0.0, 0.0, mul(e.x, far_sq)), hi + margin - vec3<f32>(0.0, 0.0, mul(e.x, near_sq)));
+}
+
+// Whether the Earth hides camera-relative point `p` (`earth::horizon::HorizonCone::hides`).
+fn below_horizon(p: vec3<f32>) -> bool {
+    let h = u.horizon;
+    let along = mul(h[3].x, p.x) + mul(h[3].y, p.y) + mul(h[3].z, p.z);
+    if !(along > h[3].w) {
+        return false;
+    }
+    let q = vec3<f32>(
+        mul(h[0].x, p.x) + mul(h[0].y, p.y) + mul(h[0].z, p.z),
+        mul(h[1].x, p.x) + mul(h[1].y, p.y) + mul(h[1].z, p.z),
+        mul(h[2].x, p.x) + mul(h[2].y, p.y) + mul(h[2].z, p.z),
+    );
+    return mul(along, along) >= mul(length_sq(q), h[3].w);
+}
+
+// Whether the Earth hides the whole box: every corner.
+fn beyond_horizon(b: CellBox) -> bool {
+    for (var corner = 0u; corner < 8u; corner += 1u) {
+        if !below_horizon(select(b.lo, b.hi, vec3<bool>((corner & 1u) != 0u, (corner & 2u) != 0u, (corner & 4u) != 0u))) {
+            return false;
+        }
+    }
+    return true;
 }
 
 // False when the box lies entirely behind one of the frustum's planes.
@@ -201,7 +249,10 @@ fn tlm_cell(ring: u32, cx: u32, cy: u32) -> TlmCell {
     let heights = height_range(ring, sx.height_tiles, sy.height_tiles);
     let lo = vec3<f32>(sx.rel_m.x, sy.rel_m.x, heights.x - u.camera_z_m);
     let hi = vec3<f32>(sx.rel_m.y, sy.rel_m.y, heights.y - u.camera_z_m);
-    if !in_frustum(lo, hi) || occluded(lo, hi) {
+    // Culled where it is drawn, on the Earth; its levels by the grid's distances, as the
+    // terrain's LOD takes them.
+    let placed = bent_box(lo, hi);
+    if !in_frustum(placed.lo, placed.hi) || beyond_horizon(placed) || occluded(placed.lo, placed.hi) {
         return culled;
     }
     let near_sq = length_sq(clamp(vec3<f32>(0.0), lo, hi));

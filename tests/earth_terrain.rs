@@ -11,26 +11,10 @@ use terramp::dataset::Dataset;
 use terramp::dataset::pose::CameraPoseError;
 use terramp::earth::placing::EarthPlacing;
 use terramp::frame::Renderer;
-use terramp::synth::SynthParams;
 use terramp_testkit::audit::{Dem, Rays};
 use terramp_testkit::camera::at_grid;
-use terramp_testkit::earth::nc_state_plane;
-use terramp_testkit::{gpu, ground_settings, synth_dataset_with};
-
-/// A synthetic dataset 60 km across with its south-west corner at nc's CRS point (600, 180) km,
-/// on the Earth there.
-fn placed_dataset() -> Dataset {
-    let params = SynthParams {
-        size: 600,
-        seed: 5,
-        spacing_m: 100.0,
-        origin_m: [600_000.0, 180_000.0],
-        ..Default::default()
-    };
-    let mut dataset = Dataset::open(&synth_dataset_with(&params)).unwrap();
-    dataset.manifest.earth = Some(nc_state_plane());
-    dataset
-}
+use terramp_testkit::earth::synth_on_nc;
+use terramp_testkit::{gpu, ground_settings};
 
 /// The longitude and latitude, degrees, of `dataset`'s grid point `grid_m`.
 fn lon_lat_deg(dataset: &Dataset, [x, y]: [f64; 2]) -> [f64; 2] {
@@ -75,7 +59,7 @@ fn vertical_misses(r: &Renderer, camera: &terramp::camera::Camera, dem: &Dem) ->
 
 #[test]
 fn the_drawn_ground_lies_where_the_exact_mapping_puts_it() {
-    let dataset = std::sync::Arc::new(placed_dataset());
+    let dataset = std::sync::Arc::new(synth_on_nc(600, 100.0, 5));
     let dem = Dem::load(&dataset);
     let mut settings = ground_settings(320, 180);
     // The finest LOD everywhere (no morph): the drawn ground is the finest mesh the oracle derives.
@@ -122,7 +106,7 @@ fn the_drawn_ground_lies_where_the_exact_mapping_puts_it() {
 
 #[test]
 fn a_curved_frame_has_no_hole_below_its_horizon() {
-    let dataset = placed_dataset();
+    let dataset = synth_on_nc(600, 100.0, 5);
     let dem = Dem::load(&dataset);
     let mut r = Renderer::new(gpu(), dataset, ground_settings(240, 136)).unwrap();
     for (yaw, pitch, above_m) in [(30.0, -1.0, 300.0), (200.0, -8.0, 2_000.0), (120.0, -0.2, 20.0)] {
@@ -145,7 +129,7 @@ fn a_curved_frame_has_no_hole_below_its_horizon() {
 /// read as before, and a dataset that does not say where it lies refuses the Earth's forms.
 #[test]
 fn cameras_are_placed_from_longitude_and_latitude() {
-    let dataset = placed_dataset();
+    let dataset = synth_on_nc(600, 100.0, 5);
     let earth = dataset.manifest.earth.clone().unwrap();
     let [ox, oy] = dataset.manifest.origin_m;
     let [lon_deg, lat_deg] = lon_lat_deg(&dataset, [30_000.0, 20_000.0]);
@@ -168,7 +152,7 @@ fn cameras_are_placed_from_longitude_and_latitude() {
     for bad in ["lonlat:1,2,3", "lonlat:a,2,3,4,5", "geo:1,2,3,4,5", "1,2,3"] {
         assert!(matches!(dataset.camera_from(bad, 60.0, 0.1), Err(CameraPoseError::Parse(_))), "{bad}");
     }
-    let mut flat = placed_dataset();
+    let mut flat = synth_on_nc(600, 100.0, 5);
     flat.manifest.earth = None;
     let refused = flat.camera_from("lonlat:-78.6,35.7,900,0,-20", 60.0, 0.1);
     assert!(matches!(refused, Err(CameraPoseError::NotOnEarth(_))), "{refused:?}");
@@ -178,7 +162,7 @@ fn cameras_are_placed_from_longitude_and_latitude() {
 /// written the same way land.
 #[test]
 fn camera_paths_on_the_earth_are_placed_in_the_dataset() {
-    let dataset = placed_dataset();
+    let dataset = synth_on_nc(600, 100.0, 5);
     let [lon_deg, lat_deg] = lon_lat_deg(&dataset, [10_000.0, 40_000.0]);
     let dir = terramp_testkit::TempDir::new("earth-path");
     let file = dir.path().join("path.toml");
@@ -198,7 +182,7 @@ fn camera_paths_on_the_earth_are_placed_in_the_dataset() {
             (camera.position_m, camera.yaw_deg, camera.pitch_deg)
         );
     }
-    let mut flat = placed_dataset();
+    let mut flat = synth_on_nc(600, 100.0, 5);
     flat.manifest.earth = None;
     assert!(terramp::profile::load_path(&flat, &file).unwrap_err().to_string().contains("keyframe 0"));
 }

@@ -10,6 +10,7 @@
 //!   h above it (the sea taken at the geoid's height under the camera: its slope over the view
 //!   moves the horizon by well under a pixel), and the column's ray at azimuth φ off the view's
 //!   centre reaches that dip tan δ / cos φ focal lengths below the image's middle.
+//! - The Tile Load Map culls its cells beyond the horizon (`the_tlm_culls_cells_beyond_the_horizon`).
 //! - From 1 km up, the peak's top stands where the exact mapping (f64, `ExactPlacing`) of its
 //!   highest sample puts it, within a pixel: about 1,770 m below the camera's horizontal by the
 //!   drop alone (d² / 2ρ; no refraction is modelled), where the flat sheet had it level.
@@ -24,8 +25,10 @@ use terramp::dataset::Dataset;
 use terramp::earth::Ellipsoid;
 use terramp::earth::placing::EarthPlacing;
 use terramp::frame::Renderer;
+use terramp::passes::tile_load_map::frame::height_tile_ranges;
 use terramp_testkit::TempDir;
 use terramp_testkit::audit::Dem;
+use terramp_testkit::tlm;
 
 use support::{build, write_geotiff};
 
@@ -203,4 +206,36 @@ fn horizon_culling_drops_nodes_not_pixels() {
         assert!(depth == all_depth, "{height_m} m, {pitch_deg}°: the depth differs");
         assert!(culled <= all, "{height_m} m, {pitch_deg}°: {culled} > {all}");
     }
+}
+
+/// The Tile Load Map over the sea, level from 1 km and 10 km up: with horizon culling its cells
+/// beyond the horizon are culled (the GPU equal to its twin, no pixel's ground in a culled cell),
+/// and never more stay visible than without; from 1 km up, fewer (from 10 km up, as many).
+#[test]
+fn the_tlm_culls_cells_beyond_the_horizon() {
+    let dir = TempDir::new("earth-horizon-tlm");
+    let dataset = std::sync::Arc::new(sea(&dir));
+    let ranges = height_tile_ranges(&dataset);
+    let mut fewer = 0;
+    for height_m in [1_000.0, 10_000.0] {
+        let mut visible_cells = [0; 2];
+        for (k, culling) in [true, false].into_iter().enumerate() {
+            let mut settings = Settings::default();
+            [settings.render.width, settings.render.height] = [480, 270];
+            settings.render.fov_deg = FOV_DEG;
+            settings.terrain.horizon_culling = culling;
+            let mut r =
+                Renderer::new(terramp_testkit::gpu(), std::sync::Arc::clone(&dataset), settings).unwrap();
+            let what = format!("{height_m} m up, horizon culling {culling}");
+            let run = tlm::run(&mut r, &camera(height_m), &ranges);
+            tlm::assert_gpu_equals_twin(&run, &what);
+            tlm::assert_no_false_culls(&r, &run, &what);
+            visible_cells[k] = tlm::visible(&run.gpu);
+        }
+        let [culled, all] = visible_cells;
+        println!("{height_m} m up, level: {culled} TLM cells visible with horizon culling, {all} without");
+        assert!(culled <= all, "{height_m} m: {culled} visible with horizon culling, {all} without");
+        fewer += usize::from(culled < all);
+    }
+    assert!(fewer > 0, "the horizon culled no cell");
 }

@@ -137,11 +137,11 @@ fn zion_seeds_grow_up_to_the_nodata_border_and_never_on_it() {
     for (what, camera) in views {
         let a = render_and_audit(&mut r, &dem, what, &camera, tol, 50);
         let (records, _) = r.read_seeds().unwrap().unwrap();
-        let o = r.dataset.manifest.origin_m;
-        let eye = camera.position_m - DVec3::new(o[0], o[1], 0.0);
+        let placing = r.exact_placing(&camera);
         let mut near_border = 0;
         for s in &records {
-            let p = [eye.x + f64::from(s.position_rel_m[0]), eye.y + f64::from(s.position_rel_m[1])];
+            let grid = placing.grid_m(DVec3::from(s.position_rel_m.map(f64::from)));
+            let p = [grid.x, grid.y];
             let q = p.map(|v| ((v + half_m) / texel_m).floor() as u32);
             let code = code_at(&r, q);
             assert!(code.is_some_and(|c| c != nodata), "{what}: a seed grew on {code:?} at {p:?}");
@@ -208,10 +208,9 @@ fn a_vertical_cliff_renders_whole_and_grows_no_seed_on_its_face() {
             a.worst_seed_gap_m
         );
         let (records, counters) = r.read_seeds().unwrap().unwrap();
-        let o = r.dataset.manifest.origin_m;
-        let eye_x = camera.position_m.x - o[0];
+        let placing = r.exact_placing(&camera);
         let on_face = records.iter().filter(|s| {
-            let x = eye_x + f64::from(s.position_rel_m[0]);
+            let x = placing.grid_m(DVec3::from(s.position_rel_m.map(f64::from))).x;
             x > foot && x < top
         });
         assert_eq!(on_face.count(), 0, "{what}: seeds on the cliff face");

@@ -38,13 +38,13 @@ fn selected_seeds(r: &mut Renderer, pose: [f64; 5]) -> (Vec<[f64; 2]>, Vec<[i64;
     r.render_resolved(&camera).unwrap();
     let (records, counters) = r.read_seeds().unwrap().unwrap();
     assert_eq!(counters.overflow, 0, "{counters:?}");
-    let origin = r.dataset.manifest.origin_m;
-    let eye = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
+    let placing = r.exact_placing(&camera);
     let cell_m = r.settings.tlm.cell_m;
     let mut xy = Vec::with_capacity(records.len());
     let mut cells = Vec::with_capacity(records.len());
     for s in &records {
-        let p = [eye.x + f64::from(s.position_rel_m[0]), eye.y + f64::from(s.position_rel_m[1])];
+        let grid = placing.grid_m(DVec3::from(s.position_rel_m.map(f64::from)));
+        let p = [grid.x, grid.y];
         let cell = s.address.map(i64::from);
         // A seed lies in its cell, up to the f32 rounding of its camera-relative position.
         for a in 0..2 {

@@ -55,9 +55,7 @@ fn renderer(dataset: Dataset, mut settings: Settings, width: u32, height: u32) -
 
 /// Largest distance between a seed's base and the f64 drawn ground under it, metres.
 fn worst_base_error_m(r: &Renderer, camera: &Camera, seeds: &[SeedRecord]) -> f64 {
-    let origin = r.dataset.manifest.origin_m;
-    let c = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
-    HeightError::of(&r.dataset, c, seeds).unwrap().max_m
+    HeightError::of(&r.dataset, &r.exact_placing(camera), seeds).unwrap().max_m
 }
 
 fn gpu_equals_twin(dataset: Dataset, views: Poses) {
@@ -151,18 +149,14 @@ fn recall_precision(r: &mut Renderer, what: &str, pose: [f64; 5]) -> (f64, f64, 
         snapshot.frame.cells.iter().map(|c| [i64::from(c.address[0]), i64::from(c.address[1])]).collect();
     let missed = agreement.missed();
     let missed_cells = truth.difference(&kept).filter(|(a, _)| !active.contains(a)).count();
-    let origin = r.dataset.manifest.origin_m;
-    let eye = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
+    let placing = r.exact_placing(&camera);
+    let eye = placing.camera_grid_m();
     let extra_hidden = gpu
         .iter()
         .filter(|g| !truth.contains(&record_id(g)))
         .filter(|g| {
-            let rel = DVec3::new(
-                f64::from(g.position_rel_m[0]),
-                f64::from(g.position_rel_m[1]),
-                f64::from(g.position_rel_m[2] + g.height_m),
-            );
-            !terramp::reference::oracle::segment_clears_dem(&r.dataset, eye, eye + rel).unwrap()
+            let rel = DVec3::from(g.position_rel_m.map(f64::from)) + DVec3::Z * f64::from(g.height_m);
+            !terramp::reference::oracle::segment_clears_dem(&r.dataset, eye, placing.grid_m(rel)).unwrap()
         })
         .count();
     println!(
@@ -259,8 +253,7 @@ fn nc_species_follow_the_land_cover() {
     let meta = r.dataset.manifest.landcover.clone().unwrap();
     let texel_m = 2.0 * meta.layer.texel_m;
     let half = 0.5 * r.dataset.manifest.height.spacing_m;
-    let origin = r.dataset.manifest.origin_m;
-    let c = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
+    let placing = r.exact_placing(&camera);
     let code_at = |x: f64, y: f64| {
         let q = [((x + half) / texel_m).floor() as u32, ((y + half) / texel_m).floor() as u32];
         meta.coding.code_of(r.dataset.landcover_index(1, q).unwrap()).unwrap_or(meta.nodata_code)
@@ -269,10 +262,8 @@ fn nc_species_follow_the_land_cover() {
     for s in &records {
         // Its class is read where its hash moves it, up to half a texel (`class_offset`).
         let offset = class_offset(s.address, s.rank, r.settings.tlm.seed).map(|v| f64::from(v) * texel_m);
-        let code = code_at(
-            c.x + f64::from(s.position_rel_m[0]) + offset[0],
-            c.y + f64::from(s.position_rel_m[1]) + offset[1],
-        );
+        let grid = placing.grid_m(DVec3::from(s.position_rel_m.map(f64::from)));
+        let code = code_at(grid.x + offset[0], grid.y + offset[1]);
         let species = &table.species[SpeciesLod::unpack(s.species_lod).species as usize];
         assert!(
             !(species.kind == SpeciesKind::Tree && (code == 1 || code == 6)),

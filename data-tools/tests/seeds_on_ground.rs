@@ -190,17 +190,20 @@ fn stand(what: &str, dir: &Path) -> Standing {
         let camera = posed(&r, pose);
         r.render_resolved(&camera).unwrap();
         let (records, _) = r.read_seeds().unwrap().unwrap();
-        let o = r.dataset.manifest.origin_m;
-        let eye = camera.position_m - DVec3::new(o[0], o[1], 0.0);
+        let placing = r.exact_placing(&camera);
         let mut view_above = f64::NEG_INFINITY;
         for record in &records {
-            let p = eye + DVec3::from(record.position_rel_m.map(f64::from));
+            let p = placing.grid_m(DVec3::from(record.position_rel_m.map(f64::from)));
             let ground_mesh_m = mesh.height_m(p.x, p.y);
             let ground_m = f64::from(record.ground_m);
             assert!(ground_m.is_finite() && p.is_finite(), "{what}: {record:?}");
             // The anchor is where the record puts it: its ground sunk by its share of its height.
             let sunk_m = ground_m - sink * f64::from(record.height_m);
-            assert!((p.z - sunk_m).abs() <= 0.01f64.max(eye.z.abs() * 2e-7), "{what}: {record:?}");
+            assert!(
+                (p.z - sunk_m).abs() <= 0.01f64.max(placing.camera_grid_m().z.abs() * 2e-7),
+                "{what}: {record:?}: anchor {} m off",
+                p.z - sunk_m
+            );
             s.coarse += usize::from(SpeciesLod::unpack(record.species_lod).height_level != 0);
             s.ground_above_m = s.ground_above_m.max(ground_m - ground_mesh_m);
             s.ground_below_m = s.ground_below_m.max(ground_mesh_m - ground_m);

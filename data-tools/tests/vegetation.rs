@@ -46,10 +46,10 @@ fn seeds(dataset: Dataset) -> Vec<([i32; 2], u32, [f64; 2])> {
         let cam = camera::posed(&r, pose);
         r.render_resolved(&cam).unwrap();
         let (records, _) = r.read_seeds().unwrap().unwrap();
-        let eye = cam.position_m;
+        let (placing, origin) = (r.exact_placing(&cam), r.dataset.manifest.origin_m);
         out.extend(records.iter().map(|s| {
-            let p = s.position_rel_m.map(f64::from);
-            (s.address, s.rank, [eye.x + p[0], eye.y + p[1]])
+            let p = placing.grid_m(glam::DVec3::from(s.position_rel_m.map(f64::from)));
+            (s.address, s.rank, [origin[0] + p.x, origin[1] + p.y])
         }));
     }
     out

@@ -59,3 +59,22 @@ fn earth_flat_direction(node: EarthNode, direction: vec3<f32>) -> vec3<f32> {
         dot(cross(j[0], j[1]), direction),
     );
 }
+
+// `v`, given in a frame whose z is straight up, stood on a place whose local vertical is `up`
+// (unit, or within 1e-6 of it): turned by the least rotation that takes z to `up` (about
+// z × up). Straight up, every vector comes back as it went in, to the bit (its products are by
+// 1 and 0).
+fn earth_stand(v: vec3<f32>, up: vec3<f32>) -> vec3<f32> {
+    let c = 1.0 / (1.0 + up.z);
+    let x = vec3<f32>(1.0 - up.x * up.x * c, -up.x * up.y * c, -up.x);
+    let y = vec3<f32>(-up.x * up.y * c, 1.0 - up.y * up.y * c, -up.y);
+    return x * v.x + y * v.y + up * v.z;
+}
+
+// `earth_stand`'s inverse: camera-frame `v` in the frame of a place whose vertical is `up`.
+fn earth_unstand(v: vec3<f32>, up: vec3<f32>) -> vec3<f32> {
+    let c = 1.0 / (1.0 + up.z);
+    let x = vec3<f32>(1.0 - up.x * up.x * c, -up.x * up.y * c, -up.x);
+    let y = vec3<f32>(-up.x * up.y * c, 1.0 - up.y * up.y * c, -up.y);
+    return vec3<f32>(dot(x, v), dot(y, v), dot(up, v));
+}

@@ -48,6 +48,23 @@ impl From<&NodeMapping> for EarthNode {
     }
 }
 
+impl From<&EarthNode> for NodeMapping {
+    fn from(n: &EarthNode) -> Self {
+        let v = |v: [f32; 4]| glam::Vec3::new(v[0], v[1], v[2]);
+        Self {
+            origin_m: v(n.origin_m),
+            d_x: v(n.d_x),
+            d_y: v(n.d_y),
+            d_h: v(n.d_h),
+            d_xx: v(n.d_xx),
+            d_xy: v(n.d_xy),
+            d_yy: v(n.d_yy),
+            d_xh: v(n.d_xh),
+            d_yh: v(n.d_yh),
+        }
+    }
+}
+
 /// Where the shader places each of `points` on its node of `nodes` (camera-relative metres).
 /// Blocking: for tests.
 pub fn probe_positions(

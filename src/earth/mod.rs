@@ -20,6 +20,7 @@
 pub mod ellipsoid;
 pub mod geodesic;
 pub mod gpu;
+pub mod horizon;
 pub mod local;
 pub mod placing;
 pub mod pose;

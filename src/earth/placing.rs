@@ -19,16 +19,13 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
+use super::EarthFrame;
+use super::horizon::{HorizonCone, SMALLEST_RADIUS_M};
 use super::local::{EcefNode, LocalFrame};
-use super::{EarthFrame, Ellipsoid};
 use crate::gpu::gpu_types::EarthNode;
 
 /// Nodes whose mappings are kept; past this the keep is emptied and refilled as frames ask.
 pub const MAX_KEPT_NODES: usize = 1 << 16;
-
-/// The smallest radius of curvature WGS 84 has (the meridian's, at the equator), metres: the
-/// bound on how fast its ground bends.
-const SMALLEST_RADIUS_M: f64 = 6_335_439.0;
 
 /// How a renderer places its dataset: on the ellipsoid, or flat.
 #[derive(Debug, Clone)]
@@ -116,6 +113,34 @@ impl ExactPlacing {
         self.round.is_some()
     }
 
+    /// The camera's grid position.
+    pub fn camera_grid_m(&self) -> DVec3 {
+        self.camera_grid_m
+    }
+
+    /// The mapping of the grid point under the camera, at height 0 (as `PlacedView::node` forms
+    /// a node's, not kept: it moves with the camera): what places the seeds, none of which
+    /// stands farther than their reach (kilometres) from it.
+    pub fn nadir_node(&self) -> EarthNode {
+        let nadir_grid_m = DVec3::new(self.camera_grid_m.x, self.camera_grid_m.y, 0.0);
+        match &self.round {
+            Some(RoundView { frame, earth, origin_m, .. }) => {
+                let origin = nadir_grid_m + DVec3::new(origin_m[0], origin_m[1], 0.0);
+                EarthNode::from(&frame.place(&EcefNode::at(earth, origin)))
+            }
+            None => flat_node(nadir_grid_m - self.camera_grid_m),
+        }
+    }
+
+    /// The horizon this camera sees over ground no lower than `lowest_height_m` (the dataset's
+    /// lowest): the ellipsoid lowered below it by the geoid's lowest undulation and
+    /// `HORIZON_MARGIN_M`. `None` flat, or with the eye below that ellipsoid.
+    pub fn horizon(&self, lowest_height_m: f64) -> Option<HorizonCone> {
+        let RoundView { frame, lowest_undulation_m, .. } = self.round.as_ref()?;
+        let height_m = lowest_height_m + lowest_undulation_m - HORIZON_MARGIN_M;
+        HorizonCone::new(frame.eye_ecef_m, frame.local_from_ecef, height_m)
+    }
+
     /// The camera-relative position of grid point `grid_m` (x, y and a height).
     pub fn position_rel_m(&self, grid_m: DVec3) -> DVec3 {
         match &self.round {
@@ -143,6 +168,11 @@ impl ExactPlacing {
         }
         grid_m
     }
+}
+
+/// The flat sheet's mapping of a node whose origin lies `origin_rel_m` from the camera.
+fn flat_node(origin_rel_m: DVec3) -> EarthNode {
+    EarthNode { origin_m: origin_rel_m.as_vec3().extend(0.0).to_array(), ..EarthNode::FLAT }
 }
 
 /// The most steps `ExactPlacing::grid_m` takes (it stops at a nanometre): enough for points
@@ -183,58 +213,15 @@ impl PlacedView<'_> {
             Some(RoundView { frame, earth, origin_m, .. }) => {
                 EarthNode::from(&frame.place(kept_node(self.kept, earth, *origin_m, origin_grid_m)))
             }
-            None => {
-                let axis = |a: usize| {
-                    let mut v = [0.0; 4];
-                    v[a] = 1.0;
-                    v
-                };
-                EarthNode {
-                    origin_m: (origin_grid_m - self.exact.camera_grid_m).as_vec3().extend(0.0).to_array(),
-                    d_x: axis(0),
-                    d_y: axis(1),
-                    d_h: axis(2),
-                    ..EarthNode::default()
-                }
-            }
+            None => flat_node(origin_grid_m - self.exact.camera_grid_m),
         }
     }
 
     /// Whether the Earth hides every point of the camera-relative box `lo`..`hi` from the camera
-    /// (horizon culling): the ellipsoid lowered below `lowest_height_m` (the dataset's lowest
-    /// ground) by the geoid's lowest undulation and `HORIZON_MARGIN_M` hides a point that lies inside the cone of its tangents
-    /// from the eye and beyond the plane of their points of contact, a convex region: a box whose
-    /// eight corners lie in it lies in it whole. Worked in the ellipsoid's scaled space (Cesium's
-    /// horizon culling), where the ellipsoid is the unit sphere and the test is exact. Flat, or
-    /// with the eye below that ellipsoid, nothing is hidden.
+    /// (horizon culling, `ExactPlacing::horizon`, over ground no lower than `lowest_height_m`).
+    /// Flat, or with the eye below that ground, nothing is hidden.
     pub fn hidden_by_earth(&self, lo: DVec3, hi: DVec3, lowest_height_m: f64) -> bool {
-        let Some(RoundView { frame, lowest_undulation_m: undulation_m, .. }) = &self.exact.round else {
-            return false;
-        };
-        let lowest_m = lowest_height_m + undulation_m - HORIZON_MARGIN_M;
-        let e = Ellipsoid::WGS84;
-        let scale = DVec3::new(e.a_m + lowest_m, e.a_m + lowest_m, e.b_m() + lowest_m).recip();
-        let eye = frame.eye_ecef_m * scale;
-        let eye_sq = eye.length_squared();
-        if eye_sq <= 1.0 {
-            return false;
-        }
-        // The cone of tangents from the eye: cos² of its half-angle is 1 − 1 / |eye|²; the plane
-        // of contact lies (|eye|² − 1) / |eye| along the axis towards the centre.
-        let (axis, tangent_sq) = (-eye, eye_sq - 1.0);
-        let ecef_from_local = frame.local_from_ecef.transpose();
-        (0..8).all(|k| {
-            let corner = DVec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            );
-            let p = (ecef_from_local * corner) * scale;
-            let along = p.dot(axis);
-            // Beyond the plane (along > tangent², |axis| folded in) and inside the cone
-            // (along² ≥ |p|² |axis|² cos²: cos² = tangent² / |axis|²).
-            along > tangent_sq && along * along >= p.length_squared() * tangent_sq
-        })
+        self.exact.horizon(lowest_height_m).is_some_and(|cone| cone.hides_box(lo, hi))
     }
 
     /// A camera-relative box holding everything the GPU draws of the grid box `min_m`..`max_m`

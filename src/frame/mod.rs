@@ -13,7 +13,7 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
-use crate::earth::placing::EarthPlacing;
+use crate::earth::placing::{EarthPlacing, ExactPlacing};
 use crate::gpu::fragments::{CountedPass, FragmentCounter, PassFragments};
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
@@ -23,7 +23,7 @@ use crate::passes::ground::gpu::GroundPass;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
 use crate::passes::terrain::select::NodeBounds;
 use crate::passes::tile_load_map::analysis::{LoadMaps, analyse};
-use crate::passes::tile_load_map::frame::{TlmFrame, height_tile_ranges};
+use crate::passes::tile_load_map::frame::{TlmEarth, TlmFrame, height_tile_ranges};
 use crate::passes::tile_load_map::gpu::{TileLoadMapPass, TlmBindings};
 use crate::passes::tile_load_map::layout::TlmLayout;
 use crate::seeds::wind::{Wind, WindFrame};
@@ -303,6 +303,19 @@ impl Renderer {
     pub fn wind_frame(&self, camera: &Camera) -> WindFrame {
         let p = camera.position_m;
         Wind::new(&self.settings.wind).frame(self.time_s, [p.x, p.y])
+    }
+
+    /// Where this renderer draws the dataset seen from `camera` (on the Earth, or flat), exact:
+    /// what turns the camera-relative positions it draws (seed records, depth) back into grid
+    /// points (`ExactPlacing::grid_m`).
+    pub fn exact_placing(&self, camera: &Camera) -> ExactPlacing {
+        let origin = self.dataset.manifest.origin_m;
+        self.placing.exact(camera.position_m - glam::DVec3::new(origin[0], origin[1], 0.0))
+    }
+
+    /// Where the Tile Load Map's cells lie seen from `camera`, as this renderer's frames place them.
+    pub fn tlm_earth(&self, camera: &Camera) -> TlmEarth {
+        TlmEarth::of(&self.exact_placing(camera), &self.dataset, self.settings.terrain.horizon_culling)
     }
 
     /// Renders one frame from `camera`.

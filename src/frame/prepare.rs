@@ -13,7 +13,7 @@ use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms
 use crate::passes::terrain::gpu::PreparedNodes;
 use crate::passes::terrain::select::{Lods, Selected, select};
 use crate::passes::tile_load_map::analysis::LoadMaps;
-use crate::passes::tile_load_map::frame::{TlmFrame, TlmImagery, TlmInputs};
+use crate::passes::tile_load_map::frame::{TlmEarth, TlmFrame, TlmImagery, TlmInputs};
 use crate::passes::tile_load_map::layout::TlmLayout;
 use crate::streaming::wants::after_pinned;
 use crate::streaming::{CacheStats, TileCache, UploadBudget};
@@ -142,6 +142,7 @@ impl Renderer {
             lods: &view.lods,
             imagery: TlmImagery::of(&self.dataset, &s.imagery),
             hiz_mips: self.depth_pyramid.mips(),
+            earth: TlmEarth::of(&view.placing, &self.dataset, s.terrain.horizon_culling),
         };
         let tlm = self.tlm.prepare(&self.gpu.queue, &inputs)?;
         Ok((layout, tlm))
@@ -192,13 +193,15 @@ impl Renderer {
         let wind = self.wind_frame(view.camera);
         let Some(stage) = self.seeds.as_mut() else { return Ok(()) };
         let cells = self.load_maps.as_ref().map_or(&[][..], |m| &m.seed_cells[..]);
+        let mut placed = self.placing.view(&view.placing);
+        let cells = super::seeds::placed_cells(&mut placed, cells, self.settings.tlm.cell_m);
         let ranks = stage.tables.active_ranks();
-        let inputs =
-            super::seeds::seed_inputs(&self.settings, &self.dataset, view.camera, view.grid_m, cells, ranks);
+        let (settings, dataset) = (&self.settings, &self.dataset);
+        let inputs = super::seeds::seed_inputs(settings, dataset, view.camera, &view.placing, &cells, ranks);
         let frame = stage.prepare(&self.gpu, &inputs)?;
         report.seed_cells = frame.cells.len();
         report.seed_cells_dropped = frame.cells_dropped;
-        stage.prepare_draw(&self.gpu, &self.settings, terrain, &wind);
+        stage.prepare_draw(&self.gpu, &self.settings, terrain, &wind, &inputs.nadir);
         (report.seed_species_drawn, report.seed_species_undrawn) = stage.species_counts();
         Ok(())
     }

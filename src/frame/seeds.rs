@@ -15,8 +15,9 @@ use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::{Dataset, LandcoverLayer};
+use crate::earth::placing::{ExactPlacing, PlacedView};
 use crate::gpu::fragments::CountedPass;
-use crate::gpu::gpu_types::{CompactParams, SeedCounters, SeedRecord, TerrainUniforms};
+use crate::gpu::gpu_types::{CompactParams, EarthNode, SeedCounters, SeedRecord, TerrainUniforms};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError};
 use crate::passes::compact::frame::CompactLimits;
@@ -163,9 +164,10 @@ impl SeedStage {
         settings: &Settings,
         terrain: &TerrainUniforms,
         wind: &WindFrame,
+        earth: &EarthNode,
     ) {
         if let Some((draw, _)) = &self.draw {
-            let uniforms = draw_uniforms(settings, terrain, wind);
+            let uniforms = draw_uniforms(settings, terrain, wind, earth);
             draw.prepare(&gpu.queue, &uniforms);
             if let Some(templates) = draw.frame_templates(settings, uniforms.focal_px)
                 && templates != self.compact.templates()
@@ -282,23 +284,36 @@ fn draw_pass(
     Ok((draw, bind_group))
 }
 
+/// `cells`, each with its mapping from `placed`: its south-west corner's (`cell_m` a side) at
+/// height 0.
+pub(super) fn placed_cells(
+    placed: &mut PlacedView,
+    cells: &[SeedCellRef],
+    cell_m: f64,
+) -> Vec<(SeedCellRef, EarthNode)> {
+    let corner =
+        |c: &SeedCellRef| DVec3::new(c.address[0] as f64 * cell_m, c.address[1] as f64 * cell_m, 0.0);
+    cells.iter().map(|c| (*c, placed.node(corner(c)))).collect()
+}
+
 /// The inputs of a frame's seed selection.
 pub(super) fn seed_inputs<'a>(
     settings: &'a Settings,
     dataset: &'a Dataset,
     camera: &'a Camera,
-    camera_grid_m: DVec3,
-    cells: &'a [SeedCellRef],
+    placing: &ExactPlacing,
+    cells: &'a [(SeedCellRef, EarthNode)],
     active_ranks: u32,
 ) -> SeedInputs<'a> {
     SeedInputs {
         settings,
         dataset,
         camera,
-        camera_grid_m,
+        camera_grid_m: placing.camera_grid_m(),
         viewport_px: [settings.render.width, settings.render.height],
         cells,
         active_ranks,
+        nadir: placing.nadir_node(),
     }
 }
 

@@ -78,7 +78,8 @@ pub fn tree_shares(renderer: &Renderer, camera: &Camera) -> Result<Option<Vec<Tr
     };
     let manifest = &renderer.dataset.manifest;
     let half_spacing_m = 0.5 * manifest.height.spacing_m;
-    let eye_grid_m = [camera.position_m.x - manifest.origin_m[0], camera.position_m.y - manifest.origin_m[1]];
+    let placing = renderer.exact_placing(camera);
+    let eye_grid_m = placing.camera_grid_m();
     let mut landcover = Landcover::new(&renderer.dataset, Some(table));
     let mut trees = Vec::new();
     for record in &records {
@@ -86,11 +87,12 @@ pub fn tree_shares(renderer: &Renderer, camera: &Camera) -> Result<Option<Vec<Tr
         if table.species.get(species).is_none_or(|s| s.kind != SpeciesKind::Tree) {
             continue;
         }
-        let rel = [record.position_rel_m[0], record.position_rel_m[1]].map(f64::from);
-        let p = [eye_grid_m[0] + rel[0], eye_grid_m[1] + rel[1]];
+        let grid_m = placing.grid_m(glam::DVec3::from(record.position_rel_m.map(f64::from)));
+        let rel = grid_m - eye_grid_m;
+        let p = [grid_m.x, grid_m.y];
         let (bilinear, seeded_around) = landcover.wooded_fraction(p, half_spacing_m)?;
         let nearest = landcover.wooded(p, half_spacing_m)?;
-        trees.push(TreeShares { nearest, bilinear, seeded_around, distance_m: rel[0].hypot(rel[1]) });
+        trees.push(TreeShares { nearest, bilinear, seeded_around, distance_m: rel.x.hypot(rel.y) });
     }
     Ok(Some(trees))
 }

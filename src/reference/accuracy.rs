@@ -14,6 +14,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::dataset::{Dataset, PackError};
+use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::SeedRecord;
 use crate::reference::oracle::OracleSeed;
 use crate::reference::worst::max_or_nan;
@@ -97,14 +98,20 @@ pub struct HeightError {
 }
 
 impl HeightError {
-    /// `seeds` as pass 3 wrote them from a camera at `camera_grid_m` (grid space).
-    pub fn of(dataset: &Dataset, camera_grid_m: DVec3, seeds: &[SeedRecord]) -> Result<Self, PackError> {
+    /// `seeds` as pass 3 wrote them, placed by `placing` (the renderer's, from its camera): each
+    /// seed's grid point is where the placing puts its anchor.
+    pub fn of(dataset: &Dataset, placing: &ExactPlacing, seeds: &[SeedRecord]) -> Result<Self, PackError> {
         let mut out = Self::default();
         for s in seeds {
-            let x = camera_grid_m.x + f64::from(s.position_rel_m[0]);
-            let y = camera_grid_m.y + f64::from(s.position_rel_m[1]);
+            let rel = DVec3::from(s.position_rel_m.map(f64::from));
             out.seeds += 1;
-            if !(x.is_finite() && y.is_finite() && s.ground_m.is_finite()) {
+            if !(rel.is_finite() && s.ground_m.is_finite()) {
+                out.non_finite += 1;
+                out.max_m = f64::NAN;
+                continue;
+            }
+            let DVec3 { x, y, .. } = placing.grid_m(rel);
+            if !(x.is_finite() && y.is_finite()) {
                 out.non_finite += 1;
                 out.max_m = f64::NAN;
                 continue;

@@ -20,27 +20,40 @@
 //! linear, so their difference is checked at the stretch's ends and where it crosses the
 //! diagonal. Outside the dataset there is no terrain; an eye below the surface sees nothing.
 //!
+//! On the Earth (the renderer's placing, `earth::placing`) a seed's distance and its sphere's
+//! centre are placed by the exact mapping (f64), the sphere's centre up the local vertical; the
+//! eye→summit segment is straight in space, so over the grid it sags below the line between its
+//! ends' heights by t (1 − t) (L² + 2 Δz²) / 2R at the grid's fraction t (L its length over the
+//! grid, Δz its rise, R the mean radius of curvature at the eye: the Earth's fall under it, and
+//! the verticals' convergence, which puts its higher points over nearer grid points; second
+//! order in the bend), and its ground track is taken as the grid's straight line. The clearance is then a convex parabola on each planar piece, checked also at
+//! its vertex.
 //! Speed: the level-0 heights around the camera are copied once into a dense window and the
 //! land-cover tiles under it decoded once; cells are judged in parallel (rayon). The result is
 //! deterministic: visible seeds sorted by (cell address, rank), counts summed.
 
+mod frame;
 mod ground;
 mod vegetation;
 
-use glam::{DMat4, DVec2, DVec3, DVec4};
+use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 use thiserror::Error;
 
 use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::{Dataset, PackError};
+use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::SeedSpecies;
 use crate::reference::seed_select::class_offset;
 use crate::seeds::patterns::SeedPatterns;
-use crate::seeds::wind::Wind;
 use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, seed_variant, species_of_rank};
+use frame::ViewFrame;
 use ground::{DemWindow, LandcoverTiles};
 use vegetation::Vegetation;
+
+/// How much farther than their reach, on the grid, the cells judged on the Earth reach.
+const REACH_MARGIN: f64 = 1.01;
 
 /// The fraction of an eye→summit segment, at the summit's end, the occlusion test ignores.
 pub const SEGMENT_END_SKIP: f64 = 1e-6;
@@ -186,6 +199,10 @@ pub fn judge_seeds(
         (lo as i64, hi as i64)
     };
     let ((x0, x1), (y0, y1)) = (range(eye.x, 0), range(eye.y, 1));
+    // On the Earth reach is measured placed, and a projection may shrink distances by its scale
+    // factor (UTM's by up to 0.04 % at a zone's edge): cells a little beyond reach on the grid
+    // are judged too.
+    let reach_m = if frame.placing.is_round() { REACH_MARGIN * reach_m } else { reach_m };
     let mut cells = Vec::new();
     for gy in y0..=y1 {
         for gx in x0..=x1 {
@@ -234,74 +251,10 @@ pub fn fates_of(inputs: &OracleInputs, culls: Culls, seeds: &[OracleSeed]) -> Re
         .collect()
 }
 
-/// What every judge of one view shares: the camera checked and where it stands, the projection's
-/// planes, the patterns checked against the settings.
-struct ViewFrame {
-    planes: [DVec4; 5],
-    /// The eye, grid space, metres.
-    eye: DVec3,
-    extent_m: [f64; 2],
-}
-
-impl ViewFrame {
-    fn new(inputs: &OracleInputs) -> Result<Self, OracleError> {
-        let &OracleInputs { dataset, settings, patterns, camera, viewport_px, .. } = inputs;
-        camera.validate()?;
-        let clip = camera.clip_from_view(viewport_px[0], viewport_px[1])? * camera.view_from_world();
-        let spp = patterns.seeds_per_pattern;
-        if patterns.count != settings.tlm.patterns
-            || patterns.corner_colours != settings.tlm.corner_colours()
-            || patterns.positions_unit.len() != patterns.count as usize * spp as usize
-        {
-            return Err(OracleError::Patterns {
-                count: patterns.count,
-                seeds_per_pattern: spp,
-                positions: patterns.positions_unit.len(),
-                wanted: settings.tlm.patterns,
-            });
-        }
-        let manifest = &dataset.manifest;
-        let spacing_m = manifest.height.spacing_m;
-        let extent_m = dataset.height.pyramid.size.map(|n| f64::from(n.max(1) - 1) * spacing_m);
-        let eye = camera.position_m - DVec3::new(manifest.origin_m[0], manifest.origin_m[1], 0.0);
-        Ok(Self { planes: frustum_planes(clip), eye, extent_m })
-    }
-
-    /// The view over the ground of the rectangle [`region_min`, `region_max`] (grid metres).
-    fn view<'a>(
-        self,
-        inputs: &'a OracleInputs<'a>,
-        culls: Culls,
-        region_min: [f64; 2],
-        region_max: [f64; 2],
-    ) -> Result<View<'a>, OracleError> {
-        let Self { planes, eye, extent_m } = self;
-        let dataset = inputs.dataset;
-        let dem = DemWindow::load(dataset, region_min, region_max)?;
-        let landcover = LandcoverTiles::load(dataset, region_min, region_max)?;
-        let vegetation = Vegetation::load(dataset, inputs.settings, region_min, region_max)?;
-        let inside = |p: DVec2| p.x >= 0.0 && p.y >= 0.0 && p.x <= extent_m[0] && p.y <= extent_m[1];
-        // An eye below the ground sees nothing (every seed reaching the occlusion test is hidden).
-        let eye_underground = inside(eye.truncate()) && eye.z < dem.ground(eye.truncate()).0;
-        let wind_reach_per_height = Wind::new(&inputs.settings.wind).reach_per_height();
-        Ok(View {
-            inputs,
-            culls,
-            dem,
-            landcover,
-            vegetation,
-            planes,
-            eye,
-            eye_underground,
-            extent_m,
-            wind_reach_per_height,
-        })
-    }
-}
-
 /// Whether the segment eye→target (grid space, metres) clears the full-resolution DEM: it never
 /// passes strictly below its drawn ground (`dataset::surface`) where the dataset has terrain. The last
-/// `SEGMENT_END_SKIP` of the segment, at the target's end, is ignored.
+/// `SEGMENT_END_SKIP` of the segment, at the target's end, is ignored. On the flat sheet: the
+/// segment does not sag as a straight one on the Earth does.
 pub fn segment_clears_dem(
     dataset: &Dataset,
     eye_grid_m: DVec3,
@@ -320,15 +273,7 @@ fn segment_min_clearance_m(
 ) -> Result<f64, PackError> {
     let (lo, hi) = (eye.min(target), eye.max(target));
     let dem = DemWindow::load(dataset, [lo.x, lo.y], [hi.x, hi.y])?;
-    Ok(dem.min_clearance_m(eye, target, 1.0 - SEGMENT_END_SKIP, stop))
-}
-
-/// The five planes (left, right, bottom, top, near; unit normals pointing inside) of a reversed-Z,
-/// infinite-far clip matrix over camera-relative space (Gribb & Hartmann, as `Frustum`).
-fn frustum_planes(clip_from_world: DMat4) -> [DVec4; 5] {
-    let m = clip_from_world.transpose();
-    let (x, y, z, w) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
-    [w + x, w - x, w + y, w - y, w - z].map(|p| p / p.truncate().length().max(1e-300))
+    Ok(dem.min_clearance_m(eye, target, 1.0 - SEGMENT_END_SKIP, 0.0, stop))
 }
 
 /// A seed's fate: the first cull it fails, in pass 3's order, or none.
@@ -360,6 +305,8 @@ struct View<'a> {
     extent_m: [f64; 2],
     /// How far the wind moves a plant's points at most, per metre of its height (pass 3's).
     wind_reach_per_height: f64,
+    placing: ExactPlacing,
+    sag_per_m2: f64,
 }
 
 impl View<'_> {
@@ -436,8 +383,7 @@ impl View<'_> {
             return Ok(Fate::Rule);
         }
         let height_m = f64::from(seed_height_m(species, hash));
-        let rel = DVec3::new(p.x, p.y, ground_m) - self.eye;
-        let distance_m = rel.length();
+        let distance_m = self.placing.position_rel_m(DVec3::new(p.x, p.y, ground_m)).length();
         let scale = (height_m / seeds.reference_height_m).min(1.0);
         let lod = match self.culls.reach_m {
             Some(reach_m) => (distance_m < reach_m).then_some(0),
@@ -451,14 +397,20 @@ impl View<'_> {
             return Ok(Fate::Distance);
         };
         let sway_m = self.sway_m(species, height_m);
-        if !self.in_frustum(species, rel, height_m, sway_m) {
+        // The sphere's centre half-way up the sunk trunk, along the local vertical.
+        let centre_m = ground_m + height_m * (0.5 - seeds.sink_fraction);
+        let centre = self.placing.position_rel_m(DVec3::new(p.x, p.y, centre_m));
+        if !self.in_frustum(species, centre, height_m, sway_m) {
             return Ok(Fate::Frustum);
         }
         // Pass 3's rule: swaying, the summit may rise into view by as far as the wind moves it.
         let summit = DVec3::new(p.x, p.y, ground_m - seeds.sink_fraction * height_m + height_m + sway_m);
+        // The fall of the Earth under the segment and its verticals' convergence (`frame::sag_per_m2`).
+        let rise = summit - self.eye;
+        let sag_m = self.sag_per_m2 * (rise.truncate().length_squared() + 2.0 * rise.z * rise.z);
         if self.culls.occlusion
             && (self.eye_underground
-                || self.dem.min_clearance_m(self.eye, summit, 1.0 - SEGMENT_END_SKIP, true) < 0.0)
+                || self.dem.min_clearance_m(self.eye, summit, 1.0 - SEGMENT_END_SKIP, sag_m, true) < 0.0)
         {
             return Ok(Fate::Occlusion);
         }
@@ -478,11 +430,9 @@ impl View<'_> {
         height_m * f64::from(species.wind_bend) * self.wind_reach_per_height
     }
 
-    /// Whether the bounding sphere of a seed whose ground point is `ground_rel_m` from the eye,
-    /// grown by its sway `sway_m`, reaches inside every plane of the view.
-    fn in_frustum(&self, species: &SeedSpecies, ground_rel_m: DVec3, height_m: f64, sway_m: f64) -> bool {
-        let sink_fraction = self.inputs.settings.seeds.sink_fraction;
-        let centre = ground_rel_m + DVec3::Z * (height_m * (0.5 - sink_fraction));
+    /// Whether the bounding sphere of a seed centred `centre` from the eye, grown by its sway
+    /// `sway_m`, reaches inside every plane of the view.
+    fn in_frustum(&self, species: &SeedSpecies, centre: DVec3, height_m: f64, sway_m: f64) -> bool {
         let radius_m = height_m * f64::from(species.radius_per_height) + sway_m;
         self.planes.iter().all(|plane| plane.truncate().dot(centre) + plane.w >= -radius_m)
     }

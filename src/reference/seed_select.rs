@@ -10,8 +10,11 @@
 
 use std::collections::HashMap;
 
+use glam::Vec3;
+
 use crate::classes::MAX_SPECIES_PER_CLASS;
 use crate::dataset::{Dataset, PackError, TileId};
+use crate::earth::local::NodeMapping;
 use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{
     CLASS_EDGE_SALT, COUNT_CHECKED, COUNT_CLASS, COUNT_DISTANCE, COUNT_FRUSTUM, COUNT_OCCLUSION,
@@ -342,10 +345,12 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         return Err(COUNT_RULE);
     }
     let height_m = species.height_m[0] + (species.height_m[1] - species.height_m[0]) * unit(hash);
-    let rel_xy = [cell.rel_m[0] + pos_unit[0] * u.cell_m, cell.rel_m[1] + pos_unit[1] * u.cell_m];
-    let ground_rel_m = ground.height_m - u.camera_z_m;
+    let in_cell = [pos_unit[0] * u.cell_m, pos_unit[1] * u.cell_m];
+    let rel_xy = [cell.rel_m[0] + in_cell[0], cell.rel_m[1] + in_cell[1]];
+    let earth = NodeMapping::from(&cell.earth);
+    let foot = earth.position_m(Vec3::new(in_cell[0], in_cell[1], ground.height_m));
 
-    let distance_sq = rel_xy[0] * rel_xy[0] + rel_xy[1] * rel_xy[1] + ground_rel_m * ground_rel_m;
+    let distance_sq = foot.x * foot.x + foot.y * foot.y + foot.z * foot.z;
     let size_scale = (height_m * u.inv_reference_height_m).min(1.0);
     let lods = seeds.lods.min(SEED_LODS);
     let lod = (0..lods)
@@ -356,10 +361,11 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         .ok_or(COUNT_DISTANCE)?;
 
     let sink_m = height_m * u.sink_fraction;
-    let base_rel_m = ground_rel_m - sink_m;
+    let up = earth.d_h + earth.d_xh * in_cell[0] + earth.d_yh * in_cell[1];
+    let base = foot - up * sink_m;
     let sway_m = height_m * (species.wind_bend * u.wind_reach_per_height);
     let radius_m = height_m * species.radius_per_height + sway_m;
-    let centre = to_clip(u, [rel_xy[0], rel_xy[1], base_rel_m + height_m * 0.5]);
+    let centre = to_clip(u, (base + up * (height_m * 0.5)).to_array());
     if centre[3] < -radius_m {
         return Err(COUNT_FRUSTUM);
     }
@@ -370,8 +376,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
         return Err(COUNT_FRUSTUM);
     }
 
-    let summit_rel_z = base_rel_m + height_m + sway_m;
-    let summit = to_clip(u, [rel_xy[0], rel_xy[1], summit_rel_z]);
+    let summit = to_clip(u, (base + up * height_m + up * sway_m).to_array());
     if summit[3] > u.near_m {
         let px = pixel_of(summit[0], summit[3], u.screen_px[0], u.ndc_per_px[0]);
         let py = pixel_of(-summit[1], summit[3], u.screen_px[1], u.ndc_per_px[1]);
@@ -396,6 +401,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
             hidden = if u.refine_max_steps == 0 {
                 behind_m * depth_at(px as i32, py as i32) > u.near_m
             } else {
+                let summit_rel_z = ground.height_m - u.camera_z_m - sink_m + height_m + sway_m;
                 occlusion_march(inputs, [rel_xy[0], rel_xy[1], summit_rel_z]).hidden
             };
         }
@@ -406,7 +412,7 @@ fn select_seed(inputs: &SeedTwinInputs, cell: &SeedCell, rank: u32) -> Result<Se
 
     let drawn = species_index + seed_variant(hash, species.variants);
     Ok(SeedRecord {
-        position_rel_m: [rel_xy[0], rel_xy[1], base_rel_m],
+        position_rel_m: base.to_array(),
         height_m,
         address: cell.address,
         rank,

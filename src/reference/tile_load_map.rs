@@ -31,6 +31,35 @@ fn height_range(u: &TlmUniforms, ranges_m: &[[f32; 2]], ring: u32, tiles_x: u32,
     range
 }
 
+/// The shader's `bent_box`: grid box `lo`..`hi` bent onto the Earth, as a camera-relative box
+/// that holds where it is drawn (`earth::horizon::EarthBend`; the box as it came when flat).
+pub fn bent_box(u: &TlmUniforms, lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+    let e = u.earth_bend;
+    let far: [f32; 2] = std::array::from_fn(|a| lo[a].abs().max(hi[a].abs()));
+    // WGSL's clamp(e, lo, hi) is min(max(e, lo), hi).
+    let near: [f32; 2] = std::array::from_fn(|a| 0.0f32.max(lo[a]).min(hi[a]));
+    let far_sq = far[0] * far[0] + far[1] * far[1];
+    let near_sq = near[0] * near[0] + near[1] * near[1];
+    let l1 = far[0] + far[1];
+    let margin = e[1] * l1 + e[2] * far_sq + e[3] * (l1 * far_sq);
+    let fall = [0.0, 0.0, e[0] * far_sq];
+    let rise = [0.0, 0.0, e[0] * near_sq];
+    (std::array::from_fn(|a| lo[a] - margin - fall[a]), std::array::from_fn(|a| hi[a] + margin - rise[a]))
+}
+
+/// The shader's `below_horizon`: whether the Earth hides camera-relative point `p`.
+fn below_horizon(u: &TlmUniforms, p: [f32; 3]) -> bool {
+    let h = &u.horizon;
+    let dot = |r: usize| h[r][0] * p[0] + h[r][1] * p[1] + h[r][2] * p[2];
+    let along = dot(3);
+    along > h[3][3] && along * along >= length_sq([dot(0), dot(1), dot(2)]) * h[3][3]
+}
+
+/// The shader's `beyond_horizon`: whether the Earth hides every corner of the box.
+fn beyond_horizon(u: &TlmUniforms, lo: [f32; 3], hi: [f32; 3]) -> bool {
+    (0..8).all(|c| below_horizon(u, std::array::from_fn(|a| if c & (1 << a) != 0 { hi[a] } else { lo[a] })))
+}
+
 fn in_frustum(u: &TlmUniforms, lo: [f32; 3], hi: [f32; 3]) -> bool {
     u.frustum_planes.iter().all(|p| {
         let c: [f32; 3] = std::array::from_fn(|a| if p[a] >= 0.0 { hi[a] } else { lo[a] });
@@ -133,7 +162,11 @@ fn tlm_cell(
     let heights = height_range(u, ranges_m, ring, sx.height_tiles, sy.height_tiles);
     let lo = [sx.rel_m[0], sy.rel_m[0], heights[0] - u.camera_z_m];
     let hi = [sx.rel_m[1], sy.rel_m[1], heights[1] - u.camera_z_m];
-    if !in_frustum(u, lo, hi) || occluded(u, hiz, lo, hi) {
+    let (placed_lo, placed_hi) = bent_box(u, lo, hi);
+    if !in_frustum(u, placed_lo, placed_hi)
+        || beyond_horizon(u, placed_lo, placed_hi)
+        || occluded(u, hiz, placed_lo, placed_hi)
+    {
         return culled;
     }
     // WGSL's clamp(e, lo, hi) is min(max(e, lo), hi).

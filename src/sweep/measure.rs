@@ -16,7 +16,6 @@
 
 use std::path::Path;
 
-use glam::DVec3;
 use image::RgbaImage;
 
 use super::report::{AnyPartFigures, PassTime, SampleFigures, SeedFigures, TradePoint};
@@ -317,7 +316,6 @@ fn seed_figures(
         return Ok(None);
     };
     let (visible, _) = visible_seeds(&inputs)?;
-    let origin = r.dataset.manifest.origin_m;
-    let camera_grid_m = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
-    Ok(Some((SeedAgreement::of(kept, &visible), HeightError::of(&r.dataset, camera_grid_m, kept)?)))
+    let placing = r.exact_placing(camera);
+    Ok(Some((SeedAgreement::of(kept, &visible), HeightError::of(&r.dataset, &placing, kept)?)))
 }

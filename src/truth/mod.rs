@@ -306,7 +306,8 @@ fn draw_seeds(
     renderer.gpu.queue.submit([encoder.finish()]);
     let scene = match (renderer.class_table(), renderer.seed_world()) {
         (Some(table), Some((tables, _))) if !seeds.is_empty() => {
-            Some((table, TruthScene::new(&renderer.dataset, &renderer.settings, tables, camera, seeds)?))
+            let placing = renderer.exact_placing(camera);
+            Some((table, TruthScene::new(&renderer.dataset, &renderer.settings, tables, &placing, seeds)?))
         }
         _ => None,
     };
@@ -314,7 +315,9 @@ fn draw_seeds(
         let (gpu, settings) = (&renderer.gpu, &renderer.settings);
         let dir = meshes.dir.clone();
         let (draw, pipeline) = meshes.get(gpu, &table.species)?;
-        let mut uniforms = draw_uniforms(settings, canvas.terrain, &renderer.wind_frame(camera));
+        let wind = renderer.wind_frame(camera);
+        let earth = renderer.exact_placing(camera).nadir_node();
+        let mut uniforms = draw_uniforms(settings, canvas.terrain, &wind, &earth);
         uniforms.draw_reach_m = [NO_FADE_REACH_M; 4];
         // Its samples average a small seed's detail themselves: no shortcut to its mean.
         uniforms.prefilter_small = 0;

@@ -3,7 +3,8 @@
 //! full density (the settings' `seeds.density_scale` set to 1 by the caller) within one reach,
 //! drawn as LOD 0 whatever its distance, culled only when its bounding sphere lies outside the
 //! view; occlusion is for the image to say. Each becomes the `SeedRecord` pass 4 draws: its anchor
-//! camera-relative (subtracted in f64, then rounded once), its jitter from the seed's hash as pass
+//! camera-relative (placed as the renderer places its grid, on the Earth or flat, in f64, then
+//! rounded once), its jitter from the seed's hash as pass
 //! 3 makes it, and its ground colour as pass 3 samples it (the bilinear imagery at the same
 //! `GROUND_SAMPLES` hashed offsets within `seeds.ground_colour_radius_m`), but from the finest
 //! imagery level, read
@@ -14,10 +15,10 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use crate::camera::Camera;
 use crate::config::Settings;
 use crate::dataset::vegetation::vegetation_coverage;
 use crate::dataset::{Dataset, PackError, imagery_texel_at};
+use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::SeedRecord;
 use crate::gpu::layout::{GROUND_SAMPLES, SpeciesLod};
 use crate::reference::oracle::OracleSeed;
@@ -35,21 +36,20 @@ pub struct TruthScene {
 }
 
 impl TruthScene {
-    /// The records of `seeds` seen from `camera` (any order in; grouped by species out).
+    /// The records of `seeds` seen from the camera `placing` places the grid from (any order in;
+    /// grouped by species out).
     pub fn new(
         dataset: &Dataset,
         settings: &Settings,
         tables: &SeedTables,
-        camera: &Camera,
+        placing: &ExactPlacing,
         mut seeds: Vec<OracleSeed>,
     ) -> Result<Self, PackError> {
         seeds.sort_by_key(|s| (s.species, s.address, s.rank));
-        let origin = dataset.manifest.origin_m;
-        let eye = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
         let imagery = ImageryTexels::new(dataset, settings);
         let records = seeds
             .iter()
-            .map(|s| record(settings, tables, eye, &imagery, s))
+            .map(|s| record(settings, tables, placing, &imagery, s))
             .collect::<Result<Vec<_>, _>>()?;
         let mut species_ranges: Vec<(u32, Range<u32>)> = Vec::new();
         for (i, s) in seeds.iter().enumerate() {
@@ -66,7 +66,7 @@ impl TruthScene {
 fn record(
     settings: &Settings,
     tables: &SeedTables,
-    eye: DVec3,
+    placing: &ExactPlacing,
     imagery: &ImageryTexels,
     seed: &OracleSeed,
 ) -> Result<SeedRecord, PackError> {
@@ -78,7 +78,7 @@ fn record(
     let radius_per_height =
         tables.species.get(seed.species as usize).map_or(0.0, |s| f64::from(s.radius_per_height));
     Ok(SeedRecord {
-        position_rel_m: (anchor_m - eye).as_vec3().to_array(),
+        position_rel_m: placing.position_rel_m(anchor_m).as_vec3().to_array(),
         height_m: seed.height_m as f32,
         address,
         rank: seed.rank,

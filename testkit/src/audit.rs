@@ -407,7 +407,7 @@ fn audit_seeds(r: &Renderer, rays: &Rays, dem: &Dem, a: &mut Audit) {
             a.seeds_not_finite += 1;
             continue;
         }
-        let p = rays.eye_grid_m + DVec3::from(position_rel_m.map(f64::from));
+        let p = rays.exact.grid_m(DVec3::from(position_rel_m.map(f64::from)));
         a.seeds_outside += usize::from(!dem.covers(p.x, p.y, -1e-3));
         let sink_m = f64::from(height_m) * s.sink_fraction;
         let gap_m = f64::from(ground_m) - sink_m - p.z;

@@ -5,6 +5,7 @@
 
 use glam::{DMat4, DVec3, DVec4};
 use terramp::camera::Camera;
+use terramp::earth::placing::ExactPlacing;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::layout::{
@@ -30,6 +31,8 @@ pub struct Run {
     pub twin: Vec<TlmCell>,
     pub clip: DMat4,
     pub camera_grid_m: DVec3,
+    /// The renderer's placing from this camera: what takes a drawn point back to the grid.
+    pub placing: ExactPlacing,
 }
 
 /// Renders `camera`, then runs the depth pyramid and the TLM on its depth, and the twin.
@@ -62,6 +65,7 @@ pub fn run_with(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]], wall_m: 
         lods: &lods,
         imagery,
         hiz_mips: hiz.mips(),
+        earth: r.tlm_earth(camera),
     };
     let frame = pass.prepare(&r.gpu.queue, &inputs).unwrap();
     let mut encoder = device.create_command_encoder(&Default::default());
@@ -102,7 +106,8 @@ pub fn run_with(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]], wall_m: 
     let mips = hiz.read_back(&r.gpu).unwrap();
     let twin = tile_load_map(&frame.uniforms, &frame.spans, &ranges, &mips);
     let clip = camera.clip_from_view(w, h).unwrap() * camera.view_from_world();
-    Run { layout, frame, lods, ranges, hiz: mips, gpu: gpu_cells, twin, clip, camera_grid_m }
+    let placing = r.exact_placing(camera);
+    Run { layout, frame, lods, ranges, hiz: mips, gpu: gpu_cells, twin, clip, camera_grid_m, placing }
 }
 
 pub fn assert_gpu_equals_twin(run: &Run, what: &str) {
@@ -133,7 +138,7 @@ pub fn assert_no_false_culls(r: &Renderer, run: &Run, what: &str) {
         let (px, py) = ((i as u32 % w) as f64 + 0.5, (i as u32 / w) as f64 + 0.5);
         let ndc = DVec4::new(px / f64::from(w) * 2.0 - 1.0, 1.0 - py / f64::from(h) * 2.0, f64::from(d), 1.0);
         let rel = inverse * ndc;
-        let p = run.camera_grid_m + rel.truncate() / rel.w;
+        let p = run.placing.grid_m(rel.truncate() / rel.w);
         if p.z < low - 1.0 || p.z > high + 1.0 {
             continue;
         }

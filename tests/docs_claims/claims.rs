@@ -62,6 +62,11 @@ pub fn percent(v: f64) -> String {
     plain(100.0 * v)
 }
 
+/// Metres as millimetres.
+pub fn mm(v: f64) -> String {
+    plain(v * 1000.0)
+}
+
 /// Metres as kilometres.
 pub fn km(v: f64) -> String {
     plain(v / 1000.0)
@@ -189,6 +194,19 @@ pub static CLAIMS: &[Claim] = &[
         doc: "docs/earth.md",
         quote: "the test allows {} roundings of the largest term",
         values: &[(test_const("tests/earth.rs", "ROUNDINGS"), plain)],
+    },
+    Claim {
+        doc: "docs/earth.md",
+        quote: "allows {} mm and {} mm); the truth",
+        values: &[
+            (test_const("src/reference/oracle/tests.rs", "MAX_SAG_HEIGHT_MISS_M"), mm),
+            (test_const("src/reference/oracle/tests.rs", "MAX_SAG_TRACK_MISS_M"), mm),
+        ],
+    },
+    Claim {
+        doc: "docs/earth.md",
+        quote: "sunk height (the test allows {} mm)",
+        values: &[(test_const("tests/earth_seeds.rs", "MAX_ANCHOR_MISS_M"), mm)],
     },
     Claim {
         doc: "docs/earth.md",

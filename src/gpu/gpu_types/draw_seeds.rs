@@ -37,6 +37,15 @@ gpu_struct! {
         pub cloud_field: [f32; 4],
         /// See `cloud_field`.
         pub cloud_shift: [f32; 4],
+        /// The local vertical at the camera's nadir (xyz; w unused), and how it turns per metre
+        /// east (`seed_up_per_x_m`) and north (`seed_up_per_y_m`): pass 3's mapping's ∂p/∂h and
+        /// its derivatives (`SeedUniforms::earth`). A seed stands along the vertical at its
+        /// place; straight up (0, 0, 1) and no turn on the flat sheet.
+        pub seed_up: [f32; 4],
+        /// See `seed_up`.
+        pub seed_up_per_x_m: [f32; 4],
+        /// See `seed_up`.
+        pub seed_up_per_y_m: [f32; 4],
         /// 1: meshes that say how shed detail as they shrink on screen (`impostor::detail`,
         /// `draw_seeds.continuous_lod`); 0: they do not.
         pub continuous_lod: u32,

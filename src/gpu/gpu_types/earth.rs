@@ -31,6 +31,22 @@ gpu_struct! {
     }
 }
 
+impl EarthNode {
+    /// The flat sheet's mapping with its origin at the camera: the identity (first derivatives
+    /// the axes, no second ones).
+    pub const FLAT: Self = Self {
+        origin_m: [0.0; 4],
+        d_x: [1.0, 0.0, 0.0, 0.0],
+        d_y: [0.0, 1.0, 0.0, 0.0],
+        d_h: [0.0, 0.0, 1.0, 0.0],
+        d_xx: [0.0; 4],
+        d_xy: [0.0; 4],
+        d_yy: [0.0; 4],
+        d_xh: [0.0; 4],
+        d_yh: [0.0; 4],
+    };
+}
+
 gpu_struct! {
     /// A point the mapping's probe places (`earth::gpu::probe_positions`): its CRS offset from its
     /// node's origin and its height above it (xyz, metres), and the node's index. WGSL:

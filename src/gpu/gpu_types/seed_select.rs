@@ -2,6 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use super::EarthNode;
 use crate::gpu::layout::{MAX_LEVELS, MAX_SPECIES_PER_CLASS};
 use crate::gpu::struct_layout::gpu_struct;
 
@@ -101,8 +102,14 @@ gpu_struct! {
         /// 1: a seed reads its class up to half a texel away (`seeds.class_edge_dither`); 0: at its
         /// own point.
         pub class_edge_dither: u32,
+        /// How far a straight segment dips below the line between its ends' heights over the
+        /// grid, at the grid's fraction t of the way: `t (1 − t) (L² + 2 Δz²)` times this, for a
+        /// segment L long over the grid rising Δz (1 / 2R, from `earth`'s curvature: the Earth's
+        /// fall under it, and the verticals' convergence); 0 on the flat sheet. The occlusion
+        /// march's segment sags by it.
+        pub chord_sag_per_m2: f32,
         /// Padding to the WGSL struct's alignment (always 0).
-        pub _pad: [u32; 3],
+        pub _pad: [u32; 2],
     }
 }
 
@@ -112,7 +119,8 @@ gpu_struct! {
     /// so no large coordinate ever reaches f32.
     #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq, Default)]
     pub struct SeedCell {
-        /// South-west corner relative to the camera, metres.
+        /// South-west corner's grid offset from the camera, metres (on the flat sheet, its
+        /// camera-relative position): what the occlusion march walks the grid from.
         pub rel_m: [f32; 2],
         /// Global ring-0 address (x, y): with the rank, a seed's identity.
         pub address: [i32; 2],
@@ -134,6 +142,10 @@ gpu_struct! {
         pub lcc_level: u32,
         /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 2],
+        /// The mapping of its south-west corner at height 0 (`PlacedView::node`): a seed at grid
+        /// offset (x, y) from the corner and height h stands at `earth_position_m(earth, (x, y,
+        /// h))`, along its up there. Flat, the identity from the corner's `rel_m`.
+        pub earth: EarthNode,
     }
 }
 

@@ -97,6 +97,13 @@ gpu_struct! {
         pub occlusion_tolerance_per_m: f32,
         /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 3],
+        /// How a cell's camera-relative grid box bends onto the Earth (`earth::horizon::EarthBend`:
+        /// its fall per m², and its margins per m, m² and m³); all 0 on the flat sheet.
+        pub earth_bend: [f32; 4],
+        /// The horizon's cone (`earth::horizon::HorizonCone::gpu`): rows of scaled space from
+        /// camera-relative space, then its axis with tangent² (w); `HorizonCone::GPU_NONE` when
+        /// nothing is hidden (flat, the eye below the ground, or `terrain.horizon_culling` off).
+        pub horizon: [[f32; 4]; 4],
         /// The terrain's CDLOD range of each LOD (`Lods::range_m`), metres, four per vec4.
         pub height_lod_range_m: [[f32; 4]; MAX_LEVELS as usize / 4],
         /// Height pyramid per level: first tile index, tiles along x, tiles along y, 0.

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use crate::classes::Species;
 use crate::config::Settings;
-use crate::gpu::gpu_types::{DrawSeedsUniforms, SeedDrawArgs, TerrainUniforms};
+use crate::gpu::gpu_types::{DrawSeedsUniforms, EarthNode, SeedDrawArgs, TerrainUniforms};
 use crate::gpu::layout::{SEED_GROUPS, SEED_LODS};
 use crate::impostor::detail::{first_leaf_kept, leaf_share, projected_px};
 use crate::impostor::{Impostor, MANIFEST_FILE};
@@ -45,9 +45,14 @@ pub fn has_impostor(dir: &Path, model: &str) -> bool {
     dir.join(model).join(MANIFEST_FILE).is_file()
 }
 
-/// The frame's constants from the settings, the terrain's matrix, sun, clouds and haze, and the
-/// wind.
-pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &WindFrame) -> DrawSeedsUniforms {
+/// The frame's constants from the settings, the terrain's matrix, sun, clouds and haze, the
+/// wind, and `earth`, the mapping pass 3 stood the seeds with (`SeedUniforms::earth`).
+pub fn draw_uniforms(
+    settings: &Settings,
+    terrain: &TerrainUniforms,
+    wind: &WindFrame,
+    earth: &EarthNode,
+) -> DrawSeedsUniforms {
     DrawSeedsUniforms {
         clip_from_view_world: terrain.clip_from_view_world,
         sun_dir: terrain.sun_dir,
@@ -60,6 +65,9 @@ pub fn draw_uniforms(settings: &Settings, terrain: &TerrainUniforms, wind: &Wind
         wind_wave: wind.wave,
         cloud_field: terrain.cloud_field,
         cloud_shift: terrain.cloud_shift,
+        seed_up: earth.d_h,
+        seed_up_per_x_m: earth.d_xh,
+        seed_up_per_y_m: earth.d_yh,
         // The pass fills it in from its geometry (`DrawSeedsPass::prepare`).
         photo_scale: [[0.0; 4]; SEED_GROUPS as usize],
         focal_px: focal_px(terrain, settings.render.height),

@@ -9,6 +9,7 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::classes::Species;
 use crate::config::Settings;
+use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{
@@ -39,6 +40,7 @@ pub const SHADER: WgslSource = WgslSource {
         HASH,
         CLOUDS,
         WIND,
+        EARTH,
         include_str!("../../../shaders/draw_seeds.wgsl"),
         include_str!("../../../shaders/draw_seeds/multisample.wgsl"),
     ],

@@ -6,7 +6,7 @@ use glam::DVec3;
 use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::Dataset;
-use crate::gpu::gpu_types::{SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
+use crate::gpu::gpu_types::{EarthNode, SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{LCC_LEVELS, MAX_LEVELS};
 use crate::seeds::wind::Wind;
 use crate::seeds::{max_cells, workgroups_per_cell};
@@ -35,11 +35,16 @@ pub struct SeedInputs<'a> {
     pub camera_grid_m: DVec3,
     /// The depth target's size, pixels.
     pub viewport_px: [u32; 2],
-    /// The TLM's visible ring-0 cells (`LoadMaps::seed_cells`), in any order: they are checked
-    /// near to far, and the farthest are dropped beyond `seeds::max_cells`.
-    pub cells: &'a [SeedCellRef],
+    /// The TLM's visible ring-0 cells (`LoadMaps::seed_cells`), in any order, each with its
+    /// mapping: its south-west corner's at height 0 (`PlacedView::node`; on the flat sheet the
+    /// identity from that corner). They are checked near to far, and the farthest are dropped
+    /// beyond `seeds::max_cells`.
+    pub cells: &'a [(SeedCellRef, EarthNode)],
     /// Ranks worth checking (`SeedTables::active_ranks`).
     pub active_ranks: u32,
+    /// The mapping of the grid point under the camera (`ExactPlacing::nadir_node`): the Earth's
+    /// bend, which the occlusion march's segment sags by.
+    pub nadir: EarthNode,
 }
 
 /// One frame's uniforms and cells: what the shader reads, and what the twin replays.
@@ -85,14 +90,19 @@ impl SeedOutput {
 /// compaction keeps the table's order within each draw, so every draw comes near to far and a
 /// nearer crown's depth hides the fragments behind it before they are shaded. Deterministic, and
 /// the cells dropped beyond `seeds::max_cells` are the farthest.
-fn near_to_far(cells: &[SeedCellRef], camera_xy: [f64; 2], cell_m: f64) -> Vec<SeedCellRef> {
+fn near_to_far(
+    cells: &[(SeedCellRef, EarthNode)],
+    camera_xy: [f64; 2],
+    cell_m: f64,
+) -> Vec<(SeedCellRef, EarthNode)> {
     let distance_sq = |c: &SeedCellRef| {
         let centre = c.address.map(|g| (g as f64 + 0.5) * cell_m);
         (centre[0] - camera_xy[0]).powi(2) + (centre[1] - camera_xy[1]).powi(2)
     };
-    let mut sorted: Vec<(f64, SeedCellRef)> = cells.iter().map(|c| (distance_sq(c), *c)).collect();
-    sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    sorted.into_iter().map(|(_, c)| c).collect()
+    let mut sorted: Vec<(f64, &(SeedCellRef, EarthNode))> =
+        cells.iter().map(|c| (distance_sq(&c.0), c)).collect();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.0.cmp(&b.1.0)));
+    sorted.into_iter().map(|(_, c)| *c).collect()
 }
 
 /// `value` (≥ 0 or not) as an integer part and a remainder in [0, 1) that f32 can carry.
@@ -101,6 +111,13 @@ fn split(value: f64) -> (i32, f32) {
     let frac = (value - whole) as f32;
     // A remainder a hair below 1 rounds to 1.0 in f32: carry it.
     if frac >= 1.0 { (whole as i32 + 1, 0.0) } else { (whole as i32, frac) }
+}
+
+/// 1 / 2R, the Earth's bend under a straight segment (`SeedUniforms::chord_sag_per_m2`): the
+/// ground falls away from the mapping's origin by its second-order term's vertical part, x² / 2R
+/// along x (the mean of x's and y's, which differ by under 1 %); 0 flat.
+fn chord_sag_per_m2(earth: &EarthNode) -> f32 {
+    (-0.5 * (earth.d_xx[2] + earth.d_yy[2])).max(0.0)
 }
 
 impl SeedFrame {
@@ -161,7 +178,8 @@ impl SeedFrame {
             imagery_levels: [[0; 4]; MAX_LEVELS as usize],
             vegetation: [0.0; 4],
             class_edge_dither: u32::from(seeds.class_edge_dither),
-            _pad: [0; 3],
+            chord_sag_per_m2: chord_sag_per_m2(&inputs.nadir),
+            _pad: [0; 2],
         };
         // Level-1 land-cover texels are twice the level-0 ones (the level that duplicates them).
         let lcc_texel_m = match (&dataset.landcover, &manifest.landcover) {
@@ -196,7 +214,7 @@ impl SeedFrame {
         let kept = inputs.cells.len().min(max_cells(u.active_ranks) as usize);
         let cells = near_to_far(inputs.cells, camera_xy, cell_m)[..kept]
             .iter()
-            .map(|c| {
+            .map(|(c, earth)| {
                 let corner = c.address.map(|g| g as f64 * cell_m);
                 let in_grid = |texel_m: f64, offset_m: f64| {
                     let (x, y) =
@@ -220,6 +238,7 @@ impl SeedFrame {
                     pattern: c.pattern,
                     lcc_level: c.radial_lod.min(LCC_LEVELS - 1),
                     _pad: [0; 2],
+                    earth: *earth,
                 }
             })
             .collect::<Vec<_>>();

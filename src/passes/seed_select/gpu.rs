@@ -7,6 +7,7 @@ use wgpu::{ShaderStages as Stage, TextureSampleType as Sample, TextureViewDimens
 
 use crate::camera::CameraError;
 use crate::config::Settings;
+use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::gpu_types::{
     SeedBlock, SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSettle, SeedSpecies, SeedUniforms,
@@ -28,6 +29,7 @@ pub const SHADER: WgslSource = WgslSource {
     parts: &[
         HASH,
         BLOCKS,
+        EARTH,
         SEED_RECORD,
         TERRAIN_SURFACE,
         LANDCOVER,

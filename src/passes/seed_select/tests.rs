@@ -11,6 +11,7 @@ use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::lcc::LccCoding;
 use crate::dataset::{Dataset, Pyramid};
+use crate::earth::placing::EarthPlacing;
 use crate::seeds::SeedTables;
 use crate::synth::{SynthParams, synthesize};
 
@@ -57,14 +58,22 @@ fn seed_frame(
         fov_deg: 60.0,
         near_m: 0.1,
     };
+    let exact = EarthPlacing::new(None, origin_m, false).exact(camera_grid_m);
+    let mut placing = EarthPlacing::new(None, origin_m, false);
+    let mut placed = placing.view(&exact);
+    let cell_m = settings.tlm.cell_m;
+    let corner =
+        |c: &SeedCellRef| DVec3::new(c.address[0] as f64 * cell_m, c.address[1] as f64 * cell_m, 0.0);
+    let cells: Vec<_> = cells.iter().map(|c| (*c, placed.node(corner(c)))).collect();
     let inputs = SeedInputs {
         settings,
         dataset,
         camera: &camera,
         camera_grid_m,
         viewport_px: [640, 360],
-        cells,
+        cells: &cells,
         active_ranks,
+        nadir: exact.nadir_node(),
     };
     SeedFrame::new(&inputs).unwrap()
 }

@@ -6,6 +6,8 @@ use glam::{DMat4, DVec3};
 use crate::camera::Camera;
 use crate::config::{ImagerySettings, TlmSettings};
 use crate::dataset::{Dataset, TileId};
+use crate::earth::horizon::{EarthBend, HorizonCone};
+use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::{TlmCell, TlmRing, TlmSpan, TlmUniforms};
 use crate::gpu::layout::{MAX_LEVELS, TLM_MAX_RINGS};
 use crate::passes::terrain::select::Lods;
@@ -61,6 +63,27 @@ impl TlmImagery {
     }
 }
 
+/// Where the TLM's cells lie: on the Earth (their boxes bent onto it, culled by its horizon),
+/// or on the flat sheet (`TlmEarth::default()`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TlmEarth {
+    /// How a cell's box bends.
+    pub bend: EarthBend,
+    /// The horizon the cells are culled by; `None`: none is.
+    pub horizon: Option<HorizonCone>,
+}
+
+impl TlmEarth {
+    /// The cells as `placing` draws `dataset` (from the frame's camera), culled by the horizon
+    /// when `horizon_culling` (`terrain.horizon_culling`).
+    pub fn of(placing: &ExactPlacing, dataset: &Dataset, horizon_culling: bool) -> Self {
+        let h = &dataset.manifest.height;
+        let max_abs_height_m = f64::from(h.min_m.abs().max(h.max_m.abs()));
+        let horizon = placing.horizon(f64::from(h.min_m)).filter(|_| horizon_culling);
+        Self { bend: EarthBend::of(&placing.nadir_node(), max_abs_height_m), horizon }
+    }
+}
+
 /// What one frame's TLM is computed from.
 pub struct TlmInputs<'a> {
     /// The `[tlm]` settings: radial bands, patterns, seed and occlusion tolerance.
@@ -79,6 +102,8 @@ pub struct TlmInputs<'a> {
     pub imagery: Option<TlmImagery>,
     /// Levels of the depth pyramid the occlusion test may read.
     pub hiz_mips: u32,
+    /// Where the cells lie: on the Earth, or flat.
+    pub earth: TlmEarth,
 }
 
 /// One frame's TLM inputs as the GPU (and the twin) read them.
@@ -127,6 +152,8 @@ impl TlmFrame {
             no_fuse: 0,
             occlusion_tolerance_per_m: s.occlusion().per_m() as f32,
             _pad: [0; 3],
+            earth_bend: inputs.earth.bend.0,
+            horizon: inputs.earth.horizon.map_or(HorizonCone::GPU_NONE, |h| h.gpu()),
             height_lod_range_m: [[0.0; 4]; MAX_LEVELS as usize / 4],
             height_levels: page_levels(&lods.pyramid),
             rings_info: [TlmRing::default(); TLM_MAX_RINGS as usize],

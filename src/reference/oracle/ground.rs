@@ -81,9 +81,18 @@ impl DemWindow {
         (height_m, DVec2::from(slope) / self.spacing_m)
     }
 
-    /// The least of z(t) − surface(x(t), y(t)) over t ∈ [0, t_end] where the segment from `eye`
-    /// to `target` lies over the dataset (∞ where it never does).
-    pub(super) fn min_clearance_m(&self, eye: DVec3, target: DVec3, t_end: f64, stop: bool) -> f64 {
+    /// The least of z(t) − sag_m t (1 − t) − surface(x(t), y(t)) over t ∈ [0, t_end] where the
+    /// segment from `eye` to `target` lies over the dataset (∞ where it never does): on the
+    /// Earth, the straight segment dips below the line between its ends' heights by the sag
+    /// (`sag_m`: L² / 2R for a horizontal length L; 0 on the flat sheet).
+    pub(super) fn min_clearance_m(
+        &self,
+        eye: DVec3,
+        target: DVec3,
+        t_end: f64,
+        sag_m: f64,
+        stop: bool,
+    ) -> f64 {
         if self.size[0] < 2 || self.size[1] < 2 {
             return f64::INFINITY;
         }
@@ -136,15 +145,30 @@ impl DemWindow {
             // Along the stretch, τ = t − ta, the segment is at pa.z + d.z·τ and over (ua + du·τ,
             // va + dv·τ) of the cell, whose drawn ground is planar on each side of the diagonal:
             // the clearance is piecewise linear, least at an end or where the diagonal is crossed.
-            let clearance =
+            let line =
                 |tau: f64| pa.z + d.z * tau - drawn_height([i, j], corners, [ua + du * tau, va + dv * tau]).0;
+            let sag = |tau: f64| sag_m * (ta + tau) * (1.0 - ta - tau);
+            let clearance = |tau: f64| line(tau) - sag(tau);
             let length = tb - ta;
             // Where u = v (rising) or u + v = 1 (falling); NaN or ∞ along the diagonal or parallel to it.
             let diagonal =
                 if diagonal_rises([i, j]) { (va - ua) / (du - dv) } else { (1.0 - ua - va) / (du + dv) };
             let mut low = clearance(0.0).min(clearance(length));
+            let mut pieces = [(0.0, length), (length, length)];
             if diagonal > 0.0 && diagonal < length {
                 low = low.min(clearance(diagonal));
+                pieces = [(0.0, diagonal), (diagonal, length)];
+            }
+            // With a sag the clearance is a convex parabola on each planar piece: least at its
+            // vertex where that lies inside (line' = sag_m (1 − 2t)).
+            if sag_m > 0.0 {
+                for (a, b) in pieces.into_iter().filter(|(a, b)| b > a) {
+                    let slope = (line(b) - line(a)) / (b - a);
+                    let vertex = 0.5 * (1.0 - slope / sag_m) - ta;
+                    if vertex > a && vertex < b {
+                        low = low.min(clearance(vertex));
+                    }
+                }
             }
             least = least.min(low);
             if (stop && least < 0.0) || tb >= t1 {

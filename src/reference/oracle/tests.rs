@@ -10,6 +10,7 @@ use crate::dataset::{
     Crs, FORMAT_VERSION, HeightLayer, LayerSpec, Manifest, Pyramid, Reduce, Sampling, Staging, Window,
     write_layer,
 };
+use crate::earth::placing::EarthPlacing;
 use crate::seeds::pcg;
 use crate::synth::{SynthParams, synthesize};
 
@@ -150,7 +151,7 @@ fn a_ridge_between_samples_is_caught() {
 /// The least height above the drawn ground of `ridge` along the segment, sampled every 1e-4: each
 /// cell is the two triangles of the terrain mesh's index buffer, here the plane through a
 /// triangle's three samples (barycentric), the one holding the point.
-fn brute_min_clearance(eye: DVec3, target: DVec3, s: f64) -> f64 {
+fn brute_min_clearance(eye: DVec3, target: DVec3, s: f64, sag_m: f64) -> f64 {
     let size = 32u32;
     let extent = f64::from(size - 1) * s;
     let (indices, _) = crate::passes::terrain::frame::grid_indices(8);
@@ -190,7 +191,7 @@ fn brute_min_clearance(eye: DVec3, target: DVec3, s: f64) -> f64 {
     let t_end = 1.0 - SEGMENT_END_SKIP;
     (0..10_000).map(|k| f64::from(k) * 1e-4).chain([t_end]).fold(f64::INFINITY, |least, t| {
         let p = eye + (target - eye) * t;
-        surface(p.x, p.y).map_or(least, |h| least.min(p.z - h))
+        surface(p.x, p.y).map_or(least, |h| least.min(p.z - sag_m * t * (1.0 - t) - h))
     })
 }
 
@@ -199,7 +200,7 @@ fn the_exact_walk_agrees_with_brute_force_on_random_segments() {
     let s = 10.0;
     let ds = dem("ridge-random", 32, s, ridge);
     let dem = DemWindow::load(&ds, [0.0, 0.0], [310.0, 310.0]).unwrap();
-    let (mut state, mut occluded) = (3u32, 0);
+    let (mut state, mut occluded, mut sag_occluded) = (3u32, 0, 0);
     for n in 0..1000 {
         let mut point = |z_lo: f64, z_hi: f64| {
             let (x, y) = (random(&mut state) * 390.0 - 40.0, random(&mut state) * 390.0 - 40.0);
@@ -208,24 +209,86 @@ fn the_exact_walk_agrees_with_brute_force_on_random_segments() {
         // Half the segments stay above the flat ground, so only the ridge can hide them.
         let (z_lo, z_hi) = if n % 2 == 0 { (0.5, 65.0) } else { (-5.0, 65.0) };
         let (eye, target) = (point(z_lo, z_hi), point(z_lo, z_hi));
-        let exact = dem.min_clearance_m(eye, target, 1.0 - SEGMENT_END_SKIP, false);
-        let brute = brute_min_clearance(eye, target, s);
-        // Samples are points of the segment: none is below the exact least; and between two
-        // samples the clearance changes by at most its steepest rate times the step.
-        let d = target - eye;
-        let rate = d.z.abs() + f64::from(RIDGE_M) / s * 2f64.sqrt() * d.truncate().length();
-        assert!(exact <= brute + 1e-9, "segment {n}: exact {exact} above a sample {brute}");
-        if brute.is_finite() {
-            assert!(brute - exact <= rate * 1e-4 + 1e-9, "segment {n}: exact {exact}, sampled {brute}");
+        // Straight over the flat sheet, and sagging as on a small Earth (6 m at the middle: the
+        // clearance's least can then lie inside a planar piece).
+        for sag_m in [0.0, 24.0] {
+            let exact = dem.min_clearance_m(eye, target, 1.0 - SEGMENT_END_SKIP, sag_m, false);
+            let brute = brute_min_clearance(eye, target, s, sag_m);
+            // Samples are points of the segment: none is below the exact least; and between two
+            // samples the clearance changes by at most its steepest rate times the step.
+            let d = target - eye;
+            let rate = d.z.abs() + sag_m + f64::from(RIDGE_M) / s * 2f64.sqrt() * d.truncate().length();
+            assert!(exact <= brute + 1e-9, "segment {n}, sag {sag_m}: exact {exact} above a sample {brute}");
+            if brute.is_finite() {
+                assert!(
+                    brute - exact <= rate * 1e-4 + 1e-9,
+                    "segment {n}, sag {sag_m}: exact {exact}, sampled {brute}"
+                );
+            }
+            // Brute force could only disagree within a step's change of 0, or over the dataset for
+            // less than a step: none of these segments is that close a call.
+            let close = exact.abs() <= rate * 1e-4 || brute.is_infinite() != exact.is_infinite();
+            assert_eq!(
+                exact < 0.0,
+                brute < 0.0,
+                "segment {n}, sag {sag_m}: exact {exact}, sampled {brute} (close: {close})"
+            );
+            if sag_m == 0.0 {
+                assert_eq!(exact < 0.0, !segment_clears_dem(&ds, eye, target).unwrap(), "segment {n}");
+                occluded += usize::from(exact < 0.0);
+            } else {
+                sag_occluded += usize::from(exact < 0.0);
+            }
         }
-        // Brute force could only disagree within a step's change of 0, or over the dataset for less
-        // than a step: none of these segments is that close a call.
-        let close = exact.abs() <= rate * 1e-4 || brute.is_infinite() != exact.is_infinite();
-        assert_eq!(exact < 0.0, brute < 0.0, "segment {n}: exact {exact}, sampled {brute} (close: {close})");
-        assert_eq!(exact < 0.0, !segment_clears_dem(&ds, eye, target).unwrap(), "segment {n}");
-        occluded += usize::from(exact < 0.0);
     }
     assert!((200..=800).contains(&occluded), "{occluded} of 1000 occluded: the test says little");
+    assert!(sag_occluded > occluded, "sagging, {sag_occluded} occluded against {occluded} straight");
+}
+
+/// Most the oracle's sagging segment may stray from the exact one over 4 km, in height and
+/// across its track, metres (both compared where the exact segment passes over the grid).
+const MAX_SAG_HEIGHT_MISS_M: f64 = 0.002;
+/// See `MAX_SAG_HEIGHT_MISS_M`.
+const MAX_SAG_TRACK_MISS_M: f64 = 0.005;
+
+/// The sag the oracle gives a straight segment on the Earth (second order: t (1 − t) (L² + 2 Δz²)
+/// / 2R, its ground track the grid's straight line) against the exact one: points of the segment in space
+/// taken back to the grid by the exact inverse, from 500 m above nc's State Plane to ground
+/// points up to 4 km away.
+#[test]
+fn a_straight_segment_sags_over_the_earth_as_the_oracle_says() {
+    let earth = crate::earth::test_frames::nc();
+    let eye = DVec3::new(40_000.0, 30_000.0, 500.0);
+    let placing = EarthPlacing::new(Some(&earth), [600_000.0, 180_000.0], true).exact(eye);
+    let sag_per_m2 = frame::sag_per_m2(&placing);
+    // 1 / 2R, R between the meridian's and the prime vertical's radii at 36° N.
+    assert!((sag_per_m2 * 2.0 * 6.37e6 - 1.0).abs() < 0.005, "{sag_per_m2}");
+    let (mut worst_height_m, mut worst_track_m) = (0.0f64, 0.0f64);
+    for k in 0..16 {
+        let angle = f64::from(k) * std::f64::consts::TAU / 16.0;
+        let target =
+            eye + DVec3::new(4_000.0 * angle.cos(), 4_000.0 * angle.sin(), -500.0 + 37.0 * f64::from(k));
+        let (rel, length_sq) = (placing.position_rel_m(target), (target - eye).truncate().length_squared());
+        for i in 1..16 {
+            let t = f64::from(i) / 16.0;
+            // Where the point lies on the grid, and at what parameter the oracle's track passes it.
+            let on_grid = placing.grid_m(rel * t);
+            let across = (target - eye).truncate();
+            let t = (on_grid - eye).truncate().dot(across) / length_sq;
+            let rise = target - eye;
+            let sag_m = sag_per_m2 * (length_sq + 2.0 * rise.z * rise.z);
+            let said = eye + rise * t - DVec3::Z * (sag_m * t * (1.0 - t));
+            worst_height_m = worst_height_m.max((on_grid.z - said.z).abs());
+            worst_track_m = worst_track_m.max((on_grid - said).truncate().length());
+        }
+    }
+    println!(
+        "at 4 km: heights {:.2} mm, track {:.2} mm off the exact segment",
+        worst_height_m * 1e3,
+        worst_track_m * 1e3
+    );
+    assert!(worst_height_m < MAX_SAG_HEIGHT_MISS_M, "the sag misses by {worst_height_m} m");
+    assert!(worst_track_m < MAX_SAG_TRACK_MISS_M, "the track misses by {worst_track_m} m");
 }
 
 /// The synthetic dataset of `size`² samples (10 m), built once per test process.

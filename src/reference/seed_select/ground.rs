@@ -99,7 +99,8 @@ pub struct OcclusionMarch {
 }
 
 /// The shader's `dem_blocks`: whether the drawn ground rises above the segment from the eye to
-/// camera-relative `target`, leaping where the tops allow.
+/// `target` (its grid offset from the camera, and its height above the camera's), sagging on the
+/// Earth (`SeedUniforms::chord_sag_per_m2`), leaping where the tops allow.
 pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMarch {
     let u = &inputs.frame.uniforms;
     let length_sq = target[0] * target[0] + target[1] * target[1];
@@ -109,23 +110,24 @@ pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMa
         steps *= 2;
     }
     let dt = 1.0 / steps as f32;
-    // Sample `k`: the point, camera-relative, where it lies in the height grid, and whether that is
-    // in the dataset.
+    let sag_m = u.chord_sag_per_m2 * (length_sq + 2.0 * (target[2] * target[2]));
+    // Sample `k`: where it lies in the height grid, whether that is in the dataset, the segment's
+    // height there and the floor under it (the shader's `march_point`).
     let point = |k: u32| {
-        let p = target.map(|v| v * (k as f32 * dt));
+        let t = k as f32 * dt;
+        let p = target.map(|v| v * t);
         let sample = grid_pos(u.camera_sample, u.camera_sample_frac, [p[0], p[1]], u.inv_spacing_m);
         let inside = (0..2).all(|a| sample.texel[a] >= 0 && sample.texel[a] < u.height_size[a] as i32);
-        (p, sample, inside)
+        let (line_m, sag_t) = (p[2] + u.camera_z_m, sag_m * t);
+        (sample, inside, line_m - (sag_t - sag_t * t), line_m - sag_t)
     };
     let square_of =
         |sample: &GridPos, level: u32, cells: u32| sample.texel.map(|v| ((v as u32) >> level) / cells);
     // The last sample from `k` (where `leap` holds) to `steps` where it still holds.
     let leap_end = |k: u32, leap: Leap| {
         let holds = |j: u32| {
-            let (p, sample, inside) = point(j);
-            inside
-                && square_of(&sample, leap.level, leap.cells) == leap.square
-                && leap.top_m <= p[2] + u.camera_z_m
+            let (sample, inside, _, floor_m) = point(j);
+            inside && square_of(&sample, leap.level, leap.cells) == leap.square && leap.top_m <= floor_m
         };
         let (mut clear, mut beyond) = (k, steps);
         while beyond - clear > 1 {
@@ -141,15 +143,14 @@ pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMa
     let tile_level = leap_level(u);
     let (mut k, mut samples_read) = (1, 0);
     while k < steps {
-        let (p, sample, inside) = point(k);
+        let (sample, inside, z_m, floor_m) = point(k);
         if !inside {
             k += 1;
             continue;
         }
         let s0 = sample.texel.map(|v| v as u32);
-        let z_m = p[2] + u.camera_z_m;
         let tile_top_m = inputs.height_tile_max_m[tile_at(u, s0, tile_level).1];
-        if tile_top_m <= z_m {
+        if tile_top_m <= floor_m {
             let square = square_of(&sample, tile_level, HEIGHT_TILE_CELLS);
             k = leap_end(k, Leap { level: tile_level, cells: HEIGHT_TILE_CELLS, square, top_m: tile_top_m })
                 + 1;
@@ -162,7 +163,7 @@ pub fn occlusion_march(inputs: &SeedTwinInputs, target: [f32; 3]) -> OcclusionMa
             if local.iter().all(|&b| b < HEIGHT_TILE_BLOCKS) {
                 let top_m =
                     inputs.height_block_max_m[&slot][(local[1] * HEIGHT_TILE_BLOCKS + local[0]) as usize];
-                if top_m <= z_m {
+                if top_m <= floor_m {
                     let level = hit.level;
                     k = leap_end(k, Leap { level, cells: HEIGHT_BLOCK_CELLS, square: block, top_m }) + 1;
                     continue;
