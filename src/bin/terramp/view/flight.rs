@@ -2,9 +2,12 @@
 //! frame by speed × elapsed time: W/S (or ↑/↓) along the view, A/D (or ←/→) sideways on the level,
 //! E/Space up and Q/Ctrl down; Shift boosts tenfold. Dragging turns the view (heading and pitch,
 //! pitch kept short of straight up or down). The speed spans 1 m/s to 1000 km/s in steps of a
-//! quarter (scroll) or doubles and halves (+/−). Ground-follow keeps the height above the ground
-//! the camera had when it was switched on (up and down then change that height). Keys that do
-//! something once (reset, next view, screenshot…) come back as an `Action` for the viewer.
+//! quarter (scroll) or doubles and halves (+/−). By height (V), the speed is the one set at
+//! `PACE_HEIGHT_M` above the ground and scales with the height above it, so one setting flies
+//! from orbit down to the ground: a tenth as fast ten times lower. Ground-follow keeps the height
+//! above the ground the camera had when it was switched on (up and down then change that height).
+//! Keys that do something once (reset, next view, screenshot…) come back as an `Action` for the
+//! viewer.
 
 use glam::DVec3;
 use winit::keyboard::KeyCode;
@@ -25,6 +28,10 @@ const TURN_DEG_PER_PX: f64 = 0.2;
 const PITCH_LIMIT_DEG: f64 = 89.0;
 /// Least height above the ground ground-follow holds, metres.
 const MIN_FOLLOW_M: f64 = 1.0;
+/// By height, the speed set is the speed this high above the ground, metres.
+pub const PACE_HEIGHT_M: f64 = 1000.0;
+/// By height, the speed never slows below the one this high above the ground, metres.
+const MIN_PACE_ABOVE_M: f64 = 0.5;
 
 /// What a key asks of the viewer, beyond moving.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +72,10 @@ pub struct Flight {
     pub speed_m_s: f64,
     /// Height above the ground held, metres, when ground-follow is on.
     pub follow_m: Option<f64>,
+    /// The speed scales with the height above the ground (`PACE_HEIGHT_M`).
+    pub by_height: bool,
+    /// The height above the ground (above the datum off the dataset) at the last step, metres.
+    above_m: f64,
     held: Held,
 }
 
@@ -72,13 +83,15 @@ impl Flight {
     /// A flight starting at `camera`, at a speed that crosses `span_m` in about a minute.
     pub fn new(camera: Camera, span_m: f64) -> Self {
         let speed_m_s = (span_m / 60.0).clamp(MIN_SPEED_M_S, MAX_SPEED_M_S);
-        Self { camera, speed_m_s, follow_m: None, held: Held::default() }
+        let above_m = camera.position_m.z;
+        Self { camera, speed_m_s, follow_m: None, by_height: false, above_m, held: Held::default() }
     }
 
-    /// The speed moving now (boost included), m/s.
+    /// The speed moving now (boost and height included), m/s.
     pub fn moving_speed_m_s(&self) -> f64 {
         let boost = if self.held.boost { BOOST } else { 1.0 };
-        (self.speed_m_s * boost).min(MAX_SPEED_M_S)
+        let pace = if self.by_height { self.above_m.max(MIN_PACE_ABOVE_M) / PACE_HEIGHT_M } else { 1.0 };
+        (self.speed_m_s * boost * pace).min(MAX_SPEED_M_S)
     }
 
     /// A key pressed or released; keys that act once act on the press.
@@ -100,6 +113,7 @@ impl Flight {
             KeyCode::F12 => return Some(Action::Screenshot),
             KeyCode::KeyP => return Some(Action::Record),
             KeyCode::KeyH | KeyCode::F1 => return Some(Action::Overlay),
+            KeyCode::KeyV => self.by_height = !self.by_height,
             KeyCode::Escape => return Some(Action::Quit),
             _ => {}
         }
@@ -141,6 +155,8 @@ impl Flight {
     pub fn step(&mut self, dt_s: f64, ground_m: impl Fn(f64, f64) -> Option<f64>) -> bool {
         let h = self.held;
         let (forward, right, up) = (axis(h.forward), axis(h.right), axis(h.up));
+        let p = self.camera.position_m;
+        self.above_m = p.z - ground_m(p.x, p.y).unwrap_or(0.0);
         let step_m = self.moving_speed_m_s() * dt_s.max(0.0);
         let yaw = self.camera.yaw_deg.to_radians();
         let level_right = DVec3::new(yaw.cos(), -yaw.sin(), 0.0);
@@ -243,6 +259,34 @@ mod tests {
         assert_eq!(f.follow_m, Some(500.0));
         f.toggle_follow(Some(0.0));
         assert_eq!(f.follow_m, None);
+    }
+
+    #[test]
+    fn by_height_the_speed_scales_with_the_height_above_the_ground() {
+        let mut f = flight();
+        f.key(KeyCode::KeyV, true);
+        assert!(f.by_height);
+        // 100 m/s set: 50 m/s at 500 m above the ground, 2 m/s at 20 m.
+        let ground = |_: f64, _: f64| Some(0.0);
+        f.key(KeyCode::KeyW, true);
+        f.step(1.0, ground);
+        assert!((f.camera.position_m.x - 1050.0).abs() < 1e-9, "{}", f.camera.position_m);
+        assert!((f.moving_speed_m_s() - 50.0).abs() < 1e-9);
+        f.camera.position_m.z = 20.0;
+        f.step(1.0, ground);
+        assert!((f.camera.position_m.x - 1052.0).abs() < 1e-9);
+        // Over ground 480 m high, the same 20 m above it; off the dataset, above the datum.
+        f.camera.position_m.z = 500.0;
+        f.step(1.0, |_, _| Some(480.0));
+        assert!((f.camera.position_m.x - 1054.0).abs() < 1e-9);
+        f.step(1.0, |_, _| None);
+        assert!((f.camera.position_m.x - 1104.0).abs() < 1e-9);
+        // At the ground it slows to the speed half a metre up, not to a stop.
+        f.step(1.0, |_, _| Some(500.0));
+        assert!((f.camera.position_m.x - 1104.05).abs() < 1e-9);
+        f.key(KeyCode::KeyV, true);
+        f.step(1.0, ground);
+        assert!((f.camera.position_m.x - 1204.05).abs() < 1e-9);
     }
 
     #[test]

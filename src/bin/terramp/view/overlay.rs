@@ -35,6 +35,10 @@ pub enum Request {
     CopyRenderLine,
     /// Switch ground-follow.
     Follow,
+    /// Switch the speed's scaling with the height above the ground.
+    ByHeight,
+    /// Go to a pose written as `--camera` takes one (CRS, or `lonlat:` / `lonlat-ground:`).
+    GoTo(String),
 }
 
 /// What the viewer shows in the overlay this frame.
@@ -45,6 +49,8 @@ pub struct Shown<'a> {
     pub camera: &'a Camera,
     pub speed_m_s: f64,
     pub follow_m: Option<f64>,
+    /// The speed scales with the height above the ground.
+    pub by_height: bool,
     pub settings: &'a Settings,
     pub preset: &'a str,
     /// Keyframes recorded so far, while recording.
@@ -63,6 +69,8 @@ pub struct Overlay {
     passes: BTreeMap<String, VecDeque<f32>>,
     /// The knob values being dragged (a remake knob waits for the drag to end).
     dragging: BTreeMap<usize, f64>,
+    /// The pose being typed for "go to".
+    go_to: String,
 }
 
 fn push(history: &mut VecDeque<f32>, value: f32) {
@@ -210,8 +218,22 @@ impl Overlay {
             if ui.button(follow).clicked() {
                 requests.push(Request::Follow);
             }
+            let pace = if shown.by_height { "speed by height (V): on" } else { "speed by height (V): off" };
+            if ui.button(pace).clicked() {
+                requests.push(Request::ByHeight);
+            }
         });
-        ui.label(format!("speed {} (scroll, +/−; Shift ×10)", speed_text(shown.speed_m_s)));
+        ui.horizontal(|ui| {
+            let hint = "lonlat-ground:LON,LAT,H,HEADING,PITCH or X,Y,Z,YAW,PITCH";
+            let field =
+                ui.add(egui::TextEdit::singleline(&mut self.go_to).hint_text(hint).desired_width(280.0));
+            let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+            if (ui.button("go to").clicked() || entered) && !self.go_to.trim().is_empty() {
+                requests.push(Request::GoTo(self.go_to.trim().to_owned()));
+            }
+        });
+        let pace = if shown.by_height { " at this height" } else { "" };
+        ui.label(format!("speed {}{pace} (scroll, +/−; Shift ×10)", speed_text(shown.speed_m_s)));
         if let Some(keys) = shown.recording {
             ui.label(
                 RichText::new(format!("● recording the path: {keys} keyframes (P stops)"))

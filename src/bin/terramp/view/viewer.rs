@@ -224,6 +224,7 @@ impl Viewer {
             camera: &self.flight.camera,
             speed_m_s: self.flight.moving_speed_m_s(),
             follow_m: self.flight.follow_m,
+            by_height: self.flight.by_height,
             settings: &self.renderer.settings,
             preset: &self.preset,
             recording: self.recording.as_ref().map(Recording::len),
@@ -318,6 +319,19 @@ impl Viewer {
                 println!("{line}");
                 self.screen.egui.copy_text(line);
                 self.message = "render line copied (and printed)".into();
+            }
+            Request::ByHeight => self.flight.by_height = !self.flight.by_height,
+            Request::GoTo(text) => {
+                let r = &self.renderer.settings.render;
+                match self.renderer.dataset.camera_from(&text, r.fov_deg, r.near_m) {
+                    Ok(camera) => {
+                        // The pose as written: ground-follow would move it to its own height.
+                        self.flight.camera = camera;
+                        self.flight.follow_m = None;
+                        self.message = format!("went to {text}");
+                    }
+                    Err(error) => self.message = error.to_string(),
+                }
             }
             Request::Follow => {
                 let p = self.flight.camera.position_m;
