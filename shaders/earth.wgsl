@@ -1,6 +1,7 @@
-// The Earth mapping's probe (`earth::gpu::probe_positions`): each point placed by
-// `earth_position_m` (`shared/earth.wgsl`) on its node, for the test that holds the shader to its
-// Rust twin (`earth::local::NodeMapping::position_m`).
+// The Earth mapping's probes (`earth::gpu`): each point placed by `earth_position_m`
+// (`shared/earth.wgsl`) on its node, for the test that holds the shader to its Rust twin
+// (`earth::local::NodeMapping::position_m`); and each point, as a vector, stood by `earth_stand`
+// on its node's vertical (`d_h`).
 
 struct EarthProbePoint {
     offset_m: vec3<f32>,
@@ -19,4 +20,14 @@ fn probe_earth_positions(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let point = probe_points[i];
     probe_positions[i] = vec4<f32>(earth_position_m(probe_nodes[point.node], point.offset_m), 0.0);
+}
+
+@compute @workgroup_size(EARTH_PROBE_WORKGROUP)
+fn probe_earth_stand(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= arrayLength(&probe_points) {
+        return;
+    }
+    let point = probe_points[i];
+    probe_positions[i] = vec4<f32>(earth_stand(point.offset_m, probe_nodes[point.node].d_h.xyz), 0.0);
 }

@@ -38,7 +38,7 @@ struct TlmUniforms {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
-    earth_bend: vec4<f32>,
+    earth_bend: array<vec4<f32>, 2>,
     horizon: array<vec4<f32>, 4>,
     height_lod_range_m: array<vec4<f32>, MAX_LEVELS / 4u>,
     height_levels: array<vec4<u32>, MAX_LEVELS>,
@@ -99,15 +99,18 @@ struct CellBox {
 
 // The grid box `lo`..`hi` bent onto the Earth (`earth::horizon::EarthBend`): each corner falls by
 // d² / 2R at its horizontal distance d (the low face by its farthest, the high by its nearest),
-// and every face moves out by the mapping's other terms' bound. Flat, the box as it came.
+// and every face moves out by the mapping's other terms' bound, across and up and down. Flat,
+// the box as it came.
 fn bent_box(lo: vec3<f32>, hi: vec3<f32>) -> CellBox {
-    let e = u.earth_bend;
+    let e = u.earth_bend[0];
+    let ez = u.earth_bend[1];
     let far = max(abs(lo.xy), abs(hi.xy));
     let near = clamp(vec2<f32>(0.0), lo.xy, hi.xy);
     let far_sq = mul(far.x, far.x) + mul(far.y, far.y);
     let near_sq = mul(near.x, near.x) + mul(near.y, near.y);
     let l1 = far.x + far.y;
-    let margin = vec3<f32>(mul(e.y, l1) + mul(e.z, far_sq) + mul(e.w, mul(l1, far_sq)));
+    let across = mul(e.y, l1) + mul(e.z, far_sq) + mul(e.w, mul(l1, far_sq));
+    let margin = vec3<f32>(across, across, mul(ez.x, l1) + mul(ez.y, far_sq) + mul(ez.z, mul(far_sq, far_sq)));
     return CellBox(lo - margin - vec3<f32>(0.0, 0.0, mul(e.x, far_sq)), hi + margin - vec3<f32>(0.0, 0.0, mul(e.x, near_sq)));
 }
 

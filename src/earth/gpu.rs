@@ -1,7 +1,8 @@
 //! How it works: the mapping's shader side. `shaders/shared/earth.wgsl` holds `EarthNode` (a
 //! node's `NodeMapping`, as the GPU reads it) and `earth_position_m`, the polynomial every pass
 //! that places a point on the Earth is to call; `probe_positions` runs it on chosen points (the
-//! compute entry of `shaders/earth.wgsl`) for the test that holds it to its Rust twin.
+//! compute entry of `shaders/earth.wgsl`) for the test that holds it to its Rust twin, and
+//! `probe_stand` runs `earth_stand` (what stands a seed's model on its place).
 
 use wgpu::ShaderStages as Stage;
 
@@ -72,6 +73,25 @@ pub fn probe_positions(
     nodes: &[EarthNode],
     points: &[EarthProbePoint],
 ) -> Result<Vec<[f32; 3]>, GpuError> {
+    probe(gpu, nodes, points, "probe_earth_positions")
+}
+
+/// Each of `points`' offset, as a vector, stood by the shader's `earth_stand` on its node's
+/// vertical (`d_h`). Blocking: for tests.
+pub fn probe_stand(
+    gpu: &Gpu,
+    nodes: &[EarthNode],
+    points: &[EarthProbePoint],
+) -> Result<Vec<[f32; 3]>, GpuError> {
+    probe(gpu, nodes, points, "probe_earth_stand")
+}
+
+fn probe(
+    gpu: &Gpu,
+    nodes: &[EarthNode],
+    points: &[EarthProbePoint],
+    entry: &str,
+) -> Result<Vec<[f32; 3]>, GpuError> {
     if points.is_empty() || nodes.is_empty() {
         return Ok(Vec::new());
     }
@@ -79,7 +99,7 @@ pub fn probe_positions(
     let module = SHADER.module(device);
     let group = PROBE_BINDINGS.layout(device);
     let layout = pipeline_layout(device, "earth probe", &[&group]);
-    let pipeline = compute_pipeline(device, "earth probe", &layout, &module, "probe_earth_positions");
+    let pipeline = compute_pipeline(device, "earth probe", &layout, &module, entry);
     use wgpu::BufferUsages as U;
     let nodes = buffer_init(device, "earth probe nodes", bytemuck::cast_slice(nodes), U::STORAGE);
     let input = buffer_init(device, "earth probe points", bytemuck::cast_slice(points), U::STORAGE);

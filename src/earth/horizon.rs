@@ -8,9 +8,12 @@
 //!
 //! `EarthBend` bounds how far the mapping of the grid point under the camera (`NodeMapping`,
 //! second order) moves a camera-relative grid box: the ground's fall, d² / 2R at horizontal
-//! distance d, taken exactly per corner, and what else the mapping does (its first-order
-//! departure from the identity: the projection's scale; its other second-order terms; its third
-//! order), bounded by a margin in d, d² and d³ that grows the box on every side.
+//! distance d, taken exactly per corner, and what else the mapping does, bounded by margins that
+//! grow the box: across, its first-order departure from the identity (the projection's scale),
+//! its other second-order terms and its third order (d³ / R²); up and down, the first and second
+//! orders' vertical parts and the fall's fourth order (d⁴ / 8R³: the quadratic has no third-order
+//! vertical term to miss on a sphere), so a box far off stays as low as the Earth puts it, which
+//! the horizon's culling needs.
 
 use glam::{DMat3, DVec3};
 
@@ -80,12 +83,13 @@ impl HorizonCone {
     pub const GPU_NONE: [[f32; 4]; 4] = [[0.0; 4], [0.0; 4], [0.0; 4], [0.0, 0.0, 0.0, f32::MAX]];
 }
 
-/// How a camera-relative grid box bends onto the Earth: `[drop, per_m, per_m2, per_m3]`, a box
-/// corner at horizontal distance d from the camera falling by `drop` d² and every face moving out
-/// by `per_m` L + `per_m2` d² + `per_m3` L d² (L ≥ d the corner's farthest |x| + |y|). All zero
-/// on the flat sheet.
+/// How a camera-relative grid box bends onto the Earth: `[drop, per_m, per_m2, per_m3]` and
+/// `[z_per_m, z_per_m2, z_per_m4, 0]`. A box corner at horizontal distance d from the camera
+/// falls by `drop` d²; its sides move out by `per_m` L + `per_m2` d² + `per_m3` L d², its top and
+/// bottom by `z_per_m` L + `z_per_m2` d² + `z_per_m4` d⁴ (L ≥ d the corner's farthest |x| + |y|).
+/// All zero on the flat sheet.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct EarthBend(pub [f32; 4]);
+pub struct EarthBend(pub [[f32; 4]; 2]);
 
 impl EarthBend {
     /// The bend of the mapping `nadir` of the grid point under the camera (at height 0), for
@@ -102,15 +106,19 @@ impl EarthBend {
         // box at its heights (d_xh, d_yh: 1 / R).
         let first = (d_x - DVec3::X).abs() + (d_y - DVec3::Y).abs();
         let turn = (v(nadir.d_xh).abs() + v(nadir.d_yh).abs()) * max_abs_height_m;
-        let per_m = (first + turn).max_element();
+        let first = first + turn;
         // Second order, less the fall taken per corner.
         let second = d_xx.abs() + d_xy.abs() + d_yy.abs();
         let residual_z = (d_xx.z + drop).abs() + d_xy.z.abs() + (d_yy.z + drop).abs();
-        let per_m2 = second.x.max(second.y).max(residual_z);
-        // Third order: the sphere's and the projection's scale's, about d³ / 6R² each.
+        // Third order across: the sphere's and the projection's scale's, about d³ / 6R² each.
         let per_m3 = 1.0 / (SMALLEST_RADIUS_M * SMALLEST_RADIUS_M);
+        // Fourth order up and down: the fall's, d⁴ / 8R³, doubled.
+        let z_per_m4 = 1.0 / (4.0 * SMALLEST_RADIUS_M.powi(3));
         // Rounded up, so the f32 margins still hold what the f64 ones do.
         let up = |x: f64| (x as f32).next_up();
-        Self([drop as f32, up(per_m), up(per_m2), up(per_m3)])
+        Self([
+            [drop as f32, up(first.x.max(first.y)), up(second.x.max(second.y)), up(per_m3)],
+            [up(first.z), up(residual_z), up(z_per_m4), 0.0],
+        ])
     }
 }

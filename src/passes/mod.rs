@@ -48,7 +48,7 @@ pub const SHADERS: &[&WgslSource] = &[
 pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     PipelineBindings {
         shader: &crate::earth::gpu::SHADER,
-        entry_points: &["probe_earth_positions"],
+        entry_points: &["probe_earth_positions", "probe_earth_stand"],
         group: 0,
         bindings: &crate::earth::gpu::PROBE_BINDINGS.bindings,
     },

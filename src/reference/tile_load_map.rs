@@ -34,17 +34,21 @@ fn height_range(u: &TlmUniforms, ranges_m: &[[f32; 2]], ring: u32, tiles_x: u32,
 /// The shader's `bent_box`: grid box `lo`..`hi` bent onto the Earth, as a camera-relative box
 /// that holds where it is drawn (`earth::horizon::EarthBend`; the box as it came when flat).
 pub fn bent_box(u: &TlmUniforms, lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
-    let e = u.earth_bend;
+    let [e, ez] = u.earth_bend;
     let far: [f32; 2] = std::array::from_fn(|a| lo[a].abs().max(hi[a].abs()));
     // WGSL's clamp(e, lo, hi) is min(max(e, lo), hi).
     let near: [f32; 2] = std::array::from_fn(|a| 0.0f32.max(lo[a]).min(hi[a]));
     let far_sq = far[0] * far[0] + far[1] * far[1];
     let near_sq = near[0] * near[0] + near[1] * near[1];
     let l1 = far[0] + far[1];
-    let margin = e[1] * l1 + e[2] * far_sq + e[3] * (l1 * far_sq);
+    let across = e[1] * l1 + e[2] * far_sq + e[3] * (l1 * far_sq);
+    let margin = [across, across, ez[0] * l1 + ez[1] * far_sq + ez[2] * (far_sq * far_sq)];
     let fall = [0.0, 0.0, e[0] * far_sq];
     let rise = [0.0, 0.0, e[0] * near_sq];
-    (std::array::from_fn(|a| lo[a] - margin - fall[a]), std::array::from_fn(|a| hi[a] + margin - rise[a]))
+    (
+        std::array::from_fn(|a| lo[a] - margin[a] - fall[a]),
+        std::array::from_fn(|a| hi[a] + margin[a] - rise[a]),
+    )
 }
 
 /// The shader's `below_horizon`: whether the Earth hides camera-relative point `p`.

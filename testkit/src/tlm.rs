@@ -9,7 +9,7 @@ use terramp::earth::placing::ExactPlacing;
 use terramp::frame::Renderer;
 use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::layout::{
-    LevelRange, RADIAL_INACTIVE, TLM_CULLED, TLM_FIRST_PATTERN, TileSpan, tlm_visibility,
+    LevelRange, RADIAL_INACTIVE, TLM_CULLED, TLM_FIRST_PATTERN, TLM_SPAN_INSIDE, TileSpan, tlm_visibility,
 };
 use terramp::passes::depth_pyramid::frame::HizMips;
 use terramp::passes::depth_pyramid::gpu::DepthPyramid;
@@ -17,7 +17,7 @@ use terramp::passes::terrain::select::Lods;
 use terramp::passes::tile_load_map::frame::{TlmFrame, TlmImagery, TlmInputs};
 use terramp::passes::tile_load_map::gpu::TileLoadMapPass;
 use terramp::passes::tile_load_map::layout::TlmLayout;
-use terramp::reference::tile_load_map::tile_load_map;
+use terramp::reference::tile_load_map::{bent_box, tile_load_map};
 use terramp::seeds::cell_pattern;
 
 /// One view's Tile Load Map, from the GPU and from the twin, with what both were computed from.
@@ -238,4 +238,62 @@ pub fn assert_levels_match_f64(r: &Renderer, run: &Run, camera: &Camera, what: &
         checked += 1;
     }
     assert!(checked > 0 || visible(&run.gpu) == 0, "{what}: nothing checked");
+}
+
+/// What `bent_boxes_hold` found.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BentBoxes {
+    /// Cells over the dataset checked.
+    pub boxes: usize,
+    /// The most a bent box reaches past the points it holds, on any side, metres.
+    pub slack_m: f64,
+    /// The farthest point held, horizontally from the eye, metres.
+    pub farthest_m: f64,
+}
+
+/// Every cell over the dataset holds, in the box the pass bends it to (`bent_box`, the twin's),
+/// a 5 × 5 lattice of its ground points at its tiles' lowest and highest heights placed by the
+/// exact mapping, up to f32's rounding of the box (a millionth of the point's distance).
+pub fn bent_boxes_hold(run: &Run) -> BentBoxes {
+    let u = &run.frame.uniforms;
+    let mut out = BentBoxes::default();
+    for index in 0..run.layout.cell_count() {
+        let (ring, cx, cy) = run.layout.cell_of(index);
+        let (sx, sy) = (
+            run.frame.spans[((ring * 2) * u.cells + cx) as usize],
+            run.frame.spans[((ring * 2 + 1) * u.cells + cy) as usize],
+        );
+        if sx.flags & sy.flags & TLM_SPAN_INSIDE == 0 {
+            continue;
+        }
+        let heights = cell_height_range(run, ring, cx, cy);
+        let lo = [sx.rel_m[0], sy.rel_m[0], heights[0] - u.camera_z_m];
+        let hi = [sx.rel_m[1], sy.rel_m[1], heights[1] - u.camera_z_m];
+        let (bent_lo, bent_hi) = bent_box(u, lo, hi);
+        let (bent_lo, bent_hi) = (DVec3::from(bent_lo.map(f64::from)), DVec3::from(bent_hi.map(f64::from)));
+        let (mut held_lo, mut held_hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for j in 0..=4 {
+            for k in 0..=4 {
+                for h in heights {
+                    let f =
+                        |a: usize, n: i32| f64::from(lo[a]) + f64::from(hi[a] - lo[a]) * f64::from(n) / 4.0;
+                    let grid = run.camera_grid_m + DVec3::new(f(0, j), f(1, k), 0.0);
+                    let p = run.placing.position_rel_m(DVec3::new(grid.x, grid.y, f64::from(h)));
+                    // The box is f32, rounded from the camera-relative grid box: a few of f32's
+                    // steps at the point's size.
+                    let rounding = DVec3::splat(1e-6 * p.abs().max_element());
+                    assert!(
+                        (p + rounding).cmpge(bent_lo).all() && (p - rounding).cmple(bent_hi).all(),
+                        "cell {:?}: {p} outside {bent_lo}..{bent_hi}",
+                        (ring, cx, cy)
+                    );
+                    (held_lo, held_hi) = (held_lo.min(p), held_hi.max(p));
+                    out.farthest_m = out.farthest_m.max(p.truncate().length());
+                }
+            }
+        }
+        out.slack_m = out.slack_m.max((held_lo - bent_lo).max(bent_hi - held_hi).max_element());
+        out.boxes += 1;
+    }
+    out
 }

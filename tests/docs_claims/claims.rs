@@ -62,6 +62,12 @@ pub fn percent(v: f64) -> String {
     plain(100.0 * v)
 }
 
+/// A number rounded to 7 significant digits, in Rust's exponent form: 1e-6.
+pub fn sci(v: f64) -> String {
+    let rounded: f64 = format!("{v:.6e}").parse().unwrap();
+    format!("{rounded:e}")
+}
+
 /// Metres as millimetres.
 pub fn mm(v: f64) -> String {
     plain(v * 1000.0)
@@ -202,6 +208,11 @@ pub static CLAIMS: &[Claim] = &[
             (test_const("src/reference/oracle/tests.rs", "MAX_SAG_HEIGHT_MISS_M"), mm),
             (test_const("src/reference/oracle/tests.rs", "MAX_SAG_TRACK_MISS_M"), mm),
         ],
+    },
+    Claim {
+        doc: "docs/earth.md",
+        quote: "(the test allows {} of it)",
+        values: &[(test_const("tests/earth.rs", "STAND_MISS"), sci)],
     },
     Claim {
         doc: "docs/earth.md",

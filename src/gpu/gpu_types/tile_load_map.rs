@@ -98,8 +98,9 @@ gpu_struct! {
         /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 3],
         /// How a cell's camera-relative grid box bends onto the Earth (`earth::horizon::EarthBend`:
-        /// its fall per m², and its margins per m, m² and m³); all 0 on the flat sheet.
-        pub earth_bend: [f32; 4],
+        /// its fall per m² and its margins across per m, m² and m³; then up and down per m, m²
+        /// and m⁴); all 0 on the flat sheet.
+        pub earth_bend: [[f32; 4]; 2],
         /// The horizon's cone (`earth::horizon::HorizonCone::gpu`): rows of scaled space from
         /// camera-relative space, then its axis with tangent² (w); `HorizonCone::GPU_NONE` when
         /// nothing is hidden (flat, the eye below the ground, or `terrain.horizon_culling` off).
