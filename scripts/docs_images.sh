@@ -47,6 +47,7 @@ docs/viewer_nc.png                        viewer             shared   short
 docs/wind_strip.png                       wind               shared   short
 docs/photo_nc.png                         photo              shared   long
 docs/earth_globe_12km.png                 earth              shared   short
+docs/earth_nc_descent.png                 earth_nc           shared   short
 docs/flight_0.png                         streaming          -        long
 docs/flight_1.png                         streaming          -        long
 docs/flight_2.png                         streaming          -        long
@@ -350,6 +351,28 @@ make_earth() {
     "$terramp" render --dataset "$globe" --camera 0,0,12000,0,-3 --width 640 --height 360 --settings "$flat" \
         --out "$out/earth_flat.png" >/dev/null
     compose --columns 1 --gap 4 --out docs/earth_globe_12km.png "$out/earth_round.png" "$out/earth_flat.png"
+}
+
+# nc on the Earth from 10 km, 1 km and 10 m above the ground at Raleigh (the trade's trees and
+# forest samples), heading 210° (Raleigh lies near its north-east corner): the dataset alone on the Earth, the horizon at its curved edge,
+# the trees on their local verticals (docs/earth.md). nc is the trade's where its manifest records
+# where it lies; one built before that gets nc_earth beside it, as scripts/earth_cost.sh builds it.
+make_earth_nc() {
+    forest
+    local nc="$data/nc" trees shots=() pose
+    if ! grep -q '^\[earth\]' "$nc/manifest.toml"; then
+        nc="$data/nc_earth"
+        [[ -f $nc/manifest.toml ]] || "$terramp_data" build --dem "$shared/nc/elev_ned_30m.tif" \
+            --imagery "$shared/nc/landsat_multiband.tif" --bands 3,2,1 \
+            --landcover "$shared/nc/landuse_r.tif" --classes nc --out "$nc" >/dev/null
+    fi
+    trees=$(layer earth_nc_trees '[draw_seeds]' "impostors = \"$(cd "$forest" && pwd)\"")
+    for pose in 10000,-55 1000,-25 10,-3; do
+        "$terramp" render --dataset "$nc" --camera "lonlat-ground:-78.66,35.77,${pose%,*},210,${pose#*,}" \
+            --width 640 --height 360 --settings "$trees" --out "$out/earth_nc_${pose%,*}.png" >/dev/null
+        shots+=("$out/earth_nc_${pose%,*}.png")
+    done
+    compose --columns 1 --scale 0.75 --gap 4 --out docs/earth_nc_descent.png "${shots[@]}"
 }
 
 make_trees_health() {
