@@ -11,6 +11,8 @@
 //!   moves the horizon by well under a pixel), and the column's ray at azimuth φ off the view's
 //!   centre reaches that dip tan δ / cos φ focal lengths below the image's middle.
 //! - The Tile Load Map culls its cells beyond the horizon (`the_tlm_culls_cells_beyond_the_horizon`).
+//! - From 1,000 km up, over a wider, coarser sea, the horizon lies where the rays of each column
+//!   first meet the ellipsoid (`from_1000_km_the_horizon_dips_as_the_ellipsoid_says`).
 //! - From 1 km up, the peak's top stands where the exact mapping (f64, `ExactPlacing`) of its
 //!   highest sample puts it, within a pixel: about 1,770 m below the camera's horizontal by the
 //!   drop alone (d² / 2ρ; no refraction is modelled), where the flat sheet had it level.
@@ -23,6 +25,7 @@ use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::dataset::Dataset;
 use terramp::earth::Ellipsoid;
+use terramp::earth::local::LocalFrame;
 use terramp::earth::placing::EarthPlacing;
 use terramp::frame::Renderer;
 use terramp::passes::tile_load_map::frame::height_tile_ranges;
@@ -238,4 +241,55 @@ fn the_tlm_culls_cells_beyond_the_horizon() {
         println!("{height_m} m up, level: {culled} TLM cells visible with horizon culling, {all} without");
         assert!(culled < all, "{height_m} m: {culled} visible with horizon culling, {all} without");
     }
+}
+
+/// From 1,000 km up (pitched 25° down: the horizon dips 30°, past a level view's edge) over a
+/// sea-level raster 72° square at 0.1° (reaching past the horizon's 3,700 km), each of five
+/// columns' first ground row lies within a pixel of the first whose ray meets the ellipsoid
+/// (raised by the geoid's undulation under the camera): found exactly, row by row, in the
+/// ellipsoid's scaled space (the ray meets the unit sphere where its quadratic has a root).
+#[test]
+fn from_1000_km_the_horizon_dips_as_the_ellipsoid_says() {
+    let dir = TempDir::new("earth-horizon-1000km");
+    let (step_deg, samples) = (0.1, 720usize);
+    let half = 0.5 * samples as f64 * step_deg;
+    let transform = [-half, step_deg, 0.0, half, 0.0, -step_deg];
+    let heights = vec![0.0f32; samples * samples];
+    let dem = write_geotiff(&dir.path().join("sea.tif"), [samples, samples], heights, transform, 4326, None);
+    let dataset = build(&dir.path().join("sea"), &["--dem", dem.to_str().unwrap()]).0;
+    let earth = dataset.manifest.earth.clone().unwrap();
+    let (lat, lon) = earth.geodetic(0.0, 0.0);
+    let sea_m = earth.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon));
+    let (height_m, pitch_deg) = (1_000_000.0, -25.0);
+    let mut r = renderer(dataset);
+    let camera = Camera { pitch_deg, ..camera(height_m) };
+    r.render_resolved(&camera).unwrap();
+    let depth = r.read_depth().unwrap();
+    // The camera's axes in its frame (x east, y north, z up along the ellipsoid's normal).
+    let (yaw, pitch) = (camera.yaw_deg.to_radians(), pitch_deg.to_radians());
+    let forward = DVec3::new(yaw.sin() * pitch.cos(), yaw.cos() * pitch.cos(), pitch.sin());
+    let right = DVec3::new(yaw.cos(), -yaw.sin(), 0.0);
+    let up = right.cross(forward);
+    let frame = LocalFrame::grid_aligned(&earth, 0.0, 0.0, height_m);
+    let e = Ellipsoid::WGS84;
+    let scale = DVec3::new(e.a_m + sea_m, e.a_m + sea_m, e.b_m() + sea_m).recip();
+    let eye = frame.eye_ecef_m * scale;
+    let meets = |x_px: f64, y_px: f64| {
+        let d_local = right * (x_px / focal_px()) - up * (y_px / focal_px()) + forward;
+        let d = (frame.local_from_ecef.transpose() * d_local) * scale;
+        let b = eye.dot(d);
+        b < 0.0 && b * b >= d.length_squared() * (eye.length_squared() - 1.0)
+    };
+    let mut worst = 0i64;
+    for column in [160, 560, 960, 1360, 1760] {
+        let x_px = f64::from(column) + 0.5 - 0.5 * f64::from(SIZE[0]);
+        let expected = (0..SIZE[1]).find(|&row| meets(x_px, f64::from(row) + 0.5 - 0.5 * f64::from(SIZE[1])));
+        let expected = expected.unwrap_or(SIZE[1]);
+        let drawn = first_ground_row(&depth, column);
+        println!("1,000 km, column {column}: horizon at row {drawn}, the ellipsoid's {expected}");
+        worst = worst.max((i64::from(drawn) - i64::from(expected)).abs());
+        assert!(expected > 50 && expected < SIZE[1] - 50, "column {column}: the horizon off the frame");
+        assert!(drawn.abs_diff(expected) <= MISS_PX, "column {column}: row {drawn}, not {expected}");
+    }
+    println!("largest miss: {worst} px");
 }
