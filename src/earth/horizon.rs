@@ -4,7 +4,7 @@
 //! sphere and the test is exact: a point is hidden when it lies inside the cone of tangents from
 //! the eye and beyond the plane of their points of contact, a convex region, so a box whose eight
 //! corners lie there is hidden whole. The test needs only the point's offset from the eye, so the
-//! GPU runs it on camera-relative positions in f32 (`HorizonCone::gpu`) to about a millimetre.
+//! GPU runs it on camera-relative positions in f32 (`HorizonCone::gpu`).
 //!
 //! `EarthBend` bounds how far the mapping of the grid point under the camera (`NodeMapping`,
 //! second order) moves a camera-relative grid box: the ground's fall, d² / 2R at horizontal
@@ -83,6 +83,13 @@ impl HorizonCone {
     pub const GPU_NONE: [[f32; 4]; 4] = [[0.0; 4], [0.0; 4], [0.0; 4], [0.0, 0.0, 0.0, f32::MAX]];
 }
 
+/// 1 / 2R, how fast the ground falls away from the camera's nadir (per square metre of horizontal
+/// distance, d² / 2R) in `nadir`, its mapping at height 0: the second-order term's vertical part,
+/// the mean of x's and y's (which differ by under 1 %); 0 on the flat sheet.
+pub fn fall_per_m2(nadir: &EarthNode) -> f64 {
+    (-0.5 * (f64::from(nadir.d_xx[2]) + f64::from(nadir.d_yy[2]))).max(0.0)
+}
+
 /// How a camera-relative grid box bends onto the Earth: `[drop, per_m, per_m2, per_m3]` and
 /// `[z_per_m, z_per_m2, z_per_m4, 0]`. A box corner at horizontal distance d from the camera
 /// falls by `drop` d²; its sides move out by `per_m` L + `per_m2` d² + `per_m3` L d², its top and
@@ -101,7 +108,7 @@ impl EarthBend {
         if d_xx == DVec3::ZERO && d_xy == DVec3::ZERO && d_yy == DVec3::ZERO {
             return Self::default();
         }
-        let drop = (-0.5 * (d_xx.z + d_yy.z)).max(0.0);
+        let drop = fall_per_m2(nadir);
         // First order: the mapping's axes against the grid's, and the vertical turning along the
         // box at its heights (d_xh, d_yh: 1 / R).
         let first = (d_x - DVec3::X).abs() + (d_y - DVec3::Y).abs();

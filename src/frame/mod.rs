@@ -315,7 +315,8 @@ impl Renderer {
 
     /// Where the Tile Load Map's cells lie seen from `camera`, as this renderer's frames place them.
     pub fn tlm_earth(&self, camera: &Camera) -> TlmEarth {
-        TlmEarth::of(&self.exact_placing(camera), &self.dataset, self.settings.terrain.horizon_culling)
+        let placing = self.exact_placing(camera);
+        TlmEarth::of(&placing, &placing.nadir_node(), &self.dataset, self.settings.terrain.horizon_culling)
     }
 
     /// Renders one frame from `camera`.

@@ -8,7 +8,7 @@ use glam::DVec3;
 
 use crate::camera::{Camera, Frustum};
 use crate::earth::placing::ExactPlacing;
-use crate::gpu::gpu_types::TerrainUniforms;
+use crate::gpu::gpu_types::{EarthNode, TerrainUniforms};
 use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms};
 use crate::passes::terrain::gpu::PreparedNodes;
 use crate::passes::terrain::select::{Lods, Selected, select};
@@ -41,6 +41,9 @@ struct View<'a> {
     lods: Lods,
     /// Where this frame draws the dataset (on the Earth, or flat), from this camera.
     placing: ExactPlacing,
+    /// The mapping of the grid point under the camera (`ExactPlacing::nadir_node`): how the
+    /// TLM's boxes bend and where the seeds stand up.
+    nadir: EarthNode,
 }
 
 impl Renderer {
@@ -53,12 +56,14 @@ impl Renderer {
         let (width, height) = (self.settings.render.width, self.settings.render.height);
         let origin = self.dataset.manifest.origin_m;
         let grid_m = camera.position_m - DVec3::new(origin[0], origin[1], 0.0);
+        let placing = self.placing.exact(grid_m);
         let view = View {
             camera,
             grid_m,
             clip_from_view_world: camera.clip_from_view(width, height)? * camera.view_from_world(),
             lods: Lods::for_view(&self.dataset, &self.settings.terrain, camera, height),
-            placing: self.placing.exact(grid_m),
+            nadir: placing.nadir_node(),
+            placing,
         };
         let selected = self.select_nodes(&view);
         self.stream(&view, &selected, report);
@@ -142,7 +147,7 @@ impl Renderer {
             lods: &view.lods,
             imagery: TlmImagery::of(&self.dataset, &s.imagery),
             hiz_mips: self.depth_pyramid.mips(),
-            earth: TlmEarth::of(&view.placing, &self.dataset, s.terrain.horizon_culling),
+            earth: TlmEarth::of(&view.placing, &view.nadir, &self.dataset, s.terrain.horizon_culling),
         };
         let tlm = self.tlm.prepare(&self.gpu.queue, &inputs)?;
         Ok((layout, tlm))
@@ -197,7 +202,15 @@ impl Renderer {
         let cells = super::seeds::placed_cells(&mut placed, cells, self.settings.tlm.cell_m);
         let ranks = stage.tables.active_ranks();
         let (settings, dataset) = (&self.settings, &self.dataset);
-        let inputs = super::seeds::seed_inputs(settings, dataset, view.camera, &view.placing, &cells, ranks);
+        let inputs = super::seeds::seed_inputs(
+            settings,
+            dataset,
+            view.camera,
+            &view.placing,
+            view.nadir,
+            &cells,
+            ranks,
+        );
         let frame = stage.prepare(&self.gpu, &inputs)?;
         report.seed_cells = frame.cells.len();
         report.seed_cells_dropped = frame.cells_dropped;

@@ -296,12 +296,14 @@ pub(super) fn placed_cells(
     cells.iter().map(|c| (*c, placed.node(corner(c)))).collect()
 }
 
-/// The inputs of a frame's seed selection.
+/// The inputs of a frame's seed selection, from a camera `placing` places the grid from, whose
+/// nadir's mapping is `nadir` (`ExactPlacing::nadir_node`).
 pub(super) fn seed_inputs<'a>(
     settings: &'a Settings,
     dataset: &'a Dataset,
     camera: &'a Camera,
     placing: &ExactPlacing,
+    nadir: EarthNode,
     cells: &'a [(SeedCellRef, EarthNode)],
     active_ranks: u32,
 ) -> SeedInputs<'a> {
@@ -313,7 +315,7 @@ pub(super) fn seed_inputs<'a>(
         viewport_px: [settings.render.width, settings.render.height],
         cells,
         active_ranks,
-        nadir: placing.nadir_node(),
+        nadir,
     }
 }
 

@@ -274,14 +274,14 @@ impl Renderer {
     /// frame left them, and waits for it: for benchmarks, which choose how many seeds to check.
     /// `read_seeds` then reads its output.
     pub fn run_seed_select(&mut self, camera: &Camera, cells: &[SeedCellRef]) -> Result<(), RenderError> {
+        let exact = self.exact_placing(camera);
         let Some(stage) = self.seeds.as_mut() else { return Ok(()) };
-        let origin = self.dataset.manifest.origin_m;
-        let exact = self.placing.exact(camera.position_m - glam::DVec3::new(origin[0], origin[1], 0.0));
         let cells =
             super::seeds::placed_cells(&mut self.placing.view(&exact), cells, self.settings.tlm.cell_m);
         let ranks = stage.tables.active_ranks();
         let (settings, dataset) = (&self.settings, &self.dataset);
-        let inputs = super::seeds::seed_inputs(settings, dataset, camera, &exact, &cells, ranks);
+        let nadir = exact.nadir_node();
+        let inputs = super::seeds::seed_inputs(settings, dataset, camera, &exact, nadir, &cells, ranks);
         stage.prepare(&self.gpu, &inputs)?;
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         stage.encode(&mut encoder);

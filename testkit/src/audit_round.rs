@@ -9,12 +9,10 @@
 //! ground; staying above it by more than the slack everywhere is sky; anything else is not judged.
 
 use glam::DVec3;
+use terramp::earth::horizon::SMALLEST_RADIUS_M;
 use terramp::earth::placing::ExactPlacing;
 
 use super::{Dem, Expect, Tolerance, slack_m};
-
-/// The Earth's smallest radius of curvature, metres: how fast a ray's height can turn.
-const SMALLEST_RADIUS_M: f64 = 6_335_439.0;
 
 /// What the ray from the camera along `dir` (camera-relative) must show over `dem`, from `t_near`
 /// on, with the finest LOD out to `fine_within_m`.

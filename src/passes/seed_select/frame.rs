@@ -6,6 +6,7 @@ use glam::DVec3;
 use crate::camera::{Camera, CameraError};
 use crate::config::Settings;
 use crate::dataset::Dataset;
+use crate::earth::horizon::fall_per_m2;
 use crate::gpu::gpu_types::{EarthNode, SeedBlock, SeedCell, SeedCounters, SeedRecord, SeedUniforms};
 use crate::gpu::layout::{LCC_LEVELS, MAX_LEVELS};
 use crate::seeds::wind::Wind;
@@ -113,13 +114,6 @@ fn split(value: f64) -> (i32, f32) {
     if frac >= 1.0 { (whole as i32 + 1, 0.0) } else { (whole as i32, frac) }
 }
 
-/// 1 / 2R, the Earth's bend under a straight segment (`SeedUniforms::chord_sag_per_m2`): the
-/// ground falls away from the mapping's origin by its second-order term's vertical part, x² / 2R
-/// along x (the mean of x's and y's, which differ by under 1 %); 0 flat.
-fn chord_sag_per_m2(earth: &EarthNode) -> f32 {
-    (-0.5 * (earth.d_xx[2] + earth.d_yy[2])).max(0.0)
-}
-
 impl SeedFrame {
     /// The frame's uniforms and cells from the camera, settings and TLM cells, in f64 and rounded once;
     /// fails when the camera has no projection for the viewport.
@@ -178,7 +172,7 @@ impl SeedFrame {
             imagery_levels: [[0; 4]; MAX_LEVELS as usize],
             vegetation: [0.0; 4],
             class_edge_dither: u32::from(seeds.class_edge_dither),
-            chord_sag_per_m2: chord_sag_per_m2(&inputs.nadir),
+            chord_sag_per_m2: fall_per_m2(&inputs.nadir) as f32,
             _pad: [0; 2],
         };
         // Level-1 land-cover texels are twice the level-0 ones (the level that duplicates them).

@@ -8,7 +8,7 @@ use crate::config::{ImagerySettings, TlmSettings};
 use crate::dataset::{Dataset, TileId};
 use crate::earth::horizon::{EarthBend, HorizonCone};
 use crate::earth::placing::ExactPlacing;
-use crate::gpu::gpu_types::{TlmCell, TlmRing, TlmSpan, TlmUniforms};
+use crate::gpu::gpu_types::{EarthNode, TlmCell, TlmRing, TlmSpan, TlmUniforms};
 use crate::gpu::layout::{MAX_LEVELS, TLM_MAX_RINGS};
 use crate::passes::terrain::select::Lods;
 use crate::streaming::page_levels;
@@ -74,13 +74,14 @@ pub struct TlmEarth {
 }
 
 impl TlmEarth {
-    /// The cells as `placing` draws `dataset` (from the frame's camera), culled by the horizon
-    /// when `horizon_culling` (`terrain.horizon_culling`).
-    pub fn of(placing: &ExactPlacing, dataset: &Dataset, horizon_culling: bool) -> Self {
+    /// The cells as `placing` draws `dataset` (from the frame's camera, whose nadir's mapping is
+    /// `nadir`: `ExactPlacing::nadir_node`), culled by the horizon when `horizon_culling`
+    /// (`terrain.horizon_culling`).
+    pub fn of(placing: &ExactPlacing, nadir: &EarthNode, dataset: &Dataset, horizon_culling: bool) -> Self {
         let h = &dataset.manifest.height;
         let max_abs_height_m = f64::from(h.min_m.abs().max(h.max_m.abs()));
         let horizon = placing.horizon(f64::from(h.min_m)).filter(|_| horizon_culling);
-        Self { bend: EarthBend::of(&placing.nadir_node(), max_abs_height_m), horizon }
+        Self { bend: EarthBend::of(nadir, max_abs_height_m), horizon }
     }
 }
 
