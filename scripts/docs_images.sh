@@ -48,6 +48,7 @@ docs/wind_strip.png                       wind               shared   short
 docs/photo_nc.png                         photo              shared   long
 docs/earth_globe_12km.png                 earth              shared   short
 docs/earth_nc_descent.png                 earth_nc           shared   short
+docs/earth_globe_orbit.png                earth_orbit        shared   short
 docs/flight_0.png                         streaming          -        long
 docs/flight_1.png                         streaming          -        long
 docs/flight_2.png                         streaming          -        long
@@ -373,6 +374,24 @@ make_earth_nc() {
         shots+=("$out/earth_nc_${pose%,*}.png")
     done
     compose --columns 1 --scale 0.75 --gap 4 --out docs/earth_nc_descent.png "${shots[@]}"
+}
+
+# GLOBE's tile from orbit, haze off (today's fixed 150 km haze hides the ground from 400 km up; the
+# sky issue replaces it): from 20,000 km over its centre (a patch of the sphere), from 2,000 km
+# over 5° N 30° E looking north-east 30° down (its limb) and from 100 km over the Himalaya looking
+# north 35° down (docs/earth.md). GLOBE built as make_earth builds it.
+make_earth_orbit() {
+    local globe="$data/globe" clear shots=() pose
+    if ! grep -q '^\[earth\]' "$globe/manifest.toml" 2>/dev/null; then
+        "$terramp_data" build --dem "$shared/globe/globe_g_30arcsec.tif" --out "$globe" >/dev/null
+    fi
+    clear=$(layer earth_orbit_clear '[render]' 'haze_half_distance_m = 1e12')
+    for pose in 45,25,20000000,0,-90 30,5,2000000,45,-30 86.9,27.2,100000,0,-35; do
+        "$terramp" render --dataset "$globe" --camera "lonlat:$pose" --width 640 --height 360 --settings "$clear" \
+            --out "$out/earth_orbit_${pose//,/_}.png" >/dev/null
+        shots+=("$out/earth_orbit_${pose//,/_}.png")
+    done
+    compose --columns 1 --scale 0.75 --gap 4 --out docs/earth_globe_orbit.png "${shots[@]}"
 }
 
 make_trees_health() {

@@ -186,6 +186,9 @@ pub struct TerrainSettings {
     pub morph_fraction: f64,
     /// Cull the nodes the Earth hides behind the horizon (on the Earth only).
     pub horizon_culling: bool,
+    /// The most a node's mapping onto the Earth may misplace its ground, pixels (> 0; `inf`
+    /// splits no node for it).
+    pub placing_miss_px: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -306,7 +309,7 @@ impl Settings {
         let r = &self.render;
         let t = &self.terrain;
         let c = &self.cache;
-        let checks: [RangeCheck; 13] = [
+        let checks: [RangeCheck; 14] = [
             (r.width >= 1 && r.width <= 16384, "render.width", r.width.to_string(), "1 to 16384 pixels"),
             (r.height >= 1 && r.height <= 16384, "render.height", r.height.to_string(), "1 to 16384 pixels"),
             (
@@ -329,6 +332,12 @@ impl Settings {
                 "a power of two from 8 to 256",
             ),
             (t.triangle_px > 0.0, "terrain.triangle_px", t.triangle_px.to_string(), "must be positive"),
+            (
+                t.placing_miss_px > 0.0,
+                "terrain.placing_miss_px",
+                t.placing_miss_px.to_string(),
+                "must be positive",
+            ),
             (
                 t.morph_fraction > 0.0 && t.morph_fraction < 1.0,
                 "terrain.morph_fraction",

@@ -33,7 +33,7 @@ use terramp_testkit::TempDir;
 use terramp_testkit::audit::Dem;
 use terramp_testkit::tlm;
 
-use support::{build, write_geotiff};
+use support::{build, sea_level, write_geotiff};
 
 const SIZE: [u32; 2] = [1920, 1080];
 /// How far a drawn row may lie from the ellipsoid's, pixels: the bound.
@@ -251,12 +251,7 @@ fn the_tlm_culls_cells_beyond_the_horizon() {
 #[test]
 fn from_1000_km_the_horizon_dips_as_the_ellipsoid_says() {
     let dir = TempDir::new("earth-horizon-1000km");
-    let (step_deg, samples) = (0.1, 720usize);
-    let half = 0.5 * samples as f64 * step_deg;
-    let transform = [-half, step_deg, 0.0, half, 0.0, -step_deg];
-    let heights = vec![0.0f32; samples * samples];
-    let dem = write_geotiff(&dir.path().join("sea.tif"), [samples, samples], heights, transform, 4326, None);
-    let dataset = build(&dir.path().join("sea"), &["--dem", dem.to_str().unwrap()]).0;
+    let dataset = sea_level(dir.path(), 0.1, 720);
     let earth = dataset.manifest.earth.clone().unwrap();
     let (lat, lon) = earth.geodetic(0.0, 0.0);
     let sea_m = earth.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon));

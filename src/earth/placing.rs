@@ -152,21 +152,15 @@ impl ExactPlacing {
     }
 
     /// The grid point (x, y and a height) placed at camera-relative `rel_m`: `position_rel_m`'s
-    /// inverse, by fixed-point steps (the mapping is the identity turned by the Earth's bend
-    /// between the camera and the point, d / R radians: each step leaves about that share of the
-    /// miss).
+    /// inverse (`EarthFrame::crs_m`), exact at any distance.
     pub fn grid_m(&self, rel_m: DVec3) -> DVec3 {
-        let mut grid_m = self.camera_grid_m + rel_m;
-        if self.round.is_some() {
-            for _ in 0..MAX_INVERSE_STEPS {
-                let miss = rel_m - self.position_rel_m(grid_m);
-                grid_m += miss;
-                if miss.length_squared() < 1e-18 {
-                    break;
-                }
+        match &self.round {
+            Some(RoundView { frame, earth, origin_m, .. }) => {
+                let ecef_m = frame.eye_ecef_m + frame.local_from_ecef.transpose() * rel_m;
+                earth.crs_m(ecef_m) - DVec3::new(origin_m[0], origin_m[1], 0.0)
             }
+            None => self.camera_grid_m + rel_m,
         }
-        grid_m
     }
 }
 
@@ -174,10 +168,6 @@ impl ExactPlacing {
 fn flat_node(origin_rel_m: DVec3) -> EarthNode {
     EarthNode { origin_m: origin_rel_m.as_vec3().extend(0.0).to_array(), ..EarthNode::FLAT }
 }
-
-/// The most steps `ExactPlacing::grid_m` takes (it stops at a nanometre): enough for points
-/// 3,000 km away (a bend of 0.5 a step).
-const MAX_INVERSE_STEPS: usize = 48;
 
 /// One frame's placing: the camera's frame, and the dataset's mappings.
 pub struct PlacedView<'a> {
@@ -245,16 +235,31 @@ impl PlacedView<'_> {
             }
         }
         // Between lattice points half a side apart a quadratic strays from the chord by a quarter
-        // of its second-order term there; the polynomial itself misses the ellipsoid by its third
-        // order (about r³ / 6R² at half-diagonal r: doubled).
+        // of its second-order term there; the polynomial itself misses by its third order.
         let (a, b) = (half.x, half.y);
         let quadratic =
             0.25 * (node.d_xx.length() * a * a + node.d_xy.length() * a * b + node.d_yy.length() * b * b);
-        let r = f64::hypot(a, b);
-        let third = r.powi(3) / (3.0 * SMALLEST_RADIUS_M * SMALLEST_RADIUS_M);
-        let margin = DVec3::splat(quadratic + third);
+        let margin = DVec3::splat(quadratic + third_order_m(a, b));
         (lo - margin, hi + margin)
     }
+
+    /// How far the GPU may draw a point of the grid box `min_m`..`max_m` from where the exact
+    /// mapping puts it, when the box's mapping's origin is its centre at height 0 (`node`): the
+    /// polynomial's third order. 0 flat.
+    pub fn miss_bound_m(&self, min_m: DVec3, max_m: DVec3) -> f64 {
+        if self.exact.round.is_none() {
+            return 0.0;
+        }
+        third_order_m(0.5 * (max_m.x - min_m.x), 0.5 * (max_m.y - min_m.y))
+    }
+}
+
+/// What a node's second-order polynomial misses the ellipsoid by at the corners of a box of
+/// half-sides `a` and `b` about its origin: its third order, about r³ / 6R² at half-diagonal r,
+/// doubled (the projection's own third order, on the frames the builder writes, is of the same
+/// size: `the_miss_bound_holds_a_continent_wide`).
+fn third_order_m(a: f64, b: f64) -> f64 {
+    f64::hypot(a, b).powi(3) / (3.0 * SMALLEST_RADIUS_M * SMALLEST_RADIUS_M)
 }
 
 #[cfg(test)]

@@ -119,7 +119,8 @@ fn a_kept_mapping_serves_every_camera() {
     assert_eq!(mapping(&kept), own);
 }
 
-/// `grid_m` undoes `position_rel_m` to a micrometre, beside the camera and 1,000 km away.
+/// `grid_m` undoes `position_rel_m` to a micrometre, beside the camera and 1,000 km away (and,
+/// on an azimuthal equidistant frame, from 20,000 km up: `the_crs_point_of_a_position_is_where_it_came_from`).
 #[test]
 fn the_exact_placing_goes_back_to_the_grid() {
     let placing = EarthPlacing::new(Some(&nc()), ORIGIN_M, true);
@@ -130,4 +131,47 @@ fn the_exact_placing_goes_back_to_the_grid() {
     }
     let flat = EarthPlacing::new(None, ORIGIN_M, true).exact(DVec3::new(1.0, 2.0, 3.0));
     assert_eq!(flat.grid_m(DVec3::new(10.0, 20.0, -3.0)), DVec3::new(11.0, 22.0, 0.0));
+}
+
+/// A node's polynomial (in f64: f32's rounding, 6e-8 of the distance, is apart) misses the
+/// exact mapping by no more than `miss_bound_m` says, on an azimuthal equidistant frame as wide as
+/// GLOBE's tile (25° N 45° E), for nodes 30 km to 3,000 km across out to 5,000 km from the frame's
+/// centre, where its scale across is 1.1.
+#[test]
+fn the_miss_bound_holds_a_continent_wide() {
+    let globe = crate::earth::test_frames::globe();
+    let placing = EarthPlacing::new(Some(&globe), [0.0, 0.0], true);
+    let exact = placing.exact(DVec3::new(0.0, 0.0, 2.0e7));
+    let mut kept = HashMap::new();
+    let view = PlacedView { exact: &exact, kept: &mut kept };
+    for side_m in [30e3, 300e3, 1_000e3, 3_000e3] {
+        for centre in [DVec3::ZERO, DVec3::new(2_000e3, -1_000e3, 0.0), DVec3::new(-3_500e3, 3_500e3, 0.0)] {
+            let half = DVec3::new(0.5 * side_m, 0.5 * side_m, 0.0);
+            let (min, max) = (centre - half, centre + half + DVec3::Z * 8_000.0);
+            let node = EcefNode::at(&globe, centre);
+            let mut worst = 0.0f64;
+            for j in 0..=8 {
+                for i in 0..=8 {
+                    for h in [0.0, 8_000.0] {
+                        let offset = DVec3::new(
+                            (f64::from(i) / 8.0 - 0.5) * side_m,
+                            (f64::from(j) / 8.0 - 0.5) * side_m,
+                            h,
+                        );
+                        let p = centre + offset;
+                        worst = worst.max((node.position_m(offset) - globe.ecef_m(p.x, p.y, p.z)).length());
+                    }
+                }
+            }
+            let bound = view.miss_bound_m(min, max);
+            let at_km = centre / 1e3;
+            println!(
+                "{:.0} km node at ({:.0}, {:.0}) km: misses {worst:.3} m, bound {bound:.3} m",
+                side_m / 1e3,
+                at_km.x,
+                at_km.y
+            );
+            assert!(worst <= bound, "{side_m} m at {centre}: {worst} > {bound}");
+        }
+    }
 }

@@ -3,9 +3,9 @@
 use glam::DVec3;
 
 use super::*;
+use crate::earth::GeoidLattice;
 use crate::earth::local::LocalFrame;
 use crate::earth::test_frames::nc;
-use crate::earth::{GeoidLattice, Projection};
 
 fn raleigh(heading_deg: f64, pitch_deg: f64) -> GeoPose {
     GeoPose { lon_deg: -78.64, lat_deg: 35.78, height_m: 1_500.0, heading_deg, pitch_deg }
@@ -62,16 +62,7 @@ fn a_pose_out_of_range_or_out_of_reach_is_an_error() {
     let pose = GeoPose { height_m: f64::NAN, ..raleigh(0.0, 0.0) };
     assert!(matches!(pose.in_crs(&nc()), Err(PoseError::Range("height", ..))));
     // A local azimuthal frame does not reach its centre's antipode.
-    let aeqd = EarthFrame::ellipsoidal(
-        Projection::AzimuthalEquidistant {
-            lat_origin_deg: 25.0,
-            lon_origin_deg: 45.0,
-            false_easting_m: 0.0,
-            false_northing_m: 0.0,
-        },
-        Ellipsoid::WGS84,
-        "WGS 84",
-    );
+    let aeqd = crate::earth::test_frames::globe();
     let antipode = GeoPose { lon_deg: -135.0, lat_deg: -25.0, ..raleigh(0.0, 0.0) };
     assert!(
         matches!(antipode.in_crs(&aeqd), Err(PoseError::Unreachable { .. })),

@@ -49,6 +49,17 @@ pub fn build(out: &Path, args: &[&str]) -> (Dataset, String) {
     (Dataset::open(out).unwrap(), stdout.into_owned())
 }
 
+/// Builds, in `dir`, a geographic sea-level raster (EPSG:4326, heights 0 above EGM96) of
+/// `samples` × `samples` every `step_deg` degrees, centred on 0° N 0° E: the builder moves it to
+/// its local azimuthal equidistant frame, centred there.
+pub fn sea_level(dir: &Path, step_deg: f64, samples: usize) -> Dataset {
+    let half = 0.5 * samples as f64 * step_deg;
+    let transform = [-half, step_deg, 0.0, half, 0.0, -step_deg];
+    let heights = vec![0.0f32; samples * samples];
+    let dem = write_geotiff(&dir.join("sea.tif"), [samples, samples], heights, transform, 4326, None);
+    build(&dir.join("sea"), &["--dem", dem.to_str().unwrap()]).0
+}
+
 /// Builds `nc/`'s co-registered trio (DEM, Landsat true colour, land use) into `out`.
 pub fn build_nc(out: &Path) -> Dataset {
     build_nc_with(out, &[])

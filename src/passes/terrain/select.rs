@@ -54,6 +54,13 @@ pub struct Lods {
     pub range_m: Vec<f64>,
     /// Per LOD: distance at which its vertices start morphing towards the coarser LOD, metres.
     pub morph_start_m: Vec<f64>,
+    /// The most a node's mapping may misplace what it draws at 1 m from the camera, metres
+    /// (`terrain.placing_miss_px` pixels): a node whose polynomial would miss by more at its
+    /// distance (`PlacedView::miss_bound_m`) is split, even beyond its finer LOD's ring (its
+    /// children then draw fully morphed: the coarser LOD's triangles, each placed by a mapping of
+    /// half the size, an eighth the miss). On a 60° view 1,080 pixels tall it matters only where
+    /// a ring's nodes grow hundreds of kilometres across, past about 1,000 km.
+    pub placing_miss_at_1m: f64,
 }
 
 impl Lods {
@@ -63,8 +70,7 @@ impl Lods {
         spacing_m: f64,
         cells: u32,
         metres_per_pixel_at_1m: f64,
-        triangle_px: f64,
-        morph_fraction: f64,
+        [triangle_px, morph_fraction, placing_miss_px]: [f64; 3],
     ) -> Self {
         let levels = pyramid.levels;
         let range_m: Vec<f64> = (0..levels)
@@ -89,7 +95,8 @@ impl Lods {
                 }
             })
             .collect();
-        Self { cells, spacing_m, pyramid, range_m, morph_start_m }
+        let placing_miss_at_1m = placing_miss_px * metres_per_pixel_at_1m;
+        Self { cells, spacing_m, pyramid, range_m, morph_start_m, placing_miss_at_1m }
     }
 
     /// The rings of `dataset`'s terrain for `camera` in a viewport `height_px` tall, as the
@@ -100,8 +107,7 @@ impl Lods {
             dataset.manifest.height.spacing_m,
             settings.node_cells,
             camera.metres_per_pixel(1.0, height_px),
-            settings.triangle_px,
-            settings.morph_fraction,
+            [settings.triangle_px, settings.morph_fraction, settings.placing_miss_px],
         )
     }
 
@@ -171,7 +177,9 @@ fn distance_to_box(p: DVec3, (min, max): (DVec3, DVec3)) -> f64 {
 /// Selects the nodes to draw for the camera `placed` sees from. `frustum` is in camera-relative
 /// space: a node is culled by the box that holds what it draws (`PlacedView::box_rel_m`: on the
 /// Earth, bent), its LOD chosen by its distance on the flat sheet (as the shader's morph measures
-/// it; the bend changes a distance by less than the drop over it, 785 m in 100 km). `bounds`
+/// it; the bend changes a distance by less than the drop over it, 785 m in 100 km), and split
+/// further where its mapping would misplace its ground by more than `Lods::placing_miss_at_1m`
+/// allows. `bounds`
 /// gives a node's height range. With `horizon` (the dataset's lowest ground, metres), a node the
 /// Earth hides from the camera is culled too (`PlacedView::hidden_by_earth`).
 pub fn select(
@@ -188,7 +196,7 @@ pub fn select(
     let [nx, ny] = lods.nodes_at(top);
     for y in 0..ny {
         for x in 0..nx {
-            search.visit(NodeId { lod: top, x, y }, &mut out);
+            search.visit(NodeId { lod: top, x, y }, false, &mut out);
         }
     }
     out
@@ -206,11 +214,12 @@ struct Search<'a, 'p> {
 
 impl Search<'_, '_> {
     /// Returns false when `node` lies beyond its own range: its parent draws that area instead.
-    fn visit(&mut self, node: NodeId, out: &mut Vec<Selected>) -> bool {
+    /// A node `placing_split` from its parent is drawn even there (its parent's mapping misses).
+    fn visit(&mut self, node: NodeId, placing_split: bool, out: &mut Vec<Selected>) -> bool {
         let lods = self.lods;
         let (min, max) = lods.node_box(node, (self.bounds)(node));
         let distance_m = distance_to_box(self.camera, (min, max));
-        if distance_m > lods.range_m[node.lod as usize] {
+        if !placing_split && distance_m > lods.range_m[node.lod as usize] {
             return false;
         }
         let (lo, hi) = self.placed.box_rel_m(min, max);
@@ -219,7 +228,8 @@ impl Search<'_, '_> {
         {
             return true;
         }
-        if node.lod == 0 || distance_m > lods.range_m[node.lod as usize - 1] {
+        let misplaced = self.placed.miss_bound_m(min, max) > lods.placing_miss_at_1m * distance_m;
+        if node.lod == 0 || (distance_m > lods.range_m[node.lod as usize - 1] && !misplaced) {
             out.push(Selected { node, quadrants: ALL_QUADRANTS });
             return true;
         }
@@ -234,7 +244,7 @@ impl Search<'_, '_> {
             if child.x >= nx || child.y >= ny {
                 continue;
             }
-            if !self.visit(child, out) {
+            if !self.visit(child, misplaced, out) {
                 parent_draws |= 1 << q;
             }
         }
