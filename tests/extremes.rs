@@ -18,7 +18,9 @@
 //! codes outside the class table (`tests/seed_select.rs`, `classes_missing_from_the_table_grow_nothing`),
 //! keys outside the draw groups (`tests/compact.rs`), no-adapter errors (`tests/render.rs`), and
 //! real data: DEM voids and nodata (`rainier/`, `zion/`) and hand-made cliffs in
-//! `data-tools/tests/extremes.rs`.
+//! `data-tools/tests/extremes.rs`; the round Earth's: the antimeridian, a pole, 0.5 m above the
+//! ground at 179.9999° E (`data-tools/tests/earth_extremes.rs`) and 40,000 km up
+//! (`data-tools/tests/earth_orbit.rs`).
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 #[path = "extremes/coordinates.rs"]

@@ -1,7 +1,7 @@
 //! From orbit (issue 44): a geographic sea-level raster made here, 72° square around 0° N 0° E at
 //! 0.1° (one azimuthal equidistant frame out to 4,000 km from its centre), built and drawn at
-//! 960 × 540 with a 60° vertical field of view from 20,000 km and 2,000 km up (straight down, and
-//! from 2,000 km 30° down towards the limb).
+//! 960 × 540 with a 60° vertical field of view from 40,000 km, 20,000 km and 2,000 km up (straight
+//! down, and from 2,000 km 30° down towards the limb).
 //!
 //! From that high a terrain node may hold a thousand kilometres, and its second-order mapping
 //! misses the ellipsoid by its third order (about r³ / 6R² at half-diagonal r). The selection
@@ -115,7 +115,9 @@ fn from_orbit_the_sea_lies_on_the_ellipsoid() {
     let dir = TempDir::new("earth-orbit");
     let dataset = Arc::new(sea_level(dir.path(), 0.1, 720));
     let miss_px = Settings::default().terrain.placing_miss_px;
-    for (height_m, pitch_deg) in [(20_000_000.0, -90.0), (2_000_000.0, -90.0), (2_000_000.0, -30.0)] {
+    for (height_m, pitch_deg) in
+        [(40_000_000.0, -90.0), (20_000_000.0, -90.0), (2_000_000.0, -90.0), (2_000_000.0, -30.0)]
+    {
         let camera = Camera {
             position_m: DVec3::new(0.0, 0.0, height_m),
             yaw_deg: 0.0,
@@ -128,7 +130,7 @@ fn from_orbit_the_sea_lies_on_the_ellipsoid() {
         let what = format!("{:.0} km up, pitch {pitch_deg}°", height_m / 1e3);
         println!("{what}: split {split:?}");
         println!("{what}: not split {whole:?}");
-        assert!(split.ground_rays > 1_000, "{what}: the sea is hardly seen: {split:?}");
+        assert!(split.ground_rays > 300, "{what}: the sea is hardly seen: {split:?}");
         assert!(split.worst_miss_px <= miss_px, "{what}: the ground misses the ellipsoid: {split:?}");
         assert_eq!((split.holes, split.stray), (0, 0), "{what}: {split:?}");
         // From 2,000 km the rings' nodes are wide enough that the split changes what is drawn.

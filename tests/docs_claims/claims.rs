@@ -221,6 +221,11 @@ pub static CLAIMS: &[Claim] = &[
     },
     Claim {
         doc: "docs/earth.md",
+        quote: "finest LOD is drawn (the test allows {} mm)",
+        values: &[(test_const("data-tools/tests/earth_extremes.rs", "FINE_HEIGHT_M"), mm)],
+    },
+    Claim {
+        doc: "docs/earth.md",
         quote: "(the test allows {} pixel)",
         values: &[(test_const("data-tools/tests/earth_horizon.rs", "MISS_PX"), plain)],
     },

@@ -214,9 +214,21 @@ fn geoid_lattice(frame: &EarthFrame, grid: &Grid) -> Result<Option<GeoidLattice>
             (south, north, west, east) = (south.min(lat), north.max(lat), west.min(lon), east.max(lon));
         }
     }
+    // A pole inside the grid lies inside its edges: the lattice then reaches it, all the way round
+    // (its first and last columns the same meridian, so it wraps without a gap).
+    for pole in [90.0f64, -90.0] {
+        let [x, y] = frame.projection.forward(&frame.ellipsoid, pole.to_radians(), centre_lon.to_radians());
+        let inside = (0.0..=extent[0]).contains(&(x - grid.corner_m[0]))
+            && (0.0..=extent[1]).contains(&(y - grid.corner_m[1]));
+        if inside {
+            (south, north) = (south.min(pole), north.max(pole));
+            (west, east) = (centre_lon - 180.0, centre_lon + 180.0);
+        }
+    }
     let step = GEOID_STEP_DEG;
     let (s, w) = ((south / step).floor() - 1.0, (west / step).floor() - 1.0);
     let (n, e) = ((north / step).ceil() + 1.0, (east / step).ceil() + 1.0);
+    let e = e.min(w + 360.0 / step);
     let (s, n) = (s.max(-90.0 / step), n.min(90.0 / step));
     let size = [(e - w) as u32 + 1, (n - s) as u32 + 1];
     let nodes: Vec<[f64; 2]> = (0..size[1])
