@@ -6,6 +6,12 @@
 # command (needs ../shared/data: nc/, models/):
 #
 #   scripts/earth_cost.sh
+#   scripts/earth_cost.sh globe    # only what GLOBE's tile costs from 10 km up (needs globe/)
+#
+# `globe`: GLOBE's tile (built into DATA_DIR/globe as scripts/docs_images.sh builds it), one frame
+# settled from 10 km above five places at four pitches, with and without horizon culling
+# (`terrain.horizon_culling`): the terrain's nodes and the Tile Load Map's visible cells, counts
+# that do not depend on the adapter.
 #
 # nc is the trade's (scripts/trade_data.sh) when its manifest records where it lies ([earth]);
 # one built before that is not rebuilt in place: nc_earth is built beside it the same way.
@@ -14,12 +20,41 @@
 # (/tmp/terramp-earth-cost), CARGO_TARGET_DIR.
 set -euo pipefail
 
-source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" nc models
+if [[ ${1:-} == globe ]]; then
+    source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" globe
+else
+    source "$(dirname "${BASH_SOURCE[0]}")/measure_env.sh" nc models
+fi
 data="${DATA_DIR:-data/trade}"
 out="${OUT:-/tmp/terramp-earth-cost}"
 mkdir -p "$data" "$out"
 cargo build --release --workspace -q
 source scripts/trade_data.sh
+
+if [[ ${1:-} == globe ]]; then
+    globe="$data/globe"
+    if ! grep -q '^\[earth\]' "$globe/manifest.toml" 2>/dev/null; then
+        "$terramp_data" build --dem "$shared/globe/globe_g_30arcsec.tif" --out "$globe" >/dev/null
+    fi
+    echo "| place | pitch | nodes | nodes, no horizon culling | TLM cells | TLM cells, no horizon culling |"
+    echo "|---|---|---|---|---|---|"
+    for place in 45,25 10,45 80,5 86.9,27.9 60,40; do
+        for pitch in 0 -10 -30 -90; do
+            row="| $place | $pitch |"
+            nodes=() cells=()
+            for culling in true false; do
+                printf '[terrain]\nhorizon_culling = %s\n' "$culling" >"$out/globe-$culling.toml"
+                line=$("$terramp" render --dataset "$globe" --camera "lonlat:$place,10000,30,$pitch" \
+                    --width 1920 --height 1080 --settings "$out/globe-$culling.toml" --out "$out/globe.png" 2>/dev/null \
+                    | grep ' nodes, ')
+                nodes+=("$(sed -E 's/.*: ([0-9]+) nodes.*/\1/' <<<"$line")")
+                cells+=("$(sed -E 's/.* ([0-9]+) TLM cells.*/\1/' <<<"$line")")
+            done
+            echo "$row ${nodes[0]} | ${nodes[1]} | ${cells[0]} | ${cells[1]} |"
+        done
+    done
+    exit 0
+fi
 
 nc="$data/nc"
 if ! grep -q '^\[earth\]' "$nc/manifest.toml"; then

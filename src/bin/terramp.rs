@@ -364,9 +364,10 @@ fn render_one(
     save_png(&image, out)?;
     let drained = renderer.profiler.drain(&renderer.gpu)?;
     println!(
-        "{}: {} nodes, {} height + {} imagery tiles resident, resolved in {frames} frames, {:.0} ms (shaders compiled on first use)",
+        "{}: {} nodes, {} TLM cells visible, {} height + {} imagery tiles resident, resolved in {frames} frames, {:.0} ms (shaders compiled on first use)",
         out.display(),
         report.nodes_drawn,
+        report.tlm_visible_cells,
         report.height.needed_resident,
         report.imagery.needed_resident,
         elapsed.as_secs_f64() * 1000.0
