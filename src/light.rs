@@ -12,7 +12,10 @@
 //! offsets in f32. Each shader that lights something calls `sun_through_clouds`
 //! (`shaders/shared/clouds.wgsl`) at its fragment's camera-relative position, so ground, seeds and
 //! texcells are shaded alike at the same world point; `CloudShadowFrame::sun_visible` is its twin,
-//! step for step in f32. No clouds (coverage or depth 0): the shaders return 1 before any
+//! step for step in f32. On the Earth the layer is a shell over the datum, not a plane: a point d
+//! from the camera lies d² / 2R lower in the camera's frame than over its own ground, and so does
+//! the layer above it, so its height for the lookup is its camera-frame height plus that fall
+//! (`CloudShadowFrame::on_earth`; 0 flat). No clouds (coverage or depth 0): the shaders return 1 before any
 //! arithmetic, so frames are those of a build without clouds, bit for bit.
 
 use std::sync::OnceLock;
@@ -38,7 +41,8 @@ pub struct CloudShadowFrame {
     /// period (xy); cells per metre (z); the noise threshold of a cloud's edge (w).
     pub field: [f32; 4],
     /// Cells the meeting point moves per metre of height (xy); the share of sunlight a cloud's core
-    /// holds back (z, 0: no clouds); unused (w).
+    /// holds back (z, 0: no clouds); the Earth's fall, 1 / 2R per square metre of horizontal
+    /// distance from the camera (w, 0 flat).
     pub shift: [f32; 4],
 }
 
@@ -76,6 +80,15 @@ impl CloudShadowFrame {
         }
     }
 
+    /// These clouds over a ground that falls away from the camera by `fall_per_m2` d² at
+    /// horizontal distance d (`earth::horizon::fall_per_m2`; 0 flat).
+    pub fn on_earth(mut self, fall_per_m2: f64) -> Self {
+        if self.shift[2] > 0.0 {
+            self.shift[3] = fall_per_m2 as f32;
+        }
+        self
+    }
+
     /// The share of the sun's light that reaches the point `rel_m` from the camera (metres,
     /// camera-relative world axes): the shaders' `sun_through_clouds`, step for step.
     pub fn sun_visible(&self, rel_m: [f32; 3]) -> f32 {
@@ -90,11 +103,9 @@ impl CloudShadowFrame {
     /// inside a cloud (tests keep away from the edges with it).
     pub fn density_at(&self, rel_m: [f32; 3]) -> f32 {
         let [fx, fy, cells_per_m, _] = self.field;
-        let [sx, sy, ..] = self.shift;
-        cloud_density([
-            fx + rel_m[0] * cells_per_m + rel_m[2] * sx,
-            fy + rel_m[1] * cells_per_m + rel_m[2] * sy,
-        ])
+        let [sx, sy, _, fall] = self.shift;
+        let up_m = rel_m[2] + fall * (rel_m[0] * rel_m[0] + rel_m[1] * rel_m[1]);
+        cloud_density([fx + rel_m[0] * cells_per_m + up_m * sx, fy + rel_m[1] * cells_per_m + up_m * sy])
     }
 }
 
@@ -231,6 +242,32 @@ mod tests {
             assert_eq!(clear.sun_visible(rel), 1.0);
             assert!((overcast.sun_visible(rel) - 0.3).abs() < 1e-6, "{}", overcast.sun_visible(rel));
         }
+    }
+
+    /// On the Earth a point lies d² / 2R lower in the camera's frame than over its own ground, as
+    /// does the layer: the ground at the camera's level 10 km off sees the clouds the flat sheet's
+    /// ground there sees, where without the fall it would look 7.8 m further towards the sun.
+    #[test]
+    fn on_the_earth_the_layer_falls_with_the_ground() {
+        let sun = DVec3::new(0.3, 0.4, 0.5).normalize();
+        let (camera, fall) = (DVec3::new(5000.0, 8000.0, 700.0), 1.0 / (2.0 * 6.371e6));
+        let flat = CloudShadowFrame::new(&cloudy(0.5), sun, 500.0, camera, 10.0);
+        let earth = flat.on_earth(fall);
+        assert_eq!(
+            CloudShadowFrame::new(&cloudy(0.0), sun, 500.0, camera, 10.0).on_earth(fall).shift[3],
+            0.0
+        );
+        let (mut worst, mut unfallen) = (0.0f32, 0.0f32);
+        for k in 0..200 {
+            let angle = f64::from(k) * 0.1;
+            let [x, y] = [(10_000.0 * angle.cos()) as f32, (10_000.0 * angle.sin()) as f32];
+            let below = -(fall * f64::from(x * x + y * y)) as f32;
+            let seen = earth.density_at([x, y, below]);
+            worst = worst.max((seen - flat.density_at([x, y, 0.0])).abs());
+            unfallen = unfallen.max((flat.density_at([x, y, below]) - flat.density_at([x, y, 0.0])).abs());
+        }
+        println!("10 km off: {worst} of the noise from the flat sheet's (without the fall: {unfallen})");
+        assert!(worst < 1e-3 && unfallen > 10.0 * worst.max(1e-4), "{worst} {unfallen}");
     }
 
     #[test]

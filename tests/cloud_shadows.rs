@@ -5,7 +5,9 @@
 //!   the clouds shows the cloudless frame, bit for bit;
 //! - no clouds (coverage 0, or no depth to them) is the cloudless frame bit for bit, whatever the
 //!   other knobs and the time;
-//! - they drift: a minute later other pixels are in shadow.
+//! - they drift: a minute later other pixels are in shadow;
+//! - on the Earth (a synthetic dataset placed on nc's State Plane) the first holds too, the layer
+//!   falling with the ground.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use terramp::camera::Camera;
@@ -13,6 +15,7 @@ use terramp::config::{CloudSettings, Settings};
 use terramp::frame::Renderer;
 use terramp::gpu::layout::CLOUD_EDGE;
 use terramp_testkit::audit::Rays;
+use terramp_testkit::earth::synth_on_nc;
 use terramp_testkit::{camera, differing_pixels, renderer, settled_colour, small_settings, synth_dataset};
 
 const IMAGE_PX: [u32; 2] = [320, 180];
@@ -29,15 +32,19 @@ fn settings(impostors: &str) -> Settings {
     s
 }
 
-fn pose(r: &Renderer) -> Camera {
-    camera::over_fraction(r, [0.45, 0.35], 25.0, 20.0, -10.0)
+/// The view: `above_m` over the ground, looking 10° down.
+fn pose(r: &Renderer, above_m: f64) -> Camera {
+    camera::over_fraction(r, [0.45, 0.35], above_m, 20.0, -10.0)
 }
 
-/// The settled frame of `r` under `clouds` at the scene's time `time_s`.
-fn frame(r: &mut Renderer, clouds: CloudSettings, time_s: f64) -> image::RgbaImage {
+/// The flat views' height over the ground, metres.
+const ABOVE_M: f64 = 25.0;
+
+/// The settled frame of `r` under `clouds` at the scene's time `time_s`, from `above_m` up.
+fn frame(r: &mut Renderer, clouds: CloudSettings, time_s: f64, above_m: f64) -> image::RgbaImage {
     r.settings.clouds = clouds;
     r.set_time_s(time_s);
-    let camera = pose(r);
+    let camera = pose(r, above_m);
     settled_colour(r, &camera)
 }
 
@@ -54,17 +61,36 @@ struct Judged {
 fn ground_and_seeds_are_shaded_alike_where_the_field_says() {
     let Some(impostors) = terramp_testkit::nc_impostors() else { return };
     let dir = synth_dataset(300, 7);
-    let base = settings(impostors.to_str().unwrap());
+    shaded_alike(impostors.to_str().unwrap(), &|s| renderer(&dir, s), [ABOVE_M, 150.0]);
+}
+
+/// The same on the Earth (a synthetic dataset 9 km across placed on nc's State Plane, seen from
+/// 400 m up across most of it), where the layer falls with the ground: 0.5 m 2.5 km away, 6 m at
+/// the far edge.
+#[test]
+fn on_the_earth_ground_and_seeds_are_shaded_alike_where_the_field_says() {
+    let Some(impostors) = terramp_testkit::nc_impostors() else { return };
+    let make = |s| Renderer::new(terramp_testkit::gpu(), synth_on_nc(300, 30.0, 7), s).unwrap();
+    // Clouds 25 m across, so that the fall moves the far ground's lookup across many of them.
+    shaded_alike(impostors.to_str().unwrap(), &make, [400.0, 25.0]);
+}
+
+/// Renders a view from `above_m` under half cover, overcast and clear, of clouds `scale_m` across,
+/// with renderers `make` makes, and checks every pixel the twin puts well inside or well clear of
+/// a cloud.
+fn shaded_alike(impostors: &str, make: &dyn Fn(Settings) -> Renderer, [above_m, scale_m]: [f64; 2]) {
+    let mut base = settings(impostors);
+    base.clouds.scale_m = scale_m;
     let half = CloudSettings { coverage: 0.5, ..base.clouds.clone() };
     let overcast = CloudSettings { coverage: 1.0, ..base.clouds.clone() };
-    let ground = frame(&mut renderer(&dir, settings("")), half.clone(), 0.0);
-    let mut r = renderer(&dir, base.clone());
-    let clear = frame(&mut r, base.clouds.clone(), 0.0);
-    let grey = frame(&mut r, overcast, 0.0);
-    let shaded = frame(&mut r, half, 0.0);
+    let ground = frame(&mut make(settings("")), half.clone(), 0.0, above_m);
+    let mut r = make(base.clone());
+    let clear = frame(&mut r, base.clouds.clone(), 0.0, above_m);
+    let grey = frame(&mut r, overcast, 0.0, above_m);
+    let shaded = frame(&mut r, half, 0.0, above_m);
     let clouds = r.last_clouds().unwrap();
     let depth = r.read_depth().unwrap();
-    let camera = pose(&r);
+    let camera = pose(&r, above_m);
     let rays = Rays::new(&r, &camera);
 
     let threshold = clouds.field[3];
@@ -110,16 +136,24 @@ fn no_clouds_is_the_cloudless_frame_bit_for_bit_and_clouds_drift() {
     let dir = synth_dataset(300, 7);
     let base = settings(impostors.to_str().unwrap());
     let mut r = renderer(&dir, base.clone());
-    let cloudless = frame(&mut r, base.clouds.clone(), 0.0);
+    let cloudless = frame(&mut r, base.clouds.clone(), 0.0, ABOVE_M);
     let still = CloudSettings { scale_m: 900.0, speed_m_s: 40.0, from_deg: 12.0, ..base.clouds.clone() };
     let no_depth = CloudSettings { coverage: 0.7, shadow_depth: 0.0, ..base.clouds.clone() };
-    assert_eq!(differing_pixels(&cloudless, &frame(&mut r, still, 321.0)), 0, "coverage 0 changed the frame");
-    assert_eq!(differing_pixels(&cloudless, &frame(&mut r, no_depth, 5.0)), 0, "depth 0 changed the frame");
+    assert_eq!(
+        differing_pixels(&cloudless, &frame(&mut r, still, 321.0, ABOVE_M)),
+        0,
+        "coverage 0 changed the frame"
+    );
+    assert_eq!(
+        differing_pixels(&cloudless, &frame(&mut r, no_depth, 5.0, ABOVE_M)),
+        0,
+        "depth 0 changed the frame"
+    );
 
     let cloudy = CloudSettings { coverage: 0.4, speed_m_s: 5.0, ..base.clouds.clone() };
-    let now = frame(&mut r, cloudy.clone(), 0.0);
-    let later = frame(&mut r, cloudy.clone(), 60.0);
-    let again = frame(&mut r, cloudy, 0.0);
+    let now = frame(&mut r, cloudy.clone(), 0.0, ABOVE_M);
+    let later = frame(&mut r, cloudy.clone(), 60.0, ABOVE_M);
+    let again = frame(&mut r, cloudy, 0.0, ABOVE_M);
     let (shaded, moved) = (differing_pixels(&cloudless, &now), differing_pixels(&now, &later));
     println!("clouds shaded {shaded} pixels, a minute later {moved} of them changed");
     assert_eq!(differing_pixels(&now, &again), 0, "the same time shows other clouds");

@@ -2,7 +2,7 @@
 // `field`: where the camera's sun ray meets the cloud layer, in cells of the largest octave modulo
 // the period (xy), cells per metre (z), the noise threshold of a cloud's edge (w); `shift`: cells
 // the meeting point moves per metre of height (xy), the share of sunlight a cloud's core holds
-// back (z, 0: no clouds).
+// back (z, 0: no clouds), the Earth's fall per square metre from the camera (w, 0 flat).
 
 // The value of lattice point `i` of octave `octave`, 0 to 1, repeating every period.
 fn cloud_lattice(i: vec2<i32>, octave: u32) -> f32 {
@@ -43,6 +43,8 @@ fn sun_through_clouds(field: vec4<f32>, shift: vec4<f32>, rel_m: vec3<f32>) -> f
     if shift.z <= 0.0 {
         return 1.0;
     }
-    let q = field.xy + rel_m.xy * field.z + rel_m.z * shift.xy;
+    // Its height over the layer's shell: the camera frame's, plus the Earth's fall (0 flat).
+    let up_m = rel_m.z + shift.w * (rel_m.x * rel_m.x + rel_m.y * rel_m.y);
+    let q = field.xy + rel_m.xy * field.z + up_m * shift.xy;
     return 1.0 - shift.z * smoothstep(field.w - CLOUD_EDGE, field.w + CLOUD_EDGE, cloud_density(q));
 }

@@ -7,6 +7,7 @@
 use glam::DVec3;
 
 use crate::camera::{Camera, Frustum};
+use crate::earth::horizon::fall_per_m2;
 use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::{EarthNode, TerrainUniforms};
 use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms};
@@ -172,8 +173,15 @@ impl Renderer {
         report.nodes_drawn = batches.len();
         report.nodes_dropped = dropped;
         let clip = view.clip_from_view_world.as_mat4();
-        let uniforms =
-            terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR, self.time_s);
+        let fall = fall_per_m2(&view.nadir);
+        let uniforms = terrain_uniforms(
+            &self.dataset,
+            &self.settings,
+            view.grid_m,
+            clip,
+            SKY_LINEAR,
+            [self.time_s, fall],
+        );
         let nodes = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
         if let Some(stage) = self.texcells.as_mut() {
             let texcell_view = TexcellView {

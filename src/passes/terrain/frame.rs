@@ -64,22 +64,24 @@ impl NodeBatches {
 }
 
 /// The terrain passes' uniforms for a camera at `camera_grid_m` (grid space) with `clip` the
-/// clip-from-camera-relative-world matrix, at the scene's time `time_s` (the clouds' drift);
-/// `sky_linear` is also the haze colour.
+/// clip-from-camera-relative-world matrix, at the scene's time `time_s` (the clouds' drift), over
+/// ground falling away from the camera by `fall_per_m2` d² (`earth::horizon::fall_per_m2`, 0
+/// flat); `sky_linear` is also the haze colour.
 pub fn terrain_uniforms(
     dataset: &Dataset,
     settings: &Settings,
     camera_grid_m: DVec3,
     clip: glam::Mat4,
     sky_linear: [f64; 3],
-    time_s: f64,
+    [time_s, fall_per_m2]: [f64; 2],
 ) -> TerrainUniforms {
     let r = &settings.render;
     let manifest = &dataset.manifest;
     let sun = sun_dir(r);
     let half_spacing = 0.5 * manifest.height.spacing_m;
     let clouds =
-        CloudShadowFrame::new(&settings.clouds, sun, manifest.height.max_m as f64, camera_grid_m, time_s);
+        CloudShadowFrame::new(&settings.clouds, sun, manifest.height.max_m as f64, camera_grid_m, time_s)
+            .on_earth(fall_per_m2);
     let mut uniforms = TerrainUniforms {
         clip_from_view_world: clip.to_cols_array_2d(),
         sun_dir: sun.as_vec3().extend(0.0).to_array(),
