@@ -124,21 +124,33 @@ pub struct EcefNode {
 
 impl EcefNode {
     /// The mapping around CRS point `origin_m` (x, y and a height): central differences of the
-    /// exact mapping `DIFFERENCE_STEP_M` apart.
+    /// exact mapping `DIFFERENCE_STEP_M` apart, the geoid held at its undulation at the origin; the
+    /// geoid then enters to the first order only, along the normal, by its slope over the same
+    /// step. Its lattice is bilinear, kinked along its nodes' meridians and parallels: a second
+    /// difference across a kink would turn a slope's jump into a curvature (1.6 m at the corners
+    /// of a node 10 km across, 100 m from a kink, under a lattice whose nodes differ by a metre).
     pub fn at(earth: &EarthFrame, origin_m: DVec3) -> Self {
         let s = DIFFERENCE_STEP_M;
-        let at = |dx: f64, dy: f64, dh: f64| earth.ecef_m(origin_m.x + dx, origin_m.y + dy, origin_m.z + dh);
+        let held_m = origin_m.z + earth.undulation_m(origin_m.x, origin_m.y);
+        let at = |dx: f64, dy: f64, dh: f64| {
+            earth.ecef_above_ellipsoid_m(origin_m.x + dx, origin_m.y + dy, held_m + dh)
+        };
+        let slope = |ux: f64, uy: f64| {
+            let n = |k: f64| earth.undulation_m(origin_m.x + k * ux, origin_m.y + k * uy);
+            (n(s) - n(-s)) / (2.0 * s)
+        };
         let p0 = at(0.0, 0.0, 0.0);
         let [east, west, north, south] =
             [at(s, 0.0, 0.0), at(-s, 0.0, 0.0), at(0.0, s, 0.0), at(0.0, -s, 0.0)];
         let corners = (at(s, s, 0.0) - at(s, -s, 0.0)) - (at(-s, s, 0.0) - at(-s, -s, 0.0));
         // Linear in the height: the rise of one step is exact, wherever it is taken.
         let up_at = |dx: f64, dy: f64| (at(dx, dy, s) - at(dx, dy, 0.0)) / s;
+        let d_h = up_at(0.0, 0.0);
         Self {
             origin_m: p0,
-            d_x: (east - west) / (2.0 * s),
-            d_y: (north - south) / (2.0 * s),
-            d_h: up_at(0.0, 0.0),
+            d_x: (east - west) / (2.0 * s) + d_h * slope(1.0, 0.0),
+            d_y: (north - south) / (2.0 * s) + d_h * slope(0.0, 1.0),
+            d_h,
             d_xx: ((east - p0) + (west - p0)) / (2.0 * s * s),
             d_xy: corners / (4.0 * s * s),
             d_yy: ((north - p0) + (south - p0)) / (2.0 * s * s),

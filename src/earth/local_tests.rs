@@ -108,3 +108,48 @@ fn the_curvature_terms_are_what_bend_a_node() {
     let drop_m = 50_000_000.0 / (2.0 * 6.38e6);
     assert!(((unbent - exact).length() - drop_m).abs() < 0.1 * drop_m, "{unbent} against {exact}");
 }
+
+/// The geoid enters a node's mapping to the first order: a kink of its bilinear lattice (a node
+/// meridian 100 m from the node's origin) costs the polynomial the slope's jump times the distance
+/// past it, growing with the node's size (twice as large a node, about twice the miss), where
+/// second differences across the kink would turn it into a curvature (about four times); inside
+/// a lattice cell the node misses by the ellipsoid's third order alone. The lattice's nodes differ
+/// by up to 2 m.
+#[test]
+fn a_kink_in_the_geoid_costs_a_slope_not_a_curvature() {
+    let mut frame = nc();
+    let (w, h) = (24u32, 16u32);
+    let undulation_m: Vec<f32> =
+        (0..w * h).map(|i| -34.0 + (i.wrapping_mul(2_654_435_761) >> 24) as f32 / 128.0).collect();
+    frame.geoid = Some(crate::earth::GeoidLattice {
+        name: "test".into(),
+        south_west_deg: [33.0, -82.0],
+        step_deg: 0.25,
+        size: [w, h],
+        undulation_m,
+        interpolation_error_m: 0.0,
+    });
+    let [x_line, y_line] =
+        frame.projection.forward(&frame.ellipsoid, 35.6f64.to_radians(), (-78.75f64).to_radians());
+    let miss = |dx: f64, side_m: f64| {
+        let origin = DVec3::new(x_line + dx, y_line, 0.0);
+        let node = EcefNode::at(&frame, origin);
+        let mut worst = 0.0f64;
+        for j in 0..=8 {
+            for i in 0..=8 {
+                let f = |k: i32| (f64::from(k) / 8.0 - 0.5) * side_m;
+                let offset = DVec3::new(f(i), f(j), 0.0);
+                let p = origin + offset;
+                worst = worst.max((node.position_m(offset) - frame.ecef_m(p.x, p.y, p.z)).length());
+            }
+        }
+        worst
+    };
+    let [near_5, near_10, inside_10] =
+        [miss(100.0, 5_000.0), miss(100.0, 10_000.0), miss(11_000.0, 10_000.0)];
+    println!(
+        "100 m from a kink: {near_5:.4} m (5 km node), {near_10:.4} m (10 km); inside a cell: {inside_10:.4} m"
+    );
+    assert!(near_10 < 3.0 * near_5, "{near_5} {near_10}: the kink bends the polynomial");
+    assert!(inside_10 < 0.005, "{inside_10}");
+}

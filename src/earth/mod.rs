@@ -161,7 +161,27 @@ impl EarthFrame {
     /// `height_m` along the normal.
     pub fn ecef_m(&self, x_m: f64, y_m: f64, height_m: f64) -> DVec3 {
         let (lat, lon) = self.geodetic(x_m, y_m);
-        let height_m = height_m + self.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon));
+        self.ecef_geodetic_m(lat, lon, height_m + self.undulation_at(lat, lon))
+    }
+
+    /// The geoid's undulation at CRS point (`x_m`, `y_m`), metres (0 without one).
+    pub fn undulation_m(&self, x_m: f64, y_m: f64) -> f64 {
+        let (lat, lon) = self.geodetic(x_m, y_m);
+        self.undulation_at(lat, lon)
+    }
+
+    /// The WGS 84 Earth-centred position of CRS point (`x_m`, `y_m`) at `height_m` above the
+    /// datum's ellipsoid (no geoid added).
+    pub fn ecef_above_ellipsoid_m(&self, x_m: f64, y_m: f64, height_m: f64) -> DVec3 {
+        let (lat, lon) = self.geodetic(x_m, y_m);
+        self.ecef_geodetic_m(lat, lon, height_m)
+    }
+
+    fn undulation_at(&self, lat: f64, lon: f64) -> f64 {
+        self.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon))
+    }
+
+    fn ecef_geodetic_m(&self, lat: f64, lon: f64, height_m: f64) -> DVec3 {
         match self.to_wgs84 {
             // PROJ's null step takes the coordinates as WGS 84's: on WGS 84's ellipsoid.
             DatumShift::None => Ellipsoid::WGS84.ecef_m(lat, lon, height_m),
