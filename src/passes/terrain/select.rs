@@ -179,9 +179,8 @@ fn distance_to_box(p: DVec3, (min, max): (DVec3, DVec3)) -> f64 {
 /// Earth, bent), its LOD chosen by its distance on the flat sheet (as the shader's morph measures
 /// it; the bend changes a distance by less than the drop over it, 785 m in 100 km), and split
 /// further where its mapping would misplace its ground by more than `Lods::placing_miss_at_1m`
-/// allows. `bounds`
-/// gives a node's height range. With `horizon` (the dataset's lowest ground, metres), a node the
-/// Earth hides from the camera is culled too (`PlacedView::hidden_by_earth`).
+/// allows. `bounds` gives a node's height range. With `horizon` (the dataset's lowest ground,
+/// metres), a node the Earth hides from the camera is culled too (`PlacedView::hidden_by_earth`).
 pub fn select(
     lods: &Lods,
     placed: &mut PlacedView,
