@@ -7,7 +7,9 @@
 //! drawn as is when its box lies beyond the finer LOD's range, and split otherwise; quadrants whose
 //! child would lie outside the finer range are drawn by the parent (a quadrant mask), exactly as
 //! Strugar does. Morphing starts at `morph_start[m]` and completes at `range[m]`, where the coarser
-//! LOD takes over, which is what keeps neighbouring LODs crack-free.
+//! LOD takes over, which is what keeps neighbouring LODs crack-free. On the Earth a node is also
+//! split, whatever its ring, while its mapping would misplace its ground by more than
+//! `terrain.placing_miss_px` pixels (only nodes hundreds of kilometres across, seen from high up).
 
 use std::collections::HashMap;
 
