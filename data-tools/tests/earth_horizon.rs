@@ -253,8 +253,7 @@ fn from_1000_km_the_horizon_dips_as_the_ellipsoid_says() {
     let dir = TempDir::new("earth-horizon-1000km");
     let dataset = sea_level(dir.path(), 0.1, 720);
     let earth = dataset.manifest.earth.clone().unwrap();
-    let (lat, lon) = earth.geodetic(0.0, 0.0);
-    let sea_m = earth.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon));
+    let sea_m = earth.undulation_m(0.0, 0.0);
     let (height_m, pitch_deg) = (1_000_000.0, -25.0);
     let mut r = renderer(dataset);
     let camera = Camera { pitch_deg, ..camera(height_m) };

@@ -64,8 +64,7 @@ fn view(dataset: &Arc<Dataset>, camera: &Camera, placing_miss_px: f64) -> Seen {
     let metres_per_pixel_at_1m = camera.metres_per_pixel(1.0, SIZE[1]);
     let earth = dataset.manifest.earth.clone().unwrap();
     let frame = LocalFrame::grid_aligned(&earth, 0.0, 0.0, camera.position_m.z);
-    let (lat, lon) = earth.geodetic(0.0, 0.0);
-    let sea_m = earth.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon));
+    let sea_m = earth.undulation_m(0.0, 0.0);
     let e = Ellipsoid::WGS84;
     let scale = DVec3::new(e.a_m + sea_m, e.a_m + sea_m, e.b_m() + sea_m).recip();
     let eye = frame.eye_ecef_m * scale;

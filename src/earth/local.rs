@@ -127,8 +127,8 @@ impl EcefNode {
     /// exact mapping `DIFFERENCE_STEP_M` apart, the geoid held at its undulation at the origin; the
     /// geoid then enters to the first order only, along the normal, by its slope over the same
     /// step. Its lattice is bilinear, kinked along its nodes' meridians and parallels: a second
-    /// difference across a kink would turn a slope's jump into a curvature (1.6 m at the corners
-    /// of a node 10 km across, 100 m from a kink, under a lattice whose nodes differ by a metre).
+    /// difference across a kink would turn a slope's jump into a curvature, a miss growing with
+    /// the square of the node's size (`a_kink_in_the_geoid_costs_a_slope_not_a_curvature`).
     pub fn at(earth: &EarthFrame, origin_m: DVec3) -> Self {
         let s = DIFFERENCE_STEP_M;
         let held_m = origin_m.z + earth.undulation_m(origin_m.x, origin_m.y);

@@ -204,7 +204,7 @@ impl EarthFrame {
             }
         };
         let [x_m, y_m] = self.projection.forward(&self.ellipsoid, lat, lon);
-        DVec3::new(x_m, y_m, height_m - self.geoid.as_ref().map_or(0.0, |g| g.undulation_at(lat, lon)))
+        DVec3::new(x_m, y_m, height_m - self.undulation_at(lat, lon))
     }
 }
 

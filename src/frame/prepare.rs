@@ -174,14 +174,8 @@ impl Renderer {
         report.nodes_dropped = dropped;
         let clip = view.clip_from_view_world.as_mat4();
         let fall = fall_per_m2(&view.nadir);
-        let uniforms = terrain_uniforms(
-            &self.dataset,
-            &self.settings,
-            view.grid_m,
-            clip,
-            SKY_LINEAR,
-            [self.time_s, fall],
-        );
+        let uniforms =
+            terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR, self.time_s, fall);
         let nodes = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
         if let Some(stage) = self.texcells.as_mut() {
             let texcell_view = TexcellView {

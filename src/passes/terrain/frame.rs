@@ -73,7 +73,8 @@ pub fn terrain_uniforms(
     camera_grid_m: DVec3,
     clip: glam::Mat4,
     sky_linear: [f64; 3],
-    [time_s, fall_per_m2]: [f64; 2],
+    time_s: f64,
+    fall_per_m2: f64,
 ) -> TerrainUniforms {
     let r = &settings.render;
     let manifest = &dataset.manifest;

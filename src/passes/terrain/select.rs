@@ -72,7 +72,9 @@ impl Lods {
         spacing_m: f64,
         cells: u32,
         metres_per_pixel_at_1m: f64,
-        [triangle_px, morph_fraction, placing_miss_px]: [f64; 3],
+        triangle_px: f64,
+        morph_fraction: f64,
+        placing_miss_px: f64,
     ) -> Self {
         let levels = pyramid.levels;
         let range_m: Vec<f64> = (0..levels)
@@ -109,7 +111,9 @@ impl Lods {
             dataset.manifest.height.spacing_m,
             settings.node_cells,
             camera.metres_per_pixel(1.0, height_px),
-            [settings.triangle_px, settings.morph_fraction, settings.placing_miss_px],
+            settings.triangle_px,
+            settings.morph_fraction,
+            settings.placing_miss_px,
         )
     }
 
