@@ -49,6 +49,7 @@ docs/photo_nc.png                         photo              shared   long
 docs/earth_globe_12km.png                 earth              shared   short
 docs/earth_nc_descent.png                 earth_nc           shared   short
 docs/earth_globe_orbit.png                earth_orbit        shared   short
+docs/atmosphere_sky.png                   atmosphere         shared   short
 docs/flight_0.png                         streaming          -        long
 docs/flight_1.png                         streaming          -        long
 docs/flight_2.png                         streaming          -        long
@@ -392,6 +393,35 @@ make_earth_orbit() {
         shots+=("$out/earth_orbit_${pose//,/_}.png")
     done
     compose --columns 1 --scale 0.75 --gap 4 --out docs/earth_globe_orbit.png "${shots[@]}"
+}
+
+# The sky from the atmosphere pass (docs/atmosphere.md): nc from 1,500 m looking west, 3° up, the
+# sun in the west at 40°, 8° and 1° (the ground keeps today's fixed haze until aerial perspective
+# lands); GLOBE from 400 km over its centre looking 10° down, haze off (the sky marched per pixel,
+# the limb). nc on the Earth as make_earth_nc finds it; GLOBE as make_earth builds it.
+make_atmosphere() {
+    local nc="$data/nc" globe="$data/globe" shots=() elevation sun
+    trade_data
+    if ! grep -q '^\[earth\]' "$nc/manifest.toml"; then
+        nc="$data/nc_earth"
+        [[ -f $nc/manifest.toml ]] || "$terramp_data" build --dem "$shared/nc/elev_ned_30m.tif" \
+            --imagery "$shared/nc/landsat_multiband.tif" --bands 3,2,1 \
+            --landcover "$shared/nc/landuse_r.tif" --classes nc --out "$nc" >/dev/null
+    fi
+    if ! grep -q '^\[earth\]' "$globe/manifest.toml" 2>/dev/null; then
+        "$terramp_data" build --dem "$shared/globe/globe_g_30arcsec.tif" --out "$globe" >/dev/null
+    fi
+    for elevation in 40 8 1; do
+        sun=$(layer "atmosphere_sun_$elevation" '[render]' 'sun_azimuth_deg = 270.0' "sun_elevation_deg = $elevation.0")
+        "$terramp" render --dataset "$nc" --camera 637500,221750,1500,270,3 --width 640 --height 360 \
+            --settings "$sun" --out "$out/atmosphere_nc_$elevation.png" >/dev/null
+        shots+=("$out/atmosphere_nc_$elevation.png")
+    done
+    sun=$(layer atmosphere_orbit '[render]' 'sun_elevation_deg = 20.0' 'haze_half_distance_m = 1e12')
+    "$terramp" render --dataset "$globe" --camera lonlat:45,25,400000,0,-10 --width 640 --height 360 \
+        --settings "$sun" --out "$out/atmosphere_globe_400km.png" >/dev/null
+    shots+=("$out/atmosphere_globe_400km.png")
+    compose --columns 2 --scale 0.75 --gap 4 --out docs/atmosphere_sky.png "${shots[@]}"
 }
 
 make_trees_health() {

@@ -14,6 +14,7 @@ use toml::{Table, Value};
 
 use crate::gpu::AdapterChoice;
 
+mod atmosphere;
 mod clouds;
 mod draw_seeds;
 mod faults;
@@ -23,6 +24,7 @@ mod texcells;
 mod tlm;
 mod wind;
 
+pub use atmosphere::AtmosphereSettings;
 pub use clouds::CloudSettings;
 pub use draw_seeds::DrawSeedsSettings;
 pub use faults::FaultSettings;
@@ -133,6 +135,8 @@ pub struct Settings {
     pub wind: WindSettings,
     /// `[clouds]`: the shadows of clouds drifting over the land.
     pub clouds: CloudSettings,
+    /// `[atmosphere]`: the air the sky is drawn from.
+    pub atmosphere: AtmosphereSettings,
     /// `[faults]`: faults injected into tile streaming (tests and soak runs; none by default).
     pub faults: FaultSettings,
 }
@@ -383,6 +387,7 @@ impl Settings {
         self.texcells.validate(&self.draw_seeds)?;
         self.wind.validate()?;
         self.clouds.validate()?;
+        self.atmosphere.validate()?;
         self.faults.validate()?;
         first_out_of_range(checks)
     }

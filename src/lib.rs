@@ -8,6 +8,7 @@
 //! behind it is `DESIGN.md` in the shared folder.
 #![warn(missing_docs)]
 
+pub mod atmosphere;
 #[cfg(feature = "bake")]
 pub mod bake;
 pub mod camera;

@@ -98,7 +98,7 @@ fn module_edges() -> BTreeMap<String, BTreeSet<String>> {
 /// ARCHITECTURE.md's layers, lowest first: a module may import only from lower layers.
 const LAYERS: &[&[&str]] = &[
     &["gpu", "camera", "publish"],
-    &["earth"],
+    &["earth", "atmosphere"],
     &["config", "dataset", "path", "impostor"],
     &["classes", "streaming"],
     &["seeds", "synth", "tree"],

@@ -13,6 +13,8 @@
 //!   its source changes what the check reads.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
+#[path = "docs_claims/atmosphere.rs"]
+mod atmosphere;
 #[path = "docs_claims/claims.rs"]
 mod claims;
 #[path = "docs_claims/presets.rs"]
@@ -20,8 +22,14 @@ mod presets;
 
 use std::path::PathBuf;
 
+use atmosphere::ATMOSPHERE_CLAIMS;
 use claims::{CLAIMS, Claim, Format, Source};
 use presets::PRESET_ROWS;
+
+/// Every claim, of every page.
+fn all_claims() -> impl Iterator<Item = &'static Claim> {
+    CLAIMS.iter().chain(ATMOSPHERE_CLAIMS)
+}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -151,12 +159,12 @@ fn check(claim: &Claim, read: &dyn Fn(&str) -> String) -> Result<String, String>
 
 #[test]
 fn every_quoted_number_is_the_constant_it_quotes() {
-    let failures: Vec<String> = CLAIMS.iter().filter_map(|c| check(c, &read).err()).collect();
+    let failures: Vec<String> = all_claims().filter_map(|c| check(c, &read).err()).collect();
     assert!(
         failures.is_empty(),
         "{} of {} claims fail:\n{}",
         failures.len(),
-        CLAIMS.len(),
+        all_claims().count(),
         failures.join("\n")
     );
 }
@@ -277,8 +285,7 @@ fn every_quoted_tolerance_is_a_claim() {
     let mut unclaimed = Vec::new();
     for page in &pages {
         let text = flat(&read(page));
-        let spans: Vec<(usize, usize)> = CLAIMS
-            .iter()
+        let spans: Vec<(usize, usize)> = all_claims()
             .filter(|c| c.doc == page)
             .filter_map(|c| check(c, &read).ok())
             .flat_map(|words| text.match_indices(&words).map(|(i, w)| (i, i + w.len())).collect::<Vec<_>>())
@@ -303,7 +310,7 @@ fn every_quoted_tolerance_is_a_claim() {
 
 #[test]
 fn a_claim_with_other_numbers_is_not_on_its_page() {
-    for claim in CLAIMS {
+    for claim in all_claims() {
         // Each number off by a tenth and one: what a changed constant or a stale page would read.
         let other: Vec<(f64, Format)> =
             numbers(claim, &read).unwrap().into_iter().map(|(v, format)| (v * 1.1 + 1.0, format)).collect();
@@ -315,7 +322,7 @@ fn a_claim_with_other_numbers_is_not_on_its_page() {
         );
     }
     // A constant changed in its source is read as changed, and the claim then fails.
-    let truth = CLAIMS.iter().find(|c| c.quote.contains("tolerance {})")).unwrap();
+    let truth = all_claims().find(|c| c.quote.contains("tolerance {})")).unwrap();
     let Source::Const { file, name } = truth.values[0].0 else {
         panic!("the control claim reads a constant")
     };

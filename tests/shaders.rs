@@ -182,12 +182,13 @@ fn binding_mismatch(module: &Module, global: &naga::GlobalVariable, b: &Binding)
             AddressSpace::Handle,
             TypeInner::Image { dim, arrayed, class },
         ) => {
+            use naga::StorageFormat as Naga;
+            use wgpu::TextureFormat as Wgpu;
             let format_ok = matches!(
                 (format, class),
-                (
-                    wgpu::TextureFormat::R32Float,
-                    ImageClass::Storage { format: naga::StorageFormat::R32Float, .. }
-                )
+                (Wgpu::R32Float, ImageClass::Storage { format: Naga::R32Float, .. })
+                    | (Wgpu::Rgba32Float, ImageClass::Storage { format: Naga::Rgba32Float, .. })
+                    | (Wgpu::Rgba16Float, ImageClass::Storage { format: Naga::Rgba16Float, .. })
             );
             format_ok && dims(dimension) == (*dim, *arrayed)
         }

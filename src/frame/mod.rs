@@ -18,6 +18,7 @@ use crate::gpu::fragments::{CountedPass, FragmentCounter, PassFragments};
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
+use crate::passes::atmosphere::gpu::AtmospherePass;
 use crate::passes::depth_pyramid::gpu::DepthPyramid;
 use crate::passes::ground::gpu::GroundPass;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
@@ -142,6 +143,8 @@ pub struct Renderer {
     terrain: TerrainPass,
     terrain_bindings: wgpu::BindGroup,
     ground: GroundPass,
+    /// The air's tables and the sky drawn from them.
+    atmosphere: AtmospherePass,
     depth_pyramid: DepthPyramid,
     tlm: TileLoadMapPass,
     tlm_bindings: TlmBindings,
@@ -182,6 +185,7 @@ impl Renderer {
         let terrain = TerrainPass::new(device, &settings);
         let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
         let ground = GroundPass::new(device, &settings, software, &terrain);
+        let atmosphere = AtmospherePass::new(&gpu, &settings.atmosphere);
         let caches = Caches::new(&gpu, &dataset, &settings)?;
         let loader = Loader::new(
             Arc::clone(&dataset),
@@ -230,6 +234,7 @@ impl Renderer {
             terrain,
             terrain_bindings,
             ground,
+            atmosphere,
             depth_pyramid,
             tlm,
             tlm_bindings,
@@ -369,6 +374,9 @@ impl Renderer {
         p.pass(gpu, encoder, "ground", |e| {
             self.ground.encode(e, mesh, &t.colour_view, &t.depth_view, SKY_LINEAR)
         })?;
+        // The sky: the air's light seen from the camera's altitude, drawn where nothing was.
+        p.pass(gpu, encoder, "sky_view", |e| self.atmosphere.encode_sky_view(e))?;
+        p.pass(gpu, encoder, "sky", |e| self.atmosphere.encode_sky(e, &t.colour_view, &t.depth_view))?;
         if let Some(stage) = &self.texcells {
             // The far forest: slices of the dense classes' samples over the ground beyond the seeds.
             let draw = |e: &mut _, count: Option<CountedPass<'_>>| stage.encode(e, mesh, targets, count);

@@ -10,6 +10,8 @@ use crate::camera::{Camera, Frustum};
 use crate::earth::horizon::fall_per_m2;
 use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::{EarthNode, TerrainUniforms};
+use crate::light::sun_dir;
+use crate::passes::atmosphere::frame::SkyView;
 use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms};
 use crate::passes::terrain::gpu::PreparedNodes;
 use crate::passes::terrain::select::{Lods, Selected, select};
@@ -177,6 +179,14 @@ impl Renderer {
         let uniforms =
             terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR, self.time_s, fall);
         let nodes = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
+        // The camera's frame is its own local one, on the Earth or flat: its zenith is +z.
+        let sky = SkyView {
+            view_world_from_clip: view.clip_from_view_world.inverse(),
+            up: DVec3::Z,
+            sun_dir: sun_dir(&self.settings.render),
+            altitude_m: view.grid_m.z,
+        };
+        self.atmosphere.prepare(&self.gpu.queue, &sky);
         if let Some(stage) = self.texcells.as_mut() {
             let texcell_view = TexcellView {
                 camera_grid_m: view.grid_m,

@@ -335,6 +335,26 @@ wgsl_constants! { earth_constants:
     pub const EARTH_PROBE_WORKGROUP: u32 = 64;
 }
 
+// --- The atmosphere (`atmosphere`, `passes::atmosphere`) ---
+wgsl_constants! { atmosphere_constants:
+    /// π in f32, for the phase functions and the sky's angles.
+    pub const PI: f32 = std::f32::consts::PI;
+    /// Texels per side of a workgroup of the atmosphere's tables.
+    pub const ATMOSPHERE_WORKGROUP: u32 = 8;
+    /// Segments of the quadrature from a point to the top of the air (the transmittance table).
+    pub const TRANSMITTANCE_STEPS: u32 = 40;
+    /// Directions per side of the grid the multiple-scattering table gathers over (8 × 8 = 64
+    /// over the sphere, Hillaire's count).
+    pub const MULTIPLE_DIRECTIONS_SIDE: u32 = 8;
+    /// Segments along each of those directions.
+    pub const MULTIPLE_STEPS: u32 = 20;
+    /// Segments along a view ray of the sky-view table (and of the sky marched per pixel).
+    pub const SKY_VIEW_STEPS: u32 = 30;
+    /// Views higher than this above the ground, km, march the sky per pixel: from there the
+    /// limb's rows of the sky-view table span more than the air's scale height (docs/atmosphere.md).
+    pub const SKY_MARCHED_ABOVE_KM: f32 = 30.0;
+}
+
 // --- Wind (`seeds::wind`) ---
 wgsl_constants! { wind_constants:
     /// Share of a plant's mean lean that gusts take away between their crests (0: no gusts).
@@ -458,6 +478,7 @@ pub fn wgsl_constants() -> Vec<(&'static str, &'static str, String)> {
         cloud_constants(),
         light_constants(),
         earth_constants(),
+        atmosphere_constants(),
     ]
     .concat()
 }

@@ -56,6 +56,18 @@ pub fn compute_pipeline(
     })
 }
 
+/// The depth state of a pass that shades only where the depth already holds exactly what it
+/// draws (the ground over the terrain's depth; the sky over the far plane), writing none.
+pub fn depth_equal(format: wgpu::TextureFormat) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Equal),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
 /// A render pass drawing over the frame: `colour` loaded (or cleared to `clear`), `depth` loaded
 /// and kept, both stored; its draws may run the `occlusion` queries.
 pub fn frame_pass<'e>(

@@ -27,6 +27,8 @@ pub const DITHER: &str = include_str!("../../shaders/shared/dither.wgsl");
 pub const BLOCKS: &str = include_str!("../../shaders/shared/blocks.wgsl");
 /// The cloud shadows' field (`light`), the same for everything the sun lights.
 pub const CLOUDS: &str = include_str!("../../shaders/shared/clouds.wgsl");
+/// The atmosphere's model: media, phases, the shell's geometry, its tables' parametrisations.
+pub const ATMOSPHERE: &str = include_str!("../../shaders/shared/atmosphere.wgsl");
 /// The wind's bend of a plant (`seeds::wind`), the same for every representation that draws one.
 pub const WIND: &str = include_str!("../../shaders/shared/wind.wgsl");
 

@@ -13,6 +13,7 @@
 //! 3. `seed_select`: the seeds of the visible near cells, culled and classified;
 //! 4. `compact` and `draw_seeds`: the survivors grouped into indirect draws, and drawn.
 
+pub mod atmosphere;
 pub mod compact;
 pub mod depth_pyramid;
 pub mod draw_seeds;
@@ -41,11 +42,36 @@ pub const SHADERS: &[&WgslSource] = &[
     &compact::gpu::SHADER,
     &draw_seeds::gpu::SHADER,
     &crate::earth::gpu::SHADER,
+    &atmosphere::gpu::SHADER,
 ];
 
 /// Every pipeline's bind group and the shader entry points it serves: what the binding-table test
 /// checks against the WGSL.
 pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
+    PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
+        entry_points: &["transmittance_lut"],
+        group: 0,
+        bindings: &atmosphere::gpu::TRANSMITTANCE_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
+        entry_points: &["multiple_scattering_lut"],
+        group: 0,
+        bindings: &atmosphere::gpu::MULTIPLE_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
+        entry_points: &["sky_view_lut"],
+        group: 0,
+        bindings: &atmosphere::gpu::SKY_VIEW_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
+        entry_points: &["vs_sky", "fs_sky"],
+        group: 0,
+        bindings: &atmosphere::gpu::SKY_BINDINGS.bindings,
+    },
     PipelineBindings {
         shader: &crate::earth::gpu::SHADER,
         entry_points: &["probe_earth_positions", "probe_earth_stand"],

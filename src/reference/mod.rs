@@ -9,6 +9,7 @@
 //! against the paper's sorted one.
 
 pub mod accuracy;
+pub mod atmosphere;
 pub mod compact;
 pub mod depth_pyramid;
 pub mod frame_change;

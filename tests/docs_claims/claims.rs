@@ -137,7 +137,7 @@ pub fn on_off(v: f64) -> String {
 /// sets none).
 const FAULTS: &str = "let control = fly(";
 
-const fn test_const(file: &'static str, name: &'static str) -> Source {
+pub const fn test_const(file: &'static str, name: &'static str) -> Source {
     Source::Const { file, name }
 }
 

@@ -4,6 +4,7 @@
 //! layout (`struct_layout`). Fields are ordered so that WGSL's alignment rules add no hidden
 //! padding.
 
+mod atmosphere;
 mod compact;
 mod draw_seeds;
 mod earth;
@@ -12,6 +13,7 @@ mod terrain;
 mod texcells;
 mod tile_load_map;
 
+pub use atmosphere::AtmosphereUniforms;
 pub use compact::{CompactParams, SeedBlock, SeedDrawArgs};
 pub use draw_seeds::{DrawSeedsUniforms, SeedMaterial, SeedShape, SeedVertex};
 pub use earth::{EarthNode, EarthProbePoint};
@@ -48,6 +50,7 @@ pub fn layouts() -> Vec<StructLayout> {
         TexcellRecord::layout(),
         EarthNode::layout(),
         EarthProbePoint::layout(),
+        AtmosphereUniforms::layout(),
     ]
 }
 

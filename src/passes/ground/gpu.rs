@@ -2,7 +2,7 @@
 
 use crate::config::Settings;
 use crate::earth::gpu::EARTH;
-use crate::gpu::resources::{frame_pass, pipeline_layout};
+use crate::gpu::resources::{depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{CLOUDS, HASH, IMAGERY, TERRAIN_MESH, WgslSource};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
@@ -42,13 +42,7 @@ impl GroundPass {
                 targets: &[Some(COLOUR_FORMAT.into())],
             }),
             primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Equal),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: Some(depth_equal(DEPTH_FORMAT)),
             multisample: Default::default(),
             multiview_mask: None,
             cache: None,

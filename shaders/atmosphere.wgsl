@@ -1,0 +1,261 @@
+// The atmosphere pass (Hillaire 2020): three look-up tables made by compute, then the sky drawn
+// behind everything from them.
+// - `transmittance_lut`: per (r, μ), the share of light that crosses the air from there to its
+//   top, by quadrature of the extinction (made when the atmosphere changes).
+// - `multiple_scattering_lut`: per (altitude, sun's zenith cosine), the light of every order of
+//   scattering above the first, by Hillaire's approximation: the second order gathered from 64
+//   directions with an isotropic phase, ground included, and the higher orders as the geometric
+//   series of the share the air scatters back, Ψ = L₂ / (1 − f) (made when the atmosphere
+//   changes).
+// - `sky_view_lut`: per view direction from the camera's altitude, the light the air scatters
+//   towards it (single scattering with the true phases and the sun's transmittance from the
+//   table, plus Ψ), up to the ground or the top (made each frame: it depends on the camera's
+//   altitude and the sun).
+// - `vs_sky`, `fs_sky`: where the depth is still the far plane (reversed-Z 0), the sky from the
+//   sky-view table, and the sun's disk through the air.
+// Radiances are per unit of the sun's irradiance; the sky is drawn in the ground's units (a white
+// plate facing the sun reflects `GROUND_SUN`: × π `GROUND_SUN`).
+
+@group(0) @binding(0) var<uniform> atmosphere: AtmosphereUniforms;
+@group(0) @binding(1) var transmittance_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(2) var transmittance: texture_2d<f32>;
+@group(0) @binding(3) var multiple_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(4) var multiple: texture_2d<f32>;
+@group(0) @binding(5) var sky_view_out: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(6) var sky_view: texture_2d<f32>;
+@group(0) @binding(7) var sky_sampler: sampler;
+
+fn sun_transmittance(r: f32, mu_sun: f32) -> vec3<f32> {
+    if hits_ground(r, mu_sun) {
+        return vec3<f32>(0.0);
+    }
+    return lut_read(transmittance, atmosphere.transmittance_size, transmittance_unit(r, mu_sun));
+}
+
+fn multiple_scattering(r: f32, mu_sun: f32) -> vec3<f32> {
+    return lut_read(multiple, atmosphere.multiple_size, multiple_unit(r, mu_sun));
+}
+
+@compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
+fn transmittance_lut(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = atmosphere.transmittance_size;
+    if any(id.xy >= size) {
+        return;
+    }
+    let r_mu = transmittance_r_mu(lut_unit(id.xy, size));
+    let length = distance_to_top(r_mu.x, r_mu.y);
+    var depth = vec3<f32>(0.0);
+    for (var k = 0u; k < TRANSMITTANCE_STEPS; k++) {
+        let segment = ray_segment(k, TRANSMITTANCE_STEPS, length);
+        let altitude = radius_along(r_mu.x, r_mu.y, segment.x) - bottom_km();
+        depth += medium_at(altitude).extinction * segment.y;
+    }
+    textureStore(transmittance_out, id.xy, vec4<f32>(exp(-depth), 1.0));
+}
+
+// Where a ray from (r, μ) leaves the air: at the ground where it meets it, else at the top.
+fn ray_length(r: f32, mu: f32) -> f32 {
+    if hits_ground(r, mu) {
+        return distance_to_bottom(r, mu);
+    }
+    return distance_to_top(r, mu);
+}
+
+// One segment of a ray from (r, μ) for the sun at zenith cosine `mu_sun` and cosine `nu` with
+// the ray: the radius and the sun's zenith cosine at its midpoint, the medium there, and the
+// segment's integral of its own falling transmittance, ∫ e^(−σt) dt = (1 − e^(−σ dt)) / σ
+// (Hillaire's energy-conserving step), with its transmittance e^(−σ dt).
+struct RayStep {
+    r: f32,
+    mu_sun: f32,
+    medium: Medium,
+    kept: vec3<f32>,
+    through: vec3<f32>,
+}
+
+fn ray_step(r: f32, mu: f32, mu_sun: f32, nu: f32, k: u32, steps: u32, length: f32) -> RayStep {
+    let segment = ray_segment(k, steps, length);
+    let r_t = radius_along(r, mu, segment.x);
+    let mu_sun_t = clamp((r * mu_sun + segment.x * nu) / r_t, -1.0, 1.0);
+    let medium = medium_at(r_t - bottom_km());
+    let through = exp(-medium.extinction * segment.y);
+    let kept = (vec3<f32>(1.0) - through) / max(medium.extinction, vec3<f32>(1e-12));
+    return RayStep(r_t, mu_sun_t, medium, kept, through);
+}
+
+// The second order's light along a ray, gathered with an isotropic phase, the ground's
+// Lambertian light where it ends there (xyz of `radiance`), and the share of light the air
+// scatters along it (`scattered`, Hillaire's f).
+struct SecondOrder {
+    radiance: vec3<f32>,
+    scattered: vec3<f32>,
+}
+
+fn second_order(r: f32, mu: f32, mu_sun: f32, nu: f32) -> SecondOrder {
+    let length = ray_length(r, mu);
+    var seen = vec3<f32>(1.0);
+    var radiance = vec3<f32>(0.0);
+    var scattered = vec3<f32>(0.0);
+    for (var k = 0u; k < MULTIPLE_STEPS; k++) {
+        let s = ray_step(r, mu, mu_sun, nu, k, MULTIPLE_STEPS, length);
+        let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
+        radiance += seen * sun_transmittance(s.r, s.mu_sun) * scattering / (4.0 * PI) * s.kept;
+        scattered += seen * scattering * s.kept;
+        seen *= s.through;
+    }
+    if hits_ground(r, mu) {
+        let r_g = bottom_km();
+        let mu_sun_g = clamp((r * mu_sun + length * nu) / r_g, -1.0, 1.0);
+        radiance += seen * sun_transmittance(r_g, mu_sun_g) * max(mu_sun_g, 0.0) * atmosphere.albedo.rgb / PI;
+    }
+    return SecondOrder(radiance, scattered);
+}
+
+// The sky's light along a ray: single scattering with the true phases, plus Ψ, up to the ground
+// or the top.
+fn in_scattered(r: f32, mu: f32, mu_sun: f32, nu: f32) -> vec3<f32> {
+    let length = ray_length(r, mu);
+    let rayleigh = rayleigh_phase(nu);
+    let mie = mie_phase(nu);
+    var seen = vec3<f32>(1.0);
+    var radiance = vec3<f32>(0.0);
+    for (var k = 0u; k < SKY_VIEW_STEPS; k++) {
+        let s = ray_step(r, mu, mu_sun, nu, k, SKY_VIEW_STEPS, length);
+        let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
+        let source = sun_transmittance(s.r, s.mu_sun) * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
+            + multiple_scattering(s.r, s.mu_sun) * scattering;
+        radiance += seen * source * s.kept;
+        seen *= s.through;
+    }
+    return radiance;
+}
+
+@compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
+fn multiple_scattering_lut(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = atmosphere.multiple_size;
+    if any(id.xy >= size) {
+        return;
+    }
+    let unit = lut_unit(id.xy, size);
+    let mu_sun = 2.0 * unit.x - 1.0;
+    let r = bottom_km() + unit.y * (top_km() - bottom_km());
+    let sun = vec3<f32>(sqrt(max(1.0 - mu_sun * mu_sun, 0.0)), 0.0, mu_sun);
+    var second = vec3<f32>(0.0);
+    var scattered = vec3<f32>(0.0);
+    let side = MULTIPLE_DIRECTIONS_SIDE;
+    for (var i = 0u; i < side * side; i++) {
+        // Uniform over the sphere: azimuth and cos θ on an even grid.
+        let azimuth = 2.0 * PI * (f32(i % side) + 0.5) / f32(side);
+        let mu = 1.0 - 2.0 * (f32(i / side) + 0.5) / f32(side);
+        let sin_theta = sqrt(max(1.0 - mu * mu, 0.0));
+        let dir = vec3<f32>(sin_theta * cos(azimuth), sin_theta * sin(azimuth), mu);
+        let gathered = second_order(r, mu, mu_sun, dot(dir, sun));
+        second += gathered.radiance;
+        scattered += gathered.scattered;
+    }
+    // Each direction weighs 4π / N steradians times the isotropic phase 1 / 4π.
+    let n = f32(side * side);
+    let psi = (second / n) / (vec3<f32>(1.0) - scattered / n);
+    textureStore(multiple_out, id.xy, vec4<f32>(psi, 1.0));
+}
+
+@compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
+fn sky_view_lut(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = atmosphere.sky_view_size;
+    if any(id.xy >= size) {
+        return;
+    }
+    let r = atmosphere.radii.z;
+    let mu_sun = atmosphere.radii.w;
+    let angles = sky_view_angles(r, lut_unit(id.xy, size));
+    let mu = cos(angles.x);
+    let sin_zenith = sin(angles.x);
+    // The sun in the view's vertical plane through x, the ray turned by the azimuth from it.
+    let nu = sin_zenith * cos(angles.y) * sqrt(max(1.0 - mu_sun * mu_sun, 0.0)) + mu * mu_sun;
+    textureStore(sky_view_out, id.xy, vec4<f32>(in_scattered(r, mu, mu_sun, nu), 1.0));
+}
+
+struct SkyOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) ndc: vec2<f32>,
+}
+
+// One triangle over the screen at the far plane (reversed-Z: depth 0).
+@vertex
+fn vs_sky(@builtin(vertex_index) vertex: u32) -> SkyOut {
+    let ndc = vec2<f32>(f32((vertex << 1u) & 2u) * 2.0 - 1.0, f32(vertex & 2u) * 2.0 - 1.0);
+    return SkyOut(vec4<f32>(ndc, 0.0, 1.0), ndc);
+}
+
+// The sky from a view at radius `r` (km, it may lie above the air) along a ray at zenith cosine
+// `mu`, marched through the air per pixel: from above the air, from where the ray enters it.
+fn marched_sky(r: f32, mu: f32, mu_sun: f32, nu: f32) -> vec3<f32> {
+    let top = top_km();
+    if r <= top {
+        return in_scattered(r, mu, mu_sun, nu);
+    }
+    let inside = r * r * (mu * mu - 1.0) + top * top;
+    if mu >= 0.0 || inside < 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let entry = -r * mu - sqrt(inside);
+    return in_scattered(top, (r * mu + entry) / top, clamp((r * mu_sun + entry * nu) / top, -1.0, 1.0), nu);
+}
+
+// What the sun's disk keeps along a ray from radius `r` at zenith cosine `mu`: the air's
+// transmittance from where the ray is in it, nothing where the ground is in the way, all of it
+// where the ray misses the air.
+fn disk_transmittance(r: f32, mu: f32) -> vec3<f32> {
+    let top = top_km();
+    if r <= top {
+        return sun_transmittance(r, mu);
+    }
+    let inside = r * r * (mu * mu - 1.0) + top * top;
+    if mu >= 0.0 || inside < 0.0 {
+        return vec3<f32>(1.0);
+    }
+    let entry = -r * mu - sqrt(inside);
+    return sun_transmittance(top, (r * mu + entry) / top);
+}
+
+// The sky's radiance along a camera-relative direction `dir` (unit), per unit of the sun's
+// irradiance, the sun's disk included: from the sky-view table for views in the lower air, marched
+// per pixel above `SKY_MARCHED_ABOVE_KM`, where the table's rows about the horizon grow coarser
+// than the limb they hold.
+fn sky_radiance(dir: vec3<f32>) -> vec3<f32> {
+    let r_view = atmosphere.up.w;
+    let up = atmosphere.up.xyz;
+    let sun = atmosphere.sun_dir.xyz;
+    let mu = clamp(dot(dir, up), -1.0, 1.0);
+    var radiance = vec3<f32>(0.0);
+    if r_view - bottom_km() > SKY_MARCHED_ABOVE_KM {
+        radiance = marched_sky(r_view, mu, clamp(dot(sun, up), -1.0, 1.0), dot(dir, sun));
+    } else {
+        let r = atmosphere.radii.z;
+        let across = dir - up * mu;
+        let sun_across = sun - up * dot(sun, up);
+        let lengths = length(across) * length(sun_across);
+        var azimuth = 0.0;
+        if lengths > 1e-6 {
+            azimuth = acos(clamp(dot(across, sun_across) / lengths, -1.0, 1.0));
+        }
+        // One bilinear sample: texel centres span the unit square corner to corner, as `lut_read`.
+        let size = vec2<f32>(atmosphere.sky_view_size);
+        let uv = (clamp(sky_view_unit(r, acos(mu), azimuth), vec2<f32>(0.0), vec2<f32>(1.0)) * (size - 1.0) + 0.5) / size;
+        radiance = textureSampleLevel(sky_view, sky_sampler, uv, 0.0).rgb;
+    }
+    let sun_radius = atmosphere.sun_dir.w;
+    if dot(dir, sun) > cos(sun_radius) && !hits_ground(r_view, mu) {
+        // The disk's radiance: the irradiance spread over its solid angle, through the air.
+        radiance += disk_transmittance(r_view, mu) / (PI * sun_radius * sun_radius);
+    }
+    return radiance;
+}
+
+@fragment
+fn fs_sky(in: SkyOut) -> @location(0) vec4<f32> {
+    // The near plane's point under the pixel, camera-relative: its direction is the view ray's.
+    let near = atmosphere.view_world_from_clip * vec4<f32>(in.ndc, 1.0, 1.0);
+    let dir = normalize(near.xyz / near.w);
+    return vec4<f32>(sky_radiance(dir) * PI * GROUND_SUN, 1.0);
+}

@@ -1,0 +1,164 @@
+// The atmosphere's model on the GPU (`atmosphere::Atmosphere`, Hillaire 2020): the media by
+// altitude, the phase functions, the shell's ray geometry in (r, μ) form, and the look-up tables'
+// parametrisations and reads. Kilometres around the Earth's centre. Twin:
+// `reference::atmosphere`, step for step in f32.
+
+struct AtmosphereUniforms {
+    rayleigh: vec4<f32>,
+    mie: vec4<f32>,
+    ozone: vec4<f32>,
+    albedo: vec4<f32>,
+    radii: vec4<f32>,
+    view_world_from_clip: mat4x4<f32>,
+    up: vec4<f32>,
+    sun_dir: vec4<f32>,
+    transmittance_size: vec2<u32>,
+    multiple_size: vec2<u32>,
+    sky_view_size: vec2<u32>,
+    _pad: vec2<u32>,
+}
+
+struct Medium {
+    rayleigh_scattering: vec3<f32>,
+    mie_scattering: f32,
+    extinction: vec3<f32>,
+}
+
+fn bottom_km() -> f32 { return atmosphere.radii.x; }
+fn top_km() -> f32 { return atmosphere.radii.y; }
+
+fn medium_at(altitude_km: f32) -> Medium {
+    let rayleigh = exp(-altitude_km / atmosphere.rayleigh.w);
+    let mie = exp(-altitude_km / atmosphere.mie.z);
+    let ozone = max(1.0 - abs(altitude_km - atmosphere.ozone.w) / atmosphere.albedo.w, 0.0);
+    let rayleigh_scattering = atmosphere.rayleigh.xyz * rayleigh;
+    let extinction = rayleigh_scattering + atmosphere.mie.y * mie + atmosphere.ozone.xyz * ozone;
+    return Medium(rayleigh_scattering, atmosphere.mie.x * mie, extinction);
+}
+
+fn rayleigh_phase(nu: f32) -> f32 {
+    return 3.0 / (16.0 * PI) * (1.0 + nu * nu);
+}
+
+fn mie_phase(nu: f32) -> f32 {
+    let g = atmosphere.mie.w;
+    let k = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
+    return k * (1.0 + nu * nu) / pow(1.0 + g * g - 2.0 * g * nu, 1.5);
+}
+
+// Distance from radius r along a ray at cosine μ from the zenith to the top of the air.
+fn distance_to_top(r: f32, mu: f32) -> f32 {
+    let top = top_km();
+    return max(-r * mu + sqrt(max(r * r * (mu * mu - 1.0) + top * top, 0.0)), 0.0);
+}
+
+fn distance_to_bottom(r: f32, mu: f32) -> f32 {
+    let bottom = bottom_km();
+    return max(-r * mu - sqrt(max(r * r * (mu * mu - 1.0) + bottom * bottom, 0.0)), 0.0);
+}
+
+fn hits_ground(r: f32, mu: f32) -> bool {
+    let bottom = bottom_km();
+    return mu < 0.0 && r * r * (mu * mu - 1.0) + bottom * bottom >= 0.0;
+}
+
+// Radius and zenith cosine t km along the ray from (r, μ) (Bruneton 2017's `r_d`, `mu_d`).
+fn radius_along(r: f32, mu: f32, t: f32) -> f32 {
+    return max(sqrt(t * t + 2.0 * r * mu * t + r * r), bottom_km());
+}
+
+// The k-th of `steps` segments of a ray `length` long, spaced as the square of their index so
+// the dense air near the ray's start is sampled finely: (midpoint, length).
+fn ray_segment(k: u32, steps: u32, length: f32) -> vec2<f32> {
+    let n = f32(steps);
+    let a = f32(k) / n;
+    let b = f32(k + 1u) / n;
+    let m = (f32(k) + 0.5) / n;
+    return vec2<f32>(length * m * m, length * (b * b - a * a));
+}
+
+// A table's texel grid spans the unit square corner to corner: texel (0, 0) is (0, 0), the last
+// texel is (1, 1); read between texels bilinearly by hand, so the twin reads the same weights.
+fn lut_unit(texel: vec2<u32>, size: vec2<u32>) -> vec2<f32> {
+    return vec2<f32>(texel) / vec2<f32>(size - 1u);
+}
+
+fn lut_read(lut: texture_2d<f32>, size: vec2<u32>, unit: vec2<f32>) -> vec3<f32> {
+    let x = clamp(unit, vec2<f32>(0.0), vec2<f32>(1.0)) * vec2<f32>(size - 1u);
+    let base = min(vec2<u32>(floor(x)), size - 2u);
+    let f = x - vec2<f32>(base);
+    let a = textureLoad(lut, base, 0).rgb;
+    let b = textureLoad(lut, base + vec2<u32>(1u, 0u), 0).rgb;
+    let c = textureLoad(lut, base + vec2<u32>(0u, 1u), 0).rgb;
+    let d = textureLoad(lut, base + vec2<u32>(1u, 1u), 0).rgb;
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+// The transmittance table (Bruneton 2017): x the distance to the top between its least and its
+// most at that radius (so the horizon lands on a texel edge's worth of resolution), y the
+// radius by the distance to the horizon from the ground.
+fn transmittance_unit(r: f32, mu: f32) -> vec2<f32> {
+    let bottom = bottom_km();
+    let top = top_km();
+    let h = sqrt(top * top - bottom * bottom);
+    let rho = sqrt(max(r * r - bottom * bottom, 0.0));
+    let d = distance_to_top(r, mu);
+    let d_min = top - r;
+    let d_max = rho + h;
+    return vec2<f32>((d - d_min) / (d_max - d_min), rho / h);
+}
+
+// (r, μ) of a point of the transmittance table's unit square.
+fn transmittance_r_mu(unit: vec2<f32>) -> vec2<f32> {
+    let bottom = bottom_km();
+    let top = top_km();
+    let h = sqrt(top * top - bottom * bottom);
+    let rho = h * unit.y;
+    let r = sqrt(rho * rho + bottom * bottom);
+    let d_min = top - r;
+    let d_max = rho + h;
+    let d = d_min + unit.x * (d_max - d_min);
+    var mu = 1.0;
+    if d > 0.0 {
+        mu = clamp((h * h - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
+    }
+    return vec2<f32>(r, mu);
+}
+
+// The multiple-scattering table: x the sun's zenith cosine from −1 to 1, y the altitude.
+fn multiple_unit(r: f32, mu_sun: f32) -> vec2<f32> {
+    return vec2<f32>(0.5 * mu_sun + 0.5, (r - bottom_km()) / (top_km() - bottom_km()));
+}
+
+// The zenith angle of the horizon seen from radius r (90° on the ground, more above it).
+fn horizon_zenith(r: f32) -> f32 {
+    return PI - asin(clamp(bottom_km() / r, 0.0, 1.0));
+}
+
+// The sky-view table, for a view at radius r: x the azimuth from the sun's vertical, 0 to π,
+// as its square root (finer towards the sun), y the zenith angle, squared away from the
+// horizon on both sides (finer at the horizon, where the sky changes fastest).
+fn sky_view_unit(r: f32, view_zenith: f32, azimuth: f32) -> vec2<f32> {
+    let horizon = horizon_zenith(r);
+    var y = 0.0;
+    if view_zenith < horizon {
+        y = 0.5 - 0.5 * sqrt(max(1.0 - view_zenith / horizon, 0.0));
+    } else {
+        y = 0.5 + 0.5 * sqrt(max((view_zenith - horizon) / (PI - horizon), 0.0));
+    }
+    return vec2<f32>(sqrt(clamp(azimuth / PI, 0.0, 1.0)), y);
+}
+
+// (zenith, azimuth) of a point of the sky-view table's unit square at radius r.
+fn sky_view_angles(r: f32, unit: vec2<f32>) -> vec2<f32> {
+    let horizon = horizon_zenith(r);
+    var zenith = 0.0;
+    if unit.y < 0.5 {
+        let s = 1.0 - 2.0 * unit.y;
+        zenith = horizon * (1.0 - s * s);
+    } else {
+        let s = 2.0 * unit.y - 1.0;
+        zenith = horizon + (PI - horizon) * s * s;
+    }
+    return vec2<f32>(zenith, PI * unit.x * unit.x);
+}

@@ -1,0 +1,53 @@
+//! The atmosphere pass's frame half: the uniforms from the settings and the view.
+
+use glam::{DMat4, DVec3};
+
+use crate::config::AtmosphereSettings;
+use crate::gpu::gpu_types::AtmosphereUniforms;
+
+/// The lowest a view sits above the model's ground, km: a camera below sea level (or on it) sees
+/// the sky from just above the ground, where a ray level with it still leaves the air.
+const LOWEST_VIEW_KM: f64 = 1e-3;
+
+/// Where the sky is seen from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkyView {
+    /// Camera-relative world (the frame's own) from clip space.
+    pub view_world_from_clip: DMat4,
+    /// The view's zenith in that space (unit).
+    pub up: DVec3,
+    /// Towards the sun in that space (unit).
+    pub sun_dir: DVec3,
+    /// The camera's height above the model's ground (the datum), metres.
+    pub altitude_m: f64,
+}
+
+/// The pass's uniforms for `view` over the air of `settings`. The sky-view table is made for the
+/// view's radius within the air (at its top for a view above it, which marches its sky per pixel).
+pub fn atmosphere_uniforms(settings: &AtmosphereSettings, view: &SkyView) -> AtmosphereUniforms {
+    let a = &settings.air;
+    let thickness_km = a.top_radius_km - a.bottom_radius_km;
+    let altitude_km = (view.altitude_m / 1000.0).max(LOWEST_VIEW_KM);
+    let view_radius_km = a.bottom_radius_km + altitude_km.min(thickness_km);
+    let f = |v: f64| v as f32;
+    let rgb = |v: [f64; 3], w: f64| [f(v[0]), f(v[1]), f(v[2]), f(w)];
+    AtmosphereUniforms {
+        rayleigh: rgb(a.rayleigh_scattering_per_km, a.rayleigh_scale_height_km),
+        mie: [f(a.mie_scattering_per_km), f(a.mie_extinction_per_km), f(a.mie_scale_height_km), f(a.mie_g)],
+        ozone: rgb(a.ozone_absorption_per_km, a.ozone_centre_km),
+        albedo: rgb(a.ground_albedo, a.ozone_half_width_km),
+        radii: [
+            f(a.bottom_radius_km),
+            f(a.top_radius_km),
+            f(view_radius_km),
+            f(view.sun_dir.dot(view.up).clamp(-1.0, 1.0)),
+        ],
+        view_world_from_clip: view.view_world_from_clip.as_mat4().to_cols_array_2d(),
+        up: view.up.as_vec3().extend(f(a.bottom_radius_km + altitude_km)).to_array(),
+        sun_dir: view.sun_dir.as_vec3().extend(f(a.sun_angular_radius_rad)).to_array(),
+        transmittance_size: settings.transmittance_lut,
+        multiple_size: settings.multiple_scattering_lut,
+        sky_view_size: settings.sky_view_lut,
+        _pad: [0; 2],
+    }
+}

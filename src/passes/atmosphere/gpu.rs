@@ -1,0 +1,310 @@
+//! The atmosphere pass's GPU half: the three tables' textures and compute pipelines, the sky's
+//! render pipeline, their binding tables; the fixed tables made once in `new`, the sky-view table
+//! and the sky recorded each frame.
+
+use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension as Dim};
+
+use crate::config::AtmosphereSettings;
+use crate::gpu::bindings::{Binding, BindingTable};
+use crate::gpu::gpu_types::AtmosphereUniforms;
+use crate::gpu::layout::ATMOSPHERE_WORKGROUP;
+use crate::gpu::readback::read_texture_mip;
+use crate::gpu::resources::{buffer, compute_pipeline, depth_equal, frame_pass, pipeline_layout};
+use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
+use crate::gpu::{Gpu, GpuError};
+use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
+
+use super::frame::{SkyView, atmosphere_uniforms};
+
+/// The tables' texel format: f32 radiances and transmittances, which storage textures can write
+/// everywhere and which the shaders read by hand (`lut_read`), so no filtering of f32 is needed.
+pub const LUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// The sky-view table's: f16, which every adapter filters, so the sky pass reads it with one
+/// bilinear sample a pixel (the twin rounds its texels the same way).
+pub const SKY_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The atmosphere's shader.
+pub const SHADER: WgslSource =
+    WgslSource { name: "atmosphere", parts: &[ATMOSPHERE, include_str!("../../../shaders/atmosphere.wgsl")] };
+
+const LUT: TextureSampleType = TextureSampleType::Float { filterable: false };
+
+/// `transmittance_lut`.
+pub const TRANSMITTANCE_BINDINGS: BindingTable<2> = BindingTable {
+    label: "atmosphere transmittance",
+    bindings: [
+        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::storage_texture(1, "transmittance_out", Stage::COMPUTE, LUT_FORMAT, Dim::D2),
+    ],
+};
+
+/// `multiple_scattering_lut`.
+pub const MULTIPLE_BINDINGS: BindingTable<3> = BindingTable {
+    label: "atmosphere multiple scattering",
+    bindings: [
+        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::storage_texture(3, "multiple_out", Stage::COMPUTE, LUT_FORMAT, Dim::D2),
+    ],
+};
+
+/// `sky_view_lut`.
+pub const SKY_VIEW_BINDINGS: BindingTable<4> = BindingTable {
+    label: "atmosphere sky view",
+    bindings: [
+        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::texture(4, "multiple", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::storage_texture(5, "sky_view_out", Stage::COMPUTE, SKY_VIEW_FORMAT, Dim::D2),
+    ],
+};
+
+/// `vs_sky`, `fs_sky`.
+pub const SKY_BINDINGS: BindingTable<5> = BindingTable {
+    label: "sky",
+    bindings: [
+        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::FRAGMENT),
+        Binding::texture(2, "transmittance", Stage::FRAGMENT, LUT, Dim::D2),
+        Binding::texture(4, "multiple", Stage::FRAGMENT, LUT, Dim::D2),
+        Binding::texture(
+            6,
+            "sky_view",
+            Stage::FRAGMENT,
+            TextureSampleType::Float { filterable: true },
+            Dim::D2,
+        ),
+        Binding::sampler(7, "sky_sampler", Stage::FRAGMENT, wgpu::SamplerBindingType::Filtering),
+    ],
+};
+
+/// One table on the GPU.
+struct Table {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+}
+
+impl Table {
+    fn new(device: &wgpu::Device, label: &str, size: [u32; 2], format: wgpu::TextureFormat) -> Self {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Self { texture, view, size, format }
+    }
+
+    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>) {
+        pass.dispatch_workgroups(
+            self.size[0].div_ceil(ATMOSPHERE_WORKGROUP),
+            self.size[1].div_ceil(ATMOSPHERE_WORKGROUP),
+            1,
+        );
+    }
+
+    fn read_back(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, GpuError> {
+        if self.format == SKY_VIEW_FORMAT {
+            let bytes = read_texture_mip(gpu, &self.texture, 0, wgpu::TextureAspect::All, 8)?;
+            let halves: Vec<[u16; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+            return Ok(halves.iter().map(|t| t.map(|bits| half::f16::from_bits(bits).to_f32())).collect());
+        }
+        let bytes = read_texture_mip(gpu, &self.texture, 0, wgpu::TextureAspect::All, 16)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+}
+
+/// The atmosphere on the GPU: its tables (the fixed two made in `new`), the sky-view table's
+/// pipeline and the sky's, and the uniforms `prepare` writes each frame.
+pub struct AtmospherePass {
+    settings: AtmosphereSettings,
+    uniforms: wgpu::Buffer,
+    transmittance: Table,
+    multiple: Table,
+    sky_view: Table,
+    sky_view_pipeline: wgpu::ComputePipeline,
+    sky_view_group: wgpu::BindGroup,
+    sky_pipeline: wgpu::RenderPipeline,
+    sky_group: wgpu::BindGroup,
+}
+
+impl AtmospherePass {
+    /// The pass for the air of `settings`; makes its transmittance and multiple-scattering tables
+    /// on `gpu` now (submitted, not waited for).
+    pub fn new(gpu: &Gpu, settings: &AtmosphereSettings) -> Self {
+        let device = &gpu.device;
+        let module = SHADER.module(device);
+        let uniforms = buffer(
+            device,
+            "atmosphere uniforms",
+            size_of::<AtmosphereUniforms>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
+        let transmittance =
+            Table::new(device, "atmosphere transmittance", settings.transmittance_lut, LUT_FORMAT);
+        let multiple = Table::new(
+            device,
+            "atmosphere multiple scattering",
+            settings.multiple_scattering_lut,
+            LUT_FORMAT,
+        );
+        let sky_view = Table::new(device, "atmosphere sky view", settings.sky_view_lut, SKY_VIEW_FORMAT);
+        use wgpu::BindingResource::TextureView as View;
+        let compute = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
+            compute_pipeline(
+                device,
+                entry_point,
+                &pipeline_layout(device, entry_point, &[layout]),
+                &module,
+                entry_point,
+            )
+        };
+        let u = uniforms.as_entire_binding();
+
+        // The fixed tables, once: the view's part of the uniforms plays no part in them.
+        let still = SkyView {
+            view_world_from_clip: glam::DMat4::IDENTITY,
+            up: glam::DVec3::Z,
+            sun_dir: glam::DVec3::Z,
+            altitude_m: 0.0,
+        };
+        gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&atmosphere_uniforms(settings, &still)));
+        let layout = TRANSMITTANCE_BINDINGS.layout(device);
+        let transmittance_group =
+            TRANSMITTANCE_BINDINGS.bind_group(device, &layout, [u.clone(), View(&transmittance.view)]);
+        let transmittance_pipeline = compute(&layout, "transmittance_lut");
+        let layout = MULTIPLE_BINDINGS.layout(device);
+        let multiple_group = MULTIPLE_BINDINGS.bind_group(
+            device,
+            &layout,
+            [u.clone(), View(&transmittance.view), View(&multiple.view)],
+        );
+        let multiple_pipeline = compute(&layout, "multiple_scattering_lut");
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("atmosphere tables"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&transmittance_pipeline);
+            pass.set_bind_group(0, &transmittance_group, &[]);
+            transmittance.dispatch(&mut pass);
+            pass.set_pipeline(&multiple_pipeline);
+            pass.set_bind_group(0, &multiple_group, &[]);
+            multiple.dispatch(&mut pass);
+        }
+        gpu.queue.submit([encoder.finish()]);
+
+        let layout = SKY_VIEW_BINDINGS.layout(device);
+        let sky_view_group = SKY_VIEW_BINDINGS.bind_group(
+            device,
+            &layout,
+            [u.clone(), View(&transmittance.view), View(&multiple.view), View(&sky_view.view)],
+        );
+        let sky_view_pipeline = compute(&layout, "sky_view_lut");
+        let sky_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("sky view"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let layout = SKY_BINDINGS.layout(device);
+        let sky_group = SKY_BINDINGS.bind_group(
+            device,
+            &layout,
+            [
+                u,
+                View(&transmittance.view),
+                View(&multiple.view),
+                View(&sky_view.view),
+                wgpu::BindingResource::Sampler(&sky_sampler),
+            ],
+        );
+        let sky_pipeline = sky_pipeline(device, &module, &layout);
+        Self {
+            settings: settings.clone(),
+            uniforms,
+            transmittance,
+            multiple,
+            sky_view,
+            sky_view_pipeline,
+            sky_view_group,
+            sky_pipeline,
+            sky_group,
+        }
+    }
+
+    /// Writes the frame's uniforms for `view`.
+    pub fn prepare(&self, queue: &wgpu::Queue, view: &SkyView) {
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&atmosphere_uniforms(&self.settings, view)));
+    }
+
+    /// Records the sky-view table for the frame's view.
+    pub fn encode_sky_view(&self, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("atmosphere sky view"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.sky_view_pipeline);
+        pass.set_bind_group(0, &self.sky_view_group, &[]);
+        self.sky_view.dispatch(&mut pass);
+    }
+
+    /// Records the sky over `colour` where `depth` still holds the far plane.
+    pub fn encode_sky(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        colour: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) {
+        let mut pass = frame_pass(encoder, "sky", colour, depth, None, None);
+        pass.set_pipeline(&self.sky_pipeline);
+        pass.set_bind_group(0, &self.sky_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// The three tables as the GPU made them (transmittance, multiple scattering, sky view),
+    /// waiting for it: for tests and tools, never the frame.
+    pub fn read_back(&self, gpu: &Gpu) -> Result<[Vec<[f32; 4]>; 3], GpuError> {
+        Ok([self.transmittance.read_back(gpu)?, self.multiple.read_back(gpu)?, self.sky_view.read_back(gpu)?])
+    }
+}
+
+fn sky_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::BindGroupLayout,
+) -> wgpu::RenderPipeline {
+    let layout = pipeline_layout(device, "sky", &[layout]);
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("sky"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_sky"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_sky"),
+            compilation_options: Default::default(),
+            targets: &[Some(COLOUR_FORMAT.into())],
+        }),
+        primitive: Default::default(),
+        // Only where nothing was drawn: the depth target still holds the far plane (reversed-Z 0).
+        depth_stencil: Some(depth_equal(DEPTH_FORMAT)),
+        multisample: Default::default(),
+        multiview_mask: None,
+        cache: None,
+    })
+}
