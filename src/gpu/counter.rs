@@ -131,8 +131,10 @@ impl Counter {
         self.args.borrow_mut().clear();
     }
 
-    /// The handle pass `label` records through.
+    /// The handle pass `label` records through; the pass has its counts this frame, all zero if
+    /// it records nothing.
     pub fn pass(&self, label: &'static str) -> Counting<'_> {
+        self.tally.borrow_mut().name(label);
         Counting { counter: Some(self), label }
     }
 
