@@ -14,6 +14,7 @@ mod floor;
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use terramp::gpu::counter::Counting;
 use terramp::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
 use terramp::gpu::layout::{SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP};
 use terramp::gpu::{AdapterChoice, Gpu};
@@ -89,7 +90,7 @@ fn compact(c: &mut Criterion) {
         let params = pass.prepare(&gpu.queue, blocks.len() as u32).expect("within the limits");
         if records <= 1 << 18 {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            pass.encode(&mut encoder, &bind_group, &params);
+            pass.encode(&mut encoder, &bind_group, &params, Counting::OFF);
             gpu.queue.submit([encoder.finish()]);
             let gpu_out = pass.read_back(&gpu).expect("read back");
             let twin = terramp::reference::compact::compact(&keys, &blocks, pass.templates()).expect("twin");
@@ -100,7 +101,7 @@ fn compact(c: &mut Criterion) {
             b.iter_custom(|iters| {
                 let mut encoder = gpu.device.create_command_encoder(&Default::default());
                 for _ in 0..iters {
-                    pass.encode(&mut encoder, &bind_group, &params);
+                    pass.encode(&mut encoder, &bind_group, &params, Counting::OFF);
                 }
                 let start = Instant::now();
                 gpu.queue.submit([encoder.finish()]);
@@ -123,7 +124,7 @@ fn compact(c: &mut Criterion) {
                 start.elapsed()
             })
         });
-        let pass_ms = floor::median_ms(&gpu, 9, |e| pass.encode(e, &bind_group, &params));
+        let pass_ms = floor::median_ms(&gpu, 9, |e| pass.encode(e, &bind_group, &params, Counting::OFF));
         let floor_ms = floor::median_ms(&gpu, 9, |e| floor.encode(e));
         eprintln!(
             "compact/{records}: {pass_ms:.3} ms, floor {floor_ms:.3} ms, ÷floor {:.2}",

@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 use terramp::config::Settings;
+use terramp::gpu::counter::Counting;
 use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::{Profiler, TimeSource};
 use terramp::passes::depth_pyramid::gpu::DepthPyramid;
@@ -72,8 +73,10 @@ fn bench(mut r: terramp::frame::Renderer) {
         let mut frames = Vec::new();
         for _ in 0..12 {
             let mut encoder = device.create_command_encoder(&Default::default());
-            profiler.pass(&r.gpu, &mut encoder, "hiz", |e| hiz.encode(e, &depth)).unwrap();
-            profiler.pass(&r.gpu, &mut encoder, "tlm", |e| pass.encode(e, &bindings, &warm.frame)).unwrap();
+            profiler.pass(&r.gpu, &mut encoder, "hiz", |e| hiz.encode(e, &depth, Counting::OFF)).unwrap();
+            profiler
+                .pass(&r.gpu, &mut encoder, "tlm", |e| pass.encode(e, &bindings, &warm.frame, Counting::OFF))
+                .unwrap();
             profiler.pass(&r.gpu, &mut encoder, "floor", |e| floor.encode(e)).unwrap();
             profiler.resolve(&mut encoder);
             r.gpu.queue.submit([encoder.finish()]);

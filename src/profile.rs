@@ -8,11 +8,13 @@
 //!   queries, or CPU-timed with a wait per pass on adapters without them; CPU work: terrain LOD
 //!   selection, streaming and uploads, TLM analysis). Those arrive a frame or two late and are
 //!   attributed to the frame they were recorded in;
-//! - pass 3's seed counters, which also arrive late, attributed to their own frame (`SeedReport.frame`).
+//! - pass 3's seed counters, which also arrive late, attributed to their own frame (`SeedReport.frame`);
+//! - each frame's counts (`gpu::counts`: draws, triangles, invocations, bytes per pass), late too,
+//!   by their own frame.
 //!
 //! Labels are whatever the frame times: no pass list is fixed here. `Summary` turns a recording
 //! into per-pass median and 95th percentile (see `stats` for the definitions), per-frame totals,
-//! frames per second and seeds per frame; it serialises to the JSON of `--json`, `table` prints it
+//! frames per second, seeds per frame and the counts' sums (`counts`); it serialises to the JSON of `--json`, `table` prints it
 //! like the paper's table and `trace` writes the recording as a Chrome trace.
 
 use std::collections::BTreeMap;
@@ -22,9 +24,11 @@ use thiserror::Error;
 
 use crate::frame::{RenderError, SeedReport};
 use crate::gpu::GpuError;
+use crate::gpu::counts::FrameCounts;
 use crate::gpu::fragments::PassFragments;
 use crate::gpu::profiler::ScopeTiming;
 
+pub mod counts;
 pub mod session;
 pub mod stats;
 pub mod summary;
@@ -114,6 +118,8 @@ pub struct Recording {
     pub seeds: BTreeMap<u64, SeedSample>,
     /// The foliage passes' fragments and pixels by frame (with `gpu.count_fragments`).
     pub fragments: BTreeMap<u64, Vec<PassFragments>>,
+    /// Each frame's counts by the frame they count.
+    pub counts: BTreeMap<u64, FrameCounts>,
 }
 
 impl Recording {
@@ -141,6 +147,7 @@ impl Recording {
             self.scopes.keys().next_back().copied(),
             self.seeds.keys().next_back().copied(),
             self.fragments.keys().next_back().copied(),
+            self.counts.keys().next_back().copied(),
         ];
         let offset = last.into_iter().flatten().max().map_or(0, |f| f + 1);
         self.frames.extend(other.frames.into_iter().map(|f| FrameSample { frame: f.frame + offset, ..f }));
@@ -152,6 +159,17 @@ impl Recording {
                 .map(|(frame, s)| (frame + offset, SeedSample { frame: frame + offset, ..s })),
         );
         self.fragments.extend(other.fragments.into_iter().map(|(frame, f)| (frame + offset, f)));
+        self.counts.extend(
+            other
+                .counts
+                .into_iter()
+                .map(|(frame, c)| (frame + offset, FrameCounts { frame: frame + offset, ..c })),
+        );
+    }
+
+    /// The counts of the profiled frames, in frame order.
+    pub fn profiled_counts(&self) -> impl Iterator<Item = &FrameCounts> {
+        self.counts.iter().filter(|(frame, _)| self.is_profiled(**frame)).map(|(_, c)| c)
     }
 
     /// The fragment counts of the profiled frames.

@@ -5,6 +5,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use terramp::atmosphere::brute::Brute;
 use terramp::config::{AtmosphereSettings, Settings};
+use terramp::gpu::counter::Counting;
 use terramp::gpu::gpu_types::AtmosphereUniforms;
 use terramp::light::sun_dir;
 use terramp::passes::atmosphere::frame::{SkyView, atmosphere_uniforms};
@@ -112,7 +113,7 @@ fn the_gpu_makes_the_twins_tables() {
     let sky = view(1500.0, 25.0);
     pass.prepare(&gpu.queue, &sky);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    pass.encode_sky_view(&mut encoder);
+    pass.encode_sky_view(&mut encoder, Counting::OFF);
     gpu.queue.submit([encoder.finish()]);
     let read = pass.read_back(&gpu).unwrap();
     let (transmittance, multiple, sky_view) = tables(&atmosphere_uniforms(&s, &sky));

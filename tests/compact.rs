@@ -5,6 +5,7 @@
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use terramp::gpu::Gpu;
+use terramp::gpu::counter::Counting;
 use terramp::gpu::gpu_types::{SeedBlock, SeedDrawArgs};
 use terramp::gpu::layout::{COMPACT_CHUNK, SEED_DRAWS, SEED_GROUPS, SEED_WORKGROUP};
 use terramp::passes::compact::frame::{CompactLimits, Compacted};
@@ -49,7 +50,7 @@ impl Harness {
         }
         let params = self.pass.prepare(queue, input.blocks.len() as u32).unwrap();
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        self.pass.encode(&mut encoder, &self.bind_group, &params);
+        self.pass.encode(&mut encoder, &self.bind_group, &params, Counting::OFF);
         queue.submit([encoder.finish()]);
         let out = self.pass.read_back(&self.gpu).unwrap();
         self.gpu.check().unwrap();

@@ -83,6 +83,10 @@ fn the_gpu_benchmark_runs_on_the_software_adapter_and_writes_its_json() {
         let checked = profile["seeds"]["checked_median"].as_f64().unwrap_or(0.0);
         println!("{checked} seeds checked a frame; {}", json["seconds"]);
         assert!(checked > 0.0, "no seed checked: {text}");
+        // The frames' counts travel in the summary: the seeds' triangles, drawn indirectly.
+        let seeds =
+            profile["counts"]["passes"].as_array().unwrap().iter().find(|p| p["label"] == "draw_seeds");
+        assert!(seeds.is_some_and(|s| s["triangles_submitted"].as_u64().is_some_and(|t| t > 0)), "{text}");
     }
     let settings = std::fs::read_to_string(out.path().join("settings-profile_depth_prepass.toml")).unwrap();
     assert!(settings.contains("depth_prepass = true"), "{settings}");

@@ -19,7 +19,9 @@ use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::frame::FrameReport;
 use terramp::gpu::Gpu;
-use terramp::gpu::fragments::FragmentCounter;
+use terramp::gpu::counter::Counter;
+use terramp::gpu::counts::Part;
+use terramp::gpu::fragments::{FragmentCounter, with_counts};
 use terramp_testkit::{camera, lavapipe_only, renderer, small_settings, synth_dataset};
 
 const IMAGE_PX: [u32; 2] = [320, 180];
@@ -178,6 +180,10 @@ fn count_triangle(gpu: &Gpu, size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u6
         cache: None,
     });
     let counter = FragmentCounter::new(gpu, &["triangle"], &target).expect("pipeline-statistics queries");
+    // The invocations are the frame's counts'; the pixels and samples the fragment counter's.
+    let mut counts = Counter::new(gpu, true);
+    counts.begin_frame(0);
+    let counting = counts.pass("triangle");
     let view = target.create_view(&Default::default());
     let mut encoder = device.create_command_encoder(&Default::default());
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -206,14 +212,20 @@ fn count_triangle(gpu: &Gpu, size: [u32; 2], corners: [[f32; 2]; 3]) -> (u64, u6
             occlusion_query_set: Some(count.occlusion_set()),
             ..Default::default()
         });
+        counting.begin(&mut pass, Part::Shading);
         count.begin(&mut pass);
         pass.set_pipeline(&pipeline);
-        pass.draw(0..3, 0..1);
+        counting.draw(&mut pass, 0..3, 0..1);
         count.end(&mut pass);
+        counting.end(&mut pass);
     });
     counter.resolve(&mut encoder);
+    counts.resolve(&mut encoder);
     gpu.queue.submit([encoder.finish()]);
-    let [counted] = counter.read(gpu).unwrap()[..] else { panic!("one pass counted") };
+    counts.submitted();
+    let pixels = counter.read(gpu).unwrap();
+    let frame = counts.collect(device).unwrap().pop().expect("the frame's counts, after a wait");
+    let [counted] = with_counts(pixels, &frame)[..] else { panic!("one pass counted") };
     // Nothing tests depth or discards: every pixel covered is written, once; one triangle of 3
     // vertices (a fan of a few, where the clipper cuts it at the screen's edge).
     assert_eq!((counted.written, counted.prepass_shaded), (counted.covered_px, 0), "{counted:?}");

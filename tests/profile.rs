@@ -1,5 +1,5 @@
 //! `terramp profile`: the JSON lists every pass the frames timed, with positive times; its seed
-//! counts are the log's; the Chrome trace parses and holds the passes; the CPU-timing fallback says
+//! counts are the log's; every profiled frame's counts are summed, each timed pass's among them; the Chrome trace parses and holds the passes; the CPU-timing fallback says
 //! so; the generated orbit stays over the dataset; seeds selected with no impostor to draw them
 //! are said.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
@@ -125,6 +125,25 @@ fn profile_json_trace_and_log_agree() {
     assert_eq!(json["seeds"]["checked_median"].as_f64(), Some(checked));
     assert_eq!(json["seeds"]["selected_median"].as_f64(), Some(selected));
     assert!(checked > 0.0, "no seeds checked: the path should fly over land cover");
+
+    // Every profiled frame's counts arrived (the session drains the last ones); each GPU pass
+    // timed has its row; the frame's row is the rows' sum, figure by figure.
+    let counts = &json["counts"];
+    assert_eq!((counts["frames"].as_u64(), counts["statistics"].as_bool()), (Some(FRAMES), Some(true)));
+    let rows = counts["passes"].as_array().unwrap();
+    for pass in passes.iter().filter(|p| p["source"] != "cpu") {
+        assert!(rows.iter().any(|r| r["label"] == pass["label"]), "no counts of {pass} in {counts}");
+    }
+    let sum = |field: &str| rows.iter().map(|r| r[field].as_u64().unwrap()).sum::<u64>();
+    for field in ["draw_calls", "indirect_draws", "dispatches", "triangles_submitted", "bytes_uploaded"] {
+        assert_eq!(counts["frame"][field].as_u64(), Some(sum(field)), "{field} in {counts}");
+    }
+    assert!(sum("triangles_submitted") > 0 && sum("bytes_read_back") > 0, "{counts}");
+    assert!(
+        run.stdout.contains("Counts per frame (mean of 12 frames, with pipeline statistics)"),
+        "{}",
+        run.stdout
+    );
 
     // The trace holds one complete event per GPU pass per frame that timed it, on the GPU track.
     let events = run.trace["traceEvents"].as_array().expect("traceEvents");

@@ -7,6 +7,7 @@
 use glam::DVec3;
 use terramp::config::{Settings, TlmSettings};
 use terramp::frame::Renderer;
+use terramp::gpu::counter::Counting;
 use terramp::gpu::layout::TLM_CULLED;
 use terramp::gpu::readback_ring::ReadbackRing;
 use terramp::passes::depth_pyramid::frame::HizMips;
@@ -297,7 +298,7 @@ fn depth_pyramid_equals_a_cpu_min_reduction_at_odd_sizes() {
         r.render(&camera).unwrap();
         let hiz = DepthPyramid::new(&r.gpu.device, w, h);
         let mut encoder = r.gpu.device.create_command_encoder(&Default::default());
-        hiz.encode(&mut encoder, &r.depth_texture().create_view(&Default::default()));
+        hiz.encode(&mut encoder, &r.depth_texture().create_view(&Default::default()), Counting::OFF);
         r.gpu.queue.submit([encoder.finish()]);
         let gpu_mips = hiz.read_back(&r.gpu).unwrap();
         let cpu_mips = depth_pyramid(&r.read_depth().unwrap(), w, h);

@@ -14,7 +14,9 @@ use crate::camera::Camera;
 use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
 use crate::earth::placing::{EarthPlacing, ExactPlacing};
-use crate::gpu::fragments::{CountedPass, FragmentCounter, PassFragments};
+use crate::gpu::counter::Counter;
+use crate::gpu::counts::FrameCounts;
+use crate::gpu::fragments::{CountedPass, FragmentCounter, PassFragments, with_counts};
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
@@ -89,6 +91,9 @@ pub struct FrameReport {
     pub texcells: TexcellReport,
     /// Per foliage pass, fragments shaded and pixels covered (only with `gpu.count_fragments`).
     pub fragments: Vec<PassFragments>,
+    /// The counts of every frame whose counts arrived during this one (a frame or two old; this
+    /// frame's own with `gpu.count_fragments`, which waits for each frame).
+    pub counts: Vec<FrameCounts>,
 }
 
 /// What a frame's Tile Load Map is read against when it comes back: the frame, its rings and
@@ -173,6 +178,8 @@ pub struct Renderer {
     last_timings: Vec<PassTiming>,
     /// Counts the foliage passes' fragments, with `gpu.count_fragments`.
     fragments: Option<FragmentCounter>,
+    /// Counts what each pass asks of the GPU, every frame.
+    counts: Counter,
 }
 
 impl Renderer {
@@ -226,6 +233,7 @@ impl Renderer {
             ),
             false => None,
         };
+        let counts = Counter::new(&gpu, true);
         Ok(Self {
             gpu,
             dataset,
@@ -253,6 +261,7 @@ impl Renderer {
             time_s: 0.0,
             last_timings: Vec::new(),
             fragments,
+            counts,
         })
     }
 
@@ -273,6 +282,12 @@ impl Renderer {
             format: Some(crate::passes::COLOUR_FORMAT.remove_srgb_suffix()),
             ..Default::default()
         })
+    }
+
+    /// The counts of every frame that has arrived since the last frame's report took them (after
+    /// waiting for the GPU: all of them); never blocks.
+    pub fn take_counts(&mut self) -> Result<Vec<FrameCounts>, RenderError> {
+        Ok(self.counts.collect(&self.gpu.device)?)
     }
 
     /// Pass timings of the latest frame whose timings have arrived (never blocks for them).
@@ -332,6 +347,7 @@ impl Renderer {
         camera.validate()?;
         let (camera, camera_lifted_m) = self.above_ground(camera);
         let mut report = FrameReport { frame: self.frame, camera_lifted_m, ..Default::default() };
+        self.counts.begin_frame(self.frame);
         let frame = self.prepare(&camera, &mut report).and_then(|plan| {
             let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
             self.encode(&mut encoder, &plan.nodes, &plan.tlm)?;
@@ -355,7 +371,7 @@ impl Renderer {
         nodes: &PreparedNodes,
         tlm: &TlmFrame,
     ) -> Result<(), RenderError> {
-        let (gpu, p, t) = (&self.gpu, &mut self.profiler, &self.targets);
+        let (gpu, p, t, c) = (&self.gpu, &mut self.profiler, &self.targets, &self.counts);
         // With `gpu.count_fragments`, the foliage passes count their fragments and pixels.
         let (targets, counter) = ((&t.colour_view, &t.depth_view), self.fragments.as_ref());
         let counted = |label, e: &mut _, record: &dyn Fn(&mut _, Option<CountedPass<'_>>)| {
@@ -364,31 +380,41 @@ impl Renderer {
         let mesh = MeshDraw { terrain: &self.terrain, bind_group: &self.terrain_bindings, nodes };
         // 0. Terrain and depth: the ground every later pass stands on and is occluded by.
         p.pass(gpu, encoder, "terrain", |e| {
-            self.terrain.encode(e, &self.terrain_bindings, &t.depth_view, nodes)
+            self.terrain.encode(e, &self.terrain_bindings, &t.depth_view, nodes, c.pass("terrain"))
         })?;
         // The depth pyramid: the occluders the Tile Load Map culls against, at every scale.
-        p.pass(gpu, encoder, "depth_pyramid", |e| self.depth_pyramid.encode(e, &t.depth_view))?;
+        p.pass(gpu, encoder, "depth_pyramid", |e| {
+            self.depth_pyramid.encode(e, &t.depth_view, c.pass("depth_pyramid"))
+        })?;
         // 1. Tile Load Map: which tiles at which levels the view needs, and the seed patterns.
-        p.pass(gpu, encoder, "tile_load_map", |e| self.tlm.encode(e, &self.tlm_bindings, tlm))?;
+        p.pass(gpu, encoder, "tile_load_map", |e| {
+            self.tlm.encode(e, &self.tlm_bindings, tlm, c.pass("tile_load_map"))
+        })?;
         // 2. Ground: imagery on the surface the depth pass kept, from the finest resident level.
         p.pass(gpu, encoder, "ground", |e| {
-            self.ground.encode(e, mesh, &t.colour_view, &t.depth_view, SKY_LINEAR)
+            self.ground.encode(e, mesh, &t.colour_view, &t.depth_view, SKY_LINEAR, c.pass("ground"))
         })?;
         // The sky: the air's light seen from the camera's altitude, drawn where nothing was.
-        p.pass(gpu, encoder, "sky_view", |e| self.atmosphere.encode_sky_view(e))?;
-        p.pass(gpu, encoder, "sky", |e| self.atmosphere.encode_sky(e, &t.colour_view, &t.depth_view))?;
+        p.pass(gpu, encoder, "sky_view", |e| self.atmosphere.encode_sky_view(e, c.pass("sky_view")))?;
+        p.pass(gpu, encoder, "sky", |e| {
+            self.atmosphere.encode_sky(e, &t.colour_view, &t.depth_view, c.pass("sky"))
+        })?;
         if let Some(stage) = &self.texcells {
             // The far forest: slices of the dense classes' samples over the ground beyond the seeds.
-            let draw = |e: &mut _, count: Option<CountedPass<'_>>| stage.encode(e, mesh, targets, count);
+            let counting = c.pass("texcells");
+            let draw =
+                |e: &mut _, count: Option<CountedPass<'_>>| stage.encode(e, mesh, targets, (count, counting));
             p.pass(gpu, encoder, "texcells", |e| counted("texcells", e, &draw))?;
         }
         if let Some(stage) = &self.seeds {
             // 3. Seed selection: the seeds of the cells the latest TLM found near and visible.
-            p.pass(gpu, encoder, "seed_select", |e| stage.encode(e))?;
+            p.pass(gpu, encoder, "seed_select", |e| stage.encode(e, c.pass("seed_select")))?;
             // 4a. Compaction: the survivors grouped per (species, LOD) into indirect draws, on the GPU.
-            p.pass(gpu, encoder, "compact", |e| stage.encode_compact(e))?;
+            p.pass(gpu, encoder, "compact", |e| stage.encode_compact(e, c.pass("compact")))?;
             // 4b. Drawing: one indirect draw per group, over the ground, depth-tested against it.
-            let draw = |e: &mut _, count: Option<CountedPass<'_>>| stage.encode_draw(e, targets, count);
+            let counting = c.pass("draw_seeds");
+            let draw =
+                |e: &mut _, count: Option<CountedPass<'_>>| stage.encode_draw(e, targets, (count, counting));
             p.pass(gpu, encoder, "draw_seeds", |e| counted("draw_seeds", e, &draw))?;
         }
         Ok(())
@@ -404,19 +430,23 @@ impl Renderer {
     ) -> Result<(), RenderError> {
         let prepare::FramePlan { layout, camera_grid_m, tlm, nodes, terrain } = plan;
         let tag = TlmTag { frame: self.frame, layout, camera_grid_m };
+        let before = self.tlm_readback.copied_bytes();
         self.tlm_readback.encode_copy(&mut encoder, self.tlm.output(), tlm.output_bytes(), tag);
+        self.counts.read_back("tile_load_map", self.tlm_readback.copied_bytes() - before);
         if let Some(stage) = self.seeds.as_mut() {
-            stage.encode_readback(&mut encoder, self.frame);
+            stage.encode_readback(&mut encoder, self.frame, &self.counts);
         }
         self.profiler.resolve(&mut encoder);
         self.fragments.iter().for_each(|counter| counter.resolve(&mut encoder));
+        self.counts.resolve(&mut encoder);
         self.gpu.queue.submit([encoder.finish()]);
-        if let Some(counter) = &self.fragments {
-            report.fragments = counter.read(&self.gpu)?;
-        }
+        self.counts.submitted();
         self.tlm_readback.submitted();
         if let Some(stage) = self.seeds.as_mut() {
             stage.submitted();
+        }
+        if self.fragments.is_some() {
+            report.fragments = self.read_fragments(report)?;
         }
         self.profiler.end_frame();
         self.gpu.device.poll(wgpu::PollType::Poll).map_err(GpuError::from)?;
@@ -426,6 +456,7 @@ impl Renderer {
             stage.collect(&self.gpu.device)?;
             report.seeds = stage.latest;
         }
+        report.counts.extend(self.counts.collect(&self.gpu.device)?);
         while let Some(timings) = self.profiler.finished_frame(&self.gpu) {
             self.last_timings = timings;
         }
@@ -433,6 +464,20 @@ impl Renderer {
         self.last = Some(LastFrame { tlm, nodes, terrain });
         self.frame += 1;
         Ok(())
+    }
+
+    /// With `gpu.count_fragments`: waits for the frame, reads the pixels its foliage passes
+    /// covered, and takes its counts (and any older ones still in flight) for their invocations.
+    fn read_fragments(&mut self, report: &mut FrameReport) -> Result<Vec<PassFragments>, RenderError> {
+        let Some(counter) = &self.fragments else { return Ok(Vec::new()) };
+        let before = self.gpu.queue.read_back_bytes();
+        let passes = counter.read(&self.gpu)?;
+        self.counts.read_back_late(self.frame, "fragments", self.gpu.queue.read_back_bytes() - before);
+        report.counts.extend(self.counts.collect(&self.gpu.device)?);
+        let counts = report.counts.iter().find(|c| c.frame == self.frame).ok_or_else(|| {
+            GpuError::Validation("a frame's counts did not arrive after waiting for it".into())
+        })?;
+        Ok(with_counts(passes, counts))
     }
 
     /// Turns every TLM that has arrived into load maps, keeping the newest.

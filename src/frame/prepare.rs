@@ -2,7 +2,8 @@
 //! selection picks the nodes; the streaming hands each cache what the terrain and the latest Tile
 //! Load Map want and uploads what the loader read, within the frame's budget; then every upload
 //! of the frame is written: the TLM's rings, the terrain's instances and uniforms, pass 3's cells
-//! and pass 4's constants. `encode` then only records commands over what this left.
+//! and pass 4's constants, each step's bytes counted as its pass's (the caches' as `streaming`).
+//! `encode` then only records commands over what this left.
 
 use glam::DVec3;
 
@@ -113,6 +114,7 @@ impl Renderer {
         }
         let wanted_landcover = after_pinned(&c.pinned_landcover, &classification);
         let (frame, queue, budget) = (self.frame, &self.gpu.queue, UploadBudget::from(&self.settings.cache));
+        let uploaded_before = queue.uploaded_bytes();
         let (loader, has_imagery) = (&self.loader, self.dataset.imagery.is_some());
         let (heights, imagery, landcover) = (&mut c.heights, &mut c.imagery, &mut c.landcover);
         [report.height, report.imagery, report.landcover] = self.profiler.cpu("streaming", || {
@@ -133,6 +135,7 @@ impl Renderer {
                 landcover.as_mut().map(uploads).unwrap_or_default(),
             ]
         });
+        self.counts.uploaded("streaming", queue.uploaded_bytes() - uploaded_before);
     }
 
     /// This frame's Tile Load Map, over rings centred on the camera.
@@ -152,7 +155,8 @@ impl Renderer {
             hiz_mips: self.depth_pyramid.mips(),
             earth: TlmEarth::of(&view.placing, &view.nadir, &self.dataset, s.terrain.horizon_culling),
         };
-        let tlm = self.tlm.prepare(&self.gpu.queue, &inputs)?;
+        let queue = &self.gpu.queue;
+        let tlm = self.counts.uploads(queue, "tile_load_map", || self.tlm.prepare(queue, &inputs))?;
         Ok((layout, tlm))
     }
 
@@ -178,7 +182,8 @@ impl Renderer {
         let fall = fall_per_m2(&view.nadir);
         let uniforms =
             terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR, self.time_s, fall);
-        let nodes = self.terrain.prepare(&self.gpu.queue, &uniforms, &batches);
+        let (queue, counts) = (&self.gpu.queue, &self.counts);
+        let nodes = counts.uploads(queue, "terrain", || self.terrain.prepare(queue, &uniforms, &batches));
         // The camera's frame is its own local one, on the Earth or flat: its zenith is +z.
         let sky = SkyView {
             view_world_from_clip: view.clip_from_view_world.inverse(),
@@ -186,14 +191,16 @@ impl Renderer {
             sun_dir: sun_dir(&self.settings.render),
             altitude_m: view.grid_m.z,
         };
-        self.atmosphere.prepare(&self.gpu.queue, &sky);
+        counts.uploads(queue, "sky_view", || self.atmosphere.prepare(queue, &sky));
         if let Some(stage) = self.texcells.as_mut() {
             let texcell_view = TexcellView {
                 camera_grid_m: view.grid_m,
                 metres_per_px_at_1m: view.camera.metres_per_pixel(1.0, self.settings.render.height),
             };
             report.texcells = self.profiler.cpu("texcell_place", || {
-                stage.prepare(&self.gpu, &self.settings, &self.dataset, &batches, &nodes, &texcell_view)
+                counts.uploads(queue, "texcells", || {
+                    stage.prepare(&self.gpu, &self.settings, &self.dataset, &batches, &nodes, &texcell_view)
+                })
             });
         }
         (nodes, uniforms)
@@ -223,10 +230,10 @@ impl Renderer {
             &cells,
             ranks,
         );
-        let frame = stage.prepare(&self.gpu, &inputs)?;
+        let frame = stage.prepare(&self.gpu, &inputs, &self.counts)?;
         report.seed_cells = frame.cells.len();
         report.seed_cells_dropped = frame.cells_dropped;
-        stage.prepare_draw(&self.gpu, &self.settings, terrain, &wind, &inputs.nadir);
+        stage.prepare_draw(&self.gpu, &self.settings, terrain, (&wind, &inputs.nadir), &self.counts);
         (report.seed_species_drawn, report.seed_species_undrawn) = stage.species_counts();
         Ok(())
     }

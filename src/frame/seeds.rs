@@ -16,6 +16,7 @@ use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::{Dataset, LandcoverLayer};
 use crate::earth::placing::{ExactPlacing, PlacedView};
+use crate::gpu::counter::{Counter, Counting};
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{CompactParams, EarthNode, SeedCounters, SeedRecord, TerrainUniforms};
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
@@ -129,24 +130,32 @@ impl SeedStage {
         }))
     }
 
-    /// Uploads this frame's cells, and the size of its block table to compaction.
-    pub fn prepare(&mut self, gpu: &Gpu, inputs: &SeedInputs) -> Result<&SeedFrame, RenderError> {
-        let frame = self.pass.prepare(&gpu.queue, inputs)?;
-        self.compact_params = self.compact.prepare(&gpu.queue, frame.blocks())?;
+    /// Uploads this frame's cells, and the size of its block table to compaction (each counted as
+    /// its pass's).
+    pub fn prepare(
+        &mut self,
+        gpu: &Gpu,
+        inputs: &SeedInputs,
+        counts: &Counter,
+    ) -> Result<&SeedFrame, RenderError> {
+        let frame = counts.uploads(&gpu.queue, "seed_select", || self.pass.prepare(&gpu.queue, inputs))?;
+        let blocks = frame.blocks();
+        self.compact_params =
+            counts.uploads(&gpu.queue, "compact", || self.compact.prepare(&gpu.queue, blocks))?;
         Ok(self.last_frame.insert(frame))
     }
 
     /// Records pass 3 over the cells `prepare` uploaded.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder) {
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, counting: Counting<'_>) {
         if let Some(frame) = &self.last_frame {
-            self.pass.encode(encoder, &self.bind_group, frame);
+            self.pass.encode(encoder, &self.bind_group, frame, counting);
         }
     }
 
     /// Records compaction of what pass 3 wrote: the frame's draw order and indirect draws.
-    pub fn encode_compact(&self, encoder: &mut wgpu::CommandEncoder) {
+    pub fn encode_compact(&self, encoder: &mut wgpu::CommandEncoder, counting: Counting<'_>) {
         if self.last_frame.is_some() {
-            self.compact.encode(encoder, &self.compact_bind_group, &self.compact_params);
+            self.compact.encode(encoder, &self.compact_bind_group, &self.compact_params, counting);
         }
     }
 
@@ -163,16 +172,17 @@ impl SeedStage {
         gpu: &Gpu,
         settings: &Settings,
         terrain: &TerrainUniforms,
-        wind: &WindFrame,
-        earth: &EarthNode,
+        (wind, earth): (&WindFrame, &EarthNode),
+        counts: &Counter,
     ) {
         if let Some((draw, _)) = &self.draw {
             let uniforms = draw_uniforms(settings, terrain, wind, earth);
-            draw.prepare(&gpu.queue, &uniforms);
+            counts.uploads(&gpu.queue, "draw_seeds", || draw.prepare(&gpu.queue, &uniforms));
             if let Some(templates) = draw.frame_templates(settings, uniforms.focal_px)
                 && templates != self.compact.templates()
             {
-                self.compact.set_templates(&gpu.queue, &templates);
+                let compact = &mut self.compact;
+                counts.uploads(&gpu.queue, "compact", || compact.set_templates(&gpu.queue, &templates));
             }
         }
     }
@@ -182,10 +192,10 @@ impl SeedStage {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         targets: (&wgpu::TextureView, &wgpu::TextureView),
-        count: Option<CountedPass<'_>>,
+        (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
         if let (Some((draw, bind_group)), Some(_)) = (&self.draw, &self.last_frame) {
-            draw.encode(encoder, bind_group, self.compact.draw_args(), targets, count);
+            draw.encode(encoder, bind_group, self.compact.draw_args(), targets, (count, counting));
         } else if let Some(count) = count {
             count.nothing(encoder, "draw_seeds", targets.0, targets.1);
         }
@@ -193,16 +203,18 @@ impl SeedStage {
 
     /// Records the copy of pass 3's counters into the staging ring (after the last timed pass:
     /// the CPU-timing fallback submits each pass on its own), unless every slot is in flight.
-    pub fn encode_readback(&mut self, encoder: &mut wgpu::CommandEncoder, frame: u64) {
+    pub fn encode_readback(&mut self, encoder: &mut wgpu::CommandEncoder, frame: u64, counts: &Counter) {
         let bytes = size_of::<SeedCounters>() as u64;
         let (cells, ranks) =
             self.last_frame.as_ref().map_or((0, 0), |f| (f.cells.len() as u32, f.uniforms.active_ranks));
+        let before = self.counters_ring.copied_bytes();
         self.counters_ring.encode_copy(
             encoder,
             self.pass.counters(),
             bytes,
             CountersTag { frame, cells, ranks },
         );
+        counts.read_back("seed_select", self.counters_ring.copied_bytes() - before);
     }
 
     /// Tells the ring its copy was submitted.

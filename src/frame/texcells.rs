@@ -15,6 +15,7 @@ use crate::classes::ClassTable;
 use crate::config::Settings;
 use crate::dataset::{Dataset, TileId};
 use crate::gpu::Gpu;
+use crate::gpu::counter::Counting;
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::TexcellUniforms;
 use crate::gpu::layout::{TEXCELL_MAX_SAMPLES, TEXCELL_MAX_SLICES};
@@ -223,15 +224,15 @@ impl TexcellStage {
         }
     }
 
-    /// Draws the frame's texcells over `colour`.
+    /// Draws the frame's texcells over `colour`, counted through `counting` (and `count`).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         mesh: MeshDraw<'_>,
         targets: (&wgpu::TextureView, &wgpu::TextureView),
-        count: Option<CountedPass<'_>>,
+        (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
-        self.pass.encode(encoder, (mesh, &self.bind_group), targets, self.prepared, count);
+        self.pass.encode(encoder, (mesh, &self.bind_group), targets, self.prepared, (count, counting));
     }
 }
 

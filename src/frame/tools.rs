@@ -7,6 +7,7 @@ use std::time::Duration;
 use crate::camera::Camera;
 use crate::classes::ClassTable;
 use crate::gpu::GpuError;
+use crate::gpu::counter::Counting;
 use crate::gpu::gpu_types::{SeedCounters, SeedDrawArgs, SeedRecord, TerrainUniforms, TlmCell};
 use crate::gpu::readback::{read_texture, read_values};
 use crate::light::CloudShadowFrame;
@@ -243,7 +244,7 @@ impl Renderer {
         });
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         let view = scratch.create_view(&Default::default());
-        self.terrain.encode(&mut encoder, &self.terrain_bindings, &view, &last.nodes);
+        self.terrain.encode(&mut encoder, &self.terrain_bindings, &view, &last.nodes, Counting::OFF);
         self.gpu.queue.submit([encoder.finish()]);
         let bytes = read_texture(&self.gpu, &scratch, wgpu::TextureAspect::DepthOnly, 4)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
@@ -282,9 +283,10 @@ impl Renderer {
         let (settings, dataset) = (&self.settings, &self.dataset);
         let nadir = exact.nadir_node();
         let inputs = super::seeds::seed_inputs(settings, dataset, camera, &exact, nadir, &cells, ranks);
-        stage.prepare(&self.gpu, &inputs)?;
+        // Its uploads go to a tally the next frame starts afresh.
+        stage.prepare(&self.gpu, &inputs, &self.counts)?;
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        stage.encode(&mut encoder);
+        stage.encode(&mut encoder, Counting::OFF);
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait()?;
         self.gpu.check()?;
@@ -305,13 +307,13 @@ impl Renderer {
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         let t = &self.targets;
-        self.terrain.encode(&mut encoder, &self.terrain_bindings, &t.depth_view, &last.nodes);
+        self.terrain.encode(&mut encoder, &self.terrain_bindings, &t.depth_view, &last.nodes, Counting::OFF);
         if through != Replay::Depth {
-            stage.encode(&mut encoder);
-            stage.encode_compact(&mut encoder);
+            stage.encode(&mut encoder, Counting::OFF);
+            stage.encode_compact(&mut encoder, Counting::OFF);
         }
         if through == Replay::Draw {
-            stage.encode_draw(&mut encoder, (&t.colour_view, &t.depth_view), None);
+            stage.encode_draw(&mut encoder, (&t.colour_view, &t.depth_view), (None, Counting::OFF));
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait()?;

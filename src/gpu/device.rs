@@ -163,8 +163,8 @@ pub enum GpuError {
 pub struct Gpu {
     /// The logical device every pass creates its buffers, textures and pipelines on.
     pub device: wgpu::Device,
-    /// The device's queue: uploads and submissions.
-    pub queue: wgpu::Queue,
+    /// The device's queue: uploads (counted) and submissions.
+    pub queue: super::Queue,
     /// The chosen adapter: name, backend, device type and driver (`describe` prints them).
     pub info: wgpu::AdapterInfo,
     /// The adapter itself: what a window's surface can be configured with is asked of it.
@@ -259,7 +259,7 @@ impl Gpu {
                 errors.push(text);
             }
         }));
-        Ok(Self { device, queue, info, adapter, has_timestamps, errors, lost })
+        Ok(Self { device, queue: super::Queue::new(queue), info, adapter, has_timestamps, errors, lost })
     }
 
     /// One line naming the adapter, for logs.

@@ -17,28 +17,23 @@
 //! shade 2 × 2 quads and count the covered fragments that pass their early tests, helper lanes not
 //! included.
 //!
-//! The same query counts the vertex shader's invocations and the triangles the clipper passes on:
-//! fragments per triangle tell a pass of small triangles (llvmpipe: about a block, 16 lanes, each)
-//! from one of large, overlapping ones.
+//! The fragments shaded are the frame's counts' (`gpu::counts`: the pass's shading draws' query,
+//! and its prepass's apart), which also give the vertex shader's invocations and the triangles the
+//! clipper passes on: fragments per triangle tell a pass of small triangles (llvmpipe: about a
+//! block, 16 lanes, each) from one of large, overlapping ones. A counting renderer waits for each
+//! frame, so its counts have arrived when the pixels are read.
 //!
 //! Two more figures do not depend on the adapter. An occlusion query over the same draws counts
 //! the samples that passed the depth test and were not discarded: those written, overwritten ones
 //! included, a lower bound of the fragments shaded in any order. A pass with a depth prepass
-//! (`draw_seeds.depth_prepass`) counts the prepass's invocations apart (`begin_prepass`), and its
+//! (`draw_seeds.depth_prepass`) counts the prepass's invocations apart, and its
 //! shading draws' written samples are then exactly the fragments that reach the lighting on a GPU
 //! that tests depth before shading.
 
+use super::counts::FrameCounts;
 use super::readback::{read_buffer, read_texture};
 use super::resources::frame_pass;
 use super::{Gpu, GpuError};
-
-/// What each pipeline-statistics query counts: its results come in the flags' bit order.
-const STATISTICS: wgpu::PipelineStatisticsTypes = wgpu::PipelineStatisticsTypes::VERTEX_SHADER_INVOCATIONS
-    .union(wgpu::PipelineStatisticsTypes::CLIPPER_PRIMITIVES_OUT)
-    .union(wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS);
-
-/// Results per pipeline-statistics query: one per flag of `STATISTICS`.
-const STATISTICS_PER_QUERY: usize = STATISTICS.bits().count_ones() as usize;
 
 /// What one counted pass did in one frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
@@ -60,11 +55,9 @@ pub struct PassFragments {
     pub covered_px: u64,
 }
 
-/// The queries and colour copies of the passes `labels` names, for one frame at a time.
+/// The occlusion queries and colour copies of the passes `labels` names, for one frame at a time.
 pub struct FragmentCounter {
     labels: Vec<&'static str>,
-    /// Per pass, the shading draws' invocations and the prepass's.
-    queries: wgpu::QuerySet,
     /// Per pass, the shading draws' samples written.
     occlusion: wgpu::QuerySet,
     resolved: wgpu::Buffer,
@@ -86,30 +79,19 @@ impl<'a> CountedPass<'a> {
         &self.counter.occlusion
     }
 
-    /// Starts counting the pass's shading draws.
+    /// Starts counting the samples the pass's shading draws write (their invocations are the
+    /// frame's counts' `Part::Shading`).
     pub fn begin(self, pass: &mut wgpu::RenderPass) {
-        pass.begin_pipeline_statistics_query(&self.counter.queries, 2 * self.index);
         pass.begin_occlusion_query(self.index);
     }
 
     /// Stops counting the shading draws (call after the last).
     pub fn end(self, pass: &mut wgpu::RenderPass) {
         pass.end_occlusion_query();
-        pass.end_pipeline_statistics_query();
-    }
-
-    /// Starts counting the depth prepass's draws (a pass without one leaves its count at 0).
-    pub fn begin_prepass(self, pass: &mut wgpu::RenderPass) {
-        pass.begin_pipeline_statistics_query(&self.counter.queries, 2 * self.index + 1);
-    }
-
-    /// Stops counting the depth prepass's draws.
-    pub fn end_prepass(self, pass: &mut wgpu::RenderPass) {
-        pass.end_pipeline_statistics_query();
     }
 
     /// Counts a pass that draws nothing this frame: an empty render pass (labelled `label`, over
-    /// `colour` and `depth`) still ends the queries, at zero.
+    /// `colour` and `depth`) still ends its query, at zero.
     pub fn nothing(
         self,
         encoder: &mut wgpu::CommandEncoder,
@@ -118,8 +100,6 @@ impl<'a> CountedPass<'a> {
         depth: &wgpu::TextureView,
     ) {
         let mut pass = frame_pass(encoder, label, colour, depth, None, Some(self.occlusion_set()));
-        self.begin_prepass(&mut pass);
-        self.end_prepass(&mut pass);
         self.begin(&mut pass);
         self.end(&mut pass);
     }
@@ -139,7 +119,7 @@ impl PassFragments {
 
 impl FragmentCounter {
     /// Counts the passes `labels` over `colour` (a `COPY_SRC` 2D colour target); `None` when the
-    /// adapter has no pipeline-statistics queries.
+    /// adapter has no pipeline-statistics queries (the frame's counts then have no invocations).
     pub fn new(gpu: &Gpu, labels: &[&'static str], colour: &wgpu::Texture) -> Option<Self> {
         if !gpu.device.features().contains(wgpu::Features::PIPELINE_STATISTICS_QUERY) {
             return None;
@@ -149,13 +129,10 @@ impl FragmentCounter {
         let query_set = |label, ty, count| {
             gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some(label), ty, count })
         };
-        let queries =
-            query_set("fragments shaded", wgpu::QueryType::PipelineStatistics(STATISTICS), 2 * count);
         let occlusion = query_set("samples written", wgpu::QueryType::Occlusion, count);
-        // The statistics of 2 × count queries, then the samples written.
         let resolved = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("fragments shaded"),
-            size: written_offset(count) + u64::from(count) * 8,
+            label: Some("samples written"),
+            size: u64::from(count) * 8,
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
@@ -172,7 +149,7 @@ impl FragmentCounter {
             })
         };
         let copies = labels.iter().map(|_| [copy(), copy()]).collect();
-        Some(Self { labels: labels.to_vec(), queries, occlusion, resolved, copies, texel_bytes })
+        Some(Self { labels: labels.to_vec(), occlusion, resolved, copies, texel_bytes })
     }
 
     /// Records pass `label` (one of this counter's) between copies of `colour`; `record` gets the
@@ -198,28 +175,21 @@ impl FragmentCounter {
 
     /// Copies the queries into a readable buffer: call on the frame's last encoder.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        let count = self.labels.len() as u32;
-        encoder.resolve_query_set(&self.queries, 0..2 * count, &self.resolved, 0);
-        encoder.resolve_query_set(&self.occlusion, 0..count, &self.resolved, written_offset(count));
+        encoder.resolve_query_set(&self.occlusion, 0..self.labels.len() as u32, &self.resolved, 0);
     }
 
-    /// Waits for the frame and returns each counted pass's fragments and pixels (every pass the
-    /// counter names must have been recorded through `around` this frame).
+    /// Waits for the frame and returns each counted pass's samples written and pixels covered,
+    /// its invocations not yet in (`with_counts` adds them once the frame's counts arrive).
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<PassFragments>, GpuError> {
         let count = self.labels.len();
-        let offset = written_offset(count as u32);
-        let results: Vec<u64> =
-            bytemuck::pod_collect_to_vec(&read_buffer(gpu, &self.resolved, offset + count as u64 * 8)?);
-        let statistics = &results[..2 * count * STATISTICS_PER_QUERY];
-        let written = &results[offset as usize / 8..];
+        let written: Vec<u64> =
+            bytemuck::pod_collect_to_vec(&read_buffer(gpu, &self.resolved, count as u64 * 8)?);
         let texel = self.texel_bytes as usize;
         self.labels
             .iter()
             .zip(&self.copies)
-            .zip(statistics.chunks_exact(2 * STATISTICS_PER_QUERY).zip(written))
-            .map(|((&label, [before, after]), (statistics, &written))| {
-                // Per query, in the flags' order: vertices, triangles, fragments.
-                let (shading, prepass) = statistics.split_at(STATISTICS_PER_QUERY);
+            .zip(written)
+            .map(|((&label, [before, after]), written)| {
                 let aspect = wgpu::TextureAspect::All;
                 let (before, after) = (
                     read_texture(gpu, before, aspect, self.texel_bytes)?,
@@ -228,23 +198,23 @@ impl FragmentCounter {
                 let covered_px =
                     before.chunks_exact(texel).zip(after.chunks_exact(texel)).filter(|(b, a)| b != a).count()
                         as u64;
-                Ok(PassFragments {
-                    label,
-                    shaded: shading[2],
-                    prepass_shaded: prepass[2],
-                    vertices: shading[0],
-                    triangles: shading[1],
-                    written,
-                    covered_px,
-                })
+                Ok(PassFragments { label, written, covered_px, ..Default::default() })
             })
             .collect()
     }
 }
 
-/// Where the samples written of `count` passes start in the resolved buffer: after their 2 ×
-/// `count` invocation counts, at the alignment a query resolve needs.
-fn written_offset(count: u32) -> u64 {
-    (u64::from(2 * count) * 8 * STATISTICS_PER_QUERY as u64)
-        .next_multiple_of(wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT)
+/// `passes` (from `FragmentCounter::read`) with the fragments shaded, vertices and triangles of
+/// their shading draws and the fragments of their prepass, from the frame's `counts` (a pass that
+/// drew nothing has none: zero).
+pub fn with_counts(mut passes: Vec<PassFragments>, counts: &FrameCounts) -> Vec<PassFragments> {
+    for pass in &mut passes {
+        let counted = counts.pass(pass.label);
+        let shading = counted.and_then(|c| c.shading).unwrap_or_default();
+        pass.shaded = shading.fragment_invocations;
+        pass.vertices = shading.vertex_invocations;
+        pass.triangles = shading.clipped_triangles;
+        pass.prepass_shaded = counted.and_then(|c| c.prepass).unwrap_or_default().fragment_invocations;
+    }
+    passes
 }

@@ -1,7 +1,8 @@
 //! How it works: blocking readbacks, for frames written to disk, tools and tests; the per-frame
 //! data paths never read back synchronously (they use `readback_ring`). A texture is copied into a
 //! mappable buffer (rows padded to wgpu's 256-byte copy alignment) and returned tightly packed; a
-//! buffer goes through a one-slot `ReadbackRing`, waited for.
+//! buffer goes through a one-slot `ReadbackRing`, waited for. Each tells the queue the bytes it
+//! copied (`Queue::note_read_back`: a texture's padded rows included).
 
 use super::readback_ring::ReadbackRing;
 use super::{Gpu, GpuError};
@@ -12,6 +13,7 @@ pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     ring.encode_copy(&mut encoder, buffer, bytes.next_multiple_of(4), ());
     gpu.queue.submit([encoder.finish()]);
+    gpu.queue.note_read_back(ring.copied_bytes());
     ring.submitted();
     gpu.wait()?;
     let taken = ring.try_take(&gpu.device)?;
@@ -75,6 +77,7 @@ pub fn read_texture_mip(
         wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
     );
     gpu.queue.submit([encoder.finish()]);
+    gpu.queue.note_read_back(buffer.size());
     let slice = buffer.slice(..);
     let (sender, receiver) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |result| {

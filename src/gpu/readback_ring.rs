@@ -6,7 +6,8 @@
 //! mapped, as owned bytes with their tag, and frees its buffer. Results come in the order they
 //! were recorded, one or two frames late, so a caller keeps no queue of its own. When every buffer
 //! is still in flight (the GPU is that far behind), the frame's copy is skipped and counted: a
-//! late CPU reader loses a frame, never the frame rate.
+//! late CPU reader loses a frame, never the frame rate. The ring counts the bytes it copied, for
+//! the frame's counts (`gpu::counts`).
 
 use std::collections::VecDeque;
 use std::sync::{Arc, OnceLock};
@@ -58,6 +59,8 @@ pub struct ReadbackRing<Tag> {
     order: VecDeque<usize>,
     capacity_bytes: u64,
     skipped: u64,
+    /// Bytes of every copy recorded so far.
+    copied_bytes: u64,
 }
 
 impl<Tag> ReadbackRing<Tag> {
@@ -75,7 +78,7 @@ impl<Tag> ReadbackRing<Tag> {
             })
             .collect::<Vec<_>>();
         let slots = buffers.iter().map(|_| Slot::Free).collect();
-        Self { buffers, slots, order: VecDeque::new(), capacity_bytes, skipped: 0 }
+        Self { buffers, slots, order: VecDeque::new(), capacity_bytes, skipped: 0, copied_bytes: 0 }
     }
 
     /// Records a copy of the first `bytes` of `source`, tagged `tag`, into a free staging
@@ -96,6 +99,7 @@ impl<Tag> ReadbackRing<Tag> {
         if bytes > 0 {
             encoder.copy_buffer_to_buffer(source, 0, &self.buffers[index], 0, bytes);
         }
+        self.copied_bytes += bytes;
         self.slots[index] = Slot::Recorded { bytes, tag };
         self.order.push_back(index);
         true
@@ -147,6 +151,11 @@ impl<Tag> ReadbackRing<Tag> {
     /// Copies skipped because no staging buffer was free (or they did not fit).
     pub fn skipped(&self) -> u64 {
         self.skipped
+    }
+
+    /// Bytes of every copy recorded so far (skipped ones are not): what this ring read back.
+    pub fn copied_bytes(&self) -> u64 {
+        self.copied_bytes
     }
 
     /// Copies recorded and not yet taken.

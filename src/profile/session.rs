@@ -6,8 +6,9 @@
 //!
 //! The profiler keeps its history on, and the session files each finished frame's scopes under
 //! the renderer's frame number (mapped from the profiler's own count, taken before each render).
-//! `finish` waits for the GPU and drains the profiler, so the last frames' timings arrive too;
-//! seed counters only arrive inside frames, so the last frame or two may have none.
+//! `finish` waits for the GPU and drains the profiler and the counts, so the last frames' timings
+//! and counts arrive too; seed counters only arrive inside frames, so the last frame or two may
+//! have none.
 //!
 //! Paths: without `--path`, the embedded `config/paths/default.toml` when the dataset is the
 //! synthetic one and holds every keyframe of it; else `orbit_path`, a loop around the dataset's
@@ -23,6 +24,7 @@ use crate::camera::Camera;
 use crate::dataset::{Dataset, PackError};
 use crate::earth::pose::GeoPose;
 use crate::frame::{FrameReport, Renderer};
+use crate::gpu::counts::FrameCounts;
 use crate::gpu::{GpuError, TimeSource};
 use crate::path::{CameraPath, EarthKey, Keyframe, PathError};
 
@@ -98,6 +100,7 @@ impl<'r> Session<'r> {
         if !report.fragments.is_empty() {
             self.recording.fragments.insert(report.frame, report.fragments.clone());
         }
+        self.file_counts(report.counts.iter().cloned());
         self.absorb_history();
         Ok(report)
     }
@@ -108,10 +111,16 @@ impl<'r> Session<'r> {
         let end_ms = self.renderer.profiler.now_ms();
         self.close_open(end_ms);
         self.renderer.gpu.wait()?;
+        let counts = self.renderer.take_counts()?;
+        self.file_counts(counts.into_iter());
         self.renderer.profiler.drain(&self.renderer.gpu)?;
         self.absorb_history();
         self.renderer.profiler.keep_history(false);
         Ok(std::mem::take(&mut self.recording))
+    }
+
+    fn file_counts(&mut self, counts: impl Iterator<Item = FrameCounts>) {
+        self.recording.counts.extend(counts.map(|c| (c.frame, c)));
     }
 
     fn throttle(&mut self, keep: usize) -> Result<(), ProfileError> {

@@ -19,14 +19,17 @@
 //!   "totals": { "gpu": stat | null, "cpu": stat | null, "frame_wall": stat | null },
 //!   "seeds": { "frames": int, "checked_median": float | null, "selected_median": float | null,
 //!              "overflow_frames": int,
-//!              "per_frame": [ { "frame", "cells", "ranks", "checked", "selected", "overflow" } ] } }
+//!              "per_frame": [ { "frame", "cells", "ranks", "checked", "selected", "overflow" } ] },
+//!   "overdraw": [ ... ], "counts": { ... } }
 //! ```
-//! where a stat is `{ "median_ms", "p95_ms", "mean_ms", "max_ms", "samples" }`.
+//! where a stat is `{ "median_ms", "p95_ms", "mean_ms", "max_ms", "samples" }`; `overdraw` (with
+//! `gpu.count_fragments`) is `Overdraw`'s, `counts` is `profile::counts`' (its doc has the layout).
 
 use std::collections::HashMap;
 
 use serde::Serialize;
 
+use super::counts::Counts;
 use super::stats::{Stat, median};
 use super::{Recording, SeedSample};
 use crate::gpu::TimeSource;
@@ -192,6 +195,8 @@ pub struct Summary {
     pub seeds: Seeds,
     /// The foliage passes' fragments per covered pixel (empty unless `gpu.count_fragments`).
     pub overdraw: Vec<Overdraw>,
+    /// What each pass asked of the GPU, summed over the profiled frames.
+    pub counts: Counts,
 }
 
 impl Summary {
@@ -232,13 +237,15 @@ impl Summary {
         }
         // GPU passes first, then CPU work; frame order within each (the sort is stable).
         order.sort_by_key(|(_, source)| *source == TimeSource::Cpu);
-        let passes = order
+        let passes: Vec<PassStats> = order
             .into_iter()
             .filter_map(|(label, source)| {
                 let stat = Stat::of(samples.get(&label)?)?;
                 Some(PassStats { label, source, stat })
             })
             .collect();
+        let labels: Vec<&str> = passes.iter().map(|p| p.label.as_str()).collect();
+        let counts = Counts::of(recording, &labels);
         let wall: Vec<f64> = recording.frames.iter().map(|f| f.wall_ms).collect();
         let frame_wall = Stat::of(&wall);
         let total_s = wall.iter().sum::<f64>() / 1000.0;
@@ -269,6 +276,7 @@ impl Summary {
             totals: Totals { gpu: Stat::of(&gpu_totals), cpu: Stat::of(&cpu_totals), frame_wall },
             seeds,
             overdraw: Overdraw::of(recording.profiled_fragments().collect()),
+            counts,
         }
     }
 

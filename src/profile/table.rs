@@ -2,7 +2,7 @@
 //! (2007): one row per pass in frame order (named as the paper does where it has a row for it),
 //! then the CPU work, the totals and the frame's wall time, each with its median and 95th
 //! percentile in milliseconds and the frames it was measured in; then seeds checked and selected
-//! per frame, and frames per second.
+//! per frame, and frames per second; then what each pass asked of the GPU per frame (`counts`).
 
 use std::fmt::Write;
 
@@ -88,10 +88,11 @@ fn write_table(out: &mut String, s: &Summary) -> std::fmt::Result {
     }
     match &s.fps {
         Some(fps) => {
-            writeln!(out, "{} {:>10.1} Hz median ({:.1} Hz mean)", label("FPS"), fps.median, fps.mean)
+            writeln!(out, "{} {:>10.1} Hz median ({:.1} Hz mean)", label("FPS"), fps.median, fps.mean)?
         }
-        None => writeln!(out, "{} {:>10}", label("FPS"), "-"),
+        None => writeln!(out, "{} {:>10}", label("FPS"), "-")?,
     }
+    super::counts::write_table(out, &s.counts)
 }
 
 fn stat_row(out: &mut String, row: &str, stat: Option<&Stat>) -> std::fmt::Result {

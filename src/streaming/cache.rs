@@ -211,7 +211,12 @@ impl TileCache {
     /// Takes the loader's results (other layers' are ignored) and uploads arrived tiles, most
     /// important first, within `budget`; the rest wait for later frames. Returns the frame's
     /// figures. Call after `set_wanted`, once a frame.
-    pub fn upload(&mut self, queue: &wgpu::Queue, loaded: &[Loaded], budget: UploadBudget) -> CacheStats {
+    pub fn upload(
+        &mut self,
+        queue: &crate::gpu::Queue,
+        loaded: &[Loaded],
+        budget: UploadBudget,
+    ) -> CacheStats {
         self.residency.accept(loaded, self.tile_bytes());
         for id in self.residency.staged_in_order() {
             let Some(payload) = self.residency.take_staged(id, budget) else { break };
@@ -225,7 +230,7 @@ impl TileCache {
     /// with no budget. `read` returns a tile's payload (all mips), checksum verified.
     pub fn load_now<B: std::ops::Deref<Target = [u8]>>(
         &mut self,
-        queue: &wgpu::Queue,
+        queue: &crate::gpu::Queue,
         wanted: &[TileId],
         frame: u64,
         mut read: impl FnMut(TileId) -> Result<B, PackError>,
@@ -256,7 +261,7 @@ impl TileCache {
         self.stats()
     }
 
-    fn place(&mut self, queue: &wgpu::Queue, id: TileId, payload: &[u8]) {
+    fn place(&mut self, queue: &crate::gpu::Queue, id: TileId, payload: &[u8]) {
         let Some(Placement { slot, evicted }) = self.residency.claim(id, payload.len() as u64) else {
             return;
         };
@@ -282,7 +287,7 @@ impl TileCache {
 
     /// Writes the changed page-table entries, one write per run of neighbouring entries: a few
     /// dozen bytes a frame, however large the pyramid.
-    fn flush_page_table(&mut self, queue: &wgpu::Queue) {
+    fn flush_page_table(&mut self, queue: &crate::gpu::Queue) {
         self.dirty.sort_unstable();
         self.dirty.dedup();
         let mut runs = self.dirty.chunk_by(|a, b| a + 1 == *b);
@@ -294,7 +299,7 @@ impl TileCache {
         self.dirty.clear();
     }
 
-    fn write_tile(&self, queue: &wgpu::Queue, slot: u32, payload: &[u8]) {
+    fn write_tile(&self, queue: &crate::gpu::Queue, slot: u32, payload: &[u8]) {
         let mut offset = 0usize;
         for mip in 0..self.mips {
             let layout = self.mip_layout(mip);

@@ -7,6 +7,7 @@ use glam::{DMat4, DVec3, DVec4};
 use terramp::camera::Camera;
 use terramp::earth::placing::ExactPlacing;
 use terramp::frame::Renderer;
+use terramp::gpu::counter::Counting;
 use terramp::gpu::gpu_types::TlmCell;
 use terramp::gpu::layout::{
     LevelRange, RADIAL_INACTIVE, TLM_CULLED, TLM_FIRST_PATTERN, TLM_SPAN_INSIDE, TileSpan, tlm_visibility,
@@ -99,8 +100,8 @@ pub fn run_with(r: &mut Renderer, camera: &Camera, ranges: &[[f32; 2]], wall_m: 
         view
     });
     let depth = wall.unwrap_or_else(|| r.depth_texture().create_view(&Default::default()));
-    hiz.encode(&mut encoder, &depth);
-    pass.encode(&mut encoder, &bindings, &frame);
+    hiz.encode(&mut encoder, &depth, Counting::OFF);
+    pass.encode(&mut encoder, &bindings, &frame, Counting::OFF);
     r.gpu.queue.submit([encoder.finish()]);
     let gpu_cells = pass.read_back(&r.gpu, &frame).unwrap();
     let mips = hiz.read_back(&r.gpu).unwrap();

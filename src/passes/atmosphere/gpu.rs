@@ -6,12 +6,14 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension as Dim
 
 use crate::config::AtmosphereSettings;
 use crate::gpu::bindings::{Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::ATMOSPHERE_WORKGROUP;
 use crate::gpu::readback::read_texture_mip;
 use crate::gpu::resources::{buffer, compute_pipeline, depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
-use crate::gpu::{Gpu, GpuError};
+use crate::gpu::{Gpu, GpuError, Queue};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
 use super::frame::{SkyView, atmosphere_uniforms};
@@ -104,12 +106,9 @@ impl Table {
         Self { texture, view, size, format }
     }
 
-    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>) {
-        pass.dispatch_workgroups(
-            self.size[0].div_ceil(ATMOSPHERE_WORKGROUP),
-            self.size[1].div_ceil(ATMOSPHERE_WORKGROUP),
-            1,
-        );
+    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, counting: Counting<'_>) {
+        let [w, h] = self.size.map(|side| side.div_ceil(ATMOSPHERE_WORKGROUP));
+        counting.dispatch(pass, [w, h, 1]);
     }
 
     fn read_back(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, GpuError> {
@@ -197,10 +196,10 @@ impl AtmospherePass {
             });
             pass.set_pipeline(&transmittance_pipeline);
             pass.set_bind_group(0, &transmittance_group, &[]);
-            transmittance.dispatch(&mut pass);
+            transmittance.dispatch(&mut pass, Counting::OFF);
             pass.set_pipeline(&multiple_pipeline);
             pass.set_bind_group(0, &multiple_group, &[]);
-            multiple.dispatch(&mut pass);
+            multiple.dispatch(&mut pass, Counting::OFF);
         }
         gpu.queue.submit([encoder.finish()]);
 
@@ -244,19 +243,21 @@ impl AtmospherePass {
     }
 
     /// Writes the frame's uniforms for `view`.
-    pub fn prepare(&self, queue: &wgpu::Queue, view: &SkyView) {
+    pub fn prepare(&self, queue: &Queue, view: &SkyView) {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&atmosphere_uniforms(&self.settings, view)));
     }
 
     /// Records the sky-view table for the frame's view.
-    pub fn encode_sky_view(&self, encoder: &mut wgpu::CommandEncoder) {
+    pub fn encode_sky_view(&self, encoder: &mut wgpu::CommandEncoder, counting: Counting<'_>) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("atmosphere sky view"),
             timestamp_writes: None,
         });
+        counting.begin(&mut pass, Part::Whole);
         pass.set_pipeline(&self.sky_view_pipeline);
         pass.set_bind_group(0, &self.sky_view_group, &[]);
-        self.sky_view.dispatch(&mut pass);
+        self.sky_view.dispatch(&mut pass, counting);
+        counting.end(&mut pass);
     }
 
     /// Records the sky over `colour` where `depth` still holds the far plane.
@@ -265,11 +266,14 @@ impl AtmospherePass {
         encoder: &mut wgpu::CommandEncoder,
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
+        counting: Counting<'_>,
     ) {
         let mut pass = frame_pass(encoder, "sky", colour, depth, None, None);
+        counting.begin(&mut pass, Part::Whole);
         pass.set_pipeline(&self.sky_pipeline);
         pass.set_bind_group(0, &self.sky_group, &[]);
-        pass.draw(0..3, 0..1);
+        counting.draw(&mut pass, 0..3, 0..1);
+        counting.end(&mut pass);
     }
 
     /// The three tables as the GPU made them (transmittance, multiple scattering, sky view),

@@ -4,6 +4,8 @@
 use wgpu::ShaderStages as Stage;
 
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::{CompactParams, SeedBlock, SeedDrawArgs};
 use crate::gpu::layout::{COMPACT_CHUNK, SEED_DRAWS, SEED_GROUPS};
 use crate::gpu::readback::read_values;
@@ -124,7 +126,7 @@ impl CompactPass {
     /// Sets the mesh fields of each draw (`index_count`, `first_index`, `base_vertex`; the rest
     /// is ignored), draw by draw from 0 (`SEED_DRAWS`: the groups', then their cross-fades');
     /// draws beyond `templates` keep theirs.
-    pub fn set_templates(&mut self, queue: &wgpu::Queue, templates: &[SeedDrawArgs]) {
+    pub fn set_templates(&mut self, queue: &crate::gpu::Queue, templates: &[SeedDrawArgs]) {
         let n = templates.len().min(SEED_DRAWS as usize);
         if n > 0 {
             self.template_copy[..n].copy_from_slice(&templates[..n]);
@@ -138,7 +140,7 @@ impl CompactPass {
     }
 
     /// Writes the run's constants: compact the first `blocks` entries of the block table.
-    pub fn prepare(&self, queue: &wgpu::Queue, blocks: u32) -> Result<CompactParams, CompactError> {
+    pub fn prepare(&self, queue: &crate::gpu::Queue, blocks: u32) -> Result<CompactParams, CompactError> {
         if blocks > self.limits.blocks {
             return Err(CompactError::TooManyBlocks {
                 blocks: blocks.into(),
@@ -157,12 +159,14 @@ impl CompactPass {
         encoder: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
         params: &CompactParams,
+        counting: Counting<'_>,
     ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("compact"),
             timestamp_writes: None,
         });
         pass.set_bind_group(0, bind_group, &[]);
+        counting.begin(&mut pass, Part::Whole);
         let steps = [
             (&self.reduce, params.chunks),
             (&self.scan, SEED_GROUPS),
@@ -172,9 +176,10 @@ impl CompactPass {
         for (pipeline, workgroups) in steps {
             if workgroups > 0 {
                 pass.set_pipeline(pipeline);
-                pass.dispatch_workgroups(workgroups, 1, 1);
+                counting.dispatch(&mut pass, [workgroups, 1, 1]);
             }
         }
+        counting.end(&mut pass);
     }
 
     /// The permutation, draw slot → record index (`limits.records` entries; a run fills the

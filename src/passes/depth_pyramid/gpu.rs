@@ -5,6 +5,8 @@
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension as Dim};
 
 use crate::gpu::bindings::{Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::layout::HIZ_WORKGROUP;
 use crate::gpu::readback::read_texture_mip;
 use crate::gpu::resources::{compute_pipeline, pipeline_layout};
@@ -116,7 +118,12 @@ impl DepthPyramid {
 
     /// Records the reduction of `depth` (a view of the Depth32Float target this pyramid was
     /// sized for) into every level.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, depth: &wgpu::TextureView) {
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+        counting: Counting<'_>,
+    ) {
         use wgpu::BindingResource::TextureView as View;
         let first = FROM_DEPTH.bind_group(
             &self.device,
@@ -128,16 +135,18 @@ impl DepthPyramid {
             timestamp_writes: None,
         });
         let groups = |[w, h]: [u32; 2]| (w.div_ceil(HIZ_WORKGROUP), h.div_ceil(HIZ_WORKGROUP));
+        counting.begin(&mut pass, Part::Whole);
         pass.set_pipeline(&self.from_depth);
         pass.set_bind_group(0, &first, &[]);
         let (x, y) = groups(self.sizes[0]);
-        pass.dispatch_workgroups(x, y, 1);
+        counting.dispatch(&mut pass, [x, y, 1]);
         pass.set_pipeline(&self.from_mip);
         for (group, &size) in self.mip_groups.iter().zip(&self.sizes[1..]) {
             pass.set_bind_group(0, group, &[]);
             let (x, y) = groups(size);
-            pass.dispatch_workgroups(x, y, 1);
+            counting.dispatch(&mut pass, [x, y, 1]);
         }
+        counting.end(&mut pass);
     }
 
     /// The whole mip chain, for passes that test against it (`textureLoad(t, texel, level)`).

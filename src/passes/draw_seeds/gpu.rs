@@ -11,6 +11,8 @@ use crate::classes::Species;
 use crate::config::Settings;
 use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{
     DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedShape, SeedVertex,
@@ -359,7 +361,7 @@ impl DrawSeedsPass {
     }
 
     /// Writes the frame's constants, with each group's colour follow-up under their sun.
-    pub fn prepare(&self, queue: &wgpu::Queue, uniforms: &DrawSeedsUniforms) {
+    pub fn prepare(&self, queue: &crate::gpu::Queue, uniforms: &DrawSeedsUniforms) {
         let mut uniforms = *uniforms;
         let sun = glam::Vec4::from(uniforms.sun_dir).truncate();
         for (scale, seen) in uniforms.photo_scale.iter_mut().zip(&self.from_above) {
@@ -369,15 +371,15 @@ impl DrawSeedsPass {
     }
 
     /// Records each group's draw and cross-fade draw from `draw_args` (compaction's) into the
-    /// targets (multisampled when `multisampled` made it so, resolved into `colour`); `count`
-    /// counts their fragments.
+    /// targets (multisampled when `multisampled` made it so, resolved into `colour`); `counting`
+    /// counts them, and `count` their samples written and pixels covered.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
         draw_args: &wgpu::Buffer,
         (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
-        count: Option<CountedPass<'_>>,
+        (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
         if self.species_drawn == 0 {
             if let Some(count) = count {
@@ -387,11 +389,13 @@ impl DrawSeedsPass {
         }
         let occlusion = count.map(CountedPass::occlusion_set);
         if let Some((targets, draw)) = &self.multisample {
-            targets.encode(encoder, occlusion, |pass| self.record(pass, draw, bind_group, draw_args, count));
+            targets.encode(encoder, (occlusion, counting), |pass| {
+                self.record(pass, draw, bind_group, draw_args, (count, counting))
+            });
             return;
         }
         let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None, occlusion);
-        self.record(&mut pass, &self.draw, bind_group, draw_args, count);
+        self.record(&mut pass, &self.draw, bind_group, draw_args, (count, counting));
     }
 
     /// Every group's indirect draws through `draw`'s pipelines.
@@ -401,7 +405,7 @@ impl DrawSeedsPass {
         draw: &Draw,
         bind_group: &wgpu::BindGroup,
         draw_args: &wgpu::Buffer,
-        count: Option<CountedPass<'_>>,
+        (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
@@ -410,21 +414,23 @@ impl DrawSeedsPass {
             pass.set_pipeline(pipeline);
             let stride = size_of::<SeedDrawArgs>() as u64;
             for draw in near_to_far_draws().filter(|&d| self.templates[d].index_count > 0) {
-                pass.draw_indexed_indirect(draw_args, draw as u64 * stride);
+                counting.draw_indexed_indirect(pass, draw_args, draw as u64 * stride);
             }
         };
         let shade = match draw {
             Draw::Plain(shade) => shade,
             Draw::Prepassed { depth, shade } => {
-                count.inspect(|c| c.begin_prepass(pass));
+                counting.begin(pass, Part::Prepass);
                 draws(pass, depth);
-                count.inspect(|c| c.end_prepass(pass));
+                counting.end(pass);
                 shade
             }
         };
+        counting.begin(pass, Part::Shading);
         count.inspect(|c| c.begin(pass));
         draws(pass, shade);
         count.inspect(|c| c.end(pass));
+        counting.end(pass);
     }
 }
 

@@ -2,6 +2,8 @@
 
 use crate::config::Settings;
 use crate::earth::gpu::EARTH;
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::resources::{depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{CLOUDS, HASH, IMAGERY, TERRAIN_MESH, WgslSource};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
@@ -71,11 +73,14 @@ impl GroundPass {
         colour: &wgpu::TextureView,
         depth: &wgpu::TextureView,
         sky_linear: [f64; 3],
+        counting: Counting<'_>,
     ) {
         let [r, g, b] = sky_linear;
         let mut pass =
             frame_pass(encoder, "ground", colour, depth, Some(wgpu::Color { r, g, b, a: 1.0 }), None);
         pass.set_pipeline(&self.pipeline);
-        mesh.draw(&mut pass);
+        counting.begin(&mut pass, Part::Whole);
+        mesh.draw(&mut pass, counting);
+        counting.end(&mut pass);
     }
 }

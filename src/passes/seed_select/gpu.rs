@@ -9,6 +9,8 @@ use crate::camera::CameraError;
 use crate::config::Settings;
 use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::{
     SeedBlock, SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSettle, SeedSpecies, SeedUniforms,
 };
@@ -228,7 +230,7 @@ impl SeedSelectPass {
     }
 
     /// Builds the frame's uniforms and cells and uploads them; returns them (the twin reads the same).
-    pub fn prepare(&self, queue: &wgpu::Queue, inputs: &SeedInputs) -> Result<SeedFrame, CameraError> {
+    pub fn prepare(&self, queue: &crate::gpu::Queue, inputs: &SeedInputs) -> Result<SeedFrame, CameraError> {
         let frame = SeedFrame::new(inputs)?;
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&frame.uniforms));
         if !frame.cells.is_empty() {
@@ -244,6 +246,7 @@ impl SeedSelectPass {
         encoder: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
         frame: &SeedFrame,
+        counting: Counting<'_>,
     ) {
         encoder.clear_buffer(&self.counters, 0, None);
         if frame.cells.is_empty() {
@@ -253,18 +256,17 @@ impl SeedSelectPass {
             label: Some("seed select"),
             timestamp_writes: None,
         });
+        counting.begin(&mut pass, Part::Whole);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind_group, &[]);
-        pass.dispatch_workgroups(
-            workgroups_per_cell(frame.uniforms.active_ranks),
-            frame.cells.len() as u32,
-            1,
-        );
+        let workgroups = [workgroups_per_cell(frame.uniforms.active_ranks), frame.cells.len() as u32, 1];
+        counting.dispatch(&mut pass, workgroups);
         pass.set_pipeline(&self.settle);
         pass.set_bind_group(1, &self.settle_group, &[]);
-        pass.dispatch_workgroups(1, 1, 1);
+        counting.dispatch(&mut pass, [1, 1, 1]);
         pass.set_pipeline(&self.pipeline);
-        pass.dispatch_workgroups_indirect(&self.settled, 0);
+        counting.dispatch_indirect(&mut pass, &self.settled, 0);
+        counting.end(&mut pass);
     }
 
     /// The record buffer (`capacity` records; a frame fills `min(selected, capacity)`).

@@ -8,6 +8,8 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 use crate::config::Settings;
 use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::{EarthNode, TerrainNode, TerrainUniforms};
 use crate::gpu::resources::{buffer, buffer_init, pipeline_layout};
 use crate::gpu::shaders::{TERRAIN_MESH, WgslSource};
@@ -80,8 +82,8 @@ pub struct MeshDraw<'a> {
 
 impl MeshDraw<'_> {
     /// Draws the node instances with the pipeline already set on `pass`.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
-        self.terrain.draw_mesh(pass, self.bind_group, self.nodes);
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, counting: Counting<'_>) {
+        self.terrain.draw_mesh(pass, self.bind_group, self.nodes, counting);
     }
 }
 
@@ -180,7 +182,7 @@ impl TerrainPass {
     /// `MAX_NODES`; the rest are dropped, coarse quadrants last, and counted by the caller).
     pub fn prepare(
         &self,
-        queue: &wgpu::Queue,
+        queue: &crate::gpu::Queue,
         uniforms: &TerrainUniforms,
         batches: &NodeBatches,
     ) -> PreparedNodes {
@@ -205,13 +207,14 @@ impl TerrainPass {
         &self.layout
     }
 
-    /// Pass 0: the mesh into a cleared depth target, nothing else.
+    /// Pass 0: the mesh into a cleared depth target, nothing else; counted through `counting`.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
         depth: &wgpu::TextureView,
         nodes: &PreparedNodes,
+        counting: Counting<'_>,
     ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("terrain"),
@@ -230,7 +233,9 @@ impl TerrainPass {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
-        self.draw_mesh(&mut pass, bind_group, nodes);
+        counting.begin(&mut pass, Part::Whole);
+        self.draw_mesh(&mut pass, bind_group, nodes, counting);
+        counting.end(&mut pass);
     }
 
     /// Draws this frame's node instances with the pipeline already set on `pass`.
@@ -239,12 +244,13 @@ impl TerrainPass {
         pass: &mut wgpu::RenderPass<'_>,
         bind_group: &wgpu::BindGroup,
         nodes: &PreparedNodes,
+        counting: Counting<'_>,
     ) {
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         for (indices, instances) in self.quadrant_indices.iter().zip(&nodes.ranges) {
             if !instances.is_empty() {
-                pass.draw_indexed(indices.clone(), 0, instances.clone());
+                counting.draw_indexed(pass, indices.clone(), 0, instances.clone());
             }
         }
     }

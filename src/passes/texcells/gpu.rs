@@ -9,6 +9,8 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 use crate::dataset::surface::diagonal_rises;
 use crate::earth::gpu::EARTH;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{TexcellRecord, TexcellUniforms};
 use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
@@ -199,12 +201,12 @@ impl TexcellsPass {
     }
 
     /// Replaces the uniforms (the band, opacity and colour settings) from the next frame on.
-    pub fn write_uniforms(&self, queue: &wgpu::Queue, uniforms: &TexcellUniforms) {
+    pub fn write_uniforms(&self, queue: &crate::gpu::Queue, uniforms: &TexcellUniforms) {
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
     }
 
     /// Uploads the frame's slice instances (at most `MAX_RECORDS`).
-    pub fn prepare(&self, queue: &wgpu::Queue, records: &[TexcellRecord]) -> PreparedTexcells {
+    pub fn prepare(&self, queue: &crate::gpu::Queue, records: &[TexcellRecord]) -> PreparedTexcells {
         let kept = &records[..records.len().min(MAX_RECORDS as usize)];
         if !kept.is_empty() {
             queue.write_buffer(&self.records, 0, bytemuck::cast_slice(kept));
@@ -213,26 +215,28 @@ impl TexcellsPass {
     }
 
     /// Draws the frame's slices over `colour`, depth-tested against the ground in `depth`;
-    /// `count` counts their fragments.
+    /// `counting` counts them, and `count` their samples written and pixels covered.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         (mesh, bind_group): (MeshDraw<'_>, &wgpu::BindGroup),
         (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
         prepared: PreparedTexcells,
-        count: Option<CountedPass<'_>>,
+        (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
         let mut pass =
             frame_pass(encoder, "texcells", colour, depth, None, count.map(CountedPass::occlusion_set));
+        counting.begin(&mut pass, Part::Shading);
         count.inspect(|c| c.begin(&mut pass));
         if prepared.instances > 0 {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, mesh.bind_group, &[]);
             pass.set_bind_group(1, bind_group, &[]);
             pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..self.index_count, 0, 0..prepared.instances);
+            counting.draw_indexed(&mut pass, 0..self.index_count, 0, 0..prepared.instances);
         }
         count.inspect(|c| c.end(&mut pass));
+        counting.end(&mut pass);
     }
 }
 

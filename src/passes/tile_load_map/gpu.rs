@@ -5,6 +5,8 @@ use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::config::Settings;
 use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::{TlmCell, TlmSpan, TlmUniforms};
 use crate::gpu::layout::{TLM_MAX_RINGS, TLM_WORKGROUP};
 use crate::gpu::readback::read_values;
@@ -108,7 +110,7 @@ impl TileLoadMapPass {
     }
 
     /// Builds the frame's uniforms and spans and uploads them; returns them (the twin reads the same).
-    pub fn prepare(&self, queue: &wgpu::Queue, inputs: &TlmInputs) -> Result<TlmFrame, TlmError> {
+    pub fn prepare(&self, queue: &crate::gpu::Queue, inputs: &TlmInputs) -> Result<TlmFrame, TlmError> {
         let layout = inputs.layout;
         if layout.cells != self.cells || layout.rings > self.max_rings {
             return Err(TlmError::LayoutMismatch {
@@ -125,7 +127,13 @@ impl TileLoadMapPass {
     }
 
     /// Records the pass: one invocation per cell of the frame's rings.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, bindings: &TlmBindings, frame: &TlmFrame) {
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        bindings: &TlmBindings,
+        frame: &TlmFrame,
+        counting: Counting<'_>,
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("tile load map"),
             timestamp_writes: None,
@@ -133,7 +141,9 @@ impl TileLoadMapPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bindings.bind_group, &[]);
         let groups = self.cells.div_ceil(TLM_WORKGROUP);
-        pass.dispatch_workgroups(groups, groups, frame.uniforms.rings);
+        counting.begin(&mut pass, Part::Whole);
+        counting.dispatch(&mut pass, [groups, groups, frame.uniforms.rings]);
+        counting.end(&mut pass);
     }
 
     /// The TLM buffer (`max_rings · cells²` cells; a frame fills `frame.output_bytes()`).

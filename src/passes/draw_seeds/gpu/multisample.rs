@@ -12,6 +12,8 @@
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension};
 
 use crate::gpu::bindings::{Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
 use crate::gpu::layout::SEED_SAMPLES;
 use crate::gpu::resources::pipeline_layout;
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
@@ -133,7 +135,7 @@ impl Multisample {
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        occlusion: Option<&wgpu::QuerySet>,
+        (occlusion, counting): (Option<&wgpu::QuerySet>, Counting<'_>),
         draw: impl FnOnce(&mut wgpu::RenderPass),
     ) {
         encoder.copy_texture_to_texture(
@@ -168,7 +170,9 @@ impl Multisample {
         });
         pass.set_pipeline(&self.fill);
         pass.set_bind_group(0, &self.fill_bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        counting.begin(&mut pass, Part::Whole);
+        counting.draw(&mut pass, 0..3, 0..1);
+        counting.end(&mut pass);
         draw(&mut pass);
     }
 }
