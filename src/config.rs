@@ -171,6 +171,9 @@ pub struct RenderSettings {
     pub sun_azimuth_deg: f64,
     /// Sun elevation above the horizon, degrees (-90 to 90).
     pub sun_elevation_deg: f64,
+    /// The instant the sun is placed for, RFC 3339 (`2026-06-21T17:30Z`), over the place under
+    /// the camera (`sun`); empty: the two angles above place it.
+    pub sun_time: String,
     /// Distance at which haze hides half of the ground colour, metres.
     pub haze_half_distance_m: f64,
     /// Draw the dataset on the Earth's ellipsoid where its manifest says where it lies; false

@@ -28,6 +28,7 @@ pub mod publish;
 pub mod reference;
 pub mod seeds;
 pub mod streaming;
+pub mod sun;
 #[cfg(feature = "sweep")]
 pub mod sweep;
 #[cfg(feature = "synth")]

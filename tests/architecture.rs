@@ -103,7 +103,7 @@ const LAYERS: &[&[&str]] = &[
     &["classes", "streaming"],
     &["seeds", "synth", "tree"],
     &["texcell", "light"],
-    &["passes", "bake"],
+    &["passes", "bake", "sun"],
     &["reference"],
     &["frame"],
     &["profile", "truth", "photo"],

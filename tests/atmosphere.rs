@@ -294,3 +294,33 @@ fn the_parts_of_the_sky() {
         println!("| {} km | {sun_deg}° | {} | {} | {} |", altitude_m / 1000.0, range(0), range(1), range(2));
     }
 }
+
+#[test]
+fn below_minus_18_degrees_it_is_night_a_dark_sky_and_no_nan() {
+    // Astronomical night: the sun 20° below the horizon lights no air the view sees (the air's
+    // top is 100 km up; the Earth's shadow covers it beyond ~350 km). Every table value finite,
+    // the sky below one 8-bit level.
+    let s = settings();
+    let night = view(300.0, -20.0);
+    let u = atmosphere_uniforms(&s, &night);
+    let (transmittance, multiple, sky_view) = tables(&u);
+    for lut in [&transmittance, &multiple, &sky_view] {
+        assert!(lut.texels.iter().flatten().all(|v| v.is_finite()), "a table holds a NaN or an infinity");
+    }
+    let twin = Tables { model: Model::new(&u), transmittance: &transmittance, multiple: Some(&multiple) };
+    for d in directions(64, false) {
+        let colour = twin.sky_colour(&sky_view, d.as_vec3());
+        assert!(colour.is_finite() && colour.max_element() < 0.5 / 255.0, "{d}: {colour}");
+    }
+    let dataset = synth_dataset(300, 7);
+    let mut settings = small_settings(64, 48);
+    settings.seeds.density_scale = 0.0;
+    settings.render.sun_elevation_deg = -20.0;
+    let mut r = renderer(&dataset, settings);
+    let camera = over_fraction(&r, [0.5, 0.5], 300.0, 0.0, 20.0);
+    r.render(&camera).unwrap();
+    let (colour, depth) = (r.read_colour().unwrap(), r.read_depth().unwrap());
+    let sky: Vec<_> = colour.pixels().zip(&depth).filter(|(_, d)| **d == 0.0).map(|(p, _)| p).collect();
+    assert!(sky.len() > 64 * 48 / 4, "{} sky pixels", sky.len());
+    assert!(sky.iter().all(|p| p[0] <= 1 && p[1] <= 1 && p[2] <= 1), "a night sky pixel is lit");
+}

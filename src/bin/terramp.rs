@@ -51,11 +51,19 @@ struct SettingsArgs {
     /// A TOML file overriding settings (see config/default.toml for every key).
     #[arg(long)]
     settings: Option<PathBuf>,
+    /// The date and time the sun stands at over the place under the camera (`render.sun_time`):
+    /// RFC 3339, e.g. 2026-06-21T17:30Z. Needs a dataset that records where it lies on the Earth.
+    #[arg(long)]
+    time: Option<String>,
 }
 
 impl SettingsArgs {
     fn load(&self) -> Result<Settings> {
-        Ok(Settings::load(&self.preset, self.settings.as_deref())?)
+        let mut settings = Settings::load(&self.preset, self.settings.as_deref())?;
+        if let Some(time) = &self.time {
+            settings.render.sun_time.clone_from(time);
+        }
+        Ok(settings)
     }
 }
 

@@ -54,6 +54,10 @@ pub enum RenderError {
     /// of LODs, or an adapter without the features it needs.
     #[error(transparent)]
     DrawSeeds(#[from] crate::passes::draw_seeds::DrawSeedsError),
+    /// `render.sun_time` cannot place the sun: a time it cannot read, or a dataset that does not
+    /// record where it lies on the Earth.
+    #[error(transparent)]
+    Sun(#[from] crate::sun::SunError),
     /// `gpu.count_fragments` is on, and the adapter has no pipeline-statistics queries.
     #[error("gpu.count_fragments: this adapter cannot count fragments (no pipeline-statistics queries)")]
     NoFragmentCounts,

@@ -187,6 +187,8 @@ impl Renderer {
     /// `dataset`; fails when the viewport, the caches or the seeds do not fit this adapter.
     pub fn new(gpu: Gpu, dataset: impl Into<Arc<Dataset>>, settings: Settings) -> Result<Self, RenderError> {
         let dataset = dataset.into();
+        // A sun time that cannot be read, or one over a dataset not on the Earth, fails here.
+        crate::sun::check(&settings.render, &dataset.manifest)?;
         let targets = Targets::new(&gpu.device, &settings)?;
         let device = &gpu.device;
         let terrain = TerrainPass::new(device, &settings);
@@ -396,9 +398,7 @@ impl Renderer {
         })?;
         // The sky: the air's light seen from the camera's altitude, drawn where nothing was.
         p.pass(gpu, encoder, "sky_view", |e| self.atmosphere.encode_sky_view(e, c.pass("sky_view")))?;
-        p.pass(gpu, encoder, "sky", |e| {
-            self.atmosphere.encode_sky(e, &t.colour_view, &t.depth_view, c.pass("sky"))
-        })?;
+        p.pass(gpu, encoder, "sky", |e| self.atmosphere.encode_sky(e, targets, c.pass("sky")))?;
         if let Some(stage) = &self.texcells {
             // The far forest: slices of the dense classes' samples over the ground beyond the seeds.
             let counting = c.pass("texcells");

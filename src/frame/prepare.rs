@@ -11,9 +11,8 @@ use crate::camera::{Camera, Frustum};
 use crate::earth::horizon::fall_per_m2;
 use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::{EarthNode, TerrainUniforms};
-use crate::light::sun_dir;
 use crate::passes::atmosphere::frame::SkyView;
-use crate::passes::terrain::frame::{height_tiles, node_batches, terrain_uniforms};
+use crate::passes::terrain::frame::{FrameLight, height_tiles, node_batches, terrain_uniforms};
 use crate::passes::terrain::gpu::PreparedNodes;
 use crate::passes::terrain::select::{Lods, Selected, select};
 use crate::passes::tile_load_map::analysis::LoadMaps;
@@ -21,6 +20,7 @@ use crate::passes::tile_load_map::frame::{TlmEarth, TlmFrame, TlmImagery, TlmInp
 use crate::passes::tile_load_map::layout::TlmLayout;
 use crate::streaming::wants::after_pinned;
 use crate::streaming::{CacheStats, TileCache, UploadBudget};
+use crate::sun::frame_sun_dir;
 
 use super::texcells::TexcellView;
 use super::{FrameReport, RenderError, Renderer, SKY_LINEAR};
@@ -48,6 +48,8 @@ struct View<'a> {
     /// The mapping of the grid point under the camera (`ExactPlacing::nadir_node`): how the
     /// TLM's boxes bend and where the seeds stand up.
     nadir: EarthNode,
+    /// Towards the sun, in the camera-relative world (`sun::frame_sun_dir`).
+    sun_dir: DVec3,
 }
 
 impl Renderer {
@@ -68,6 +70,11 @@ impl Renderer {
             lods: Lods::for_view(&self.dataset, &self.settings.terrain, camera, height),
             nadir: placing.nadir_node(),
             placing,
+            sun_dir: frame_sun_dir(
+                &self.settings.render,
+                self.dataset.manifest.earth.as_ref(),
+                camera.position_m,
+            )?,
         };
         let selected = self.select_nodes(&view);
         self.stream(&view, &selected, report);
@@ -180,15 +187,16 @@ impl Renderer {
         report.nodes_dropped = dropped;
         let clip = view.clip_from_view_world.as_mat4();
         let fall = fall_per_m2(&view.nadir);
+        let light = FrameLight { sun_dir: view.sun_dir, haze_linear: SKY_LINEAR };
         let uniforms =
-            terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, SKY_LINEAR, self.time_s, fall);
+            terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, light, self.time_s, fall);
         let (queue, counts) = (&self.gpu.queue, &self.counts);
         let nodes = counts.uploads(queue, "terrain", || self.terrain.prepare(queue, &uniforms, &batches));
         // The camera's frame is its own local one, on the Earth or flat: its zenith is +z.
         let sky = SkyView {
             view_world_from_clip: view.clip_from_view_world.inverse(),
             up: DVec3::Z,
-            sun_dir: sun_dir(&self.settings.render),
+            sun_dir: view.sun_dir,
             altitude_m: view.grid_m.z,
         };
         counts.uploads(queue, "sky_view", || self.atmosphere.prepare(queue, &sky));

@@ -273,6 +273,11 @@ pub static CLAIMS: &[Claim] = &[
     },
     Claim {
         doc: "docs/README.md",
+        quote: "(it allows at most {} there)",
+        values: &[(test_const("data-tools/tests/draw_seeds.rs", "MAX_CLASS_FADE_BLOCK_CHANGE"), plain)],
+    },
+    Claim {
+        doc: "docs/README.md",
         quote: "`data-tools/tests/reference/nc_trees_320x180.png`, ≥ {} dB PSNR",
         values: &[(test_const("data-tools/tests/draw_seeds.rs", "MIN_PSNR_DB"), plain)],
     },

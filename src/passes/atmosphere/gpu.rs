@@ -260,12 +260,12 @@ impl AtmospherePass {
         counting.end(&mut pass);
     }
 
-    /// Records the sky over `colour` where `depth` still holds the far plane.
+    /// Records the sky over the frame's (colour, depth) targets where the depth still holds the
+    /// far plane.
     pub fn encode_sky(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
+        (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
         counting: Counting<'_>,
     ) {
         let mut pass = frame_pass(encoder, "sky", colour, depth, None, None);

@@ -12,7 +12,7 @@ use crate::dataset::{Dataset, ImageryFormat, TileId};
 use crate::earth::placing::PlacedView;
 use crate::gpu::gpu_types::{EarthNode, TerrainNode, TerrainUniforms};
 use crate::gpu::layout::{IMAGERY_NONE, IMAGERY_PUNCHED, IMAGERY_STRAIGHT, IMAGERY_VEGETATION, MAX_LEVELS};
-use crate::light::{CloudShadowFrame, sun_dir};
+use crate::light::CloudShadowFrame;
 use crate::streaming::{TileCache, page_levels};
 
 use super::select::{Lods, NodeId, Selected};
@@ -63,22 +63,33 @@ impl NodeBatches {
     }
 }
 
+/// The frame's light: towards the sun (unit, in the camera-relative world: `sun::frame_sun_dir`),
+/// and the colour the distance fades into (linear RGB).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameLight {
+    /// Towards the sun.
+    pub sun_dir: DVec3,
+    /// The haze's colour.
+    pub haze_linear: [f64; 3],
+}
+
 /// The terrain passes' uniforms for a camera at `camera_grid_m` (grid space) with `clip` the
-/// clip-from-camera-relative-world matrix, at the scene's time `time_s` (the clouds' drift), over
-/// ground falling away from the camera by `fall_per_m2` d² (`earth::horizon::fall_per_m2`, 0
-/// flat); `sky_linear` is also the haze colour.
+/// clip-from-camera-relative-world matrix, in `light`, at the scene's time `time_s` (the clouds'
+/// drift), over ground falling away from the camera by `fall_per_m2` d²
+/// (`earth::horizon::fall_per_m2`, 0 flat).
 pub fn terrain_uniforms(
     dataset: &Dataset,
     settings: &Settings,
     camera_grid_m: DVec3,
     clip: glam::Mat4,
-    sky_linear: [f64; 3],
+    light: FrameLight,
     time_s: f64,
     fall_per_m2: f64,
 ) -> TerrainUniforms {
     let r = &settings.render;
     let manifest = &dataset.manifest;
-    let sun = sun_dir(r);
+    let sun = light.sun_dir;
+    let sky_linear = light.haze_linear;
     let half_spacing = 0.5 * manifest.height.spacing_m;
     let clouds =
         CloudShadowFrame::new(&settings.clouds, sun, manifest.height.max_m as f64, camera_grid_m, time_s)
