@@ -11,8 +11,9 @@
 //   towards it (single scattering with the true phases and the sun's transmittance from the
 //   table, plus Ψ), up to the ground or the top (made each frame: it depends on the camera's
 //   altitude and the sun).
-// - `vs_sky`, `fs_sky`: where the depth is still the far plane (reversed-Z 0), the sky from the
-//   sky-view table, and the sun's disk through the air.
+// - `vs_sky` with `fs_sky` or `fs_sky_marched`: where the depth is still the far plane
+//   (reversed-Z 0), the sky from the sky-view table (or marched per pixel from high up), and the
+//   sun's disk through the air.
 // Radiances are per unit of the sun's irradiance; the sky is drawn in the ground's units (a white
 // plate facing the sun reflects `GROUND_SUN`: × π `GROUND_SUN`).
 
@@ -218,44 +219,57 @@ fn disk_transmittance(r: f32, mu: f32) -> vec3<f32> {
     return sun_transmittance(top, (r * mu + entry) / top);
 }
 
-// The sky's radiance along a camera-relative direction `dir` (unit), per unit of the sun's
-// irradiance, the sun's disk included: from the sky-view table for views in the lower air, marched
-// per pixel above `SKY_MARCHED_ABOVE_KM`, where the table's rows about the horizon grow coarser
-// than the limb they hold.
-fn sky_radiance(dir: vec3<f32>) -> vec3<f32> {
-    let r_view = atmosphere.up.w;
+// The sun's disk along a camera-relative direction `dir` (unit) at zenith cosine `mu` from a view
+// at radius `r_view`: the sun's irradiance spread over its solid angle, through the air, where
+// the ground does not hide it.
+fn sun_disk(dir: vec3<f32>, r_view: f32, mu: f32) -> vec3<f32> {
+    let sun_radius = atmosphere.sun_dir.w;
+    if dot(dir, atmosphere.sun_dir.xyz) > cos(sun_radius) && !hits_ground(r_view, mu) {
+        return disk_transmittance(r_view, mu) / (PI * sun_radius * sun_radius);
+    }
+    return vec3<f32>(0.0);
+}
+
+// The view ray under a pixel of the full-screen triangle: the direction of the near plane's point,
+// camera-relative.
+fn sky_ray(ndc: vec2<f32>) -> vec3<f32> {
+    let near = atmosphere.view_world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+    return normalize(near.xyz / near.w);
+}
+
+// The sky from the sky-view table, for views in the lower air (up to `SKY_MARCHED_ABOVE_KM`).
+@fragment
+fn fs_sky(in: SkyOut) -> @location(0) vec4<f32> {
+    let dir = sky_ray(in.ndc);
     let up = atmosphere.up.xyz;
     let sun = atmosphere.sun_dir.xyz;
     let mu = clamp(dot(dir, up), -1.0, 1.0);
-    var radiance = vec3<f32>(0.0);
-    if r_view - bottom_km() > SKY_MARCHED_ABOVE_KM {
-        radiance = marched_sky(r_view, mu, clamp(dot(sun, up), -1.0, 1.0), dot(dir, sun));
-    } else {
-        let r = atmosphere.radii.z;
-        let across = dir - up * mu;
-        let sun_across = sun - up * dot(sun, up);
-        let lengths = length(across) * length(sun_across);
-        var azimuth = 0.0;
-        if lengths > 1e-6 {
-            azimuth = acos(clamp(dot(across, sun_across) / lengths, -1.0, 1.0));
-        }
-        // One bilinear sample: texel centres span the unit square corner to corner, as `lut_read`.
-        let size = vec2<f32>(atmosphere.sky_view_size);
-        let uv = (clamp(sky_view_unit(r, acos(mu), azimuth), vec2<f32>(0.0), vec2<f32>(1.0)) * (size - 1.0) + 0.5) / size;
-        radiance = textureSampleLevel(sky_view, sky_sampler, uv, 0.0).rgb;
+    let across = dir - up * mu;
+    let sun_across = sun - up * dot(sun, up);
+    let lengths = length(across) * length(sun_across);
+    var azimuth = 0.0;
+    if lengths > 1e-6 {
+        azimuth = acos(clamp(dot(across, sun_across) / lengths, -1.0, 1.0));
     }
-    let sun_radius = atmosphere.sun_dir.w;
-    if dot(dir, sun) > cos(sun_radius) && !hits_ground(r_view, mu) {
-        // The disk's radiance: the irradiance spread over its solid angle, through the air.
-        radiance += disk_transmittance(r_view, mu) / (PI * sun_radius * sun_radius);
-    }
-    return radiance;
+    // One bilinear sample: texel centres span the unit square corner to corner, as `lut_read`.
+    let size = vec2<f32>(atmosphere.sky_view_size);
+    let unit = sky_view_unit(atmosphere.radii.z, acos(mu), azimuth);
+    let uv = (clamp(unit, vec2<f32>(0.0), vec2<f32>(1.0)) * (size - 1.0) + 0.5) / size;
+    let radiance = textureSampleLevel(sky_view, sky_sampler, uv, 0.0).rgb + sun_disk(dir, atmosphere.up.w, mu);
+    return vec4<f32>(radiance * PI * GROUND_SUN, 1.0);
 }
 
+// The sky marched per pixel, for views above `SKY_MARCHED_ABOVE_KM`, where the table's rows about
+// the horizon grow coarser than the limb they hold. Its own pipeline: on lavapipe a fragment
+// shader that merely holds the march's loops grows the process's memory every frame, so the
+// table's pipeline must not (docs/atmosphere.md).
 @fragment
-fn fs_sky(in: SkyOut) -> @location(0) vec4<f32> {
-    // The near plane's point under the pixel, camera-relative: its direction is the view ray's.
-    let near = atmosphere.view_world_from_clip * vec4<f32>(in.ndc, 1.0, 1.0);
-    let dir = normalize(near.xyz / near.w);
-    return vec4<f32>(sky_radiance(dir) * PI * GROUND_SUN, 1.0);
+fn fs_sky_marched(in: SkyOut) -> @location(0) vec4<f32> {
+    let dir = sky_ray(in.ndc);
+    let up = atmosphere.up.xyz;
+    let sun = atmosphere.sun_dir.xyz;
+    let r_view = atmosphere.up.w;
+    let mu = clamp(dot(dir, up), -1.0, 1.0);
+    let radiance = marched_sky(r_view, mu, clamp(dot(sun, up), -1.0, 1.0), dot(dir, sun)) + sun_disk(dir, r_view, mu);
+    return vec4<f32>(radiance * PI * GROUND_SUN, 1.0);
 }

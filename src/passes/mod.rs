@@ -73,6 +73,12 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
         bindings: &atmosphere::gpu::SKY_BINDINGS.bindings,
     },
     PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
+        entry_points: &["vs_sky", "fs_sky_marched"],
+        group: 0,
+        bindings: &atmosphere::gpu::SKY_MARCHED_BINDINGS.bindings,
+    },
+    PipelineBindings {
         shader: &crate::earth::gpu::SHADER,
         entry_points: &["probe_earth_positions", "probe_earth_stand"],
         group: 0,

@@ -2,6 +2,8 @@
 //! render pipeline, their binding tables; the fixed tables made once in `new`, the sky-view table
 //! and the sky recorded each frame.
 
+use std::cell::Cell;
+
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension as Dim};
 
 use crate::config::AtmosphereSettings;
@@ -9,7 +11,7 @@ use crate::gpu::bindings::{Binding, BindingTable};
 use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::AtmosphereUniforms;
-use crate::gpu::layout::ATMOSPHERE_WORKGROUP;
+use crate::gpu::layout::{ATMOSPHERE_WORKGROUP, SKY_MARCHED_ABOVE_KM};
 use crate::gpu::readback::read_texture_mip;
 use crate::gpu::resources::{buffer, compute_pipeline, depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
@@ -62,13 +64,12 @@ pub const SKY_VIEW_BINDINGS: BindingTable<4> = BindingTable {
     ],
 };
 
-/// `vs_sky`, `fs_sky`.
-pub const SKY_BINDINGS: BindingTable<5> = BindingTable {
+/// `vs_sky`, `fs_sky`: the sky from the sky-view table.
+pub const SKY_BINDINGS: BindingTable<4> = BindingTable {
     label: "sky",
     bindings: [
         Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::FRAGMENT),
         Binding::texture(2, "transmittance", Stage::FRAGMENT, LUT, Dim::D2),
-        Binding::texture(4, "multiple", Stage::FRAGMENT, LUT, Dim::D2),
         Binding::texture(
             6,
             "sky_view",
@@ -77,6 +78,16 @@ pub const SKY_BINDINGS: BindingTable<5> = BindingTable {
             Dim::D2,
         ),
         Binding::sampler(7, "sky_sampler", Stage::FRAGMENT, wgpu::SamplerBindingType::Filtering),
+    ],
+};
+
+/// `vs_sky`, `fs_sky_marched`: the sky marched per pixel.
+pub const SKY_MARCHED_BINDINGS: BindingTable<3> = BindingTable {
+    label: "sky marched",
+    bindings: [
+        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::FRAGMENT),
+        Binding::texture(2, "transmittance", Stage::FRAGMENT, LUT, Dim::D2),
+        Binding::texture(4, "multiple", Stage::FRAGMENT, LUT, Dim::D2),
     ],
 };
 
@@ -132,8 +143,10 @@ pub struct AtmospherePass {
     sky_view: Table,
     sky_view_pipeline: wgpu::ComputePipeline,
     sky_view_group: wgpu::BindGroup,
-    sky_pipeline: wgpu::RenderPipeline,
-    sky_group: wgpu::BindGroup,
+    /// The sky's pipelines and bind groups: from the table, then marched per pixel.
+    sky: [(wgpu::RenderPipeline, wgpu::BindGroup); 2],
+    /// Whether this frame's view marches its sky (above `SKY_MARCHED_ABOVE_KM`).
+    marched: Cell<bool>,
 }
 
 impl AtmospherePass {
@@ -217,18 +230,24 @@ impl AtmospherePass {
             ..Default::default()
         });
         let layout = SKY_BINDINGS.layout(device);
-        let sky_group = SKY_BINDINGS.bind_group(
+        let table_group = SKY_BINDINGS.bind_group(
             device,
             &layout,
             [
-                u,
+                u.clone(),
                 View(&transmittance.view),
-                View(&multiple.view),
                 View(&sky_view.view),
                 wgpu::BindingResource::Sampler(&sky_sampler),
             ],
         );
-        let sky_pipeline = sky_pipeline(device, &module, &layout);
+        let table_sky = (sky_pipeline(device, &module, &layout, "fs_sky"), table_group);
+        let layout = SKY_MARCHED_BINDINGS.layout(device);
+        let marched_group = SKY_MARCHED_BINDINGS.bind_group(
+            device,
+            &layout,
+            [u, View(&transmittance.view), View(&multiple.view)],
+        );
+        let marched_sky = (sky_pipeline(device, &module, &layout, "fs_sky_marched"), marched_group);
         Self {
             settings: settings.clone(),
             uniforms,
@@ -237,14 +256,16 @@ impl AtmospherePass {
             sky_view,
             sky_view_pipeline,
             sky_view_group,
-            sky_pipeline,
-            sky_group,
+            sky: [table_sky, marched_sky],
+            marched: Cell::new(false),
         }
     }
 
     /// Writes the frame's uniforms for `view`.
     pub fn prepare(&self, queue: &Queue, view: &SkyView) {
-        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&atmosphere_uniforms(&self.settings, view)));
+        let uniforms = atmosphere_uniforms(&self.settings, view);
+        self.marched.set(uniforms.up[3] - uniforms.radii[0] > SKY_MARCHED_ABOVE_KM);
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
     }
 
     /// Records the sky-view table for the frame's view.
@@ -270,8 +291,9 @@ impl AtmospherePass {
     ) {
         let mut pass = frame_pass(encoder, "sky", colour, depth, None, None);
         counting.begin(&mut pass, Part::Whole);
-        pass.set_pipeline(&self.sky_pipeline);
-        pass.set_bind_group(0, &self.sky_group, &[]);
+        let (pipeline, group) = &self.sky[usize::from(self.marched.get())];
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
         counting.draw(&mut pass, 0..3, 0..1);
         counting.end(&mut pass);
     }
@@ -287,8 +309,9 @@ fn sky_pipeline(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
     layout: &wgpu::BindGroupLayout,
+    fragment: &str,
 ) -> wgpu::RenderPipeline {
-    let layout = pipeline_layout(device, "sky", &[layout]);
+    let layout = pipeline_layout(device, fragment, &[layout]);
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("sky"),
         layout: Some(&layout),
@@ -300,7 +323,7 @@ fn sky_pipeline(
         },
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some("fs_sky"),
+            entry_point: Some(fragment),
             compilation_options: Default::default(),
             targets: &[Some(COLOUR_FORMAT.into())],
         }),
