@@ -25,6 +25,8 @@
 @group(0) @binding(5) var sky_view_out: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(6) var sky_view: texture_2d<f32>;
 @group(0) @binding(7) var sky_sampler: sampler;
+@group(0) @binding(8) var aerial_inscatter_out: texture_storage_3d<rgba16float, write>;
+@group(0) @binding(9) var aerial_transmittance_out: texture_storage_3d<rgba16float, write>;
 
 fn sun_transmittance(r: f32, mu_sun: f32) -> vec3<f32> {
     if hits_ground(r, mu_sun) {
@@ -76,12 +78,25 @@ struct RayStep {
 
 fn ray_step(r: f32, mu: f32, mu_sun: f32, nu: f32, k: u32, steps: u32, length: f32) -> RayStep {
     let segment = ray_segment(k, steps, length);
-    let r_t = radius_along(r, mu, segment.x);
-    let mu_sun_t = clamp((r * mu_sun + segment.x * nu) / r_t, -1.0, 1.0);
+    return ray_step_at(r, mu, mu_sun, nu, segment.x, segment.y);
+}
+
+// The segment `dt` long around `t` km along the ray.
+fn ray_step_at(r: f32, mu: f32, mu_sun: f32, nu: f32, t: f32, dt: f32) -> RayStep {
+    let r_t = radius_along(r, mu, t);
+    let mu_sun_t = clamp((r * mu_sun + t * nu) / r_t, -1.0, 1.0);
     let medium = medium_at(r_t - bottom_km());
-    let through = exp(-medium.extinction * segment.y);
+    let through = exp(-medium.extinction * dt);
     let kept = (vec3<f32>(1.0) - through) / max(medium.extinction, vec3<f32>(1e-12));
     return RayStep(r_t, mu_sun_t, medium, kept, through);
+}
+
+// What a segment scatters towards the view per unit length: single scattering with the true
+// phases (`rayleigh`, `mie` at the view's angle to the sun) and Ψ.
+fn sky_source(s: RayStep, rayleigh: f32, mie: f32) -> vec3<f32> {
+    let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
+    return sun_transmittance(s.r, s.mu_sun) * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
+        + multiple_scattering(s.r, s.mu_sun) * scattering;
 }
 
 // The second order's light along a ray, gathered with an isotropic phase, the ground's
@@ -122,10 +137,7 @@ fn in_scattered(r: f32, mu: f32, mu_sun: f32, nu: f32) -> vec3<f32> {
     var radiance = vec3<f32>(0.0);
     for (var k = 0u; k < SKY_VIEW_STEPS; k++) {
         let s = ray_step(r, mu, mu_sun, nu, k, SKY_VIEW_STEPS, length);
-        let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
-        let source = sun_transmittance(s.r, s.mu_sun) * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
-            + multiple_scattering(s.r, s.mu_sun) * scattering;
-        radiance += seen * source * s.kept;
+        radiance += seen * sky_source(s, rayleigh, mie) * s.kept;
         seen *= s.through;
     }
     return radiance;
@@ -174,6 +186,41 @@ fn sky_view_lut(@builtin(global_invocation_id) id: vec3<u32>) {
     // The sun in the view's vertical plane through x, the ray turned by the azimuth from it.
     let nu = sin_zenith * cos(angles.y) * sqrt(max(1.0 - mu_sun * mu_sun, 0.0)) + mu * mu_sun;
     textureStore(sky_view_out, id.xy, vec4<f32>(in_scattered(r, mu, mu_sun, nu), 1.0));
+}
+
+// The aerial-perspective volume (Hillaire's froxels): per tile of the screen (x, y) and slice z,
+// the light the air scatters towards the camera and the share of light it lets through from the
+// camera out to `aerial_distance(z)`, marched once per column, `AERIAL_SUBSTEPS` segments a slice.
+@compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
+fn aerial_perspective_lut(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = atmosphere.aerial_size;
+    if any(id.xy >= size) {
+        return;
+    }
+    let ndc = vec2<f32>((f32(id.x) + 0.5) / f32(size.x) * 2.0 - 1.0, 1.0 - (f32(id.y) + 0.5) / f32(size.y) * 2.0);
+    let near = atmosphere.view_world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+    let dir = normalize(near.xyz / near.w);
+    let r = atmosphere.radii.z;
+    let mu_sun = atmosphere.radii.w;
+    let mu = clamp(dot(dir, atmosphere.up.xyz), -1.0, 1.0);
+    let nu = dot(dir, atmosphere.sun_dir.xyz);
+    let rayleigh = rayleigh_phase(nu);
+    let mie = mie_phase(nu);
+    var seen = vec3<f32>(1.0);
+    var light = vec3<f32>(0.0);
+    var t = 0.0;
+    for (var z = 0u; z < atmosphere.aerial_slices; z++) {
+        let end = aerial_distance(z);
+        let dt = (end - t) / f32(AERIAL_SUBSTEPS);
+        for (var k = 0u; k < AERIAL_SUBSTEPS; k++) {
+            let s = ray_step_at(r, mu, mu_sun, nu, t + (f32(k) + 0.5) * dt, dt);
+            light += seen * sky_source(s, rayleigh, mie) * s.kept;
+            seen *= s.through;
+        }
+        t = end;
+        textureStore(aerial_inscatter_out, vec3<u32>(id.xy, z), vec4<f32>(light, 1.0));
+        textureStore(aerial_transmittance_out, vec3<u32>(id.xy, z), vec4<f32>(seen, 1.0));
+    }
 }
 
 struct SkyOut {

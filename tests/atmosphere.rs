@@ -34,6 +34,12 @@ const TABLE_OFF: f32 = 1e-3;
 const SKY_VIEW_OFF: f32 = 3e-3;
 /// ... and the sky-view rows just below the horizon, whose rays graze the ground.
 const GRAZING_OFF: f32 = 2e-2;
+/// The aerial-perspective volume's last slice along a ray that leaves the air within its reach,
+/// against the sky's light along that ray: two quadratures of one integral (the sky's 30
+/// segments, the volume's 32 × 4)...
+const AERIAL_SKY_OFF: f32 = 0.02;
+/// ... and against the transmittance table's share to the top (40 segments).
+const AERIAL_THROUGH_OFF: f32 = 0.01;
 /// The drawn sky against the twin's, 8-bit levels.
 const SKY_LEVELS: i32 = 2;
 
@@ -323,4 +329,78 @@ fn below_minus_18_degrees_it_is_night_a_dark_sky_and_no_nan() {
     let sky: Vec<_> = colour.pixels().zip(&depth).filter(|(_, d)| **d == 0.0).map(|(p, _)| p).collect();
     assert!(sky.len() > 64 * 48 / 4, "{} sky pixels", sky.len());
     assert!(sky.iter().all(|p| p[0] <= 1 && p[1] <= 1 && p[2] <= 1), "a night sky pixel is lit");
+}
+
+#[test]
+fn the_gpu_makes_the_twins_aerial_perspective_and_its_far_slice_is_the_sky() {
+    // A camera 1.5 km up looking 10° above level, 60° high: the upper tiles look into the sky,
+    // the lower ones at the ground's horizon.
+    let gpu = gpu();
+    let s = settings();
+    let camera = terramp::camera::Camera {
+        position_m: DVec3::new(0.0, 0.0, 1500.0),
+        yaw_deg: 90.0,
+        pitch_deg: 10.0,
+        fov_deg: 60.0,
+        near_m: 0.1,
+    };
+    let clip = camera.clip_from_view(320, 180).unwrap() * camera.view_from_world();
+    let sky = SkyView {
+        view_world_from_clip: clip.inverse(),
+        up: DVec3::Z,
+        sun_dir: sun(25.0),
+        altitude_m: 1500.0,
+    };
+    let pass = AtmospherePass::new(&gpu, &s);
+    pass.prepare(&gpu.queue, &sky);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    pass.encode_aerial(&mut encoder, Counting::OFF);
+    gpu.queue.submit([encoder.finish()]);
+    let [inscatter, through] = pass.read_back_aerial(&gpu).unwrap();
+    let u = atmosphere_uniforms(&s, &sky);
+    let (transmittance, multiple, _) = tables(&u);
+    let twin = Tables { model: Model::new(&u), transmittance: &transmittance, multiple: Some(&multiple) };
+    let volume = twin.aerial_volume();
+    for (name, twin, gpu) in
+        [("in-scattering", &volume.inscatter, &inscatter), ("transmittance", &volume.transmittance, &through)]
+    {
+        let brightest = twin.iter().flat_map(|t| t[..3].to_vec()).fold(0.0f32, f32::max);
+        let off = twin
+            .iter()
+            .zip(gpu)
+            .flat_map(|(t, g)| (0..3).map(move |c| (t[c] - g[c]).abs() / t[c].abs().max(1e-3 * brightest)))
+            .fold(0.0f32, f32::max);
+        assert!(off < SKY_VIEW_OFF, "aerial {name}: GPU off the twin by {off:e}");
+    }
+    // Its last slice reaches past the air's top along the upper tiles' rays: there it holds the
+    // sky's light along them and the transmittance table's share.
+    let [w, h, slices] = volume.size;
+    let x = w / 2;
+    let y = 2;
+    let ndc = glam::DVec4::new(
+        (f64::from(x) + 0.5) / f64::from(w) * 2.0 - 1.0,
+        1.0 - (f64::from(y) + 0.5) / f64::from(h) * 2.0,
+        1.0,
+        1.0,
+    );
+    let near = sky.view_world_from_clip * ndc;
+    let dir = (near.truncate() / near.w).normalize().as_vec3();
+    let (r, mu_sun) = (u.radii[2], u.radii[3]);
+    let (mu, nu) = (dir.z, dir.dot(sun(25.0).as_vec3()));
+    assert!(mu > 0.3, "the tile looks {mu} up");
+    let last = (((slices - 1) * h + y) * w + x) as usize;
+    let light = glam::Vec3::from_slice(&volume.inscatter[last][..3]);
+    let expected = twin.sky_along(r, mu, mu_sun, nu);
+    let share = glam::Vec3::from_slice(&volume.transmittance[last][..3]);
+    let to_top = twin.to_top(r, mu);
+    for c in 0..3 {
+        assert!(
+            (light[c] / expected[c] - 1.0).abs() < AERIAL_SKY_OFF,
+            "in-scattering {light} against the sky's {expected}"
+        );
+        assert!(
+            (share[c] / to_top[c] - 1.0).abs() < AERIAL_THROUGH_OFF,
+            "transmittance {share} against the table's {to_top}"
+        );
+    }
 }

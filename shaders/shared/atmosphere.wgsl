@@ -15,6 +15,9 @@ struct AtmosphereUniforms {
     transmittance_size: vec2<u32>,
     multiple_size: vec2<u32>,
     sky_view_size: vec2<u32>,
+    aerial_size: vec2<u32>,
+    aerial_far_km: f32,
+    aerial_slices: u32,
     _pad: vec2<u32>,
 }
 
@@ -161,4 +164,11 @@ fn sky_view_angles(r: f32, unit: vec2<f32>) -> vec2<f32> {
         zenith = horizon + (PI - horizon) * s * s;
     }
     return vec2<f32>(zenith, PI * unit.x * unit.x);
+}
+
+// The distance from the camera, km, that slice z of the aerial-perspective volume holds the
+// light out to: the volume's reach by the square of the slice's share, so near slices are short.
+fn aerial_distance(z: u32) -> f32 {
+    let share = f32(z + 1u) / f32(atmosphere.aerial_slices);
+    return atmosphere.aerial_far_km * share * share;
 }

@@ -20,6 +20,8 @@ pub struct AtmosphereSettings {
     pub multiple_scattering_lut: [u32; 2],
     /// The sky-view table's width (azimuth) and height (zenith), texels.
     pub sky_view_lut: [u32; 2],
+    /// The aerial-perspective volume's tiles across and down the screen, and its slices in depth.
+    pub aerial_perspective_lut: [u32; 3],
     /// The air itself.
     pub air: Atmosphere,
 }
@@ -30,7 +32,7 @@ impl AtmosphereSettings {
         let text = |size: [u32; 2]| format!("{size:?}");
         let a = &self.air;
         let non_negative = |values: &[f64]| values.iter().all(|v| v.is_finite() && *v >= 0.0);
-        let checks: [RangeCheck; 9] = [
+        let checks: [RangeCheck; 10] = [
             (
                 side(self.transmittance_lut),
                 "atmosphere.transmittance_lut",
@@ -48,6 +50,12 @@ impl AtmosphereSettings {
                 "atmosphere.sky_view_lut",
                 text(self.sky_view_lut),
                 "2 to 4096 texels a side",
+            ),
+            (
+                self.aerial_perspective_lut.iter().all(|s| (2..=256).contains(s)),
+                "atmosphere.aerial_perspective_lut",
+                format!("{:?}", self.aerial_perspective_lut),
+                "2 to 256 a side",
             ),
             (
                 a.bottom_radius_km > 0.0

@@ -353,6 +353,8 @@ wgsl_constants! { atmosphere_constants:
     /// Views higher than this above the ground, km, march the sky per pixel: from there the
     /// limb's rows of the sky-view table span more than the air's scale height (docs/atmosphere.md).
     pub const SKY_MARCHED_ABOVE_KM: f32 = 30.0;
+    /// Segments per slice of the aerial-perspective volume.
+    pub const AERIAL_SUBSTEPS: u32 = 4;
 }
 
 // --- Wind (`seeds::wind`) ---

@@ -46,11 +46,36 @@ pub fn read_texture(
     read_texture_mip(gpu, texture, 0, aspect, texel_bytes)
 }
 
+/// The texels of every depth slice of 3D `texture`, slice by slice, each top row first.
+pub fn read_texture_slices(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    texel_bytes: u32,
+) -> Result<Vec<u8>, GpuError> {
+    let mut texels = Vec::new();
+    for slice in 0..texture.depth_or_array_layers() {
+        texels.extend(read_texture_at(gpu, texture, 0, slice, wgpu::TextureAspect::All, texel_bytes)?);
+    }
+    Ok(texels)
+}
+
 /// The texels of mip `mip` of `texture`, top row first, `texel_bytes` per texel.
 pub fn read_texture_mip(
     gpu: &Gpu,
     texture: &wgpu::Texture,
     mip: u32,
+    aspect: wgpu::TextureAspect,
+    texel_bytes: u32,
+) -> Result<Vec<u8>, GpuError> {
+    read_texture_at(gpu, texture, mip, 0, aspect, texel_bytes)
+}
+
+/// The texels of mip `mip`, depth slice `slice` of `texture`.
+fn read_texture_at(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    mip: u32,
+    slice: u32,
     aspect: wgpu::TextureAspect,
     texel_bytes: u32,
 ) -> Result<Vec<u8>, GpuError> {
@@ -65,7 +90,12 @@ pub fn read_texture_mip(
     });
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture, mip_level: mip, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: mip,
+            origin: wgpu::Origin3d { x: 0, y: 0, z: slice },
+            aspect,
+        },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {

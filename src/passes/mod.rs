@@ -68,6 +68,12 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     },
     PipelineBindings {
         shader: &atmosphere::gpu::SHADER,
+        entry_points: &["aerial_perspective_lut"],
+        group: 0,
+        bindings: &atmosphere::gpu::AERIAL_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
         entry_points: &["vs_sky", "fs_sky"],
         group: 0,
         bindings: &atmosphere::gpu::SKY_BINDINGS.bindings,

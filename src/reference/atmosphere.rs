@@ -8,8 +8,8 @@ use glam::{Vec2, Vec3, Vec4Swizzles};
 
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::{
-    GROUND_SUN, MULTIPLE_DIRECTIONS_SIDE, MULTIPLE_STEPS, PI, SKY_MARCHED_ABOVE_KM, SKY_VIEW_STEPS,
-    TRANSMITTANCE_STEPS,
+    AERIAL_SUBSTEPS, GROUND_SUN, MULTIPLE_DIRECTIONS_SIDE, MULTIPLE_STEPS, PI, SKY_MARCHED_ABOVE_KM,
+    SKY_VIEW_STEPS, TRANSMITTANCE_STEPS,
 };
 
 /// One table: its size and texels, row by row (rgb used, a = 1).
@@ -234,8 +234,13 @@ impl Tables<'_> {
     /// `ray_step`.
     #[allow(clippy::too_many_arguments, reason = "the shader's `ray_step`, argument for argument")]
     fn ray_step(&self, r: f32, mu: f32, mu_sun: f32, nu: f32, k: u32, steps: u32, length: f32) -> RayStep {
-        let m = &self.model;
         let (t, dt) = ray_segment(k, steps, length);
+        self.ray_step_at(r, mu, mu_sun, nu, t, dt)
+    }
+
+    /// `ray_step_at`.
+    fn ray_step_at(&self, r: f32, mu: f32, mu_sun: f32, nu: f32, t: f32, dt: f32) -> RayStep {
+        let m = &self.model;
         let r_t = m.radius_along(r, mu, t);
         let mu_sun_t = ((r * mu_sun + t * nu) / r_t).clamp(-1.0, 1.0);
         let medium = m.medium(r_t - m.bottom());
@@ -265,6 +270,69 @@ impl Tables<'_> {
         (radiance, scattered)
     }
 
+    /// `sky_source`.
+    fn sky_source(&self, s: &RayStep, rayleigh: f32, mie: f32) -> Vec3 {
+        let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
+        self.sun_transmittance(s.r, s.mu_sun)
+            * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
+            + self.multiple_scattering(s.r, s.mu_sun) * scattering
+    }
+
+    /// `aerial_perspective_lut`, its texels rounded to f16 as the pass stores them.
+    pub fn aerial_volume(&self) -> Volume {
+        let m = &self.model;
+        let u = m.u;
+        let ([w, h], slices) = (u.aerial_size, u.aerial_slices);
+        let texels = (w * h * slices) as usize;
+        let mut volume = Volume {
+            size: [w, h, slices],
+            inscatter: vec![[0.0; 4]; texels],
+            transmittance: vec![[0.0; 4]; texels],
+        };
+        let world_from_clip = glam::Mat4::from_cols_array_2d(&u.view_world_from_clip);
+        let (up, sun) = (Vec3::from_slice(&u.up[..3]), Vec3::from_slice(&u.sun_dir[..3]));
+        let (r, mu_sun) = (u.radii[2], u.radii[3]);
+        let stored = |v: Vec3| v.extend(1.0).to_array().map(|c| half::f16::from_f32(c).to_f32());
+        for y in 0..h {
+            for x in 0..w {
+                let ndc = Vec2::new(
+                    (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                    1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+                );
+                let near = world_from_clip * glam::Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
+                let dir = (near.xyz() / near.w).normalize();
+                let (mu, nu) = (dir.dot(up).clamp(-1.0, 1.0), dir.dot(sun));
+                let (rayleigh, mie) = (3.0 / (16.0 * PI) * (1.0 + nu * nu), m.mie_phase(nu));
+                let (mut seen, mut light, mut t) = (Vec3::ONE, Vec3::ZERO, 0.0f32);
+                for z in 0..slices {
+                    let end = aerial_distance(u, z);
+                    let dt = (end - t) / AERIAL_SUBSTEPS as f32;
+                    for k in 0..AERIAL_SUBSTEPS {
+                        let s = self.ray_step_at(r, mu, mu_sun, nu, t + (k as f32 + 0.5) * dt, dt);
+                        light += seen * self.sky_source(&s, rayleigh, mie) * s.kept;
+                        seen *= s.through;
+                    }
+                    t = end;
+                    let i = ((z * h + y) * w + x) as usize;
+                    volume.inscatter[i] = stored(light);
+                    volume.transmittance[i] = stored(seen);
+                }
+            }
+        }
+        volume
+    }
+
+    /// `in_scattered`, unrounded: the sky's light along a ray from radius `r` at zenith cosine
+    /// `mu`, the sun at zenith cosine `mu_sun` and cosine `nu` with the ray.
+    pub fn sky_along(&self, r: f32, mu: f32, mu_sun: f32, nu: f32) -> Vec3 {
+        self.in_scattered(r, mu, mu_sun, nu)
+    }
+
+    /// The transmittance table's share of light from radius `r` at zenith cosine `mu` to the top.
+    pub fn to_top(&self, r: f32, mu: f32) -> Vec3 {
+        self.sun_transmittance(r, mu)
+    }
+
     /// `in_scattered`.
     fn in_scattered(&self, r: f32, mu: f32, mu_sun: f32, nu: f32) -> Vec3 {
         let length = self.ray_length(r, mu);
@@ -273,11 +341,7 @@ impl Tables<'_> {
         let (mut seen, mut radiance) = (Vec3::ONE, Vec3::ZERO);
         for k in 0..SKY_VIEW_STEPS {
             let s = self.ray_step(r, mu, mu_sun, nu, k, SKY_VIEW_STEPS, length);
-            let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
-            let source = self.sun_transmittance(s.r, s.mu_sun)
-                * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
-                + self.multiple_scattering(s.r, s.mu_sun) * scattering;
-            radiance += seen * source * s.kept;
+            radiance += seen * self.sky_source(&s, rayleigh, mie) * s.kept;
             seen *= s.through;
         }
         radiance
@@ -379,6 +443,24 @@ impl Tables<'_> {
     pub fn sky_colour(&self, sky_view: &Lut, dir: Vec3) -> Vec3 {
         self.sky_radiance(sky_view, dir) * PI * GROUND_SUN
     }
+}
+
+/// `aerial_distance`: how far slice `z` of the aerial-perspective volume reaches, km.
+pub fn aerial_distance(u: &AtmosphereUniforms, z: u32) -> f32 {
+    let share = (z + 1) as f32 / u.aerial_slices as f32;
+    u.aerial_far_km * share * share
+}
+
+/// The aerial-perspective volume: per tile and slice, the light the air scatters towards the
+/// camera and the share it lets through, out to the slice's distance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Volume {
+    /// Tiles across, down, and slices.
+    pub size: [u32; 3],
+    /// In-scattered light per unit of the sun's irradiance, slice by slice, row by row.
+    pub inscatter: Vec<[f32; 4]>,
+    /// Transmittance, the same way.
+    pub transmittance: Vec<[f32; 4]>,
 }
 
 /// All three tables of `u`, made as the pass makes them: (transmittance, multiple, sky view).

@@ -7,6 +7,14 @@ use super::claims::{Claim, Source, percent, plain, sci, test_const};
 pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
     Claim {
         doc: "docs/atmosphere.md",
+        quote: "the sky's light along that ray (the test allows {} % between the two quadratures) and the transmittance table's share (the test allows {} %)",
+        values: &[
+            (test_const("tests/atmosphere.rs", "AERIAL_SKY_OFF"), percent),
+            (test_const("tests/atmosphere.rs", "AERIAL_THROUGH_OFF"), percent),
+        ],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
         quote: "asserts a mean of at most {} % and a largest error of at most {} %",
         values: &[
             (test_const("tests/atmosphere.rs", "SKY_MEAN_ERROR"), percent),

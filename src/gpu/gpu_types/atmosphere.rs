@@ -33,6 +33,12 @@ gpu_struct! {
         pub multiple_size: [u32; 2],
         /// The sky-view table's.
         pub sky_view_size: [u32; 2],
+        /// The aerial-perspective volume's tiles across and down the screen.
+        pub aerial_size: [u32; 2],
+        /// How far its last slice reaches from the camera, km.
+        pub aerial_far_km: f32,
+        /// Its slices.
+        pub aerial_slices: u32,
         /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 2],
     }

@@ -2,6 +2,7 @@
 
 use glam::{DMat4, DVec3};
 
+use crate::atmosphere::Atmosphere;
 use crate::config::AtmosphereSettings;
 use crate::gpu::gpu_types::AtmosphereUniforms;
 
@@ -20,6 +21,13 @@ pub struct SkyView {
     pub sun_dir: DVec3,
     /// The camera's height above the model's ground (the datum), metres.
     pub altitude_m: f64,
+}
+
+/// How far the aerial-perspective volume reaches from a view at `view_radius_km`: to the ground's
+/// horizon and on to where that line leaves the air, the farthest ground the view can see.
+pub fn aerial_far_km(air: &Atmosphere, view_radius_km: f64) -> f64 {
+    let (bottom, top) = (air.bottom_radius_km, air.top_radius_km);
+    (view_radius_km.powi(2) - bottom * bottom).max(0.0).sqrt() + (top * top - bottom * bottom).sqrt()
 }
 
 /// The pass's uniforms for `view` over the air of `settings`. The sky-view table is made for the
@@ -48,6 +56,9 @@ pub fn atmosphere_uniforms(settings: &AtmosphereSettings, view: &SkyView) -> Atm
         transmittance_size: settings.transmittance_lut,
         multiple_size: settings.multiple_scattering_lut,
         sky_view_size: settings.sky_view_lut,
+        aerial_size: [settings.aerial_perspective_lut[0], settings.aerial_perspective_lut[1]],
+        aerial_far_km: f(aerial_far_km(a, view_radius_km)),
+        aerial_slices: settings.aerial_perspective_lut[2],
         _pad: [0; 2],
     }
 }

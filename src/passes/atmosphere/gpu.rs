@@ -12,7 +12,7 @@ use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::{ATMOSPHERE_WORKGROUP, SKY_MARCHED_ABOVE_KM};
-use crate::gpu::readback::read_texture_mip;
+use crate::gpu::readback::{read_texture_mip, read_texture_slices};
 use crate::gpu::resources::{buffer, compute_pipeline, depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
 use crate::gpu::{Gpu, GpuError, Queue};
@@ -61,6 +61,18 @@ pub const SKY_VIEW_BINDINGS: BindingTable<4> = BindingTable {
         Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
         Binding::texture(4, "multiple", Stage::COMPUTE, LUT, Dim::D2),
         Binding::storage_texture(5, "sky_view_out", Stage::COMPUTE, SKY_VIEW_FORMAT, Dim::D2),
+    ],
+};
+
+/// `aerial_perspective_lut`.
+pub const AERIAL_BINDINGS: BindingTable<5> = BindingTable {
+    label: "atmosphere aerial perspective",
+    bindings: [
+        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::texture(4, "multiple", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::storage_texture(8, "aerial_inscatter_out", Stage::COMPUTE, SKY_VIEW_FORMAT, Dim::D3),
+        Binding::storage_texture(9, "aerial_transmittance_out", Stage::COMPUTE, SKY_VIEW_FORMAT, Dim::D3),
     ],
 };
 
@@ -147,6 +159,10 @@ pub struct AtmospherePass {
     sky: [(wgpu::RenderPipeline, wgpu::BindGroup); 2],
     /// Whether this frame's view marches its sky (above `SKY_MARCHED_ABOVE_KM`).
     marched: Cell<bool>,
+    /// The aerial-perspective volume: in-scattered light, then transmittance (f16, 3D).
+    aerial: [wgpu::Texture; 2],
+    aerial_pipeline: wgpu::ComputePipeline,
+    aerial_group: wgpu::BindGroup,
 }
 
 impl AtmospherePass {
@@ -248,6 +264,22 @@ impl AtmospherePass {
             [u, View(&transmittance.view), View(&multiple.view)],
         );
         let marched_sky = (sky_pipeline(device, &module, &layout, "fs_sky_marched"), marched_group);
+        let aerial = ["aerial perspective in-scattering", "aerial perspective transmittance"]
+            .map(|label| aerial_volume(device, label, settings.aerial_perspective_lut));
+        let layout = AERIAL_BINDINGS.layout(device);
+        let views = aerial.each_ref().map(|t| t.create_view(&Default::default()));
+        let aerial_group = AERIAL_BINDINGS.bind_group(
+            device,
+            &layout,
+            [
+                uniforms.as_entire_binding(),
+                View(&transmittance.view),
+                View(&multiple.view),
+                View(&views[0]),
+                View(&views[1]),
+            ],
+        );
+        let aerial_pipeline = compute(&layout, "aerial_perspective_lut");
         Self {
             settings: settings.clone(),
             uniforms,
@@ -258,6 +290,9 @@ impl AtmospherePass {
             sky_view_group,
             sky: [table_sky, marched_sky],
             marched: Cell::new(false),
+            aerial,
+            aerial_pipeline,
+            aerial_group,
         }
     }
 
@@ -298,6 +333,31 @@ impl AtmospherePass {
         counting.end(&mut pass);
     }
 
+    /// Records the aerial-perspective volume for the frame's view. Not yet in the frame: the
+    /// ground, the seeds and the texcells still fade by the fixed haze (docs/atmosphere.md).
+    pub fn encode_aerial(&self, encoder: &mut wgpu::CommandEncoder, counting: Counting<'_>) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("aerial perspective"),
+            timestamp_writes: None,
+        });
+        counting.begin(&mut pass, Part::Whole);
+        pass.set_pipeline(&self.aerial_pipeline);
+        pass.set_bind_group(0, &self.aerial_group, &[]);
+        let [w, h, _] = self.settings.aerial_perspective_lut;
+        counting.dispatch(&mut pass, [w.div_ceil(ATMOSPHERE_WORKGROUP), h.div_ceil(ATMOSPHERE_WORKGROUP), 1]);
+        counting.end(&mut pass);
+    }
+
+    /// The aerial-perspective volume as the GPU made it (in-scattering, transmittance; slice by
+    /// slice, row by row), waiting for it: for tests and tools.
+    pub fn read_back_aerial(&self, gpu: &Gpu) -> Result<[Vec<[f32; 4]>; 2], GpuError> {
+        let read = |texture: &wgpu::Texture| -> Result<Vec<[f32; 4]>, GpuError> {
+            let halves: Vec<[u16; 4]> = bytemuck::pod_collect_to_vec(&read_texture_slices(gpu, texture, 8)?);
+            Ok(halves.iter().map(|t| t.map(|bits| half::f16::from_bits(bits).to_f32())).collect())
+        };
+        Ok([read(&self.aerial[0])?, read(&self.aerial[1])?])
+    }
+
     /// The three tables as the GPU made them (transmittance, multiple scattering, sky view),
     /// waiting for it: for tests and tools, never the frame.
     pub fn read_back(&self, gpu: &Gpu) -> Result<[Vec<[f32; 4]>; 3], GpuError> {
@@ -333,5 +393,20 @@ fn sky_pipeline(
         multisample: Default::default(),
         multiview_mask: None,
         cache: None,
+    })
+}
+
+fn aerial_volume(device: &wgpu::Device, label: &str, [w, h, d]: [u32; 3]) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: d },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format: SKY_VIEW_FORMAT,
+        usage: wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
     })
 }
