@@ -237,6 +237,10 @@ fn the_tables_sky_is_the_brute_force_sky() {
 fn the_tables_sky_against_the_brute_force_in_full() {
     let floor = LUMINANCE_FLOOR;
     let row = |view: String, sun: &str, pairs: &[(f64, f64, f64)]| {
+        assert!(
+            !pairs.is_empty() && pairs.iter().all(|p| p.0.is_finite() && p.1.is_finite()),
+            "{view} {sun}"
+        );
         let (mean, max) = errors(pairs, floor);
         let noise = pairs.iter().map(|&(r, _, e)| e / r.max(floor)).sum::<f64>() / pairs.len() as f64;
         println!(
@@ -292,6 +296,7 @@ fn the_parts_of_the_sky() {
                 [a / rs, (b - a) / rm, rm / (rs + rm)]
             })
             .collect();
+        assert!(parts.iter().flatten().all(|v| v.is_finite() && *v > 0.0), "{parts:?}");
         let range = |k: usize| {
             let (lo, hi) =
                 parts.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[k]), hi.max(p[k])));
@@ -390,9 +395,9 @@ fn the_gpu_makes_the_twins_aerial_perspective_and_its_far_slice_is_the_sky() {
     assert!(mu > 0.3, "the tile looks {mu} up");
     let last = (((slices - 1) * h + y) * w + x) as usize;
     let light = glam::Vec3::from_slice(&volume.inscatter[last][..3]);
-    let expected = twin.sky_along(r, mu, mu_sun, nu);
+    let expected = twin.in_scattered(r, mu, mu_sun, nu);
     let share = glam::Vec3::from_slice(&volume.transmittance[last][..3]);
-    let to_top = twin.to_top(r, mu);
+    let to_top = twin.sun_transmittance(r, mu);
     for c in 0..3 {
         assert!(
             (light[c] / expected[c] - 1.0).abs() < AERIAL_SKY_OFF,

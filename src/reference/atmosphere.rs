@@ -215,7 +215,9 @@ pub struct Tables<'a> {
 }
 
 impl Tables<'_> {
-    fn sun_transmittance(&self, r: f32, mu_sun: f32) -> Vec3 {
+    /// `sun_transmittance`: the transmittance table's share of light from radius `r` at zenith
+    /// cosine `mu_sun` to the top (0 where the ground is in the way).
+    pub fn sun_transmittance(&self, r: f32, mu_sun: f32) -> Vec3 {
         if self.model.hits_ground(r, mu_sun) {
             return Vec3::ZERO;
         }
@@ -322,19 +324,9 @@ impl Tables<'_> {
         volume
     }
 
-    /// `in_scattered`, unrounded: the sky's light along a ray from radius `r` at zenith cosine
-    /// `mu`, the sun at zenith cosine `mu_sun` and cosine `nu` with the ray.
-    pub fn sky_along(&self, r: f32, mu: f32, mu_sun: f32, nu: f32) -> Vec3 {
-        self.in_scattered(r, mu, mu_sun, nu)
-    }
-
-    /// The transmittance table's share of light from radius `r` at zenith cosine `mu` to the top.
-    pub fn to_top(&self, r: f32, mu: f32) -> Vec3 {
-        self.sun_transmittance(r, mu)
-    }
-
-    /// `in_scattered`.
-    fn in_scattered(&self, r: f32, mu: f32, mu_sun: f32, nu: f32) -> Vec3 {
+    /// `in_scattered`: the sky's light along a ray from radius `r` at zenith cosine `mu`, the sun
+    /// at zenith cosine `mu_sun` and cosine `nu` with the ray (unrounded: no table holds it).
+    pub fn in_scattered(&self, r: f32, mu: f32, mu_sun: f32, nu: f32) -> Vec3 {
         let length = self.ray_length(r, mu);
         let rayleigh = 3.0 / (16.0 * PI) * (1.0 + nu * nu);
         let mie = self.model.mie_phase(nu);
