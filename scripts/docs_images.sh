@@ -377,28 +377,30 @@ make_earth_nc() {
     compose --columns 1 --scale 0.75 --gap 4 --out docs/earth_nc_descent.png "${shots[@]}"
 }
 
-# GLOBE's tile from orbit, haze off (today's fixed 150 km haze hides the ground from 400 km up; the
-# sky issue replaces it): from 20,000 km over its centre (a patch of the sphere), from 2,000 km
-# over 5° N 30° E looking north-east 30° down (its limb) and from 100 km over the Himalaya looking
-# north 35° down (docs/earth.md). GLOBE built as make_earth builds it.
+# GLOBE's tile from orbit, seen through the air (docs/atmosphere.md): from 20,000 km over its
+# centre (a patch of the sphere), from 2,000 km over 5° N 30° E looking north-east 30° down (its
+# limb) and from 100 km over the Himalaya looking north 35° down (docs/earth.md). GLOBE built as
+# make_earth builds it.
 make_earth_orbit() {
-    local globe="$data/globe" clear shots=() pose
+    local globe="$data/globe" shots=() pose
     if ! grep -q '^\[earth\]' "$globe/manifest.toml" 2>/dev/null; then
         "$terramp_data" build --dem "$shared/globe/globe_g_30arcsec.tif" --out "$globe" >/dev/null
     fi
-    clear=$(layer earth_orbit_clear '[render]' 'haze_half_distance_m = 1e12')
     for pose in 45,25,20000000,0,-90 30,5,2000000,45,-30 86.9,27.2,100000,0,-35; do
-        "$terramp" render --dataset "$globe" --camera "lonlat:$pose" --width 640 --height 360 --settings "$clear" \
+        "$terramp" render --dataset "$globe" --camera "lonlat:$pose" --width 640 --height 360 \
             --out "$out/earth_orbit_${pose//,/_}.png" >/dev/null
         shots+=("$out/earth_orbit_${pose//,/_}.png")
     done
     compose --columns 1 --scale 0.75 --gap 4 --out docs/earth_globe_orbit.png "${shots[@]}"
 }
 
-# The sky from the atmosphere pass (docs/atmosphere.md): nc from 1,500 m looking west, 3° up, the
-# sun in the west at 40°, 8° and 1° (the ground keeps today's fixed haze until aerial perspective
-# lands); GLOBE from 400 km over its centre looking 10° down, haze off (the sky marched per pixel,
-# the limb). nc on the Earth as make_earth_nc finds it; GLOBE as make_earth builds it.
+# The air from the atmosphere pass (docs/atmosphere.md): nc from 1,500 m looking west, 3° up, the
+# sun in the west at 40°, 8° and 1°, the ground lit by the sun and the sky through the air and
+# seen through it; the same at 8° without aerial perspective; nc from 10 km looking west 50° down,
+# the sun at 20°; zion from 10 km over its southern edge looking north 30° down, the sun in the
+# west-south-west at 40° and at 3°; GLOBE from 400 km over its centre
+# looking 10° down (the sky marched per pixel, the limb). nc on the Earth as make_earth_nc finds
+# it; GLOBE as make_earth builds it.
 make_atmosphere() {
     local nc="$data/nc" globe="$data/globe" shots=() elevation sun
     trade_data
@@ -417,7 +419,22 @@ make_atmosphere() {
             --settings "$sun" --out "$out/atmosphere_nc_$elevation.png" >/dev/null
         shots+=("$out/atmosphere_nc_$elevation.png")
     done
-    sun=$(layer atmosphere_orbit '[render]' 'sun_elevation_deg = 20.0' 'haze_half_distance_m = 1e12')
+    sun=$(layer atmosphere_clear '[render]' 'sun_azimuth_deg = 270.0' 'sun_elevation_deg = 8.0' \
+        '[atmosphere]' 'aerial_perspective = false')
+    "$terramp" render --dataset "$nc" --camera 637500,221750,1500,270,3 --width 640 --height 360 \
+        --settings "$sun" --out "$out/atmosphere_nc_clear.png" >/dev/null
+    shots+=("$out/atmosphere_nc_clear.png")
+    sun=$(layer atmosphere_high '[render]' 'sun_azimuth_deg = 270.0' 'sun_elevation_deg = 20.0')
+    "$terramp" render --dataset "$nc" --camera 637500,221750,10000,270,-50 --width 640 --height 360 \
+        --settings "$sun" --out "$out/atmosphere_nc_10km.png" >/dev/null
+    shots+=("$out/atmosphere_nc_10km.png")
+    for elevation in 40 3; do
+        sun=$(layer "atmosphere_zion_$elevation" '[render]' 'sun_azimuth_deg = 250.0' "sun_elevation_deg = $elevation.0")
+        "$terramp" render --dataset "$data/zion" --camera lonlat:-113.05,37.15,10000,0,-30 --width 640 \
+            --height 360 --settings "$sun" --out "$out/atmosphere_zion_$elevation.png" >/dev/null
+        shots+=("$out/atmosphere_zion_$elevation.png")
+    done
+    sun=$(layer atmosphere_orbit '[render]' 'sun_elevation_deg = 20.0')
     "$terramp" render --dataset "$globe" --camera lonlat:45,25,400000,0,-10 --width 640 --height 360 \
         --settings "$sun" --out "$out/atmosphere_globe_400km.png" >/dev/null
     shots+=("$out/atmosphere_globe_400km.png")

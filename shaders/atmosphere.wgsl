@@ -11,13 +11,18 @@
 //   towards it (single scattering with the true phases and the sun's transmittance from the
 //   table, plus Ψ), up to the ground or the top (made each frame: it depends on the camera's
 //   altitude and the sun).
+// - `irradiance_lut`: per (altitude, sun's zenith cosine), the sky's light on a level surface,
+//   gathered from the upper hemisphere (made when the atmosphere changes), which lights the
+//   ground and the plants beside the sun (`shared/air.wgsl`); `daylight_balance` from it and
+//   the transmittance, once: the display's balance for daylight (`display`).
 // - `vs_sky` with `fs_sky` or `fs_sky_marched`: where the depth is still the far plane
 //   (reversed-Z 0), the sky from the sky-view table (or marched per pixel from high up), and the
 //   sun's disk through the air.
-// Radiances are per unit of the sun's irradiance; the sky is drawn in the ground's units (a white
-// plate facing the sun reflects `GROUND_SUN`: × π `GROUND_SUN`).
+// Radiances are per unit of the sun's irradiance above the air; the display shows them balanced
+// for daylight (`display`), as the ground and the plants are.
 
-@group(0) @binding(0) var<uniform> atmosphere: AtmosphereUniforms;
+// Storage, not uniform: see `AtmospherePass::new`.
+@group(0) @binding(0) var<storage, read> atmosphere: AtmosphereUniforms;
 @group(0) @binding(1) var transmittance_out: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(2) var transmittance: texture_2d<f32>;
 @group(0) @binding(3) var multiple_out: texture_storage_2d<rgba32float, write>;
@@ -27,17 +32,10 @@
 @group(0) @binding(7) var sky_sampler: sampler;
 @group(0) @binding(8) var aerial_inscatter_out: texture_storage_3d<rgba16float, write>;
 @group(0) @binding(9) var aerial_transmittance_out: texture_storage_3d<rgba16float, write>;
-
-fn sun_transmittance(r: f32, mu_sun: f32) -> vec3<f32> {
-    if hits_ground(r, mu_sun) {
-        return vec3<f32>(0.0);
-    }
-    return lut_read(transmittance, atmosphere.transmittance_size, transmittance_unit(r, mu_sun));
-}
-
-fn multiple_scattering(r: f32, mu_sun: f32) -> vec3<f32> {
-    return lut_read(multiple, atmosphere.multiple_size, multiple_unit(r, mu_sun));
-}
+@group(0) @binding(10) var irradiance_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(11) var irradiance: texture_2d<f32>;
+@group(0) @binding(12) var<storage, read_write> daylight_out: vec4<f32>;
+@group(0) @binding(13) var<uniform> daylight: vec4<f32>;
 
 @compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
 fn transmittance_lut(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -62,41 +60,6 @@ fn ray_length(r: f32, mu: f32) -> f32 {
         return distance_to_bottom(r, mu);
     }
     return distance_to_top(r, mu);
-}
-
-// One segment of a ray from (r, μ) for the sun at zenith cosine `mu_sun` and cosine `nu` with
-// the ray: the radius and the sun's zenith cosine at its midpoint, the medium there, and the
-// segment's integral of its own falling transmittance, ∫ e^(−σt) dt = (1 − e^(−σ dt)) / σ
-// (Hillaire's energy-conserving step), with its transmittance e^(−σ dt).
-struct RayStep {
-    r: f32,
-    mu_sun: f32,
-    medium: Medium,
-    kept: vec3<f32>,
-    through: vec3<f32>,
-}
-
-fn ray_step(r: f32, mu: f32, mu_sun: f32, nu: f32, k: u32, steps: u32, length: f32) -> RayStep {
-    let segment = ray_segment(k, steps, length);
-    return ray_step_at(r, mu, mu_sun, nu, segment.x, segment.y);
-}
-
-// The segment `dt` long around `t` km along the ray.
-fn ray_step_at(r: f32, mu: f32, mu_sun: f32, nu: f32, t: f32, dt: f32) -> RayStep {
-    let r_t = radius_along(r, mu, t);
-    let mu_sun_t = clamp((r * mu_sun + t * nu) / r_t, -1.0, 1.0);
-    let medium = medium_at(r_t - bottom_km());
-    let through = exp(-medium.extinction * dt);
-    let kept = (vec3<f32>(1.0) - through) / max(medium.extinction, vec3<f32>(1e-12));
-    return RayStep(r_t, mu_sun_t, medium, kept, through);
-}
-
-// What a segment scatters towards the view per unit length: single scattering with the true
-// phases (`rayleigh`, `mie` at the view's angle to the sun) and Ψ.
-fn sky_source(s: RayStep, rayleigh: f32, mie: f32) -> vec3<f32> {
-    let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
-    return sun_transmittance(s.r, s.mu_sun) * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
-        + multiple_scattering(s.r, s.mu_sun) * scattering;
 }
 
 // The second order's light along a ray, gathered with an isotropic phase, the ground's
@@ -143,26 +106,39 @@ fn in_scattered(r: f32, mu: f32, mu_sun: f32, nu: f32) -> vec3<f32> {
     return radiance;
 }
 
+// (r, μ_sun) of a texel of a table in the multiple-scattering table's parametrisation
+// (`multiple_unit`: x the sun's zenith cosine from −1 to 1, y the altitude).
+fn multiple_r_mu_sun(texel: vec2<u32>, size: vec2<u32>) -> vec2<f32> {
+    let unit = lut_unit(texel, size);
+    return vec2<f32>(bottom_km() + unit.y * (top_km() - bottom_km()), 2.0 * unit.x - 1.0);
+}
+
+// Direction `i` of a `side` × `side` grid even in azimuth and in the zenith cosine, which runs
+// from `mu_from` to `mu_to` (so even in solid angle), cell centres.
+fn grid_direction(i: u32, side: u32, mu_from: f32, mu_to: f32) -> vec3<f32> {
+    let azimuth = 2.0 * PI * (f32(i % side) + 0.5) / f32(side);
+    let mu = mu_from + (mu_to - mu_from) * (f32(i / side) + 0.5) / f32(side);
+    let sin_theta = sqrt(max(1.0 - mu * mu, 0.0));
+    return vec3<f32>(sin_theta * cos(azimuth), sin_theta * sin(azimuth), mu);
+}
+
 @compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
 fn multiple_scattering_lut(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = atmosphere.multiple_size;
     if any(id.xy >= size) {
         return;
     }
-    let unit = lut_unit(id.xy, size);
-    let mu_sun = 2.0 * unit.x - 1.0;
-    let r = bottom_km() + unit.y * (top_km() - bottom_km());
+    let r_mu_sun = multiple_r_mu_sun(id.xy, size);
+    let r = r_mu_sun.x;
+    let mu_sun = r_mu_sun.y;
     let sun = vec3<f32>(sqrt(max(1.0 - mu_sun * mu_sun, 0.0)), 0.0, mu_sun);
     var second = vec3<f32>(0.0);
     var scattered = vec3<f32>(0.0);
     let side = MULTIPLE_DIRECTIONS_SIDE;
     for (var i = 0u; i < side * side; i++) {
-        // Uniform over the sphere: azimuth and cos θ on an even grid.
-        let azimuth = 2.0 * PI * (f32(i % side) + 0.5) / f32(side);
-        let mu = 1.0 - 2.0 * (f32(i / side) + 0.5) / f32(side);
-        let sin_theta = sqrt(max(1.0 - mu * mu, 0.0));
-        let dir = vec3<f32>(sin_theta * cos(azimuth), sin_theta * sin(azimuth), mu);
-        let gathered = second_order(r, mu, mu_sun, dot(dir, sun));
+        // Uniform over the sphere.
+        let dir = grid_direction(i, side, 1.0, -1.0);
+        let gathered = second_order(r, dir.z, mu_sun, dot(dir, sun));
         second += gathered.radiance;
         scattered += gathered.scattered;
     }
@@ -200,7 +176,8 @@ fn aerial_perspective_lut(@builtin(global_invocation_id) id: vec3<u32>) {
     let ndc = vec2<f32>((f32(id.x) + 0.5) / f32(size.x) * 2.0 - 1.0, 1.0 - (f32(id.y) + 0.5) / f32(size.y) * 2.0);
     let near = atmosphere.view_world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
     let dir = normalize(near.xyz / near.w);
-    let r = atmosphere.radii.z;
+    // From the camera itself, above the air or not (beyond the air the march gathers nothing).
+    let r = atmosphere.up.w;
     let mu_sun = atmosphere.radii.w;
     let mu = clamp(dot(dir, atmosphere.up.xyz), -1.0, 1.0);
     let nu = dot(dir, atmosphere.sun_dir.xyz);
@@ -221,6 +198,42 @@ fn aerial_perspective_lut(@builtin(global_invocation_id) id: vec3<u32>) {
         textureStore(aerial_inscatter_out, vec3<u32>(id.xy, z), vec4<f32>(light, 1.0));
         textureStore(aerial_transmittance_out, vec3<u32>(id.xy, z), vec4<f32>(seen, 1.0));
     }
+}
+
+// The sky's light on a level surface at each (altitude, sun's zenith cosine) of the table (the
+// multiple-scattering table's parametrisation): the sky's radiance gathered from
+// `IRRADIANCE_DIRECTIONS_SIDE`² directions of the upper hemisphere, even in azimuth and in the
+// zenith cosine (so even in solid angle), each weighed by its cosine.
+@compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
+fn irradiance_lut(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(irradiance_out);
+    if any(id.xy >= size) {
+        return;
+    }
+    let r_mu_sun = multiple_r_mu_sun(id.xy, size);
+    let r = r_mu_sun.x;
+    let mu_sun = r_mu_sun.y;
+    let sun = vec3<f32>(sqrt(max(1.0 - mu_sun * mu_sun, 0.0)), 0.0, mu_sun);
+    let side = IRRADIANCE_DIRECTIONS_SIDE;
+    var gathered = vec3<f32>(0.0);
+    for (var i = 0u; i < side * side; i++) {
+        let dir = grid_direction(i, side, 0.0, 1.0);
+        gathered += in_scattered(r, dir.z, mu_sun, dot(dir, sun)) * dir.z;
+    }
+    // Each direction weighs 2π / N steradians of the hemisphere.
+    let n = f32(side * side);
+    textureStore(irradiance_out, id.xy, vec4<f32>(gathered * 2.0 * PI / n, 1.0));
+}
+
+// The display's balance for daylight: per channel, 1 over the light on level ground at sea level
+// with the sun `DAYLIGHT_SUN_COS` from the zenith, sun and sky (a camera set to daylight: white
+// ground under that sun shows white, redder light at dusk shows red).
+@compute @workgroup_size(1)
+fn daylight_balance() {
+    let r = bottom_km();
+    let sun = sun_transmittance(r, DAYLIGHT_SUN_COS) * DAYLIGHT_SUN_COS;
+    let sky = lut_read(irradiance, textureDimensions(irradiance), multiple_unit(r, DAYLIGHT_SUN_COS));
+    daylight_out = vec4<f32>(1.0 / (sun + sky), 1.0);
 }
 
 struct SkyOut {
@@ -303,7 +316,7 @@ fn fs_sky(in: SkyOut) -> @location(0) vec4<f32> {
     let unit = sky_view_unit(atmosphere.radii.z, acos(mu), azimuth);
     let uv = (clamp(unit, vec2<f32>(0.0), vec2<f32>(1.0)) * (size - 1.0) + 0.5) / size;
     let radiance = textureSampleLevel(sky_view, sky_sampler, uv, 0.0).rgb + sun_disk(dir, atmosphere.up.w, mu);
-    return vec4<f32>(radiance * PI * GROUND_SUN, 1.0);
+    return vec4<f32>(display(radiance * PI), 1.0);
 }
 
 // The sky marched per pixel, for views above `SKY_MARCHED_ABOVE_KM`, where the table's rows about
@@ -318,5 +331,5 @@ fn fs_sky_marched(in: SkyOut) -> @location(0) vec4<f32> {
     let r_view = atmosphere.up.w;
     let mu = clamp(dot(dir, up), -1.0, 1.0);
     let radiance = marched_sky(r_view, mu, clamp(dot(sun, up), -1.0, 1.0), dot(dir, sun)) + sun_disk(dir, r_view, mu);
-    return vec4<f32>(radiance * PI * GROUND_SUN, 1.0);
+    return vec4<f32>(display(radiance * PI), 1.0);
 }

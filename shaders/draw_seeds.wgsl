@@ -8,8 +8,9 @@
 // colour (times a layer of the texture array), are alpha-tested, follow the photograph's colour
 // under the seed (foliage, by its species' `ground_blend`; bark keeps its own: the colour
 // follow-up, a ratio transfer, `photo_scale`), are varied by the seed's colour variation and by
-// the luminosity of their place in the plant (`crown_luminosity`), lit (the sun through the
-// clouds, `shared/clouds.wgsl`) and hazed like the ground. A seed a few pixels tall seen from
+// the luminosity of their place in the plant (`crown_luminosity`), lit (the sun through the air
+// and the clouds, the sky: `shared/air.wgsl`, `shared/clouds.wgsl`) and seen through the air
+// like the ground. A seed a few pixels tall seen from
 // above shows its mean colour instead of one sample of its detail a pixel (`small_seed_mean`).
 //
 // Continuous LOD (`draw_seeds.continuous_lod`, `u.continuous_lod`): a mesh whose materials say how
@@ -26,7 +27,6 @@
 struct DrawSeedsUniforms {
     clip_from_view_world: mat4x4<f32>,
     sun_dir: vec4<f32>,
-    haze: vec4<f32>,
     draw_reach_m: vec4<f32>,
     inv_reference_height_m: f32,
     sink_fraction: f32,
@@ -43,7 +43,7 @@ struct DrawSeedsUniforms {
     prefilter_small: u32,
     _pad0: u32,
     _pad1: u32,
-    photo_scale: array<vec4<f32>, SEED_GROUPS>,
+    from_above: array<vec4<f32>, SEED_GROUPS>,
 }
 
 struct SeedShape {
@@ -113,6 +113,11 @@ struct VertexOut {
     // The seed's mean albedo seen from above, in units of flat ground's light (rgb), and how much
     // of it the foliage shows in place of its own detail (w, `small_seed_mean`).
     @location(10) @interpolate(flat) far: vec4<f32>,
+    // The light at the seed's anchor (`light_at`): a plant is small beside the distances over
+    // which the sun's and the sky's light change, so every fragment of it takes its anchor's.
+    @location(11) @interpolate(flat) sun_light: vec3<f32>,
+    @location(12) @interpolate(flat) sky_light: vec3<f32>,
+    @location(13) @interpolate(flat) air_up: vec3<f32>,
 }
 
 // The local vertical at camera-relative `rel_m` (pass 3's `up_at`, from the camera's mapping):
@@ -345,7 +350,11 @@ fn vs_main(
     // the model keeps its texture, shading and gaps). Bark keeps its own colour, as does
     // geometry with no foliage to measure (a scale of 0).
     let ground = unpack4x8unorm(record.ground_colour);
-    let photo_scale = u.photo_scale[seed_group(species, material.lod)].rgb;
+    let light = light_at(record.position_rel_m);
+    out.sun_light = light.sun;
+    out.sky_light = light.sky;
+    out.air_up = light.up;
+    let photo_scale = photo_scale_at(u.from_above[seed_group(species, material.lod)], light);
     var follow = shape.ground_blend * ground.a;
     if (material.flags & MATERIAL_BARK) != 0u || photo_scale.g <= 0.0 {
         follow = 0.0;
@@ -361,6 +370,20 @@ fn vs_main(
     return out;
 }
 
+// The colour follow-up's factor per channel for a group seen from above as `from_above` says
+// (mean albedo, xyz; mean facing towards the sun, w: `draw_seeds::from_above`) under a seed's
+// `light`: level ground's light over the group's mean lit colour, clouds aside; 0 where nothing is
+// measured or lit (the seed keeps its own colours). Twin: `FromAbove::photo_scale`.
+fn photo_scale_at(from_above: vec4<f32>, light: SunAndSky) -> vec3<f32> {
+    let sun_up = max(dot(light.up, u.sun_dir.xyz), 0.0);
+    let foliage = light.sun * (FOLIAGE_SUN * from_above.w + FOLIAGE_SUN_WRAP * sun_up) + light.sky * FOLIAGE_SKY;
+    let lit = from_above.rgb * foliage;
+    if from_above.g <= 0.0 || any(lit <= vec3<f32>(1e-6)) {
+        return vec3<f32>(0.0);
+    }
+    return level_ground_light(light, u.sun_dir.xyz, 1.0) / lit;
+}
+
 // How much of a seed's foliage shows its mean colour seen from above rather than its own detail
 // (`draw_seeds.prefilter_small`): all of it where the seed stands `SEED_DETAIL_NONE_PX` tall on
 // screen or less, none from `SEED_DETAIL_FULL_PX`, and only for views from above (the follow-up's
@@ -374,7 +397,7 @@ fn small_seed_mean(record: SeedRecord, distance_m: f32, up: vec3<f32>) -> f32 {
     return (1.0 - smoothstep(SEED_DETAIL_NONE_PX, SEED_DETAIL_FULL_PX, tall_px)) * from_above;
 }
 
-// A fragment of a seed, before the alpha test: its lit, hazed colour, its alpha and how fast that
+// A fragment of a seed, before the alpha test: its colour lit and seen through the air, its alpha and how fast that
 // alpha changes across the pixel.
 struct Surface {
     colour: vec4<f32>,
@@ -410,15 +433,15 @@ fn surface(in: VertexOut) -> Surface {
         normal = -normal;
     }
     let clouds = sun_through_clouds(u.cloud_field, u.cloud_shift, in.rel_m);
-    let sun = (FOLIAGE_SUN * max(dot(normal, u.sun_dir.xyz), 0.0) + FOLIAGE_SUN_WRAP * max(u.sun_dir.z, 0.0)) * clouds;
-    var lit = albedo * (sun + FOLIAGE_SKY);
+    let light = SunAndSky(in.sun_light, in.sky_light, in.air_up);
+    let sun = u.sun_dir.xyz;
+    let facing = FOLIAGE_SUN * max(dot(normal, sun), 0.0) + FOLIAGE_SUN_WRAP * max(dot(light.up, sun), 0.0);
+    var lit = albedo * (light.sun * facing * clouds + light.sky * FOLIAGE_SKY);
     if in.far.w > 0.0 {
-        // Its mean seen from above, lit as flat ground (`photo_scale`'s yardstick).
-        let ground_light = GROUND_SUN * max(u.sun_dir.z, 0.0) * clouds + GROUND_SKY;
-        lit = mix(lit, in.far.rgb * ground_light, in.far.w);
+        // Its mean seen from above, lit as level ground (`photo_scale`'s yardstick).
+        lit = mix(lit, in.far.rgb * level_ground_light(light, sun, clouds), in.far.w);
     }
-    let haze = 1.0 - exp2(-length(in.rel_m) / u.haze.w);
-    return Surface(vec4<f32>(mix(lit, u.haze.rgb, haze), 1.0), texel.a, fwidth(texel.a));
+    return Surface(vec4<f32>(through_air(lit, in.rel_m), 1.0), texel.a, fwidth(texel.a));
 }
 
 // Whether the cross-fade gives this pixel to the other of the seed's two draws, or the slicings'
@@ -431,7 +454,7 @@ fn faded_out(in: VertexOut) -> bool {
     return t < in.keep.x || t >= in.keep.y || b < in.blend.x || b >= in.blend.y;
 }
 
-// The fragment's lit, hazed colour, or discarded (alpha test, dither).
+// The fragment's colour lit and seen through the air, or discarded (alpha test, dither).
 fn shade(in: VertexOut) -> vec4<f32> {
     let s = surface(in);
     if cut_out(in, s.alpha) {

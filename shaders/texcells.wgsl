@@ -10,7 +10,7 @@
 // of its slice in the slice pyramid level the patch draws, at that level's mip or coarser. The
 // texel is premultiplied coverage; its opacity is corrected for the oblique path between slices
 // (A' = 1 − (1 − A)^k, k = 1 / cos of the view to the ground's normal, clamped), its colour made
-// to follow the photograph under it (a ratio transfer, `shade`), lit and hazed like the ground,
+// to follow the photograph under it (a ratio transfer, `shade`), lit and seen through the air like the ground,
 // and it fades in
 // (dithered) where the last billboard clouds fade out, and out before the reach.
 //
@@ -241,9 +241,9 @@ struct Surface {
 }
 
 // The premultiplied colour of forest `surface` of opacity `opacity` at `rel_m` from the camera,
-// seen along `view`, `distance_m` away, over ground of albedo `ground` (`ground_albedo`: the
-// photograph, or the relief tint where it has no data, as the ground pass shows). In its own colours
-// it is lit as the seeds' leaves are on average: the leaves the eye sees face it (the seeds turn
+// seen along `view`, `distance_m` away (seen through the air between, `through_air`), over
+// ground of albedo `ground` (`ground_albedo`: the photograph, or the relief tint where it has
+// no data, as the ground pass shows). In its own colours it is lit as the seeds' leaves are on average: the leaves the eye sees face it (the seeds turn
 // every surface towards the eye), their normals spread over the half of directions facing it,
 // whose mean clamped cosine towards the sun is (1 + cos(eye, sun)) / 4. The colour follow-up (a
 // ratio transfer, as the seeds'), by `ground_blend`: the albedo times the photograph's colour over
@@ -254,13 +254,16 @@ struct Surface {
 // already shows it, and fades out (its slab's parallax would only shift the photograph).
 fn shade(surface: Surface, ground: vec3<f32>, rel_m: vec3<f32>, view: vec3<f32>, distance_m: f32, coverage: f32) -> vec4<f32> {
     let clouds = sun_through_clouds(u.cloud_field, u.cloud_shift, rel_m);
-    let facing = 0.25 * (1.0 - dot(view, u.sun_dir.xyz));
-    let own = surface.albedo * ((FOLIAGE_SUN * facing + FOLIAGE_SUN_WRAP * max(u.sun_dir.z, 0.0)) * clouds + FOLIAGE_SKY);
+    let light = light_at(rel_m);
+    let sun = u.sun_dir.xyz;
+    let facing = 0.25 * (1.0 - dot(view, sun));
+    let own_sun = (FOLIAGE_SUN * facing + FOLIAGE_SUN_WRAP * max(dot(light.up, sun), 0.0)) * clouds;
+    let own = surface.albedo * (light.sun * own_sun + light.sky * FOLIAGE_SKY);
     var lit = own;
     var opacity = coverage;
     if u.imagery_texels != IMAGERY_NONE && all(surface.sample_mean > vec3<f32>(0.0)) {
         let n = surface.normal;
-        let ground_light = max(dot(n, u.sun_dir.xyz), 0.0) * clouds * GROUND_SUN + GROUND_SKY * (0.5 + 0.5 * n.z);
+        let ground_light = light.sun * max(dot(n, sun), 0.0) * clouds + light.sky * (0.5 + 0.5 * dot(n, light.up));
         let followed = ground * surface.albedo / surface.sample_mean * ground_light;
         lit = mix(own, followed, tu.ground_blend);
         let px_m = distance_m * tu.metres_per_px_at_1m;
@@ -268,8 +271,7 @@ fn shade(surface: Surface, ground: vec3<f32>, rel_m: vec3<f32>, view: vec3<f32>,
         let flat = smoothstep(TEXCELL_DETAIL_FULL_PX_M, TEXCELL_DETAIL_NONE_PX_M, px_m) * from_above;
         opacity *= 1.0 - flat * tu.ground_blend;
     }
-    let haze = 1.0 - exp2(-distance_m / u.haze.w);
-    return vec4<f32>(mix(lit, u.haze.rgb, haze) * opacity, opacity);
+    return vec4<f32>(through_air(lit, rel_m) * opacity, opacity);
 }
 
 // A silhouette texcell's fragment on the slab's top: its ray through the 3D texture, sampled where
@@ -352,7 +354,7 @@ fn silhouette(flat_rel_m: vec3<f32>, node_index: u32, camera_view: vec3<f32>, di
     if opacity <= 0.0 {
         discard;
     }
-    // Shaded where the ray first met the canopy, as its haze is.
+    // Shaded where the ray first met the canopy, and seen through the air from there.
     // The forest's colour follows the photograph by the first sample the ray met; the ground's
     // normal is taken as up (the ray crosses the slab, not one point of the ground).
     let surface = Surface(colour / opacity, sample_mean, vec3<f32>(0.0, 0.0, 1.0));

@@ -115,7 +115,7 @@ pub enum SettingsError {
 pub struct Settings {
     /// `[gpu]`: the adapter and how passes are timed.
     pub gpu: GpuSettings,
-    /// `[render]`: output size, projection, sun and haze.
+    /// `[render]`: output size, projection, sun.
     pub render: RenderSettings,
     /// `[terrain]`: the LOD rings of the terrain mesh.
     pub terrain: TerrainSettings,
@@ -174,8 +174,6 @@ pub struct RenderSettings {
     /// The instant the sun is placed for, RFC 3339 (`2026-06-21T17:30Z`), over the place under
     /// the camera (`sun`); empty: the two angles above place it.
     pub sun_time: String,
-    /// Distance at which haze hides half of the ground colour, metres.
-    pub haze_half_distance_m: f64,
     /// Draw the dataset on the Earth's ellipsoid where its manifest says where it lies; false
     /// draws its grid as a flat sheet.
     pub curved_earth: bool,

@@ -117,7 +117,7 @@ fn the_gpu_makes_the_twins_tables() {
     let s = settings();
     let pass = AtmospherePass::new(&gpu, &s);
     let sky = view(1500.0, 25.0);
-    pass.prepare(&gpu.queue, &sky);
+    pass.prepare(&gpu.queue, &sky, &s);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     pass.encode_sky_view(&mut encoder, Counting::OFF);
     gpu.queue.submit([encoder.finish()]);
@@ -190,6 +190,7 @@ fn the_frame_draws_the_twins_sky_where_nothing_else_is() {
     let u = atmosphere_uniforms(&settings.atmosphere, &sky);
     let (transmittance, multiple, sky_view) = tables(&u);
     let twin = Tables { model: Model::new(&u), transmittance: &transmittance, multiple: Some(&multiple) };
+    let daylight = twin.daylight_balance(&twin.irradiance_lut(settings.atmosphere.irradiance_lut));
     let (mut sky_pixels, mut worst) = (0, 0i32);
     for (x, y, pixel) in colour.enumerate_pixels() {
         if depth[(y * width + x) as usize] != 0.0 {
@@ -204,7 +205,7 @@ fn the_frame_draws_the_twins_sky_where_nothing_else_is() {
         );
         let near = sky.view_world_from_clip * ndc;
         let dir = (near.truncate() / near.w).normalize().as_vec3();
-        let expected = twin.sky_colour(&sky_view, dir);
+        let expected = twin.sky_colour(&sky_view, dir, daylight);
         for c in 0..3 {
             worst = worst.max((i32::from(pixel[c]) - i32::from(srgb8(expected[c]))).abs());
         }
@@ -319,8 +320,9 @@ fn below_minus_18_degrees_it_is_night_a_dark_sky_and_no_nan() {
         assert!(lut.texels.iter().flatten().all(|v| v.is_finite()), "a table holds a NaN or an infinity");
     }
     let twin = Tables { model: Model::new(&u), transmittance: &transmittance, multiple: Some(&multiple) };
+    let daylight = twin.daylight_balance(&twin.irradiance_lut(s.irradiance_lut));
     for d in directions(64, false) {
-        let colour = twin.sky_colour(&sky_view, d.as_vec3());
+        let colour = twin.sky_colour(&sky_view, d.as_vec3(), daylight);
         assert!(colour.is_finite() && colour.max_element() < 0.5 / 255.0, "{d}: {colour}");
     }
     let dataset = synth_dataset(300, 7);
@@ -357,7 +359,7 @@ fn the_gpu_makes_the_twins_aerial_perspective_and_its_far_slice_is_the_sky() {
         altitude_m: 1500.0,
     };
     let pass = AtmospherePass::new(&gpu, &s);
-    pass.prepare(&gpu.queue, &sky);
+    pass.prepare(&gpu.queue, &sky, &s);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     pass.encode_aerial(&mut encoder, Counting::OFF);
     gpu.queue.submit([encoder.finish()]);

@@ -10,6 +10,7 @@ struct AtmosphereUniforms {
     albedo: vec4<f32>,
     radii: vec4<f32>,
     view_world_from_clip: mat4x4<f32>,
+    clip_from_view_world: mat4x4<f32>,
     up: vec4<f32>,
     sun_dir: vec4<f32>,
     transmittance_size: vec2<u32>,
@@ -18,7 +19,8 @@ struct AtmosphereUniforms {
     aerial_size: vec2<u32>,
     aerial_far_km: f32,
     aerial_slices: u32,
-    _pad: vec2<u32>,
+    exposure: f32,
+    aerial_on: u32,
 }
 
 struct Medium {
@@ -78,6 +80,68 @@ fn ray_segment(k: u32, steps: u32, length: f32) -> vec2<f32> {
     let b = f32(k + 1u) / n;
     let m = (f32(k) + 0.5) / n;
     return vec2<f32>(length * m * m, length * (b * b - a * a));
+}
+
+// What reaches radius r from the sun at zenith cosine `mu_sun` through the air: the
+// transmittance table's share, none where the Earth is in the way. Reads the includer's
+// `transmittance` table.
+fn sun_transmittance(r: f32, mu_sun: f32) -> vec3<f32> {
+    if hits_ground(r, mu_sun) {
+        return vec3<f32>(0.0);
+    }
+    return lut_read(transmittance, atmosphere.transmittance_size, transmittance_unit(r, mu_sun));
+}
+
+// Ψ, the light of every order above the first, at radius r for the sun at zenith cosine
+// `mu_sun`. Reads the includer's `multiple` table.
+fn multiple_scattering(r: f32, mu_sun: f32) -> vec3<f32> {
+    return lut_read(multiple, atmosphere.multiple_size, multiple_unit(r, mu_sun));
+}
+
+// One segment of a ray from (r, μ) for the sun at zenith cosine `mu_sun` and cosine `nu` with
+// the ray: the radius and the sun's zenith cosine at its midpoint, the medium there, and the
+// segment's integral of its own falling transmittance, ∫ e^(−σt) dt = (1 − e^(−σ dt)) / σ
+// (Hillaire's energy-conserving step), with its transmittance e^(−σ dt).
+struct RayStep {
+    r: f32,
+    mu_sun: f32,
+    medium: Medium,
+    kept: vec3<f32>,
+    through: vec3<f32>,
+}
+
+fn ray_step(r: f32, mu: f32, mu_sun: f32, nu: f32, k: u32, steps: u32, length: f32) -> RayStep {
+    let segment = ray_segment(k, steps, length);
+    return ray_step_at(r, mu, mu_sun, nu, segment.x, segment.y);
+}
+
+// The segment `dt` long around `t` km along the ray.
+fn ray_step_at(r: f32, mu: f32, mu_sun: f32, nu: f32, t: f32, dt: f32) -> RayStep {
+    let r_t = radius_along(r, mu, t);
+    let mu_sun_t = clamp((r * mu_sun + t * nu) / r_t, -1.0, 1.0);
+    let medium = medium_at(r_t - bottom_km());
+    let through = exp(-medium.extinction * dt);
+    let kept = (vec3<f32>(1.0) - through) / max(medium.extinction, vec3<f32>(1e-12));
+    return RayStep(r_t, mu_sun_t, medium, kept, through);
+}
+
+// What a segment scatters towards the view per unit length: single scattering with the true
+// phases (`rayleigh`, `mie` at the view's angle to the sun) and Ψ.
+fn sky_source(s: RayStep, rayleigh: f32, mie: f32) -> vec3<f32> {
+    let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
+    return sun_transmittance(s.r, s.mu_sun) * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
+        + multiple_scattering(s.r, s.mu_sun) * scattering;
+}
+
+// A radiance times π (what a white Lambertian surface sends under that irradiance) as the
+// display shows it: balanced for daylight by the includer's `daylight` (`daylight_balance`),
+// exposed, then through the tone curve: the identity up to `DISPLAY_KNEE`, then a shoulder
+// towards 1 of the same slope. The targets are sRGB: the hardware encodes on store.
+fn display(radiance_pi: vec3<f32>) -> vec3<f32> {
+    let x = max(radiance_pi * daylight.xyz * atmosphere.exposure, vec3<f32>(0.0));
+    let span = 1.0 - DISPLAY_KNEE;
+    let over = max(x - DISPLAY_KNEE, vec3<f32>(0.0));
+    return min(x, vec3<f32>(DISPLAY_KNEE)) + span * (1.0 - exp(-over / span));
 }
 
 // A table's texel grid spans the unit square corner to corner: texel (0, 0) is (0, 0), the last

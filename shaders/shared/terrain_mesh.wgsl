@@ -17,7 +17,6 @@
 struct TerrainUniforms {
     clip_from_view_world: mat4x4<f32>,
     sun_dir: vec4<f32>,
-    haze: vec4<f32>,
     camera_grid_m: vec4<f32>,
     height_range_m: vec2<f32>,
     node_cells: u32,

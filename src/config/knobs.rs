@@ -125,6 +125,13 @@ pub const KNOBS: &[Knob] = &[
         |s| s.wind.speed_m_s, Value::Float(s.wind.speed_m_s)),
     knob!("cloud cover", "clouds.coverage", "", 0.0..=1.0, Linear, Live,
         |s| s.clouds.coverage, Value::Float(s.clouds.coverage)),
+    // The time of day as the sun's place (`render.sun_time`, when set, places it instead).
+    knob!("sun elevation", "render.sun_elevation_deg", "°", -20.0..=90.0, Linear, Live,
+        |s| s.render.sun_elevation_deg, Value::Float(s.render.sun_elevation_deg)),
+    knob!("sun azimuth", "render.sun_azimuth_deg", "°", 0.0..=360.0, Linear, Live,
+        |s| s.render.sun_azimuth_deg, Value::Float(s.render.sun_azimuth_deg)),
+    knob!("exposure", "atmosphere.exposure_ev", "EV", -4.0..=4.0, Linear, Live,
+        |s| s.atmosphere.exposure_ev, Value::Float(s.atmosphere.exposure_ev)),
 ];
 
 /// `base` (a settings layer, or empty) with every knob's field set to its value in `settings`,

@@ -48,9 +48,6 @@ pub use texcells::TexcellReport;
 pub use tools::{RESOLVE_GUARD_FRAMES, Replay};
 pub use undrawn::UndrawnSeeds;
 
-/// Linear-RGB colour of the sky, also the haze the distance fades into.
-const SKY_LINEAR: [f64; 3] = [0.42, 0.55, 0.75];
-
 /// What one frame did, for logs and tests.
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct FrameReport {
@@ -193,8 +190,8 @@ impl Renderer {
         let device = &gpu.device;
         let terrain = TerrainPass::new(device, &settings);
         let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
-        let ground = GroundPass::new(device, &settings, software, &terrain);
         let atmosphere = AtmospherePass::new(&gpu, &settings.atmosphere);
+        let ground = GroundPass::new(device, &settings, software, &terrain, atmosphere.air().layout());
         let caches = Caches::new(&gpu, &dataset, &settings)?;
         let loader = Loader::new(
             Arc::clone(&dataset),
@@ -209,14 +206,15 @@ impl Renderer {
         let tlm_bindings = tlm.bind_group(device, &height_tile_ranges(&dataset), &depth_pyramid);
         let tlm_readback = ReadbackRing::new(device, "tile load map", tlm.capacity_bytes(), DEFAULT_SLOTS);
         let terrain_bindings = terrain.bind_group(device, &caches.heights, &caches.imagery, ground.sampler());
-        let seeds = seeds::SeedStage::new(&gpu, &dataset, &settings, &caches, &targets)?;
+        let seeds =
+            seeds::SeedStage::new(&gpu, &dataset, &settings, &caches, (&targets, atmosphere.air().layout()))?;
         let (texcells, texcells_unbaked) = match &seeds {
             Some(stage) => texcells::TexcellStage::new(
                 &gpu,
                 &dataset,
                 &settings,
                 &stage.table,
-                &terrain,
+                (&terrain, atmosphere.air().layout()),
                 caches.landcover.as_ref(),
             )?,
             None => (None, Vec::new()),
@@ -392,18 +390,23 @@ impl Renderer {
         p.pass(gpu, encoder, "tile_load_map", |e| {
             self.tlm.encode(e, &self.tlm_bindings, tlm, c.pass("tile_load_map"))
         })?;
-        // 2. Ground: imagery on the surface the depth pass kept, from the finest resident level.
-        p.pass(gpu, encoder, "ground", |e| {
-            self.ground.encode(e, mesh, &t.colour_view, &t.depth_view, SKY_LINEAR, c.pass("ground"))
-        })?;
-        // The sky: the air's light seen from the camera's altitude, drawn where nothing was.
+        // The air: the sky seen from the camera's altitude, and what lies between the camera and
+        // everything drawn next (lit and seen through it, `shared/air.wgsl`).
         p.pass(gpu, encoder, "sky_view", |e| self.atmosphere.encode_sky_view(e, c.pass("sky_view")))?;
+        p.pass(gpu, encoder, "aerial_perspective", |e| {
+            self.atmosphere.encode_aerial(e, c.pass("aerial_perspective"))
+        })?;
+        let air = self.atmosphere.air();
+        // 2. Ground: imagery on the surface the depth pass kept, from the finest resident level.
+        p.pass(gpu, encoder, "ground", |e| self.ground.encode(e, mesh, targets, air, c.pass("ground")))?;
+        // The sky, drawn where nothing was.
         p.pass(gpu, encoder, "sky", |e| self.atmosphere.encode_sky(e, targets, c.pass("sky")))?;
         if let Some(stage) = &self.texcells {
             // The far forest: slices of the dense classes' samples over the ground beyond the seeds.
             let counting = c.pass("texcells");
-            let draw =
-                |e: &mut _, count: Option<CountedPass<'_>>| stage.encode(e, mesh, targets, (count, counting));
+            let draw = |e: &mut _, count: Option<CountedPass<'_>>| {
+                stage.encode(e, (mesh, air), targets, (count, counting))
+            };
             p.pass(gpu, encoder, "texcells", |e| counted("texcells", e, &draw))?;
         }
         if let Some(stage) = &self.seeds {
@@ -413,8 +416,9 @@ impl Renderer {
             p.pass(gpu, encoder, "compact", |e| stage.encode_compact(e, c.pass("compact")))?;
             // 4b. Drawing: one indirect draw per group, over the ground, depth-tested against it.
             let counting = c.pass("draw_seeds");
-            let draw =
-                |e: &mut _, count: Option<CountedPass<'_>>| stage.encode_draw(e, targets, (count, counting));
+            let draw = |e: &mut _, count: Option<CountedPass<'_>>| {
+                stage.encode_draw(e, (targets, air), (count, counting))
+            };
             p.pass(gpu, encoder, "draw_seeds", |e| counted("draw_seeds", e, &draw))?;
         }
         Ok(())

@@ -23,7 +23,7 @@ use crate::streaming::{CacheStats, TileCache, UploadBudget};
 use crate::sun::frame_sun_dir;
 
 use super::texcells::TexcellView;
-use super::{FrameReport, RenderError, Renderer, SKY_LINEAR};
+use super::{FrameReport, RenderError, Renderer};
 
 /// What `prepare` uploaded for a frame, which the passes are recorded over.
 pub(super) struct FramePlan {
@@ -32,7 +32,7 @@ pub(super) struct FramePlan {
     pub camera_grid_m: DVec3,
     pub tlm: TlmFrame,
     pub nodes: PreparedNodes,
-    /// The terrain's uniforms: its matrix, sun and haze, which everything drawn over it shares.
+    /// The terrain's uniforms: its matrix, sun and clouds, which everything drawn over it shares.
     pub terrain: TerrainUniforms,
 }
 
@@ -169,7 +169,7 @@ impl Renderer {
 
     /// The terrain's instances (each node over its own height tile, or its finest resident
     /// ancestor) and the uniforms both terrain passes read, uploaded; the uniforms are returned
-    /// for pass 4, which draws with the same matrix, sun and haze.
+    /// for pass 4, which draws with the same matrix, sun and clouds.
     fn prepare_terrain(
         &mut self,
         view: &View,
@@ -187,7 +187,7 @@ impl Renderer {
         report.nodes_dropped = dropped;
         let clip = view.clip_from_view_world.as_mat4();
         let fall = fall_per_m2(&view.nadir);
-        let light = FrameLight { sun_dir: view.sun_dir, haze_linear: SKY_LINEAR };
+        let light = FrameLight { sun_dir: view.sun_dir };
         let uniforms =
             terrain_uniforms(&self.dataset, &self.settings, view.grid_m, clip, light, self.time_s, fall);
         let (queue, counts) = (&self.gpu.queue, &self.counts);
@@ -199,7 +199,8 @@ impl Renderer {
             sun_dir: view.sun_dir,
             altitude_m: view.grid_m.z,
         };
-        counts.uploads(queue, "sky_view", || self.atmosphere.prepare(queue, &sky));
+        let live = &self.settings.atmosphere;
+        counts.uploads(queue, "sky_view", || self.atmosphere.prepare(queue, &sky, live));
         if let Some(stage) = self.texcells.as_mut() {
             let texcell_view = TexcellView {
                 camera_grid_m: view.grid_m,
@@ -215,7 +216,7 @@ impl Renderer {
     }
 
     /// Pass 3's cells (those the latest TLM found near and visible), and pass 4's constants (the
-    /// terrain's matrix, sun and haze).
+    /// terrain's matrix, sun and clouds).
     fn prepare_seeds(
         &mut self,
         view: &View,

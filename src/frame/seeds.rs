@@ -80,13 +80,13 @@ pub(super) struct SeedStage {
 
 impl SeedStage {
     /// The stage for `dataset` over the renderer's caches and depth target, or `None` when it has
-    /// no land cover (nothing to grow seeds from).
+    /// no land cover (nothing to grow seeds from); pass 4 binds the atmosphere's `air`.
     pub fn new(
         gpu: &Gpu,
         dataset: &Dataset,
         settings: &Settings,
         caches: &Caches,
-        targets: &Targets,
+        (targets, air): (&Targets, &wgpu::BindGroupLayout),
     ) -> Result<Option<Self>, RenderError> {
         let (Some(landcover), Some(landcover_cache)) = (&dataset.manifest.landcover, &caches.landcover)
         else {
@@ -111,7 +111,9 @@ impl SeedStage {
             ReadbackRing::new(device, "seed counters", size_of::<SeedCounters>() as u64, DEFAULT_SLOTS);
         let draw = match settings.draw_seeds.impostors.as_str() {
             "" => None,
-            dir => Some(draw_pass(gpu, settings, Path::new(dir), &table, &pass, &mut compact, targets)?),
+            dir => {
+                Some(draw_pass(gpu, settings, Path::new(dir), &table, &pass, &mut compact, (targets, air))?)
+            }
         };
         Ok(Some(Self {
             table,
@@ -165,7 +167,7 @@ impl SeedStage {
         self.draw.as_ref().map_or((0, self.table.species.len()), |(draw, _)| draw.species_counts())
     }
 
-    /// Writes pass 4's constants for this frame (the terrain's matrix, sun and haze, the wind),
+    /// Writes pass 4's constants for this frame (the terrain's matrix, sun and clouds, the wind),
     /// and, with continuous LOD, the draws' index ranges for this frame's lens (when they change).
     pub fn prepare_draw(
         &mut self,
@@ -191,11 +193,11 @@ impl SeedStage {
     pub fn encode_draw(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        targets: (&wgpu::TextureView, &wgpu::TextureView),
+        (targets, air): ((&wgpu::TextureView, &wgpu::TextureView), &crate::passes::atmosphere::gpu::air::Air),
         (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
         if let (Some((draw, bind_group)), Some(_)) = (&self.draw, &self.last_frame) {
-            draw.encode(encoder, bind_group, self.compact.draw_args(), targets, (count, counting));
+            draw.encode(encoder, (bind_group, air), self.compact.draw_args(), targets, (count, counting));
         } else if let Some(count) = count {
             count.nothing(encoder, "draw_seeds", targets.0, targets.1);
         }
@@ -281,12 +283,13 @@ fn draw_pass(
     table: &ClassTable,
     pass: &SeedSelectPass,
     compact: &mut CompactPass,
-    targets: &Targets,
+    (targets, air): (&Targets, &wgpu::BindGroupLayout),
 ) -> Result<(DrawSeedsPass, wgpu::BindGroup), RenderError> {
     let impostors = load_impostors(dir, &table.species)?;
     let choices = LodChoices::of(&settings.draw_seeds, &table.species);
     let prepass = settings.draw_seeds.depth_prepass;
-    let mut draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, choices, prepass)?;
+    let mut draw =
+        DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, &table.species, choices, prepass, air)?;
     if settings.draw_seeds.samples > 1 {
         draw = draw.multisampled(&gpu.device, &targets.colour, &targets.depth);
     }

@@ -80,7 +80,7 @@ impl TexcellStage {
         dataset: &Dataset,
         settings: &Settings,
         table: &ClassTable,
-        terrain: &TerrainPass,
+        (terrain, air): (&TerrainPass, &wgpu::BindGroupLayout),
         landcover: Option<&TileCache>,
     ) -> Result<(Option<Self>, Vec<u8>), RenderError> {
         let (Some(meta), Some(landcover)) = (&dataset.manifest.landcover, landcover) else {
@@ -148,7 +148,7 @@ impl TexcellStage {
         let pass = TexcellsPass::new(
             &gpu.device,
             &gpu.queue,
-            terrain,
+            (terrain, air),
             settings.terrain.node_cells,
             &samples,
             &sample_of_class,
@@ -228,11 +228,11 @@ impl TexcellStage {
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: MeshDraw<'_>,
+        (mesh, air): (MeshDraw<'_>, &crate::passes::atmosphere::gpu::air::Air),
         targets: (&wgpu::TextureView, &wgpu::TextureView),
         (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
-        self.pass.encode(encoder, (mesh, &self.bind_group), targets, self.prepared, (count, counting));
+        self.pass.encode(encoder, (mesh, &self.bind_group, air), targets, self.prepared, (count, counting));
     }
 }
 

@@ -29,6 +29,8 @@ pub(crate) struct Canvas<'a> {
     pub terrain: &'a TerrainUniforms,
     pub colour: &'a wgpu::Texture,
     pub depth: &'a wgpu::Texture,
+    /// The air the frame was lit and seen through (its tables hold the last frame's view).
+    pub air: &'a crate::passes::atmosphere::gpu::air::Air,
 }
 
 /// Frames `Renderer::render_resolved` renders at most before it calls a view stuck: far more than
@@ -172,10 +174,15 @@ impl Renderer {
     }
 
     /// What the ground truth draws its seeds over: the last frame's terrain uniforms (matrix,
-    /// sun, haze) and its colour and depth targets (`None` before a first frame).
+    /// sun) and its colour and depth targets (`None` before a first frame).
     pub(crate) fn last_canvas(&self) -> Option<Canvas<'_>> {
         let last = self.last.as_ref()?;
-        Some(Canvas { terrain: &last.terrain, colour: &self.targets.colour, depth: &self.targets.depth })
+        Some(Canvas {
+            terrain: &last.terrain,
+            colour: &self.targets.colour,
+            depth: &self.targets.depth,
+            air: self.atmosphere.air(),
+        })
     }
 
     /// The last frame's seeds as pass 3 wrote them, with its counters, waiting for the GPU
@@ -313,7 +320,8 @@ impl Renderer {
             stage.encode_compact(&mut encoder, Counting::OFF);
         }
         if through == Replay::Draw {
-            stage.encode_draw(&mut encoder, (&t.colour_view, &t.depth_view), (None, Counting::OFF));
+            let targets = ((&t.colour_view, &t.depth_view), self.atmosphere.air());
+            stage.encode_draw(&mut encoder, targets, (None, Counting::OFF));
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.wait()?;

@@ -302,16 +302,13 @@ wgsl_constants! { cloud_constants:
 
 // --- Light: how the ground and the foliage are lit (`light`, the colour follow-up) ---
 wgsl_constants! { light_constants:
-    /// The ground's direct sun: albedo × (this × max(n · sun, 0) × clouds + sky).
-    pub const GROUND_SUN: f32 = 0.9;
-    /// The ground's sky light, facing straight up; a slope facing sideways gets half of it.
-    pub const GROUND_SKY: f32 = 0.35;
-    /// Foliage's direct sun on its own facing (leaves, billboards, slices: normals that scatter).
-    pub const FOLIAGE_SUN: f32 = 0.55;
-    /// Foliage's sun through the crown, by the sun's height alone (light wraps around leaves).
-    pub const FOLIAGE_SUN_WRAP: f32 = 0.35;
-    /// Foliage's sky light.
-    pub const FOLIAGE_SKY: f32 = 0.3;
+    /// Foliage's direct sun on its own facing (leaves, billboards, slices: normals that scatter),
+    /// as a share of the sun on level ground from straight above...
+    pub const FOLIAGE_SUN: f32 = 0.61;
+    /// ... its sun through the crown by the sun's height alone (light wraps around leaves)...
+    pub const FOLIAGE_SUN_WRAP: f32 = 0.39;
+    /// ... and its sky light, as a share of the sky's on level ground.
+    pub const FOLIAGE_SKY: f32 = 0.86;
     /// The follow-up's fades of detail (the texcells' by pixel size, `TEXCELL_DETAIL_*`, a seed's
     /// by its own size on screen, `SEED_DETAIL_*`) apply to views from above, which the
     /// photograph was taken from: none where the eye looks down at the forest less steeply than
@@ -355,6 +352,16 @@ wgsl_constants! { atmosphere_constants:
     pub const SKY_MARCHED_ABOVE_KM: f32 = 30.0;
     /// Segments per slice of the aerial-perspective volume.
     pub const AERIAL_SUBSTEPS: u32 = 4;
+    /// Directions per side of the grid the sky-irradiance table gathers over (8 × 8 = 64 over
+    /// the upper hemisphere).
+    pub const IRRADIANCE_DIRECTIONS_SIDE: u32 = 8;
+    /// The sun's zenith cosine of the daylight the display is balanced for (45°): level white
+    /// ground at sea level under it, sun and sky, shows white (`daylight_balance`).
+    pub const DAYLIGHT_SUN_COS: f32 = 0.70710677;
+    /// The display's tone curve is the identity up to this (linear), then a shoulder that
+    /// approaches 1 with the same slope, so the photograph's colours pass unchanged and the sun's
+    /// glare and snow at noon do not clip (`display`).
+    pub const DISPLAY_KNEE: f32 = 0.8;
 }
 
 // --- Wind (`seeds::wind`) ---

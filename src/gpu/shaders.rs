@@ -29,6 +29,9 @@ pub const BLOCKS: &str = include_str!("../../shaders/shared/blocks.wgsl");
 pub const CLOUDS: &str = include_str!("../../shaders/shared/clouds.wgsl");
 /// The atmosphere's model: media, phases, the shell's geometry, its tables' parametrisations.
 pub const ATMOSPHERE: &str = include_str!("../../shaders/shared/atmosphere.wgsl");
+/// The air for the passes that light what they draw: the light at a point, the air between it
+/// and the camera, the display (bindings at `passes::atmosphere::gpu::air::AIR_GROUP`).
+pub const AIR: &str = include_str!("../../shaders/shared/air.wgsl");
 /// The wind's bend of a plant (`seeds::wind`), the same for every representation that draws one.
 pub const WIND: &str = include_str!("../../shaders/shared/wind.wgsl");
 

@@ -74,6 +74,18 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     },
     PipelineBindings {
         shader: &atmosphere::gpu::SHADER,
+        entry_points: &["irradiance_lut"],
+        group: 0,
+        bindings: &atmosphere::gpu::IRRADIANCE_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
+        entry_points: &["daylight_balance"],
+        group: 0,
+        bindings: &atmosphere::gpu::DAYLIGHT_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &atmosphere::gpu::SHADER,
         entry_points: &["vs_sky", "fs_sky"],
         group: 0,
         bindings: &atmosphere::gpu::SKY_BINDINGS.bindings,
@@ -167,6 +179,24 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
         entry_points: &["vs_main", "fs_main", "fs_coverage", "fs_truth"],
         group: 0,
         bindings: &draw_seeds::gpu::BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &ground::gpu::SHADER,
+        entry_points: &["vs_main", "fs_main"],
+        group: atmosphere::gpu::air::AIR_GROUP,
+        bindings: &atmosphere::gpu::air::AIR_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &texcells::gpu::SHADER,
+        entry_points: &["vs_texcell", "fs_texcell"],
+        group: atmosphere::gpu::air::AIR_GROUP,
+        bindings: &atmosphere::gpu::air::AIR_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &draw_seeds::gpu::SHADER,
+        entry_points: &["vs_main", "fs_main", "fs_coverage", "fs_shade_samples", "fs_truth"],
+        group: atmosphere::gpu::air::AIR_GROUP,
+        bindings: &atmosphere::gpu::air::AIR_BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &draw_seeds::gpu::SHADER,

@@ -5,14 +5,15 @@
 //! - the **amplified frame**: the settings as given (seeds, texcells, whatever they draw);
 //! - the **photograph frame**: the same settings with nothing grown (`photograph_settings`:
 //!   `seeds.density_scale` 0, `texcells.reach_m` 0), which is the ground pass alone: the imagery
-//!   draped on the terrain, lit by the same sun and clouds and hazed by the same distance.
+//!   draped on the terrain, lit by the same sun and clouds and seen through the same air.
 //!
 //! Both are settled (`Renderer::render_resolved`) and read straight from the colour target
-//! (`Renderer::read_colour`): there is no tone mapping anywhere in terramp, so the target's sRGB
-//! bytes decode to the linear light the passes wrote, and every mean is taken in linear light.
-//! The ground's lighting and haze are in both frames alike: where the amplified frame shows its
-//! ground they cancel, and where it shows a tree the tree is lit by the same sun and hazed by the
-//! same distance as the ground it stands on, so what is left is what the amplification changed.
+//! (`Renderer::read_colour`): the display's tone curve is the identity below `DISPLAY_KNEE` (0.8
+//! linear, where forest and fields lie), so the target's sRGB bytes decode to the linear light the
+//! passes wrote there, and every mean is taken in linear light. The ground's lighting and air are
+//! in both frames alike: where the amplified frame shows its ground they cancel, and where it
+//! shows a tree the tree is lit by the same sun and seen through the same air as the ground it
+//! stands on, so what is left is what the amplification changed.
 //! Each pixel is keyed by the terrain point it shows (`keys`: the level-0 imagery texel, and
 //! whether its land cover grows trees), and `measure` compares the frames per texel footprint,
 //! per 5 × 5 block and per pixel (CIEDE2000 of mean colours, `colour`; the amplified frame's

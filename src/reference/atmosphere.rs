@@ -1,15 +1,18 @@
-//! The atmosphere pass's twin: its three tables and its sky, step for step as
+//! The atmosphere pass's twin: its tables and its sky, step for step as
 //! `shaders/atmosphere.wgsl` and `shaders/shared/atmosphere.wgsl` compute them, in f32, from the
 //! same `AtmosphereUniforms`. Tables are read between texels by hand in both, with the same
-//! weights. `tests/atmosphere.rs` holds the GPU to it; the brute-force model
-//! (`atmosphere::brute`) judges them both.
+//! weights. `light` twins the sky's irradiance, the display and what the lit passes take from the
+//! air (`shaders/shared/air.wgsl`). `tests/atmosphere.rs` holds the GPU to it; the brute-force
+//! model (`atmosphere::brute`) judges them both.
+
+pub mod light;
 
 use glam::{Vec2, Vec3, Vec4Swizzles};
 
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::{
-    AERIAL_SUBSTEPS, GROUND_SUN, MULTIPLE_DIRECTIONS_SIDE, MULTIPLE_STEPS, PI, SKY_MARCHED_ABOVE_KM,
-    SKY_VIEW_STEPS, TRANSMITTANCE_STEPS,
+    AERIAL_SUBSTEPS, MULTIPLE_DIRECTIONS_SIDE, MULTIPLE_STEPS, PI, SKY_MARCHED_ABOVE_KM, SKY_VIEW_STEPS,
+    TRANSMITTANCE_STEPS,
 };
 
 /// One table: its size and texels, row by row (rgb used, a = 1).
@@ -22,7 +25,7 @@ pub struct Lut {
 }
 
 impl Lut {
-    fn made(size: [u32; 2], texel: impl Fn([u32; 2]) -> Vec3) -> Self {
+    pub(crate) fn made(size: [u32; 2], texel: impl Fn([u32; 2]) -> Vec3) -> Self {
         let texels = (0..size[1])
             .flat_map(|y| (0..size[0]).map(move |x| [x, y]))
             .map(|xy| texel(xy).extend(1.0).to_array())
@@ -78,11 +81,11 @@ impl<'a> Model<'a> {
         Self { u }
     }
 
-    fn bottom(&self) -> f32 {
+    pub(crate) fn bottom(&self) -> f32 {
         self.u.radii[0]
     }
 
-    fn top(&self) -> f32 {
+    pub(crate) fn top(&self) -> f32 {
         self.u.radii[1]
     }
 
@@ -144,7 +147,7 @@ impl<'a> Model<'a> {
         (r, mu)
     }
 
-    fn multiple_unit(&self, r: f32, mu_sun: f32) -> Vec2 {
+    pub(crate) fn multiple_unit(&self, r: f32, mu_sun: f32) -> Vec2 {
         Vec2::new(0.5 * mu_sun + 0.5, (r - self.bottom()) / (self.top() - self.bottom()))
     }
 
@@ -293,7 +296,8 @@ impl Tables<'_> {
         };
         let world_from_clip = glam::Mat4::from_cols_array_2d(&u.view_world_from_clip);
         let (up, sun) = (Vec3::from_slice(&u.up[..3]), Vec3::from_slice(&u.sun_dir[..3]));
-        let (r, mu_sun) = (u.radii[2], u.radii[3]);
+        // From the camera itself, above the air or not.
+        let (r, mu_sun) = (u.up[3], u.radii[3]);
         let stored = |v: Vec3| v.extend(1.0).to_array().map(|c| half::f16::from_f32(c).to_f32());
         for y in 0..h {
             for x in 0..w {
@@ -431,9 +435,10 @@ impl Tables<'_> {
         radiance
     }
 
-    /// `fs_sky`'s colour for a direction, in the ground's units.
-    pub fn sky_colour(&self, sky_view: &Lut, dir: Vec3) -> Vec3 {
-        self.sky_radiance(sky_view, dir) * PI * GROUND_SUN
+    /// `fs_sky`'s colour for a direction on the display balanced by `daylight`
+    /// (`light::daylight_balance`).
+    pub fn sky_colour(&self, sky_view: &Lut, dir: Vec3, daylight: Vec3) -> Vec3 {
+        light::display(self.sky_radiance(sky_view, dir) * PI, daylight, self.model.u.exposure)
     }
 }
 

@@ -39,6 +39,7 @@ use crate::frame::{RenderError, Renderer};
 use crate::gpu::readback::read_texture;
 use crate::gpu::resources::buffer_init;
 use crate::gpu::{Gpu, GpuError};
+use crate::passes::atmosphere::gpu::air::AirVariants;
 use crate::passes::draw_seeds::frame::{draw_uniforms, load_impostors};
 use crate::passes::draw_seeds::gpu::{DrawSeedsInputs, DrawSeedsPass, SEED_ID_FORMAT};
 use crate::passes::draw_seeds::{DrawSeedsError, LodChoices};
@@ -226,7 +227,7 @@ impl TruthRenderer {
 /// Pass 4 set up to draw the seeds' full meshes with the truth's pipeline, built on first use.
 struct MeshDrawer {
     dir: PathBuf,
-    built: Option<(DrawSeedsPass, wgpu::RenderPipeline)>,
+    built: Option<(DrawSeedsPass, AirVariants<wgpu::RenderPipeline>)>,
 }
 
 impl MeshDrawer {
@@ -240,7 +241,8 @@ impl MeshDrawer {
         &mut self,
         gpu: &Gpu,
         species: &[crate::classes::Species],
-    ) -> Result<&(DrawSeedsPass, wgpu::RenderPipeline), TruthError> {
+        air: &wgpu::BindGroupLayout,
+    ) -> Result<&(DrawSeedsPass, AirVariants<wgpu::RenderPipeline>), TruthError> {
         let built = match self.built.take() {
             Some(built) => built,
             None => {
@@ -251,7 +253,8 @@ impl MeshDrawer {
                 // Every seed its whole mesh: no continuous LOD; drawn with `truth_pipeline`, not the
                 // frame's draws, so no prepass.
                 let choices = LodChoices::default();
-                let draw = DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species, choices, false)?;
+                let draw =
+                    DrawSeedsPass::new(&gpu.device, &gpu.queue, &impostors, species, choices, false, air)?;
                 let pipeline = draw.truth_pipeline(&gpu.device);
                 (draw, pipeline)
             }
@@ -314,7 +317,7 @@ fn draw_seeds(
     if let Some((table, scene)) = &scene {
         let (gpu, settings) = (&renderer.gpu, &renderer.settings);
         let dir = meshes.dir.clone();
-        let (draw, pipeline) = meshes.get(gpu, &table.species)?;
+        let (draw, pipeline) = meshes.get(gpu, &table.species, canvas.air.layout())?;
         let wind = renderer.wind_frame(camera);
         let earth = renderer.exact_placing(camera).nadir_node();
         let mut uniforms = draw_uniforms(settings, canvas.terrain, &wind, &earth);
@@ -365,7 +368,12 @@ fn draw_seeds(
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            draw.encode_meshes(&mut pass, pipeline, &bind_group, &draws);
+            draw.encode_meshes(
+                &mut pass,
+                pipeline.get(canvas.air),
+                (&bind_group, canvas.air.group()),
+                &draws,
+            );
         }
         gpu.queue.submit([encoder.finish()]);
         gpu.check()?;

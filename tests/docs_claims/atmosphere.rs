@@ -1,8 +1,12 @@
 //! What docs/atmosphere.md quotes, and where each number is defined.
 
-use terramp::gpu::layout::SKY_MARCHED_ABOVE_KM;
+use terramp::gpu::layout::{
+    DISPLAY_KNEE, FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, IRRADIANCE_DIRECTIONS_SIDE,
+    SKY_MARCHED_ABOVE_KM,
+};
+use terramp::passes::atmosphere::gpu::air::AIR_GROUP;
 
-use super::claims::{Claim, Source, percent, plain, sci, test_const};
+use super::claims::{Claim, Source, km, percent, plain, sci, test_const};
 
 pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
     Claim {
@@ -45,5 +49,57 @@ pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
         doc: "docs/atmosphere.md",
         quote: "`SKY_MARCHED_ABOVE_KM` ({} km)",
         values: &[(Source::Value(SKY_MARCHED_ABOVE_KM as f64), plain)],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "The test allows {} % a channel (`IRRADIANCE_OFF`)",
+        values: &[(test_const("tests/air.rs", "IRRADIANCE_OFF"), percent)],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "irradiance texels and the daylight balance within {} (texels under 1 % of the brightest",
+        values: &[(test_const("tests/air.rs", "TABLE_OFF"), sci)],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "the test allows {} % of each part beyond {} levels), where the air changes the ground beyond {} km by 14.5 levels on average (the test asks at least {})",
+        values: &[
+            (test_const("tests/air.rs", "AIR_OUTLIERS"), percent),
+            (test_const("tests/air.rs", "AIR_LEVELS"), plain),
+            (test_const("tests/air.rs", "FAR_M"), km),
+            (test_const("tests/air.rs", "AIR_MIN_CHANGE"), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "by the shares `FOLIAGE_SUN` ({}), `FOLIAGE_SUN_WRAP` ({}) and `FOLIAGE_SKY` ({})",
+        values: &[
+            (Source::Value(FOLIAGE_SUN as f64), plain),
+            (Source::Value(FOLIAGE_SUN_WRAP as f64), plain),
+            (Source::Value(FOLIAGE_SKY as f64), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "The tone curve is the identity up to {} (`DISPLAY_KNEE`, linear)",
+        values: &[(Source::Value(DISPLAY_KNEE as f64), plain)],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "one bind group at `AIR_GROUP` = {}",
+        values: &[(Source::Value(AIR_GROUP as f64), plain)],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "gathered over {} × {} directions of the upper half",
+        values: &[
+            (Source::Value(IRRADIANCE_DIRECTIONS_SIDE as f64), plain),
+            (Source::Value(IRRADIANCE_DIRECTIONS_SIDE as f64), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "| sky irradiance | {} × {} (`atmosphere.irradiance_lut`)",
+        values: &[(Source::Setting { preset: None, key: "atmosphere.irradiance_lut" }, plain)],
     },
 ];

@@ -22,6 +22,9 @@ gpu_struct! {
         pub radii: [f32; 4],
         /// Camera-relative world from clip space: the sky's view rays.
         pub view_world_from_clip: [[f32; 4]; 4],
+        /// Its inverse: where a point of the lit passes lies on the aerial-perspective volume's
+        /// tiles.
+        pub clip_from_view_world: [[f32; 4]; 4],
         /// The view's zenith in camera-relative world space (xyz), its radius, km, wherever it
         /// is (w; `radii.z` holds it within the air).
         pub up: [f32; 4],
@@ -39,7 +42,11 @@ gpu_struct! {
         pub aerial_far_km: f32,
         /// Its slices.
         pub aerial_slices: u32,
-        /// Padding to the WGSL struct's alignment (always 0).
-        pub _pad: [u32; 2],
+        /// The display's exposure: a factor on every radiance (2^`atmosphere.exposure_ev`).
+        pub exposure: f32,
+        /// 1 where the ground, the seeds and the texcells are seen through the air (aerial
+        /// perspective), 0 where the air is left out between them and the camera.
+        pub aerial_on: u32,
+
     }
 }

@@ -14,8 +14,6 @@ gpu_struct! {
         pub clip_from_view_world: [[f32; 4]; 4],
         /// Unit vector towards the sun, w unused.
         pub sun_dir: [f32; 4],
-        /// Haze colour (linear RGB), and the distance that hides half of what is behind it (w).
-        pub haze: [f32; 4],
         /// Each draw LOD's reach (`draw_seeds.reach_m`), metres, scaled by each seed's size.
         pub draw_reach_m: [f32; 4],
         /// 1 / the seed height that gets the full reaches, 1/m: a smaller seed's reach shrinks with
@@ -54,11 +52,12 @@ gpu_struct! {
         pub prefilter_small: u32,
         /// Padding to the WGSL struct's alignment (always 0).
         pub _pad: [u32; 2],
-        /// The colour follow-up, per (species, draw LOD) group (`species · SEED_LODS + lod`): the
-        /// factor per channel (xyz) that turns the group's geometry's mean lit colour seen from
-        /// above into that of flat ground of albedo 1 under this sun (`draw_seeds::from_above`);
-        /// 0: the model keeps its colours.
-        pub photo_scale: [[f32; 4]; SEED_GROUPS as usize],
+        /// The colour follow-up's yardstick, per (species, draw LOD) group
+        /// (`species · SEED_LODS + lod`): the group's foliage seen from above
+        /// (`draw_seeds::from_above`), its mean albedo (xyz) and its mean facing towards this
+        /// frame's sun (w), from which the shader scales it to the photograph under the light at
+        /// each seed (`photo_scale_at`); 0: the model keeps its colours.
+        pub from_above: [[f32; 4]; SEED_GROUPS as usize],
     }
 }
 

@@ -13,8 +13,6 @@ gpu_struct! {
         pub clip_from_view_world: [[f32; 4]; 4],
         /// Unit vector towards the sun, w unused.
         pub sun_dir: [f32; 4],
-        /// Haze colour (linear RGB) and, in w, the distance that hides half the ground, metres.
-        pub haze: [f32; 4],
         /// Camera position in grid space (metres east/north of the grid origin, height), w unused.
         /// Grid-space positions of vertices are node origin + offset, so this stays an f32 offset.
         pub camera_grid_m: [f32; 4],

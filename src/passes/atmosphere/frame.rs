@@ -31,7 +31,8 @@ pub fn aerial_far_km(air: &Atmosphere, view_radius_km: f64) -> f64 {
 }
 
 /// The pass's uniforms for `view` over the air of `settings`. The sky-view table is made for the
-/// view's radius within the air (at its top for a view above it, which marches its sky per pixel).
+/// view's radius within the air (at its top for a view above it, which marches its sky per pixel);
+/// the aerial-perspective volume is marched from the view itself, wherever it is.
 pub fn atmosphere_uniforms(settings: &AtmosphereSettings, view: &SkyView) -> AtmosphereUniforms {
     let a = &settings.air;
     let thickness_km = a.top_radius_km - a.bottom_radius_km;
@@ -51,14 +52,16 @@ pub fn atmosphere_uniforms(settings: &AtmosphereSettings, view: &SkyView) -> Atm
             f(view.sun_dir.dot(view.up).clamp(-1.0, 1.0)),
         ],
         view_world_from_clip: view.view_world_from_clip.as_mat4().to_cols_array_2d(),
+        clip_from_view_world: view.view_world_from_clip.inverse().as_mat4().to_cols_array_2d(),
         up: view.up.as_vec3().extend(f(a.bottom_radius_km + altitude_km)).to_array(),
         sun_dir: view.sun_dir.as_vec3().extend(f(a.sun_angular_radius_rad)).to_array(),
         transmittance_size: settings.transmittance_lut,
         multiple_size: settings.multiple_scattering_lut,
         sky_view_size: settings.sky_view_lut,
         aerial_size: [settings.aerial_perspective_lut[0], settings.aerial_perspective_lut[1]],
-        aerial_far_km: f(aerial_far_km(a, view_radius_km)),
+        aerial_far_km: f(aerial_far_km(a, a.bottom_radius_km + altitude_km)),
         aerial_slices: settings.aerial_perspective_lut[2],
-        _pad: [0; 2],
+        exposure: f(settings.exposure_ev.exp2()),
+        aerial_on: u32::from(settings.aerial_perspective),
     }
 }

@@ -1,24 +1,28 @@
-//! The atmosphere pass's GPU half: the three tables' textures and compute pipelines, the sky's
-//! render pipeline, their binding tables; the fixed tables made once in `new`, the sky-view table
-//! and the sky recorded each frame.
+//! The atmosphere pass's GPU half: the tables' textures and compute pipelines, the sky's render
+//! pipelines, their binding tables; the fixed tables (transmittance, multiple scattering, sky
+//! irradiance, the daylight balance) made once in `new`, the sky-view table, the
+//! aerial-perspective volume and the sky recorded each frame.
 
-use std::cell::Cell;
+pub mod air;
+mod tables;
 
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension as Dim};
 
 use crate::config::AtmosphereSettings;
-use crate::gpu::bindings::{Binding, BindingTable};
+use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::{ATMOSPHERE_WORKGROUP, SKY_MARCHED_ABOVE_KM};
-use crate::gpu::readback::{read_texture_mip, read_texture_slices};
+use crate::gpu::readback::{read_buffer, read_texture_slices};
 use crate::gpu::resources::{buffer, compute_pipeline, depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
 use crate::gpu::{Gpu, GpuError, Queue};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
 use super::frame::{SkyView, atmosphere_uniforms};
+use air::Air;
+use tables::{Table, aerial_volume};
 
 /// The tables' texel format: f32 radiances and transmittances, which storage textures can write
 /// everywhere and which the shaders read by hand (`lut_read`), so no filtering of f32 is needed.
@@ -38,7 +42,7 @@ const LUT: TextureSampleType = TextureSampleType::Float { filterable: false };
 pub const TRANSMITTANCE_BINDINGS: BindingTable<2> = BindingTable {
     label: "atmosphere transmittance",
     bindings: [
-        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE, Access::Read),
         Binding::storage_texture(1, "transmittance_out", Stage::COMPUTE, LUT_FORMAT, Dim::D2),
     ],
 };
@@ -47,7 +51,7 @@ pub const TRANSMITTANCE_BINDINGS: BindingTable<2> = BindingTable {
 pub const MULTIPLE_BINDINGS: BindingTable<3> = BindingTable {
     label: "atmosphere multiple scattering",
     bindings: [
-        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE, Access::Read),
         Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
         Binding::storage_texture(3, "multiple_out", Stage::COMPUTE, LUT_FORMAT, Dim::D2),
     ],
@@ -57,7 +61,7 @@ pub const MULTIPLE_BINDINGS: BindingTable<3> = BindingTable {
 pub const SKY_VIEW_BINDINGS: BindingTable<4> = BindingTable {
     label: "atmosphere sky view",
     bindings: [
-        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE, Access::Read),
         Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
         Binding::texture(4, "multiple", Stage::COMPUTE, LUT, Dim::D2),
         Binding::storage_texture(5, "sky_view_out", Stage::COMPUTE, SKY_VIEW_FORMAT, Dim::D2),
@@ -68,7 +72,7 @@ pub const SKY_VIEW_BINDINGS: BindingTable<4> = BindingTable {
 pub const AERIAL_BINDINGS: BindingTable<5> = BindingTable {
     label: "atmosphere aerial perspective",
     bindings: [
-        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE),
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE, Access::Read),
         Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
         Binding::texture(4, "multiple", Stage::COMPUTE, LUT, Dim::D2),
         Binding::storage_texture(8, "aerial_inscatter_out", Stage::COMPUTE, SKY_VIEW_FORMAT, Dim::D3),
@@ -76,11 +80,34 @@ pub const AERIAL_BINDINGS: BindingTable<5> = BindingTable {
     ],
 };
 
+/// `irradiance_lut`.
+pub const IRRADIANCE_BINDINGS: BindingTable<4> = BindingTable {
+    label: "atmosphere sky irradiance",
+    bindings: [
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE, Access::Read),
+        Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::texture(4, "multiple", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::storage_texture(10, "irradiance_out", Stage::COMPUTE, LUT_FORMAT, Dim::D2),
+    ],
+};
+
+/// `daylight_balance`.
+pub const DAYLIGHT_BINDINGS: BindingTable<4> = BindingTable {
+    label: "atmosphere daylight balance",
+    bindings: [
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::COMPUTE, Access::Read),
+        Binding::texture(2, "transmittance", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::texture(11, "irradiance", Stage::COMPUTE, LUT, Dim::D2),
+        Binding::storage::<[f32; 4]>(12, "daylight_out", Stage::COMPUTE, Access::ReadWrite),
+    ],
+};
+
 /// `vs_sky`, `fs_sky`: the sky from the sky-view table.
-pub const SKY_BINDINGS: BindingTable<4> = BindingTable {
+pub const SKY_BINDINGS: BindingTable<5> = BindingTable {
     label: "sky",
     bindings: [
-        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::FRAGMENT),
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::FRAGMENT, Access::Read),
+        Binding::uniform::<[f32; 4]>(13, "daylight", Stage::FRAGMENT),
         Binding::texture(2, "transmittance", Stage::FRAGMENT, LUT, Dim::D2),
         Binding::texture(
             6,
@@ -94,98 +121,66 @@ pub const SKY_BINDINGS: BindingTable<4> = BindingTable {
 };
 
 /// `vs_sky`, `fs_sky_marched`: the sky marched per pixel.
-pub const SKY_MARCHED_BINDINGS: BindingTable<3> = BindingTable {
+pub const SKY_MARCHED_BINDINGS: BindingTable<4> = BindingTable {
     label: "sky marched",
     bindings: [
-        Binding::uniform::<AtmosphereUniforms>(0, "atmosphere", Stage::FRAGMENT),
+        Binding::storage::<AtmosphereUniforms>(0, "atmosphere", Stage::FRAGMENT, Access::Read),
+        Binding::uniform::<[f32; 4]>(13, "daylight", Stage::FRAGMENT),
         Binding::texture(2, "transmittance", Stage::FRAGMENT, LUT, Dim::D2),
         Binding::texture(4, "multiple", Stage::FRAGMENT, LUT, Dim::D2),
     ],
 };
 
-/// One table on the GPU.
-struct Table {
-    texture: wgpu::Texture,
-    view: wgpu::TextureView,
-    size: [u32; 2],
-    format: wgpu::TextureFormat,
-}
-
-impl Table {
-    fn new(device: &wgpu::Device, label: &str, size: [u32; 2], format: wgpu::TextureFormat) -> Self {
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&Default::default());
-        Self { texture, view, size, format }
-    }
-
-    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, counting: Counting<'_>) {
-        let [w, h] = self.size.map(|side| side.div_ceil(ATMOSPHERE_WORKGROUP));
-        counting.dispatch(pass, [w, h, 1]);
-    }
-
-    fn read_back(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, GpuError> {
-        if self.format == SKY_VIEW_FORMAT {
-            let bytes = read_texture_mip(gpu, &self.texture, 0, wgpu::TextureAspect::All, 8)?;
-            let halves: Vec<[u16; 4]> = bytemuck::pod_collect_to_vec(&bytes);
-            return Ok(halves.iter().map(|t| t.map(|bits| half::f16::from_bits(bits).to_f32())).collect());
-        }
-        let bytes = read_texture_mip(gpu, &self.texture, 0, wgpu::TextureAspect::All, 16)?;
-        Ok(bytemuck::pod_collect_to_vec(&bytes))
-    }
-}
-
-/// The atmosphere on the GPU: its tables (the fixed two made in `new`), the sky-view table's
-/// pipeline and the sky's, and the uniforms `prepare` writes each frame.
+/// The atmosphere on the GPU: its tables (the fixed ones made in `new`), the sky-view table's
+/// and the aerial-perspective volume's pipelines, the sky's, the air the lit passes bind, and the
+/// uniforms `prepare` writes each frame.
 pub struct AtmospherePass {
     settings: AtmosphereSettings,
     uniforms: wgpu::Buffer,
     transmittance: Table,
     multiple: Table,
     sky_view: Table,
+    irradiance: Table,
+    /// The display's balance for daylight (`daylight_balance`): 1 / the light per channel.
+    daylight: wgpu::Buffer,
     sky_view_pipeline: wgpu::ComputePipeline,
     sky_view_group: wgpu::BindGroup,
     /// The sky's pipelines and bind groups: from the table, then marched per pixel.
     sky: [(wgpu::RenderPipeline, wgpu::BindGroup); 2],
-    /// Whether this frame's view marches its sky (above `SKY_MARCHED_ABOVE_KM`).
-    marched: Cell<bool>,
     /// The aerial-perspective volume: in-scattered light, then transmittance (f16, 3D).
     aerial: [wgpu::Texture; 2],
     aerial_pipeline: wgpu::ComputePipeline,
     aerial_group: wgpu::BindGroup,
+    /// What the ground, the seeds and the texcells bind of all this.
+    air: Air,
 }
 
 impl AtmospherePass {
-    /// The pass for the air of `settings`; makes its transmittance and multiple-scattering tables
-    /// on `gpu` now (submitted, not waited for).
+    /// The pass for the air of `settings`; makes its fixed tables and the daylight balance on
+    /// `gpu` now (submitted, not waited for).
     pub fn new(gpu: &Gpu, settings: &AtmosphereSettings) -> Self {
         let device = &gpu.device;
         let module = SHADER.module(device);
+        // Read as storage, never as a uniform: lavapipe specialises a shader on the values of
+        // uniforms that steer its branches and keeps every variant, and the view's radius and the
+        // sun's height steer the march's (`hits_ground`) and change every frame.
         let uniforms = buffer(
             device,
             "atmosphere uniforms",
             size_of::<AtmosphereUniforms>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
-        let transmittance =
-            Table::new(device, "atmosphere transmittance", settings.transmittance_lut, LUT_FORMAT);
-        let multiple = Table::new(
+        let daylight = buffer(
             device,
-            "atmosphere multiple scattering",
-            settings.multiple_scattering_lut,
-            LUT_FORMAT,
+            "atmosphere daylight balance",
+            size_of::<[f32; 4]>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         );
-        let sky_view = Table::new(device, "atmosphere sky view", settings.sky_view_lut, SKY_VIEW_FORMAT);
+        let table = |label: &str, size: [u32; 2], format| Table::new(device, label, size, format);
+        let transmittance = table("atmosphere transmittance", settings.transmittance_lut, LUT_FORMAT);
+        let multiple = table("atmosphere multiple scattering", settings.multiple_scattering_lut, LUT_FORMAT);
+        let sky_view = table("atmosphere sky view", settings.sky_view_lut, SKY_VIEW_FORMAT);
+        let irradiance = table("atmosphere sky irradiance", settings.irradiance_lut, LUT_FORMAT);
         use wgpu::BindingResource::TextureView as View;
         let compute = |layout: &wgpu::BindGroupLayout, entry_point: &str| {
             compute_pipeline(
@@ -206,29 +201,59 @@ impl AtmospherePass {
             altitude_m: 0.0,
         };
         gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&atmosphere_uniforms(settings, &still)));
-        let layout = TRANSMITTANCE_BINDINGS.layout(device);
-        let transmittance_group =
-            TRANSMITTANCE_BINDINGS.bind_group(device, &layout, [u.clone(), View(&transmittance.view)]);
-        let transmittance_pipeline = compute(&layout, "transmittance_lut");
-        let layout = MULTIPLE_BINDINGS.layout(device);
-        let multiple_group = MULTIPLE_BINDINGS.bind_group(
-            device,
-            &layout,
-            [u.clone(), View(&transmittance.view), View(&multiple.view)],
-        );
-        let multiple_pipeline = compute(&layout, "multiple_scattering_lut");
+        let fixed = [
+            {
+                let layout = TRANSMITTANCE_BINDINGS.layout(device);
+                let group = TRANSMITTANCE_BINDINGS.bind_group(
+                    device,
+                    &layout,
+                    [u.clone(), View(&transmittance.view)],
+                );
+                (compute(&layout, "transmittance_lut"), group, transmittance.workgroups())
+            },
+            {
+                let layout = MULTIPLE_BINDINGS.layout(device);
+                let views = [View(&transmittance.view), View(&multiple.view)];
+                let [a, b] = views;
+                let group = MULTIPLE_BINDINGS.bind_group(device, &layout, [u.clone(), a, b]);
+                (compute(&layout, "multiple_scattering_lut"), group, multiple.workgroups())
+            },
+            {
+                let layout = IRRADIANCE_BINDINGS.layout(device);
+                let group = IRRADIANCE_BINDINGS.bind_group(
+                    device,
+                    &layout,
+                    [u.clone(), View(&transmittance.view), View(&multiple.view), View(&irradiance.view)],
+                );
+                (compute(&layout, "irradiance_lut"), group, irradiance.workgroups())
+            },
+            {
+                let layout = DAYLIGHT_BINDINGS.layout(device);
+                let group = DAYLIGHT_BINDINGS.bind_group(
+                    device,
+                    &layout,
+                    [
+                        u.clone(),
+                        View(&transmittance.view),
+                        View(&irradiance.view),
+                        daylight.as_entire_binding(),
+                    ],
+                );
+                (compute(&layout, "daylight_balance"), group, [1, 1, 1])
+            },
+        ];
         let mut encoder = device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("atmosphere tables"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(&transmittance_pipeline);
-            pass.set_bind_group(0, &transmittance_group, &[]);
-            transmittance.dispatch(&mut pass, Counting::OFF);
-            pass.set_pipeline(&multiple_pipeline);
-            pass.set_bind_group(0, &multiple_group, &[]);
-            multiple.dispatch(&mut pass, Counting::OFF);
+            // In order: each reads the tables before it.
+            for (pipeline, group, workgroups) in &fixed {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                Counting::OFF.dispatch(&mut pass, *workgroups);
+            }
         }
         gpu.queue.submit([encoder.finish()]);
 
@@ -239,18 +264,21 @@ impl AtmospherePass {
             [u.clone(), View(&transmittance.view), View(&multiple.view), View(&sky_view.view)],
         );
         let sky_view_pipeline = compute(&layout, "sky_view_lut");
-        let sky_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("sky view"),
+        let linear = wgpu::SamplerDescriptor {
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
-        });
+        };
+        let sky_sampler =
+            device.create_sampler(&wgpu::SamplerDescriptor { label: Some("sky view"), ..linear.clone() });
+        let d = daylight.as_entire_binding();
         let layout = SKY_BINDINGS.layout(device);
         let table_group = SKY_BINDINGS.bind_group(
             device,
             &layout,
             [
                 u.clone(),
+                d.clone(),
                 View(&transmittance.view),
                 View(&sky_view.view),
                 wgpu::BindingResource::Sampler(&sky_sampler),
@@ -261,7 +289,7 @@ impl AtmospherePass {
         let marched_group = SKY_MARCHED_BINDINGS.bind_group(
             device,
             &layout,
-            [u, View(&transmittance.view), View(&multiple.view)],
+            [u.clone(), d, View(&transmittance.view), View(&multiple.view)],
         );
         let marched_sky = (sky_pipeline(device, &module, &layout, "fs_sky_marched"), marched_group);
         let aerial = ["aerial perspective in-scattering", "aerial perspective transmittance"]
@@ -271,35 +299,53 @@ impl AtmospherePass {
         let aerial_group = AERIAL_BINDINGS.bind_group(
             device,
             &layout,
-            [
-                uniforms.as_entire_binding(),
-                View(&transmittance.view),
-                View(&multiple.view),
-                View(&views[0]),
-                View(&views[1]),
-            ],
+            [u, View(&transmittance.view), View(&multiple.view), View(&views[0]), View(&views[1])],
         );
         let aerial_pipeline = compute(&layout, "aerial_perspective_lut");
+        let aerial_sampler =
+            device.create_sampler(&wgpu::SamplerDescriptor { label: Some("aerial perspective"), ..linear });
+        let air = Air::new(
+            device,
+            &uniforms,
+            &daylight,
+            [&transmittance.view, &irradiance.view, &multiple.view],
+            &views,
+            &aerial_sampler,
+        );
         Self {
             settings: settings.clone(),
             uniforms,
             transmittance,
             multiple,
             sky_view,
+            irradiance,
+            daylight,
             sky_view_pipeline,
             sky_view_group,
             sky: [table_sky, marched_sky],
-            marched: Cell::new(false),
             aerial,
             aerial_pipeline,
             aerial_group,
+            air,
         }
     }
 
-    /// Writes the frame's uniforms for `view`.
-    pub fn prepare(&self, queue: &Queue, view: &SkyView) {
-        let uniforms = atmosphere_uniforms(&self.settings, view);
-        self.marched.set(uniforms.up[3] - uniforms.radii[0] > SKY_MARCHED_ABOVE_KM);
+    /// What the lit passes bind at `AIR_GROUP`: its layout for their pipelines, its group to set.
+    pub fn air(&self) -> &Air {
+        &self.air
+    }
+
+    /// Writes the frame's uniforms for `view`, the display's exposure and aerial perspective as
+    /// `live` has them now (a viewer turns them; the air and the tables' sizes stay the pass's
+    /// own, fixed when it was built).
+    pub fn prepare(&self, queue: &Queue, view: &SkyView, live: &AtmosphereSettings) {
+        let settings = AtmosphereSettings {
+            exposure_ev: live.exposure_ev,
+            aerial_perspective: live.aerial_perspective,
+            ..self.settings.clone()
+        };
+        let uniforms = atmosphere_uniforms(&settings, view);
+        self.air.marched.set(uniforms.up[3] - uniforms.radii[0] > SKY_MARCHED_ABOVE_KM);
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
     }
 
@@ -326,15 +372,15 @@ impl AtmospherePass {
     ) {
         let mut pass = frame_pass(encoder, "sky", colour, depth, None, None);
         counting.begin(&mut pass, Part::Whole);
-        let (pipeline, group) = &self.sky[usize::from(self.marched.get())];
+        let (pipeline, group) = &self.sky[usize::from(self.air.marched())];
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, group, &[]);
         counting.draw(&mut pass, 0..3, 0..1);
         counting.end(&mut pass);
     }
 
-    /// Records the aerial-perspective volume for the frame's view. Not yet in the frame: the
-    /// ground, the seeds and the texcells still fade by the fixed haze (docs/atmosphere.md).
+    /// Records the aerial-perspective volume for the frame's view, which the ground, the seeds
+    /// and the texcells are seen through.
     pub fn encode_aerial(&self, encoder: &mut wgpu::CommandEncoder, counting: Counting<'_>) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("aerial perspective"),
@@ -358,10 +404,21 @@ impl AtmospherePass {
         Ok([read(&self.aerial[0])?, read(&self.aerial[1])?])
     }
 
-    /// The three tables as the GPU made them (transmittance, multiple scattering, sky view),
-    /// waiting for it: for tests and tools, never the frame.
-    pub fn read_back(&self, gpu: &Gpu) -> Result<[Vec<[f32; 4]>; 3], GpuError> {
-        Ok([self.transmittance.read_back(gpu)?, self.multiple.read_back(gpu)?, self.sky_view.read_back(gpu)?])
+    /// The four tables as the GPU made them (transmittance, multiple scattering, sky view, sky
+    /// irradiance), waiting for it: for tests and tools, never the frame.
+    pub fn read_back(&self, gpu: &Gpu) -> Result<[Vec<[f32; 4]>; 4], GpuError> {
+        Ok([
+            self.transmittance.read_back(gpu)?,
+            self.multiple.read_back(gpu)?,
+            self.sky_view.read_back(gpu)?,
+            self.irradiance.read_back(gpu)?,
+        ])
+    }
+
+    /// The display's daylight balance as the GPU made it (rgb), waiting for it: for tests.
+    pub fn read_back_daylight(&self, gpu: &Gpu) -> Result<[f32; 4], GpuError> {
+        let bytes = read_buffer(gpu, &self.daylight, size_of::<[f32; 4]>() as u64)?;
+        Ok(bytemuck::pod_read_unaligned(&bytes))
     }
 }
 
@@ -393,20 +450,5 @@ fn sky_pipeline(
         multisample: Default::default(),
         multiview_mask: None,
         cache: None,
-    })
-}
-
-fn aerial_volume(device: &wgpu::Device, label: &str, [w, h, d]: [u32; 3]) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: d },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D3,
-        format: SKY_VIEW_FORMAT,
-        usage: wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
     })
 }

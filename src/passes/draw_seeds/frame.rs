@@ -45,7 +45,7 @@ pub fn has_impostor(dir: &Path, model: &str) -> bool {
     dir.join(model).join(MANIFEST_FILE).is_file()
 }
 
-/// The frame's constants from the settings, the terrain's matrix, sun, clouds and haze, the
+/// The frame's constants from the settings, the terrain's matrix, sun and clouds, the
 /// wind, and `earth`, the mapping pass 3 stood the seeds with (`SeedUniforms::earth`).
 pub fn draw_uniforms(
     settings: &Settings,
@@ -56,7 +56,6 @@ pub fn draw_uniforms(
     DrawSeedsUniforms {
         clip_from_view_world: terrain.clip_from_view_world,
         sun_dir: terrain.sun_dir,
-        haze: terrain.haze,
         draw_reach_m: settings.draw_seeds.reach_m.map(|r| r as f32),
         inv_reference_height_m: (1.0 / settings.seeds.reference_height_m) as f32,
         sink_fraction: settings.seeds.sink_fraction as f32,
@@ -69,7 +68,7 @@ pub fn draw_uniforms(
         seed_up_per_x_m: earth.d_xh,
         seed_up_per_y_m: earth.d_yh,
         // The pass fills it in from its geometry (`DrawSeedsPass::prepare`).
-        photo_scale: [[0.0; 4]; SEED_GROUPS as usize],
+        from_above: [[0.0; 4]; SEED_GROUPS as usize],
         focal_px: focal_px(terrain, settings.render.height),
         continuous_lod: settings.draw_seeds.continuous_lod.into(),
         prefilter_small: settings.draw_seeds.prefilter_small.into(),

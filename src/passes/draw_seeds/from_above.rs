@@ -13,15 +13,17 @@
 //! shading's mean at its height over the seed's turns (the side towards the sun averages out). Its
 //! lighting depends on the frame's sun: the shader turns every normal to face the eye, so from
 //! above a normal is known by its upward component alone, kept as a histogram of `UP_BINS` bins;
-//! the sun's share over the seed's turns then has a closed form. Leaves hiding leaves are not
-//! modelled: every foliage triangle counts as seen.
+//! the sun's share over the seed's turns then has a closed form (`facing`). The CPU hands the
+//! shader the mean albedo and that facing each frame (`yardstick`); the shader scales by the light
+//! that reaches each seed through the air (`photo_scale_at` in `shaders/draw_seeds.wgsl`, whose
+//! twin is `photo_scale`). Leaves hiding leaves are not modelled: every foliage triangle counts as
+//! seen.
 
 use glam::Vec3;
 
 use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
 use crate::gpu::layout::{
-    FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, GROUND_SKY, GROUND_SUN, MATERIAL_BARK, MATERIAL_REPEAT,
-    MATERIAL_TEXTURED,
+    FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, MATERIAL_BARK, MATERIAL_REPEAT, MATERIAL_TEXTURED,
 };
 use crate::impostor::mip_size;
 use crate::texcell::pyramid::decode_srgb;
@@ -44,29 +46,52 @@ pub struct FromAbove {
     up_bins: [(f32, f32); UP_BINS],
 }
 
+/// The light at a seed, per unit of the sun's irradiance above the air (`SunAndSky` in
+/// `shaders/shared/air.wgsl`): the sun's share that reaches it and the sky's on level ground.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeedLight {
+    /// The sun through the air, per channel.
+    pub sun: [f32; 3],
+    /// The sky's light on a level surface, per channel.
+    pub sky: [f32; 3],
+}
+
 impl FromAbove {
-    /// The mean lit colour, per channel, under a sun along `sun` (unit, towards it), clouds aside:
-    /// the shader's foliage lighting averaged over the normals and the seed's turns.
-    pub fn lit(&self, sun: Vec3) -> [f32; 3] {
+    /// max(n · sun, 0) averaged over the foliage's normals and the seed's turns, under a sun
+    /// along `sun` (unit, towards it, +z up).
+    pub fn facing(&self, sun: Vec3) -> f32 {
         let total: f32 = self.up_bins.iter().map(|(w, _)| w).sum();
-        let facing = if total > 0.0 {
-            let bins = self.up_bins.iter().filter(|(w, _)| *w > 0.0);
-            bins.map(|&(w, up)| w * turned_facing(up, sun)).sum::<f32>() / total
-        } else {
-            0.0
-        };
-        let light = FOLIAGE_SUN * facing + FOLIAGE_SUN_WRAP * sun.z.max(0.0) + FOLIAGE_SKY;
-        self.albedo.map(|a| a * light)
+        if total <= 0.0 {
+            return 0.0;
+        }
+        let bins = self.up_bins.iter().filter(|(w, _)| *w > 0.0);
+        bins.map(|&(w, up)| w * turned_facing(up, sun)).sum::<f32>() / total
+    }
+
+    /// What the shader needs of this geometry each frame: its mean albedo (xyz) and `facing`
+    /// (w).
+    pub fn yardstick(&self, sun: Vec3) -> [f32; 4] {
+        let [r, g, b] = self.albedo;
+        [r, g, b, self.facing(sun)]
+    }
+
+    /// The mean lit colour, per channel, under a sun along `sun` in `light`, clouds aside: the
+    /// shader's foliage lighting averaged over the normals and the seed's turns.
+    pub fn lit(&self, sun: Vec3, light: &SeedLight) -> [f32; 3] {
+        let sun_share = FOLIAGE_SUN * self.facing(sun) + FOLIAGE_SUN_WRAP * sun.z.max(0.0);
+        std::array::from_fn(|c| self.albedo[c] * (light.sun[c] * sun_share + light.sky[c] * FOLIAGE_SKY))
     }
 
     /// The factor per channel that turns this geometry's mean lit colour into the lit colour of
-    /// flat ground of albedo 1 (the imagery's colour then multiplies it in the shader); 0 where
-    /// nothing is seen (the shader then keeps the model's colour).
-    pub fn photo_scale(&self, sun: Vec3) -> [f32; 4] {
-        let ground = GROUND_SUN * sun.z.max(0.0) + GROUND_SKY;
-        let lit = self.lit(sun);
-        let scale = lit.map(|l| if l > 1e-4 { ground / l } else { 0.0 });
-        [scale[0], scale[1], scale[2], 0.0]
+    /// level ground of albedo 1 (the imagery's colour then multiplies it in the shader); 0 where
+    /// nothing is seen or nothing lights it (the shader then keeps the model's colour). Twin of
+    /// `photo_scale_at`.
+    pub fn photo_scale(&self, sun: Vec3, light: &SeedLight) -> [f32; 3] {
+        let lit = self.lit(sun, light);
+        if self.albedo[1] <= 0.0 || lit.iter().any(|l| *l <= 1e-6) {
+            return [0.0; 3];
+        }
+        std::array::from_fn(|c| (light.sun[c] * sun.z.max(0.0) + light.sky[c]) / lit[c])
     }
 }
 

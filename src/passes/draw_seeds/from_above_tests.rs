@@ -2,11 +2,9 @@
 
 use glam::Vec3;
 
-use super::{FromAbove, Layers, from_above, turned_facing};
+use super::{FromAbove, Layers, SeedLight, from_above, turned_facing};
 use crate::gpu::gpu_types::{SeedDrawArgs, SeedMaterial, SeedVertex};
-use crate::gpu::layout::{
-    FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, GROUND_SKY, GROUND_SUN, MATERIAL_BARK, MATERIAL_TEXTURED,
-};
+use crate::gpu::layout::{FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, MATERIAL_BARK, MATERIAL_TEXTURED};
 use crate::texcell::pyramid::decode_srgb;
 
 /// A unit square, model space (y up), `up` its normal's upward component (1: lying flat, 0:
@@ -88,17 +86,22 @@ fn flat_foliage_seen_from_above_is_scaled_to_the_ground_s_light() {
     let seen = seen(&[(1.0, 0.0, 0)], &[plain(green, 0)], (&[], 1), 0.0).unwrap();
     assert_eq!(seen.albedo, green);
     let sun = Vec3::new(0.0, 0.6, 0.8);
+    // A reddened sun and a blue sky, as the air gives at a lowish sun.
+    let air = SeedLight { sun: [0.9, 0.8, 0.6], sky: [0.05, 0.08, 0.15] };
+    assert!(close(seen.facing(sun), 0.8, 1e-6));
+    assert_eq!(seen.yardstick(sun), [green[0], green[1], green[2], seen.facing(sun)]);
     // A leaf lying flat faces the sun by its height: lit as foliage is, 0.8 of the sun's share.
-    let light = FOLIAGE_SUN * 0.8 + FOLIAGE_SUN_WRAP * 0.8 + FOLIAGE_SKY;
-    let lit = seen.lit(sun);
+    let lit = seen.lit(sun, &air);
+    let scale = seen.photo_scale(sun, &air);
     for c in 0..3 {
-        assert!(close(lit[c], green[c] * light, 1e-5), "{lit:?}");
+        let foliage = air.sun[c] * (FOLIAGE_SUN * 0.8 + FOLIAGE_SUN_WRAP * 0.8) + air.sky[c] * FOLIAGE_SKY;
+        assert!(close(lit[c], green[c] * foliage, 1e-5), "{lit:?}");
+        let ground = air.sun[c] * 0.8 + air.sky[c];
+        assert!(close(scale[c], ground / (green[c] * foliage), 1e-4), "{scale:?}");
     }
-    let scale = seen.photo_scale(sun);
-    let ground = GROUND_SUN * 0.8 + GROUND_SKY;
-    for c in 0..3 {
-        assert!(close(scale[c], ground / (green[c] * light), 1e-4), "{scale:?}");
-    }
+    // No light (the sun below the horizon, a dark sky): the model keeps its colours.
+    let night = SeedLight { sun: [0.0; 3], sky: [0.0; 3] };
+    assert_eq!(seen.photo_scale(sun, &night), [0.0; 3]);
 }
 
 #[test]

@@ -18,11 +18,11 @@ use crate::gpu::gpu_types::{
     DrawSeedsUniforms, SeedDrawArgs, SeedMaterial, SeedRecord, SeedShape, SeedVertex,
 };
 use crate::gpu::layout::{SEED_GROUPS, SEED_LODS};
-use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
-use crate::gpu::shaders::{CLOUDS, DITHER, HASH, SEED_RECORD, WIND, WgslSource};
-use crate::gpu::struct_layout::GpuLayout;
+use crate::gpu::resources::{buffer, buffer_init, frame_pass, write_rgba8_layer};
+use crate::gpu::shaders::{AIR, ATMOSPHERE, CLOUDS, DITHER, HASH, SEED_RECORD, WIND, WgslSource};
 use crate::impostor::{Impostor, mip_size};
-use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
+use crate::passes::COLOUR_FORMAT;
+use crate::passes::atmosphere::gpu::air::{AIR_GROUP, Air, AirVariants};
 use crate::seeds::wind::bend_of;
 
 use super::assets::{self, MeshDetail};
@@ -30,8 +30,10 @@ use super::frame::detail_templates;
 use super::from_above::{FromAbove, Layers, from_above};
 use super::{DrawSeedsError, LodChoices};
 use multisample::Multisample;
+use pipelines::{DepthTest, Draw, pipeline};
 
 pub mod multisample;
+mod pipelines;
 
 /// Pass 4's shader.
 pub const SHADER: WgslSource = WgslSource {
@@ -43,6 +45,8 @@ pub const SHADER: WgslSource = WgslSource {
         CLOUDS,
         WIND,
         EARTH,
+        ATMOSPHERE,
+        AIR,
         include_str!("../../../shaders/draw_seeds.wgsl"),
         include_str!("../../../shaders/draw_seeds/multisample.wgsl"),
     ],
@@ -86,8 +90,9 @@ pub struct DrawSeedsInputs<'a> {
 /// Pass 4b on the GPU: the species' geometry, materials and texture array uploaded and the pipeline
 /// built once in `new`; each frame `prepare` writes the constants and `encode` records the draws.
 pub struct DrawSeedsPass {
-    draw: Draw,
-    layout: wgpu::BindGroupLayout,
+    draw: AirVariants<Draw>,
+    /// The pass's own bind group layout (group 0) and the air's (`AIR_GROUP`).
+    layouts: [wgpu::BindGroupLayout; 2],
     uniforms: wgpu::Buffer,
     materials: wgpu::Buffer,
     species: wgpu::Buffer,
@@ -107,60 +112,16 @@ pub struct DrawSeedsPass {
     species_drawn: usize,
     species_missing: usize,
     /// What each (species, draw LOD) group's geometry shows from above: the colour follow-up's
-    /// yardstick, turned into `DrawSeedsUniforms::photo_scale` for each frame's sun.
+    /// yardstick, turned into `DrawSeedsUniforms::from_above` for each frame's sun.
     from_above: Vec<Option<FromAbove>>,
     /// With `draw_seeds.samples` > 1: the multisampled targets and their draw.
-    multisample: Option<(Multisample, Draw)>,
-}
-
-/// The pipelines a frame's draws go through: at once, or after a depth prepass.
-enum Draw {
-    /// Each fragment alpha-tested, shaded and its depth written in one draw.
-    Plain(wgpu::RenderPipeline),
-    /// `depth` writes the depth of what the draws keep (colour writes off); `shade` repeats the
-    /// draws with the depth test `Equal` and no depth write, lighting one fragment per sample.
-    Prepassed { depth: wgpu::RenderPipeline, shade: wgpu::RenderPipeline },
-}
-
-impl Draw {
-    /// The draw at 1 sample per pixel or `SEED_SAMPLES` (`multisample`), with or without a prepass.
-    fn new(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, multisample: bool, prepass: bool) -> Self {
-        let colour = [Some(COLOUR_FORMAT.into())];
-        let no_colour =
-            [Some(wgpu::ColorTargetState { write_mask: wgpu::ColorWrites::empty(), ..COLOUR_FORMAT.into() })];
-        let (state, [plain, depth, shade]) = match multisample {
-            false => (Default::default(), ["fs_main", "fs_depth", "fs_main"]),
-            true => (multisample::state(), ["fs_coverage", "fs_depth_coverage", "fs_shade_samples"]),
-        };
-        let written = DepthTest::Written;
-        if !prepass {
-            return Self::Plain(pipeline(device, layout, plain, &colour, state, written));
-        }
-        Self::Prepassed {
-            depth: pipeline(device, layout, depth, &no_colour, state, written),
-            shade: pipeline(device, layout, shade, &colour, state, DepthTest::EqualToWritten),
-        }
-    }
-
-    /// Whether this draw has a depth prepass.
-    fn prepassed(&self) -> bool {
-        matches!(self, Self::Prepassed { .. })
-    }
-}
-
-/// How a pipeline of the pass tests depth (reversed-Z).
-#[derive(Clone, Copy)]
-enum DepthTest {
-    /// Nearer than or as near as what is there, and written.
-    Written,
-    /// Exactly what the prepass wrote, not written again.
-    EqualToWritten,
+    multisample: Option<(Multisample, AirVariants<Draw>)>,
 }
 
 impl DrawSeedsPass {
     /// Uploads the impostors of `species` (by species index; `None`: not drawn), LOD 1 as
     /// `choices` says (continuous LOD, slicings), and builds the pipelines, with a depth prepass
-    /// when `depth_prepass` (`draw_seeds.depth_prepass`).
+    /// when `depth_prepass` (`draw_seeds.depth_prepass`), over the atmosphere's `air` layout.
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -168,6 +129,7 @@ impl DrawSeedsPass {
         species: &[Species],
         choices: LodChoices,
         depth_prepass: bool,
+        air: &wgpu::BindGroupLayout,
     ) -> Result<Self, DrawSeedsError> {
         if !device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE) {
             return Err(DrawSeedsError::NoFirstInstance);
@@ -219,7 +181,8 @@ impl DrawSeedsPass {
             })
         };
         let layout = BINDINGS.layout(device);
-        let draw = Draw::new(device, &layout, false, depth_prepass);
+        let layouts = [layout, air.clone()];
+        let draw = Draw::variants(device, &layouts, (false, depth_prepass));
         let species_drawn = impostors.iter().filter(|i| i.is_some()).count();
         let layers = Layers { levels: &built.layers, size: built.size };
         let from_above = (0..SEED_GROUPS as usize)
@@ -242,7 +205,7 @@ impl DrawSeedsPass {
             .collect();
         Ok(Self {
             draw,
-            layout,
+            layouts,
             uniforms: buffer(
                 device,
                 "draw_seeds uniforms",
@@ -276,7 +239,7 @@ impl DrawSeedsPass {
         colour: &wgpu::Texture,
         depth: &wgpu::Texture,
     ) -> Self {
-        let draw = Draw::new(device, &self.layout, true, self.draw.prepassed());
+        let draw = Draw::variants(device, &self.layouts, (true, self.draw.of(false).prepassed()));
         self.multisample = Some((Multisample::new(device, colour, depth), draw));
         self
     }
@@ -313,7 +276,7 @@ impl DrawSeedsPass {
         use wgpu::BindingResource as R;
         BINDINGS.bind_group(
             device,
-            &self.layout,
+            &self.layouts[0],
             [
                 self.uniforms.as_entire_binding(),
                 inputs.records.as_entire_binding(),
@@ -329,9 +292,13 @@ impl DrawSeedsPass {
 
     /// The ground truth's pipeline over this pass's geometry and bindings: `fs_truth` writes each
     /// fragment's colour and its seed's id (`SEED_ID_FORMAT`).
-    pub fn truth_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        let targets = [Some(COLOUR_FORMAT.into()), Some(SEED_ID_FORMAT.into())];
-        pipeline(device, &self.layout, "fs_truth", &targets, Default::default(), DepthTest::Written)
+    pub fn truth_pipeline(&self, device: &wgpu::Device) -> AirVariants<wgpu::RenderPipeline> {
+        let (device, layouts) = (device.clone(), self.layouts.clone());
+        AirVariants::new(move |marched| {
+            let targets = [Some(COLOUR_FORMAT.into()), Some(SEED_ID_FORMAT.into())];
+            let options = (DepthTest::Written, marched);
+            pipeline(&device, &layouts, ("fs_truth", &targets), Default::default(), options)
+        })
     }
 
     /// Species `species`'s full mesh (its LOD 0 geometry), or `None` when its model has none
@@ -341,17 +308,18 @@ impl DrawSeedsPass {
     }
 
     /// Records the ground truth's draws into `pass` (its pipeline from `truth_pipeline`, the bind
-    /// group over records whose `order` is the identity): per entry, `mesh` once for each record
-    /// in the range.
+    /// group over records whose `order` is the identity, and the air's): per entry, `mesh` once
+    /// for each record in the range.
     pub fn encode_meshes(
         &self,
         pass: &mut wgpu::RenderPass,
         pipeline: &wgpu::RenderPipeline,
-        bind_group: &wgpu::BindGroup,
+        (bind_group, air): (&wgpu::BindGroup, &wgpu::BindGroup),
         draws: &[(SeedDrawArgs, Range<u32>)],
     ) {
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
+        pass.set_bind_group(AIR_GROUP, air, &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         for (mesh, instances) in draws {
@@ -364,19 +332,20 @@ impl DrawSeedsPass {
     pub fn prepare(&self, queue: &crate::gpu::Queue, uniforms: &DrawSeedsUniforms) {
         let mut uniforms = *uniforms;
         let sun = glam::Vec4::from(uniforms.sun_dir).truncate();
-        for (scale, seen) in uniforms.photo_scale.iter_mut().zip(&self.from_above) {
-            *scale = seen.as_ref().map_or([0.0; 4], |seen| seen.photo_scale(sun));
+        for (yardstick, seen) in uniforms.from_above.iter_mut().zip(&self.from_above) {
+            *yardstick = seen.as_ref().map_or([0.0; 4], |seen| seen.yardstick(sun));
         }
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
     }
 
     /// Records each group's draw and cross-fade draw from `draw_args` (compaction's) into the
-    /// targets (multisampled when `multisampled` made it so, resolved into `colour`); `counting`
-    /// counts them, and `count` their samples written and pixels covered.
+    /// targets (multisampled when `multisampled` made it so, resolved into `colour`), lit and
+    /// seen through the air's group; `counting` counts them, and `count` their samples written
+    /// and pixels covered.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        bind_group: &wgpu::BindGroup,
+        bind_group: (&wgpu::BindGroup, &Air),
         draw_args: &wgpu::Buffer,
         (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
         (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
@@ -390,12 +359,12 @@ impl DrawSeedsPass {
         let occlusion = count.map(CountedPass::occlusion_set);
         if let Some((targets, draw)) = &self.multisample {
             targets.encode(encoder, (occlusion, counting), |pass| {
-                self.record(pass, draw, bind_group, draw_args, (count, counting))
+                self.record(pass, draw.get(bind_group.1), bind_group, draw_args, (count, counting))
             });
             return;
         }
         let mut pass = frame_pass(encoder, "draw_seeds", colour, depth, None, occlusion);
-        self.record(&mut pass, &self.draw, bind_group, draw_args, (count, counting));
+        self.record(&mut pass, self.draw.get(bind_group.1), bind_group, draw_args, (count, counting));
     }
 
     /// Every group's indirect draws through `draw`'s pipelines.
@@ -403,11 +372,12 @@ impl DrawSeedsPass {
         &self,
         pass: &mut wgpu::RenderPass,
         draw: &Draw,
-        bind_group: &wgpu::BindGroup,
+        (bind_group, air): (&wgpu::BindGroup, &Air),
         draw_args: &wgpu::Buffer,
         (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
     ) {
         pass.set_bind_group(0, bind_group, &[]);
+        pass.set_bind_group(AIR_GROUP, air.group(), &[]);
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         let draws = |pass: &mut wgpu::RenderPass, pipeline| {
@@ -444,54 +414,5 @@ pub(super) fn near_to_far_draws() -> impl Iterator<Item = usize> {
     (0..lods).flat_map(move |lod| {
         let own = (0..species).map(move |s| s * lods + lod);
         own.clone().chain(own.map(move |g| groups + g))
-    })
-}
-
-fn pipeline(
-    device: &wgpu::Device,
-    layout: &wgpu::BindGroupLayout,
-    fragment: &str,
-    targets: &[Option<wgpu::ColorTargetState>],
-    multisample: wgpu::MultisampleState,
-    depth_test: DepthTest,
-) -> wgpu::RenderPipeline {
-    let (depth_write_enabled, depth_compare) = match depth_test {
-        DepthTest::Written => (true, wgpu::CompareFunction::GreaterEqual),
-        DepthTest::EqualToWritten => (false, wgpu::CompareFunction::Equal),
-    };
-    let module = SHADER.module(device);
-    let pipeline_layout = pipeline_layout(device, "draw_seeds", &[layout]);
-    let attributes = SeedVertex::layout().vertex_attributes();
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("draw_seeds"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: size_of::<SeedVertex>() as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &attributes,
-            })],
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some(fragment),
-            compilation_options: Default::default(),
-            targets,
-        }),
-        // A billboard is seen from both sides, and so are leaves (the glTF's double-sided ones).
-        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(depth_write_enabled),
-            depth_compare: Some(depth_compare),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample,
-        multiview_mask: None,
-        cache: None,
     })
 }

@@ -4,50 +4,76 @@ use crate::config::Settings;
 use crate::earth::gpu::EARTH;
 use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
-use crate::gpu::resources::{depth_equal, frame_pass, pipeline_layout};
-use crate::gpu::shaders::{CLOUDS, HASH, IMAGERY, TERRAIN_MESH, WgslSource};
+use crate::gpu::resources::{depth_equal, frame_pass};
+use crate::gpu::shaders::{AIR, ATMOSPHERE, CLOUDS, HASH, IMAGERY, TERRAIN_MESH, WgslSource};
+use crate::passes::atmosphere::gpu::air::{
+    AIR_GROUP, Air, AirVariants, air_constants, pipeline_layout_with_air,
+};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
 /// The ground pass's shader: the terrain mesh again, shaded (its bindings are the terrain's,
-/// `terrain::gpu::BINDINGS`).
+/// `terrain::gpu::BINDINGS`, and the air's, `atmosphere::gpu::air::AIR_BINDINGS`).
 pub const SHADER: WgslSource = WgslSource {
     name: "ground",
-    parts: &[TERRAIN_MESH, EARTH, IMAGERY, HASH, CLOUDS, include_str!("../../../shaders/ground.wgsl")],
+    parts: &[
+        TERRAIN_MESH,
+        EARTH,
+        IMAGERY,
+        HASH,
+        CLOUDS,
+        ATMOSPHERE,
+        AIR,
+        include_str!("../../../shaders/ground.wgsl"),
+    ],
 };
 
-/// Pass 2 on the GPU: its pipeline (depth-equal, no depth write) and imagery sampler built once in
-/// `new`; `encode` records each frame's clear to the sky and the shaded redraw of the terrain's nodes.
+/// Pass 2 on the GPU: its pipelines (depth-equal, no depth write; in the air's two variants) and
+/// imagery sampler built once in `new`; `encode` records each frame's clear and the shaded redraw
+/// of the terrain's nodes.
 pub struct GroundPass {
-    pipeline: wgpu::RenderPipeline,
+    pipelines: AirVariants<wgpu::RenderPipeline>,
     sampler: wgpu::Sampler,
 }
 
 impl GroundPass {
-    /// `software`: the adapter is a CPU rasteriser (decides automatic anisotropy).
-    pub fn new(device: &wgpu::Device, settings: &Settings, software: bool, terrain: &TerrainPass) -> Self {
+    /// `software`: the adapter is a CPU rasteriser (decides automatic anisotropy); `air`: the
+    /// atmosphere's bind group layout (`AIR_GROUP`).
+    pub fn new(
+        device: &wgpu::Device,
+        settings: &Settings,
+        software: bool,
+        terrain: &TerrainPass,
+        air: &wgpu::BindGroupLayout,
+    ) -> Self {
         let module = SHADER.module(device);
-        let layout = pipeline_layout(device, "ground", &[terrain.bind_group_layout()]);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("ground"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(COLOUR_FORMAT.into())],
-            }),
-            primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
-            depth_stencil: Some(depth_equal(DEPTH_FORMAT)),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
+        let layout = pipeline_layout_with_air(device, "ground", &[terrain.bind_group_layout()], air);
+        let device_ = device.clone();
+        let pipelines = AirVariants::new(move |marched| {
+            let constants = air_constants(marched);
+            let compilation_options =
+                wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+            device_.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("ground"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: compilation_options.clone(),
+                    buffers: &[],
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options,
+                    targets: &[Some(COLOUR_FORMAT.into())],
+                }),
+                primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+                depth_stencil: Some(depth_equal(DEPTH_FORMAT)),
+                multisample: Default::default(),
+                multiview_mask: None,
+                cache: None,
+            })
         });
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("imagery"),
@@ -57,7 +83,7 @@ impl GroundPass {
             anisotropy_clamp: settings.imagery.anisotropy_on(software),
             ..Default::default()
         });
-        Self { pipeline, sampler }
+        Self { pipelines, sampler }
     }
 
     /// The imagery sampler the terrain bind group must hold.
@@ -65,20 +91,19 @@ impl GroundPass {
         &self.sampler
     }
 
-    /// Clears `colour` to the sky and shades the ground the depth pass kept.
+    /// Clears the (colour, depth) targets' colour (the sky pass fills what the ground leaves)
+    /// and shades the ground the depth pass kept, lit and seen through `air`.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         mesh: MeshDraw<'_>,
-        colour: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-        sky_linear: [f64; 3],
+        (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
+        air: &Air,
         counting: Counting<'_>,
     ) {
-        let [r, g, b] = sky_linear;
-        let mut pass =
-            frame_pass(encoder, "ground", colour, depth, Some(wgpu::Color { r, g, b, a: 1.0 }), None);
-        pass.set_pipeline(&self.pipeline);
+        let mut pass = frame_pass(encoder, "ground", colour, depth, Some(wgpu::Color::BLACK), None);
+        pass.set_pipeline(self.pipelines.get(air));
+        pass.set_bind_group(AIR_GROUP, air.group(), &[]);
         counting.begin(&mut pass, Part::Whole);
         mesh.draw(&mut pass, counting);
         counting.end(&mut pass);

@@ -63,14 +63,12 @@ impl NodeBatches {
     }
 }
 
-/// The frame's light: towards the sun (unit, in the camera-relative world: `sun::frame_sun_dir`),
-/// and the colour the distance fades into (linear RGB).
+/// The frame's light: towards the sun (unit, in the camera-relative world: `sun::frame_sun_dir`).
+/// What reaches the ground of it, and of the sky, is the air's (`shared/air.wgsl`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrameLight {
     /// Towards the sun.
     pub sun_dir: DVec3,
-    /// The haze's colour.
-    pub haze_linear: [f64; 3],
 }
 
 /// The terrain passes' uniforms for a camera at `camera_grid_m` (grid space) with `clip` the
@@ -86,10 +84,8 @@ pub fn terrain_uniforms(
     time_s: f64,
     fall_per_m2: f64,
 ) -> TerrainUniforms {
-    let r = &settings.render;
     let manifest = &dataset.manifest;
     let sun = light.sun_dir;
-    let sky_linear = light.haze_linear;
     let half_spacing = 0.5 * manifest.height.spacing_m;
     let clouds =
         CloudShadowFrame::new(&settings.clouds, sun, manifest.height.max_m as f64, camera_grid_m, time_s)
@@ -97,12 +93,6 @@ pub fn terrain_uniforms(
     let mut uniforms = TerrainUniforms {
         clip_from_view_world: clip.to_cols_array_2d(),
         sun_dir: sun.as_vec3().extend(0.0).to_array(),
-        haze: [
-            sky_linear[0] as f32,
-            sky_linear[1] as f32,
-            sky_linear[2] as f32,
-            r.haze_half_distance_m as f32,
-        ],
         camera_grid_m: camera_grid_m.as_vec3().extend(0.0).to_array(),
         height_range_m: [manifest.height.min_m, manifest.height.max_m],
         node_cells: settings.terrain.node_cells,

@@ -13,8 +13,13 @@ use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
 use crate::gpu::fragments::CountedPass;
 use crate::gpu::gpu_types::{TexcellRecord, TexcellUniforms};
-use crate::gpu::resources::{buffer, buffer_init, frame_pass, pipeline_layout, write_rgba8_layer};
-use crate::gpu::shaders::{CLOUDS, DITHER, HASH, IMAGERY, LANDCOVER, TERRAIN_MESH, WgslSource};
+use crate::gpu::resources::{buffer, buffer_init, frame_pass, write_rgba8_layer};
+use crate::gpu::shaders::{
+    AIR, ATMOSPHERE, CLOUDS, DITHER, HASH, IMAGERY, LANDCOVER, TERRAIN_MESH, WgslSource,
+};
+use crate::passes::atmosphere::gpu::air::{
+    AIR_GROUP, Air, AirVariants, air_constants, pipeline_layout_with_air,
+};
 use crate::passes::terrain::gpu::{MeshDraw, TerrainPass};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 use crate::streaming::TileCache;
@@ -36,6 +41,8 @@ pub const SHADER: WgslSource = WgslSource {
         CLOUDS,
         DITHER,
         LANDCOVER,
+        ATMOSPHERE,
+        AIR,
         include_str!("../../../shaders/texcells.wgsl"),
     ],
 };
@@ -75,7 +82,7 @@ pub const BINDINGS: BindingTable<8> = BindingTable {
 
 /// The texcell pass: built once per renderer over the forest samples of its dense classes.
 pub struct TexcellsPass {
-    pipeline: wgpu::RenderPipeline,
+    pipelines: AirVariants<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     records: wgpu::Buffer,
@@ -101,7 +108,7 @@ impl TexcellsPass {
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        terrain: &TerrainPass,
+        (terrain, air): (&TerrainPass, &wgpu::BindGroupLayout),
         node_cells: u32,
         samples: &[ForestSample],
         sample_of_class: &[u32],
@@ -166,9 +173,9 @@ impl TexcellsPass {
         let index_data = quadrant_indices(node_cells / 2);
         let indices = buffer_init(device, "texcell grid", bytemuck::cast_slice(&index_data), U::INDEX);
         let layout = BINDINGS.layout(device);
-        let pipeline = pipeline(device, terrain, &layout);
+        let pipelines = pipelines(device, (terrain, air), &layout);
         Ok(Self {
-            pipeline,
+            pipelines,
             layout,
             uniforms,
             records,
@@ -214,12 +221,13 @@ impl TexcellsPass {
         PreparedTexcells { instances: kept.len() as u32 }
     }
 
-    /// Draws the frame's slices over `colour`, depth-tested against the ground in `depth`;
-    /// `counting` counts them, and `count` their samples written and pixels covered.
+    /// Draws the frame's slices over `colour`, depth-tested against the ground in `depth`, lit
+    /// and seen through `air` (the atmosphere's group); `counting` counts them, and `count` their
+    /// samples written and pixels covered.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        (mesh, bind_group): (MeshDraw<'_>, &wgpu::BindGroup),
+        (mesh, bind_group, air): (MeshDraw<'_>, &wgpu::BindGroup, &Air),
         (colour, depth): (&wgpu::TextureView, &wgpu::TextureView),
         prepared: PreparedTexcells,
         (count, counting): (Option<CountedPass<'_>>, Counting<'_>),
@@ -229,9 +237,10 @@ impl TexcellsPass {
         counting.begin(&mut pass, Part::Shading);
         count.inspect(|c| c.begin(&mut pass));
         if prepared.instances > 0 {
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(self.pipelines.get(air));
             pass.set_bind_group(0, mesh.bind_group, &[]);
             pass.set_bind_group(1, bind_group, &[]);
+            pass.set_bind_group(AIR_GROUP, air.group(), &[]);
             pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
             counting.draw_indexed(&mut pass, 0..self.index_count, 0, 0..prepared.instances);
         }
@@ -279,31 +288,43 @@ fn volume_texture(
 
 /// The blended slice pipeline: premultiplied "over", both faces (a camera inside the canopy sees
 /// slices from below), depth-tested against the ground (reversed-Z), no depth written.
+fn pipelines(
+    device: &wgpu::Device,
+    (terrain, air): (&TerrainPass, &wgpu::BindGroupLayout),
+    own: &wgpu::BindGroupLayout,
+) -> AirVariants<wgpu::RenderPipeline> {
+    let module = SHADER.module(device);
+    let layout = pipeline_layout_with_air(device, "texcells", &[terrain.bind_group_layout(), own], air);
+    let device = device.clone();
+    AirVariants::new(move |marched| pipeline(&device, (&module, &layout), marched))
+}
+
 fn pipeline(
     device: &wgpu::Device,
-    terrain: &TerrainPass,
-    own: &wgpu::BindGroupLayout,
+    (module, layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
+    marched: bool,
 ) -> wgpu::RenderPipeline {
-    let module = SHADER.module(device);
-    let layout = pipeline_layout(device, "texcells", &[terrain.bind_group_layout(), own]);
     let over = wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::One,
         dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
         operation: wgpu::BlendOperation::Add,
     };
+    let constants = air_constants(marched);
+    let compilation_options =
+        wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("texcells"),
-        layout: Some(&layout),
+        layout: Some(layout),
         vertex: wgpu::VertexState {
-            module: &module,
+            module,
             entry_point: Some("vs_texcell"),
-            compilation_options: Default::default(),
+            compilation_options: compilation_options.clone(),
             buffers: &[],
         },
         fragment: Some(wgpu::FragmentState {
-            module: &module,
+            module,
             entry_point: Some("fs_texcell"),
-            compilation_options: Default::default(),
+            compilation_options,
             targets: &[Some(wgpu::ColorTargetState {
                 format: COLOUR_FORMAT,
                 blend: Some(wgpu::BlendState { color: over, alpha: over }),
