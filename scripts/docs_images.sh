@@ -394,9 +394,10 @@ make_earth_orbit() {
     compose --columns 1 --scale 0.75 --gap 4 --out docs/earth_globe_orbit.png "${shots[@]}"
 }
 
-# The air from the atmosphere pass (docs/atmosphere.md): nc from 1,500 m looking west, 3° up, the
-# sun in the west at 40°, 8° and 1°, the ground lit by the sun and the sky through the air and
-# seen through it; the same at 8° without aerial perspective; nc from 10 km looking west 50° down,
+# The air from the atmosphere pass (docs/atmosphere.md): nc from 300 m looking west, level, with
+# the trade's trees, the sun in the west at 40°, 1° and −4° (day, sunset, dusk), the ground and the
+# trees lit by the sun and the sky through the air and seen through it; the same at 40° without
+# aerial perspective; nc from 10 km looking west 50° down,
 # the sun at 20°; zion from 10 km over its southern edge looking north 30° down, the sun in the
 # west-south-west at 40° and at 3°; GLOBE from 400 km over its centre
 # looking 10° down (the sky marched per pixel, the limb). nc on the Earth as make_earth_nc finds
@@ -413,15 +414,18 @@ make_atmosphere() {
     if ! grep -q '^\[earth\]' "$globe/manifest.toml" 2>/dev/null; then
         "$terramp_data" build --dem "$shared/globe/globe_g_30arcsec.tif" --out "$globe" >/dev/null
     fi
-    for elevation in 40 8 1; do
-        sun=$(layer "atmosphere_sun_$elevation" '[render]' 'sun_azimuth_deg = 270.0' "sun_elevation_deg = $elevation.0")
-        "$terramp" render --dataset "$nc" --camera 637500,221750,1500,270,3 --width 640 --height 360 \
+    local trees_at
+    trees_at="impostors = \"$(cd "$impostors" && pwd)\""
+    for elevation in 40 1 -4; do
+        sun=$(layer "atmosphere_sun_$elevation" '[render]' 'sun_azimuth_deg = 270.0' "sun_elevation_deg = $elevation.0" \
+            '[draw_seeds]' "$trees_at")
+        "$terramp" render --dataset "$nc" --camera 637500,221750,300,270,0 --width 640 --height 360 \
             --settings "$sun" --out "$out/atmosphere_nc_$elevation.png" >/dev/null
         shots+=("$out/atmosphere_nc_$elevation.png")
     done
-    sun=$(layer atmosphere_clear '[render]' 'sun_azimuth_deg = 270.0' 'sun_elevation_deg = 8.0' \
-        '[atmosphere]' 'aerial_perspective = false')
-    "$terramp" render --dataset "$nc" --camera 637500,221750,1500,270,3 --width 640 --height 360 \
+    sun=$(layer atmosphere_clear '[render]' 'sun_azimuth_deg = 270.0' 'sun_elevation_deg = 40.0' \
+        '[atmosphere]' 'aerial_perspective = false' '[draw_seeds]' "$trees_at")
+    "$terramp" render --dataset "$nc" --camera 637500,221750,300,270,0 --width 640 --height 360 \
         --settings "$sun" --out "$out/atmosphere_nc_clear.png" >/dev/null
     shots+=("$out/atmosphere_nc_clear.png")
     sun=$(layer atmosphere_high '[render]' 'sun_azimuth_deg = 270.0' 'sun_elevation_deg = 20.0')

@@ -32,6 +32,9 @@ const AIR_OUTLIERS: f64 = 0.005;
 /// ... and the air must change the ground beyond `FAR_M` by at least this mean, levels, for the
 /// check to mean anything.
 const AIR_MIN_CHANGE: f64 = 3.0;
+/// From 100 km, the share of the ground's contrast the frame keeps against the brute force's
+/// transmittance along each pixel's ray, relative, per channel (the bound).
+const CONTRAST_OFF: f64 = 0.05;
 const FAR_M: f32 = 1000.0;
 
 /// Rec. 709 luminance of linear RGB.
@@ -294,4 +297,83 @@ fn the_ground_is_lit_by_the_sun_through_the_air_red_at_dusk_and_dark_at_night() 
     let (high, low) = (sun_light(40.0), sun_light(3.0));
     println!("the sun's light on the ground at 40°: {high}, at 3°: {low}");
     assert!(low.x / low.z > 3.0 * (high.x / high.z), "at 3° {low} is not redder than at 40° {high}");
+}
+
+#[test]
+fn from_100_km_a_relief_keeps_the_contrast_the_brute_force_transmittance_gives_it() {
+    // A 90 km synthetic dataset straight down from 100 km (the air's top): the frame with aerial
+    // perspective against the one without, their neighbouring pixels' differences in linear
+    // light per channel (the in-scattering, smooth across the view, drops out of them): the
+    // least-squares slope of one on the other is the share of the ground's contrast the air lets
+    // through, and the brute-force model's transmittance along each pixel's ray says what it is.
+    let dataset =
+        synth_dataset_with(&SynthParams { size: 300, seed: 7, spacing_m: 300.0, ..Default::default() });
+    let (width, height) = (192, 108);
+    let frame = |aerial: bool| {
+        let mut s = small_settings(width, height);
+        s.seeds.density_scale = 0.0;
+        s.atmosphere.aerial_perspective = aerial;
+        let mut r = renderer(&dataset, s.clone());
+        let camera = over_fraction(&r, [0.5, 0.5], 0.0, 0.0, -90.0);
+        // 100 km above the datum, wherever the ground below is.
+        let camera = terramp::camera::Camera {
+            position_m: DVec3::new(camera.position_m.x, camera.position_m.y, 100_000.0),
+            ..camera
+        };
+        r.render_resolved(&camera).unwrap();
+        (r.read_colour().unwrap(), r.read_depth().unwrap(), camera, s)
+    };
+    let (clear, _, _, _) = frame(false);
+    let (seen, depth, camera, s) = frame(true);
+    let clip = camera.clip_from_view(width, height).unwrap() * camera.view_from_world();
+    let brute = Brute::new(s.atmosphere.air);
+    let camera_km = DVec3::new(0.0, 0.0, s.atmosphere.air.bottom_radius_km + camera.position_m.z / 1000.0);
+    let ground = |x: u32, y: u32| -> Option<DVec3> {
+        let d = depth[(y * width + x) as usize];
+        (d != 0.0).then(|| {
+            let ndc = glam::DVec4::new(
+                (f64::from(x) + 0.5) / f64::from(width) * 2.0 - 1.0,
+                1.0 - (f64::from(y) + 0.5) / f64::from(height) * 2.0,
+                f64::from(d),
+                1.0,
+            );
+            let p = clip.inverse() * ndc;
+            p.truncate() / p.w
+        })
+    };
+    let lin =
+        |image: &image::RgbaImage, x: u32, y: u32, c: usize| f64::from(linear(image.get_pixel(x, y)[c]));
+    // Per channel: Σ dA², Σ dA dB, Σ T dA².
+    let mut sums = [[0.0f64; 3]; 3];
+    let mut pairs = 0;
+    // The central third of the view (rays within ~11° of the nadir).
+    for y in height / 3..2 * height / 3 {
+        for x in width / 3..2 * width / 3 {
+            let (Some(rel_m), Some(_)) = (ground(x, y), ground(x + 1, y)) else { continue };
+            let below_knee = |image: &image::RgbaImage| {
+                (0..3).all(|c| lin(image, x, y, c) < 0.8 && lin(image, x + 1, y, c) < 0.8)
+            };
+            if !below_knee(&clear) || !below_knee(&seen) {
+                continue;
+            }
+            let point_km = camera_km + rel_m / 1000.0;
+            let through = brute.sun_transmittance(point_km, -rel_m.normalize());
+            pairs += 1;
+            for (c, t) in through.iter().enumerate() {
+                let da = lin(&clear, x + 1, y, c) - lin(&clear, x, y, c);
+                let db = lin(&seen, x + 1, y, c) - lin(&seen, x, y, c);
+                sums[c][0] += da * da;
+                sums[c][1] += da * db;
+                sums[c][2] += t * da * da;
+            }
+        }
+    }
+    assert!(pairs > 1000, "{pairs} pixel pairs");
+    for (c, [squares, products, weighted]) in sums.into_iter().enumerate() {
+        let (kept, truth) = (products / squares, weighted / squares);
+        println!(
+            "channel {c}: the frame keeps {kept:.4} of the contrast, the brute force's transmittance {truth:.4}"
+        );
+        assert!((kept / truth - 1.0).abs() < CONTRAST_OFF, "channel {c}: {kept} against {truth}");
+    }
 }

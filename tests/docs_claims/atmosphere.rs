@@ -102,4 +102,9 @@ pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
         quote: "| sky irradiance | {} × {} (`atmosphere.irradiance_lut`)",
         values: &[(Source::Setting { preset: None, key: "atmosphere.irradiance_lut" }, plain)],
     },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "the truth 0.941, 0.867, 0.763 (the test allows {} % a channel)",
+        values: &[(test_const("tests/air.rs", "CONTRAST_OFF"), percent)],
+    },
 ];
