@@ -10,7 +10,9 @@ use terramp::gpu::gpu_types::AtmosphereUniforms;
 use terramp::light::sun_dir;
 use terramp::passes::atmosphere::frame::{SkyView, atmosphere_uniforms};
 use terramp::passes::atmosphere::gpu::AtmospherePass;
+use terramp::photo::colour::luminance;
 use terramp::reference::atmosphere::{Model, Tables, tables};
+use terramp::texcell::pyramid::encode_srgb;
 use terramp_testkit::camera::over_fraction;
 use terramp_testkit::{gpu, renderer, small_settings, synth_dataset};
 
@@ -42,11 +44,6 @@ const AERIAL_SKY_OFF: f32 = 0.02;
 const AERIAL_THROUGH_OFF: f32 = 0.01;
 /// The drawn sky against the twin's, 8-bit levels.
 const SKY_LEVELS: i32 = 2;
-
-/// Rec. 709 luminance of linear RGB.
-fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
-}
 
 fn settings() -> AtmosphereSettings {
     Settings::default().atmosphere
@@ -163,13 +160,6 @@ fn the_gpu_makes_the_twins_tables() {
     assert!(sky_view.texels.iter().all(|t| t[2] > 0.0), "a sky-view texel holds no light");
 }
 
-/// Linear to 8-bit sRGB, as the colour target stores.
-fn srgb8(linear: f32) -> u8 {
-    let v = linear.clamp(0.0, 1.0);
-    let encoded = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
-    (encoded * 255.0).round() as u8
-}
-
 #[test]
 fn the_frame_draws_the_twins_sky_where_nothing_else_is() {
     let dataset = synth_dataset(300, 7);
@@ -207,7 +197,7 @@ fn the_frame_draws_the_twins_sky_where_nothing_else_is() {
         let dir = (near.truncate() / near.w).normalize().as_vec3();
         let expected = twin.sky_colour(&sky_view, dir, daylight);
         for c in 0..3 {
-            worst = worst.max((i32::from(pixel[c]) - i32::from(srgb8(expected[c]))).abs());
+            worst = worst.max((i32::from(pixel[c]) - i32::from(encode_srgb(expected[c]))).abs());
         }
     }
     // Half the frame looks above the horizon; the sky's rounding to 8 bits and the adapter's

@@ -25,7 +25,7 @@ pub struct Lut {
 }
 
 impl Lut {
-    pub(crate) fn made(size: [u32; 2], texel: impl Fn([u32; 2]) -> Vec3) -> Self {
+    fn made(size: [u32; 2], texel: impl Fn([u32; 2]) -> Vec3) -> Self {
         let texels = (0..size[1])
             .flat_map(|y| (0..size[0]).map(move |x| [x, y]))
             .map(|xy| texel(xy).extend(1.0).to_array())
@@ -81,11 +81,11 @@ impl<'a> Model<'a> {
         Self { u }
     }
 
-    pub(crate) fn bottom(&self) -> f32 {
+    fn bottom(&self) -> f32 {
         self.u.radii[0]
     }
 
-    pub(crate) fn top(&self) -> f32 {
+    fn top(&self) -> f32 {
         self.u.radii[1]
     }
 
@@ -147,8 +147,15 @@ impl<'a> Model<'a> {
         (r, mu)
     }
 
-    pub(crate) fn multiple_unit(&self, r: f32, mu_sun: f32) -> Vec2 {
+    fn multiple_unit(&self, r: f32, mu_sun: f32) -> Vec2 {
         Vec2::new(0.5 * mu_sun + 0.5, (r - self.bottom()) / (self.top() - self.bottom()))
+    }
+
+    /// `multiple_r_mu_sun`: (r, μ_sun) of a texel of a table in the multiple-scattering table's
+    /// parametrisation.
+    fn multiple_r_mu_sun(&self, texel: [u32; 2], size: [u32; 2]) -> (f32, f32) {
+        let unit = lut_unit(texel, size);
+        (self.bottom() + unit.y * (self.top() - self.bottom()), 2.0 * unit.x - 1.0)
     }
 
     fn horizon_zenith(&self, r: f32) -> f32 {
@@ -184,6 +191,15 @@ fn ray_segment(k: u32, steps: u32, length: f32) -> (f32, f32) {
     let b = (k + 1) as f32 / n;
     let m = (k as f32 + 0.5) / n;
     (length * m * m, length * (b * b - a * a))
+}
+
+/// `grid_direction`: direction `i` of a `side` × `side` grid even in azimuth and in the zenith
+/// cosine, which runs from `mu_from` to `mu_to`, cell centres.
+fn grid_direction(i: u32, side: u32, mu_from: f32, mu_to: f32) -> Vec3 {
+    let azimuth = 2.0 * PI * ((i % side) as f32 + 0.5) / side as f32;
+    let mu = mu_from + (mu_to - mu_from) * ((i / side) as f32 + 0.5) / side as f32;
+    let sin_theta = (1.0 - mu * mu).max(0.0).sqrt();
+    Vec3::new(sin_theta * azimuth.cos(), sin_theta * azimuth.sin(), mu)
 }
 
 fn lut_unit(texel: [u32; 2], size: [u32; 2]) -> Vec2 {
@@ -348,18 +364,14 @@ impl Tables<'_> {
         let m = &self.model;
         let size = m.u.multiple_size;
         Lut::made(size, |texel| {
-            let unit = lut_unit(texel, size);
-            let mu_sun = 2.0 * unit.x - 1.0;
-            let r = m.bottom() + unit.y * (m.top() - m.bottom());
+            let (r, mu_sun) = m.multiple_r_mu_sun(texel, size);
             let sun = Vec3::new((1.0 - mu_sun * mu_sun).max(0.0).sqrt(), 0.0, mu_sun);
             let (mut second, mut scattered) = (Vec3::ZERO, Vec3::ZERO);
             let side = MULTIPLE_DIRECTIONS_SIDE;
             for i in 0..side * side {
-                let azimuth = 2.0 * PI * ((i % side) as f32 + 0.5) / side as f32;
-                let mu = 1.0 - 2.0 * ((i / side) as f32 + 0.5) / side as f32;
-                let sin_theta = (1.0 - mu * mu).max(0.0).sqrt();
-                let dir = Vec3::new(sin_theta * azimuth.cos(), sin_theta * azimuth.sin(), mu);
-                let (radiance, share) = self.second_order(r, mu, mu_sun, dir.dot(sun));
+                // Uniform over the sphere.
+                let dir = grid_direction(i, side, 1.0, -1.0);
+                let (radiance, share) = self.second_order(r, dir.z, mu_sun, dir.dot(sun));
                 second += radiance;
                 scattered += share;
             }

@@ -48,12 +48,20 @@ impl GroundPass {
     ) -> Self {
         let module = SHADER.module(device);
         let layout = pipeline_layout_with_air(device, "ground", &[terrain.bind_group_layout()], air);
-        let device_ = device.clone();
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("imagery"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            anisotropy_clamp: settings.imagery.anisotropy_on(software),
+            ..Default::default()
+        });
+        let device = device.clone();
         let pipelines = AirVariants::new(move |marched| {
             let constants = air_constants(marched);
             let compilation_options =
                 wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-            device_.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("ground"),
                 layout: Some(&layout),
                 vertex: wgpu::VertexState {
@@ -74,14 +82,6 @@ impl GroundPass {
                 multiview_mask: None,
                 cache: None,
             })
-        });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("imagery"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            anisotropy_clamp: settings.imagery.anisotropy_on(software),
-            ..Default::default()
         });
         Self { pipelines, sampler }
     }

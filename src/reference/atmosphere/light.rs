@@ -8,7 +8,7 @@
 
 use glam::{Vec2, Vec3, Vec4Swizzles};
 
-use super::{Lut, Tables, Volume, aerial_distance, lut_unit, mix, ray_segment};
+use super::{Lut, Tables, Volume, aerial_distance, grid_direction, mix, ray_segment};
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::{
     DAYLIGHT_SUN_COS, DISPLAY_KNEE, IRRADIANCE_DIRECTIONS_SIDE, PI, SKY_MARCHED_ABOVE_KM, SKY_VIEW_STEPS,
@@ -32,17 +32,12 @@ impl Tables<'_> {
         let m = &self.model;
         let side = IRRADIANCE_DIRECTIONS_SIDE;
         Lut::made(size, |texel| {
-            let unit = lut_unit(texel, size);
-            let mu_sun = 2.0 * unit.x - 1.0;
-            let r = m.bottom() + unit.y * (m.top() - m.bottom());
+            let (r, mu_sun) = m.multiple_r_mu_sun(texel, size);
             let sun = Vec3::new((1.0 - mu_sun * mu_sun).max(0.0).sqrt(), 0.0, mu_sun);
             let mut gathered = Vec3::ZERO;
             for i in 0..side * side {
-                let azimuth = 2.0 * PI * ((i % side) as f32 + 0.5) / side as f32;
-                let mu = ((i / side) as f32 + 0.5) / side as f32;
-                let sin_theta = (1.0 - mu * mu).max(0.0).sqrt();
-                let dir = Vec3::new(sin_theta * azimuth.cos(), sin_theta * azimuth.sin(), mu);
-                gathered += self.in_scattered(r, mu, mu_sun, dir.dot(sun)) * mu;
+                let dir = grid_direction(i, side, 0.0, 1.0);
+                gathered += self.in_scattered(r, dir.z, mu_sun, dir.dot(sun)) * dir.z;
             }
             gathered * 2.0 * PI / (side * side) as f32
         })
