@@ -50,6 +50,7 @@ docs/earth_globe_12km.png                 earth              shared   short
 docs/earth_nc_descent.png                 earth_nc           shared   short
 docs/earth_globe_orbit.png                earth_orbit        shared   short
 docs/atmosphere_sky.png                   atmosphere         shared   short
+docs/display_curves.png                   display            shared   short
 docs/flight_0.png                         streaming          -        long
 docs/flight_1.png                         streaming          -        long
 docs/flight_2.png                         streaming          -        long
@@ -395,7 +396,7 @@ make_earth_orbit() {
 }
 
 # The air from the atmosphere pass (docs/atmosphere.md): nc from 300 m looking west, level, with
-# the trade's trees, the sun in the west at 40°, 1° and −4° (day, sunset, dusk), the ground and the
+# the trade's trees, the sun in the west at 40°, 1° and −4° (day, sunset, dusk; EV100 15, 12, 8), the ground and the
 # trees lit by the sun and the sky through the air and seen through it; the same at 40° without
 # aerial perspective; nc from 10 km looking west 50° down,
 # the sun at 20°; zion from 10 km over its southern edge looking north 30° down, the sun in the
@@ -403,7 +404,7 @@ make_earth_orbit() {
 # looking 10° down (the sky marched per pixel, the limb). nc on the Earth as make_earth_nc finds
 # it; GLOBE as make_earth builds it.
 make_atmosphere() {
-    local nc="$data/nc" globe="$data/globe" shots=() elevation sun
+    local nc="$data/nc" globe="$data/globe" shots=() elevation sun shot
     trade_data
     if ! grep -q '^\[earth\]' "$nc/manifest.toml"; then
         nc="$data/nc_earth"
@@ -416,9 +417,11 @@ make_atmosphere() {
     fi
     local trees_at
     trees_at="impostors = \"$(cd "$impostors" && pwd)\""
-    for elevation in 40 1 -4; do
+    # Each exposed as a photographer would: EV100 15 by day, 12 at sunset, 8 at dusk.
+    for shot in 40:15 1:12 -4:8; do
+        elevation=${shot%:*}
         sun=$(layer "atmosphere_sun_$elevation" '[render]' 'sun_azimuth_deg = 270.0' "sun_elevation_deg = $elevation.0" \
-            '[draw_seeds]' "$trees_at")
+            '[draw_seeds]' "$trees_at" '[display]' "ev100 = ${shot#*:}.0")
         "$terramp" render --dataset "$nc" --camera 637500,221750,300,270,0 --width 640 --height 360 \
             --settings "$sun" --out "$out/atmosphere_nc_$elevation.png" >/dev/null
         shots+=("$out/atmosphere_nc_$elevation.png")
@@ -443,6 +446,22 @@ make_atmosphere() {
         --settings "$sun" --out "$out/atmosphere_globe_400km.png" >/dev/null
     shots+=("$out/atmosphere_globe_400km.png")
     compose --columns 2 --scale 0.75 --gap 4 --out docs/atmosphere_sky.png "${shots[@]}"
+}
+
+# The display's tone curves (docs/atmosphere.md): nc from 300 m looking west with the trade's
+# trees, the sun in the west at 40°, at EV100 15 through AgX, ACES and the linear display.
+make_display() {
+    local shots=() curve settings trees_at
+    trade_data
+    trees_at="impostors = \"$(cd "$impostors" && pwd)\""
+    for curve in agx aces linear; do
+        settings=$(layer "display_$curve" '[render]' 'sun_azimuth_deg = 270.0' 'sun_elevation_deg = 40.0' \
+            '[draw_seeds]' "$trees_at" '[display]' "tone_curve = \"$curve\"")
+        "$terramp" render --dataset "$data/nc" --camera 637500,221750,300,270,0 --width 640 --height 360 \
+            --settings "$settings" --out "$out/display_$curve.png" >/dev/null
+        shots+=("$out/display_$curve.png")
+    done
+    compose --columns 3 --scale 0.5 --gap 4 --out docs/display_curves.png "${shots[@]}"
 }
 
 make_trees_health() {

@@ -14,12 +14,12 @@
 // - `irradiance_lut`: per (altitude, sun's zenith cosine), the sky's light on a level surface,
 //   gathered from the upper hemisphere (made when the atmosphere changes), which lights the
 //   ground and the plants beside the sun (`shared/air.wgsl`); `daylight_balance` from it and
-//   the transmittance, once: the display's balance for daylight (`display`).
+//   the transmittance, once: the frame's balance for daylight (`balanced`).
 // - `vs_sky` with `fs_sky` or `fs_sky_marched`: where the depth is still the far plane
 //   (reversed-Z 0), the sky from the sky-view table (or marched per pixel from high up), and the
 //   sun's disk through the air.
-// Radiances are per unit of the sun's irradiance above the air; the display shows them balanced
-// for daylight (`display`), as the ground and the plants are.
+// Radiances are per unit of the sun's irradiance above the air; the frame holds them balanced
+// for daylight (`balanced`), as the ground and the plants are.
 
 // Storage, not uniform: see `AtmospherePass::new`.
 @group(0) @binding(0) var<storage, read> atmosphere: AtmosphereUniforms;
@@ -225,9 +225,9 @@ fn irradiance_lut(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(irradiance_out, id.xy, vec4<f32>(gathered * 2.0 * PI / n, 1.0));
 }
 
-// The display's balance for daylight: per channel, 1 over the light on level ground at sea level
+// The frame's balance for daylight: per channel, 1 over the light on level ground at sea level
 // with the sun `DAYLIGHT_SUN_COS` from the zenith, sun and sky (a camera set to daylight: white
-// ground under that sun shows white, redder light at dusk shows red).
+// ground under that sun is grey, 1, redder light at dusk is red; `display.wgsl` exposes it).
 @compute @workgroup_size(1)
 fn daylight_balance() {
     let r = bottom_km();
@@ -316,7 +316,7 @@ fn fs_sky(in: SkyOut) -> @location(0) vec4<f32> {
     let unit = sky_view_unit(atmosphere.radii.z, acos(mu), azimuth);
     let uv = (clamp(unit, vec2<f32>(0.0), vec2<f32>(1.0)) * (size - 1.0) + 0.5) / size;
     let radiance = textureSampleLevel(sky_view, sky_sampler, uv, 0.0).rgb + sun_disk(dir, atmosphere.up.w, mu);
-    return vec4<f32>(display(radiance * PI), 1.0);
+    return vec4<f32>(balanced(radiance * PI), 1.0);
 }
 
 // The sky marched per pixel, for views above `SKY_MARCHED_ABOVE_KM`, where the table's rows about
@@ -331,5 +331,5 @@ fn fs_sky_marched(in: SkyOut) -> @location(0) vec4<f32> {
     let r_view = atmosphere.up.w;
     let mu = clamp(dot(dir, up), -1.0, 1.0);
     let radiance = marched_sky(r_view, mu, clamp(dot(sun, up), -1.0, 1.0), dot(dir, sun)) + sun_disk(dir, r_view, mu);
-    return vec4<f32>(display(radiance * PI), 1.0);
+    return vec4<f32>(balanced(radiance * PI), 1.0);
 }

@@ -16,6 +16,7 @@ use crate::gpu::AdapterChoice;
 
 mod atmosphere;
 mod clouds;
+mod display;
 mod draw_seeds;
 mod faults;
 pub mod knobs;
@@ -26,6 +27,7 @@ mod wind;
 
 pub use atmosphere::AtmosphereSettings;
 pub use clouds::CloudSettings;
+pub use display::{DisplaySettings, EV100_RANGE, ToneCurve};
 pub use draw_seeds::DrawSeedsSettings;
 pub use faults::FaultSettings;
 pub use seeds::{OcclusionTolerance, SeedSettings};
@@ -137,6 +139,8 @@ pub struct Settings {
     pub clouds: CloudSettings,
     /// `[atmosphere]`: the air the sky is drawn from.
     pub atmosphere: AtmosphereSettings,
+    /// `[display]`: the exposure and the tone curve the frame is shown through.
+    pub display: DisplaySettings,
     /// `[faults]`: faults injected into tile streaming (tests and soak runs; none by default).
     pub faults: FaultSettings,
 }
@@ -389,6 +393,7 @@ impl Settings {
         self.wind.validate()?;
         self.clouds.validate()?;
         self.atmosphere.validate()?;
+        self.display.validate()?;
         self.faults.validate()?;
         first_out_of_range(checks)
     }

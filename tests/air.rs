@@ -12,10 +12,13 @@ use terramp::light::sun_dir;
 use terramp::passes::atmosphere::frame::{SkyView, atmosphere_uniforms};
 use terramp::passes::atmosphere::gpu::AtmospherePass;
 use terramp::photo::colour::luminance;
-use terramp::reference::atmosphere::light::{through_air, undisplayed};
+use terramp::reference::atmosphere::light::through_air;
 use terramp::reference::atmosphere::{Model, Tables, tables};
 use terramp::synth::SynthParams;
 use terramp::texcell::pyramid::{decode_srgb, encode_srgb};
+
+/// A frame's light (`Renderer::read_light`), pixel by pixel.
+type Light = Vec<[f32; 3]>;
 use terramp_testkit::camera::over_fraction;
 use terramp_testkit::{gpu, renderer, small_settings, synth_dataset_with};
 
@@ -25,8 +28,8 @@ const TABLE_OFF: f32 = 1e-3;
 /// relative, per channel (the table gathers the tables' sky from 64 directions; the truth
 /// integrates its own sky over 256).
 const IRRADIANCE_OFF: f64 = 0.08;
-/// A frame through the air against the twin's air over the same frame without it, 8-bit
-/// levels: most pixels within `AIR_LEVELS`...
+/// A frame's light through the air against the twin's air over the same frame's light without
+/// it, in levels of 8-bit sRGB: most pixels within `AIR_LEVELS`...
 const AIR_LEVELS: i32 = 2;
 /// ... all but this share of them (pixels where a silhouette's depth and colour come from
 /// different surfaces, whose air the per-pixel depth cannot tell)...
@@ -129,9 +132,9 @@ struct AirCheck {
     far: (u32, f64),
 }
 
-/// The frame of a 9 km synthetic dataset (with nc's trees) from `pose` (fraction across, along,
-/// metres above the ground, yaw, pitch) without aerial perspective, undone through the tone curve
-/// and taken through the twin's air at each pixel's depth, against the frame with it.
+/// The light of a frame of a 9 km synthetic dataset (with nc's trees) from `pose` (fraction
+/// across, along, metres above the ground, yaw, pitch) without aerial perspective, taken through
+/// the twin's air at each pixel's depth, against the frame's with it.
 fn check_air(pose: ([f64; 2], f64, f64, f64)) -> AirCheck {
     let impostors = terramp_testkit::nc_impostors().unwrap();
     let dataset =
@@ -149,7 +152,7 @@ fn check_air(pose: ([f64; 2], f64, f64, f64)) -> AirCheck {
         let (at, above_m, yaw_deg, pitch_deg) = pose;
         let camera = over_fraction(&r, at, above_m, yaw_deg, pitch_deg);
         r.render_resolved(&camera).unwrap();
-        (r.read_colour().unwrap(), r.read_depth().unwrap(), camera, s)
+        (r.read_light().unwrap(), r.read_depth().unwrap(), camera, s)
     };
     let (bare, ..) = frame(false, false);
     let (clear, _, _, _) = frame(false, true);
@@ -167,11 +170,13 @@ fn check_air(pose: ([f64; 2], f64, f64, f64)) -> AirCheck {
     let daylight = twin.daylight_balance(&twin.irradiance_lut(s.atmosphere.irradiance_lut));
     let volume = twin.aerial_volume();
     let mut check = AirCheck { parts: [(0, 0, 0); 2], far: (0, 0.0) };
-    for (x, y, shown) in hazed.enumerate_pixels() {
-        let d = depth[(y * width + x) as usize];
+    let code = |light: [f32; 3]| light.map(encode_srgb);
+    for (i, (&seen, &lit)) in hazed.iter().zip(&clear).enumerate() {
+        let d = depth[i];
         if d == 0.0 {
             continue;
         }
+        let (x, y) = (i as u32 % width, i as u32 / width);
         let ndc = glam::DVec4::new(
             (f64::from(x) + 0.5) / f64::from(width) * 2.0 - 1.0,
             1.0 - (f64::from(y) + 0.5) / f64::from(height) * 2.0,
@@ -180,14 +185,12 @@ fn check_air(pose: ([f64; 2], f64, f64, f64)) -> AirCheck {
         );
         let point = clip.inverse() * ndc;
         let rel_m = (point.truncate() / point.w).as_vec3();
-        let lit = clear.get_pixel(x, y);
-        let lit_pi = undisplayed(Vec3::new(decode_srgb(lit[0]), decode_srgb(lit[1]), decode_srgb(lit[2])))
-            / (daylight * u.exposure);
-        let expected = through_air(&twin, &volume, daylight, lit_pi, rel_m);
-        let seed = bare.get_pixel(x, y) != lit;
+        let lit_pi = Vec3::from_array(lit) / daylight;
+        let expected = code(through_air(&twin, &volume, daylight, lit_pi, rel_m).to_array());
+        let (shown, lit) = (code(seen), code(lit));
+        let seed = code(bare[i]) != lit;
         let part = &mut check.parts[usize::from(seed)];
-        let off =
-            (0..3).map(|c| (i32::from(shown[c]) - i32::from(encode_srgb(expected[c]))).abs()).max().unwrap();
+        let off = (0..3).map(|c| (i32::from(shown[c]) - i32::from(expected[c])).abs()).max().unwrap();
         part.0 += 1;
         part.1 += u32::from(off > AIR_LEVELS);
         part.2 = part.2.max(off);
@@ -257,14 +260,13 @@ fn the_ground_is_lit_by_the_sun_through_the_air_red_at_dusk_and_dark_at_night() 
         let mut r = renderer(&dataset, s);
         let camera = over_fraction(&r, [0.5, 0.5], 400.0, 0.0, -60.0);
         r.render_resolved(&camera).unwrap();
-        let (colour, depth) = (r.read_colour().unwrap(), r.read_depth().unwrap());
-        let ground: Vec<_> =
-            colour.pixels().zip(&depth).filter(|(_, d)| **d != 0.0).map(|(p, _)| p).collect();
+        let (light, depth) = (r.read_light().unwrap(), r.read_depth().unwrap());
+        let ground: Vec<_> = light.iter().zip(&depth).filter(|(_, d)| **d != 0.0).map(|(p, _)| p).collect();
         assert!(ground.len() > 96 * 64 / 2, "{} ground pixels", ground.len());
         let mut sum = [0.0f64; 3];
         for p in &ground {
             for c in 0..3 {
-                sum[c] += f64::from(decode_srgb(p[c]));
+                sum[c] += f64::from(p[c]);
             }
         }
         sum.map(|v| v / ground.len() as f64)
@@ -308,7 +310,7 @@ fn from_100_km_a_relief_keeps_the_contrast_the_brute_force_transmittance_gives_i
             ..camera
         };
         r.render_resolved(&camera).unwrap();
-        (r.read_colour().unwrap(), r.read_depth().unwrap(), camera, s)
+        (r.read_light().unwrap(), r.read_depth().unwrap(), camera, s)
     };
     let (clear, _, _, _) = frame(false);
     let (seen, depth, camera, s) = frame(true);
@@ -328,8 +330,7 @@ fn from_100_km_a_relief_keeps_the_contrast_the_brute_force_transmittance_gives_i
             p.truncate() / p.w
         })
     };
-    let lin =
-        |image: &image::RgbaImage, x: u32, y: u32, c: usize| f64::from(decode_srgb(image.get_pixel(x, y)[c]));
+    let lin = |light: &Light, x: u32, y: u32, c: usize| f64::from(light[(y * width + x) as usize][c]);
     // Per channel: Σ dA², Σ dA dB, Σ T dA².
     let mut sums = [[0.0f64; 3]; 3];
     let mut pairs = 0;
@@ -337,12 +338,6 @@ fn from_100_km_a_relief_keeps_the_contrast_the_brute_force_transmittance_gives_i
     for y in height / 3..2 * height / 3 {
         for x in width / 3..2 * width / 3 {
             let (Some(rel_m), Some(_)) = (ground(x, y), ground(x + 1, y)) else { continue };
-            let below_knee = |image: &image::RgbaImage| {
-                (0..3).all(|c| lin(image, x, y, c) < 0.8 && lin(image, x + 1, y, c) < 0.8)
-            };
-            if !below_knee(&clear) || !below_knee(&seen) {
-                continue;
-            }
             let point_km = camera_km + rel_m / 1000.0;
             let through = brute.sun_transmittance(point_km, -rel_m.normalize());
             pairs += 1;

@@ -12,6 +12,7 @@ use terramp::passes::atmosphere::frame::{SkyView, atmosphere_uniforms};
 use terramp::passes::atmosphere::gpu::AtmospherePass;
 use terramp::photo::colour::luminance;
 use terramp::reference::atmosphere::{Model, Tables, tables};
+use terramp::reference::display::shown;
 use terramp::texcell::pyramid::encode_srgb;
 use terramp_testkit::camera::over_fraction;
 use terramp_testkit::{gpu, renderer, small_settings, synth_dataset};
@@ -181,6 +182,7 @@ fn the_frame_draws_the_twins_sky_where_nothing_else_is() {
     let (transmittance, multiple, sky_view) = tables(&u);
     let twin = Tables { model: Model::new(&u), transmittance: &transmittance, multiple: Some(&multiple) };
     let daylight = twin.daylight_balance(&twin.irradiance_lut(settings.atmosphere.irradiance_lut));
+    let display = terramp::passes::display::uniforms(&settings.display);
     let (mut sky_pixels, mut worst) = (0, 0i32);
     for (x, y, pixel) in colour.enumerate_pixels() {
         if depth[(y * width + x) as usize] != 0.0 {
@@ -195,12 +197,14 @@ fn the_frame_draws_the_twins_sky_where_nothing_else_is() {
         );
         let near = sky.view_world_from_clip * ndc;
         let dir = (near.truncate() / near.w).normalize().as_vec3();
-        let expected = twin.sky_colour(&sky_view, dir, daylight);
+        let expected =
+            shown(&display, settings.display.tone_curve, daylight, twin.sky_colour(&sky_view, dir, daylight));
         for c in 0..3 {
             worst = worst.max((i32::from(pixel[c]) - i32::from(encode_srgb(expected[c]))).abs());
         }
     }
-    // Half the frame looks above the horizon; the sky's rounding to 8 bits and the adapter's
+    // Half the frame looks above the horizon, the sky drawn and displayed (exposed, through the
+    // tone curve) as the twins do it; its rounding to f16 and 8 bits and the adapter's
     // transcendentals: 2 levels.
     assert!(sky_pixels > (width * height / 4) as usize, "{sky_pixels} sky pixels");
     assert!(worst <= SKY_LEVELS, "the drawn sky is off the twin's by {worst} levels");

@@ -23,6 +23,9 @@ fn dataset(imagery_format: ImageryFormat) -> std::path::PathBuf {
 fn views(dir: &std::path::Path, decode: bool) -> (Vec<image::RgbaImage>, wgpu::TextureFormat, usize, Gpu) {
     let mut settings = ground_settings(320, 180);
     settings.imagery.blocks = if decode { ImageryBlocks::Decode } else { ImageryBlocks::Sample };
+    // Shown as the passes wrote it: a level of a texel is a level of the frame, where a tone
+    // curve steeper than 1 would widen the sampler's rounding.
+    settings.display.tone_curve = terramp::config::ToneCurve::Linear;
     let mut r = renderer(dir, settings);
     let images = [([0.4, 0.4], 120.0, -20.0), ([0.5, 0.1], 2500.0, -40.0)]
         .map(|(at, above_m, pitch)| {

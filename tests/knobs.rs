@@ -69,7 +69,7 @@ fn turned(knob: &Knob) -> f64 {
         "cloud cover" => 0.5,
         "sun elevation" => 12.0,
         "sun azimuth" => 200.0,
-        "exposure" => 0.7,
+        "exposure" => 13.0,
         "seed occlusion tolerance" => 100.0,
         "seed occlusion tolerance per km" => 100.0,
         "TLM occlusion tolerance" => 0.0,

@@ -2,7 +2,7 @@
 // light that reaches a point (`light_at`: the sun through the air, none where the Earth hides
 // it, and the sky's light on a level surface there, from the atmosphere pass's tables) and the
 // air between it and the camera (`through_air`: the aerial-perspective volume's in-scattering
-// and transmittance at the fragment's tile and distance), then the display (`display`). The
+// and transmittance at the fragment's tile and distance), balanced for daylight (`balanced`). The
 // atmosphere pass makes every table this reads; its bind group is `passes::atmosphere::gpu::air`.
 // Twin: `reference::atmosphere::light`.
 
@@ -99,12 +99,12 @@ fn air_marched(rel_m: vec3<f32>) -> AirBetween {
     return AirBetween(light, seen);
 }
 
-// A point's light on the display: `lit_pi` (its radiance times π: albedo times the light that
+// A point's light as the frame holds it: `lit_pi` (its radiance times π: albedo times the light that
 // falls on it) at `rel_m` from the camera, through the air between, unless aerial perspective
 // is off.
 fn through_air(lit_pi: vec3<f32>, rel_m: vec3<f32>) -> vec3<f32> {
     if atmosphere.aerial_on == 0u {
-        return display(lit_pi);
+        return balanced(lit_pi);
     }
     var air: AirBetween;
     if AIR_MARCHED {
@@ -112,7 +112,7 @@ fn through_air(lit_pi: vec3<f32>, rel_m: vec3<f32>) -> vec3<f32> {
     } else {
         air = air_between(rel_m);
     }
-    return display(lit_pi * air.transmittance + PI * air.in_scattered);
+    return balanced(lit_pi * air.transmittance + PI * air.in_scattered);
 }
 
 // The light on level ground (its zenith `light.up`) of the sun along `sun` through clouds that

@@ -19,8 +19,8 @@ struct AtmosphereUniforms {
     aerial_size: vec2<u32>,
     aerial_far_km: f32,
     aerial_slices: u32,
-    exposure: f32,
     aerial_on: u32,
+    _pad: u32,
 }
 
 struct Medium {
@@ -133,15 +133,12 @@ fn sky_source(s: RayStep, rayleigh: f32, mie: f32) -> vec3<f32> {
         + multiple_scattering(s.r, s.mu_sun) * scattering;
 }
 
-// A radiance times π (what a white Lambertian surface sends under that irradiance) as the
-// display shows it: balanced for daylight by the includer's `daylight` (`daylight_balance`),
-// exposed, then through the tone curve: the identity up to `DISPLAY_KNEE`, then a shoulder
-// towards 1 of the same slope. The targets are sRGB: the hardware encodes on store.
-fn display(radiance_pi: vec3<f32>) -> vec3<f32> {
-    let x = max(radiance_pi * daylight.xyz * atmosphere.exposure, vec3<f32>(0.0));
-    let span = 1.0 - DISPLAY_KNEE;
-    let over = max(x - DISPLAY_KNEE, vec3<f32>(0.0));
-    return min(x, vec3<f32>(DISPLAY_KNEE)) + span * (1.0 - exp(-over / span));
+// A radiance times π (what a white Lambertian surface sends under that irradiance) as the frame
+// holds it: balanced for daylight by the includer's `daylight` (`daylight_balance`), so white
+// ground in daylight is 1, and kept within the colour target's f16. The display pass exposes it
+// and brings it into the display's range (`shaders/display.wgsl`).
+fn balanced(radiance_pi: vec3<f32>) -> vec3<f32> {
+    return min(max(radiance_pi * daylight.xyz, vec3<f32>(0.0)), vec3<f32>(SCENE_LIGHT_MAX));
 }
 
 // A table's texel grid spans the unit square corner to corner: texel (0, 0) is (0, 0), the last

@@ -24,6 +24,10 @@ use serde::Deserialize;
 /// Linear RGB, one value per channel.
 pub type Rgb = [f64; 3];
 
+/// The luminance (CIE Y) of linear sRGB's red, green and blue primaries, white 1 (IEC 61966-2-1,
+/// D65): the Y row of its matrix to CIE XYZ.
+pub const LUMINANCE_OF_LINEAR_SRGB: Rgb = [0.2126729, 0.7151522, 0.0721750];
+
 /// The atmosphere's physical parameters: the `[atmosphere]` table's model part. The defaults
 /// (`Atmosphere::earth`) are Bruneton's and Hillaire's clear-sky Earth.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]

@@ -27,9 +27,6 @@ pub struct AtmosphereSettings {
     /// Whether the ground, the seeds and the texcells are seen through the air (aerial
     /// perspective); off, they show their lit colours at any distance.
     pub aerial_perspective: bool,
-    /// The display's exposure, in stops over the daylight balance (0: level white ground at sea
-    /// level under a sun 45° high shows white).
-    pub exposure_ev: f64,
     /// The air itself.
     pub air: Atmosphere,
 }
@@ -40,7 +37,7 @@ impl AtmosphereSettings {
         let text = |size: [u32; 2]| format!("{size:?}");
         let a = &self.air;
         let non_negative = |values: &[f64]| values.iter().all(|v| v.is_finite() && *v >= 0.0);
-        let checks: [RangeCheck; 12] = [
+        let checks: [RangeCheck; 11] = [
             (
                 side(self.transmittance_lut),
                 "atmosphere.transmittance_lut",
@@ -70,12 +67,6 @@ impl AtmosphereSettings {
                 "atmosphere.irradiance_lut",
                 text(self.irradiance_lut),
                 "2 to 4096 texels a side",
-            ),
-            (
-                self.exposure_ev.is_finite() && self.exposure_ev.abs() <= 20.0,
-                "atmosphere.exposure_ev",
-                self.exposure_ev.to_string(),
-                "-20 to 20 stops",
             ),
             (
                 a.bottom_radius_km > 0.0

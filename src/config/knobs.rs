@@ -130,8 +130,8 @@ pub const KNOBS: &[Knob] = &[
         |s| s.render.sun_elevation_deg, Value::Float(s.render.sun_elevation_deg)),
     knob!("sun azimuth", "render.sun_azimuth_deg", "°", 0.0..=360.0, Linear, Live,
         |s| s.render.sun_azimuth_deg, Value::Float(s.render.sun_azimuth_deg)),
-    knob!("exposure", "atmosphere.exposure_ev", "EV", -4.0..=4.0, Linear, Live,
-        |s| s.atmosphere.exposure_ev, Value::Float(s.atmosphere.exposure_ev)),
+    knob!("exposure", "display.ev100", "EV100", 4.0..=18.0, Linear, Live,
+        |s| s.display.ev100, Value::Float(s.display.ev100)),
 ];
 
 /// `base` (a settings layer, or empty) with every knob's field set to its value in `settings`,

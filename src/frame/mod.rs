@@ -22,6 +22,7 @@ use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
 use crate::passes::atmosphere::gpu::AtmospherePass;
 use crate::passes::depth_pyramid::gpu::DepthPyramid;
+use crate::passes::display::gpu::DisplayPass;
 use crate::passes::ground::gpu::GroundPass;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
 use crate::passes::terrain::select::NodeBounds;
@@ -123,12 +124,14 @@ struct Caches {
     pinned_landcover: Vec<TileId>,
 }
 
-/// The frame's render targets and their views, made once.
+/// The frame's targets (the passes' light, the depth, the display made of it) and views, made once.
 struct Targets {
     colour: wgpu::Texture,
     depth: wgpu::Texture,
+    display: wgpu::Texture,
     colour_view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
+    display_view: wgpu::TextureView,
 }
 
 /// The GPU resources of one dataset (caches, loader threads, passes, targets) and the state carried
@@ -147,6 +150,8 @@ pub struct Renderer {
     ground: GroundPass,
     /// The air's tables and the sky drawn from them.
     atmosphere: AtmospherePass,
+    /// The frame's light exposed and through the tone curve, into the display target.
+    display: DisplayPass,
     depth_pyramid: DepthPyramid,
     tlm: TileLoadMapPass,
     tlm_bindings: TlmBindings,
@@ -192,6 +197,7 @@ impl Renderer {
         let software = gpu.info.device_type == wgpu::DeviceType::Cpu;
         let atmosphere = AtmospherePass::new(&gpu, &settings.atmosphere);
         let ground = GroundPass::new(device, &settings, software, &terrain, atmosphere.air().layout());
+        let display = DisplayPass::new(&gpu, &settings.display, &targets.colour_view, atmosphere.daylight());
         let caches = Caches::new(&gpu, &dataset, &settings)?;
         let loader = Loader::new(
             Arc::clone(&dataset),
@@ -243,6 +249,7 @@ impl Renderer {
             terrain_bindings,
             ground,
             atmosphere,
+            display,
             depth_pyramid,
             tlm,
             tlm_bindings,
@@ -273,15 +280,6 @@ impl Renderer {
         fresh.time_s = self.time_s;
         *self = fresh;
         Ok(())
-    }
-
-    /// A view of the last frame's colour as plain `Rgba8Unorm` (the sRGB-encoded bytes, not
-    /// decoded when sampled): what a window shows them through, byte for byte.
-    pub fn colour_bytes_view(&self) -> wgpu::TextureView {
-        self.targets.colour.create_view(&wgpu::TextureViewDescriptor {
-            format: Some(crate::passes::COLOUR_FORMAT.remove_srgb_suffix()),
-            ..Default::default()
-        })
     }
 
     /// The counts of every frame that has arrived since the last frame's report took them (after
@@ -421,6 +419,8 @@ impl Renderer {
             };
             p.pass(gpu, encoder, "draw_seeds", |e| counted("draw_seeds", e, &draw))?;
         }
+        // The frame's light as the screen shows it: exposed, through the tone curve.
+        p.pass(gpu, encoder, "display", |e| self.display.encode(e, &t.display_view, c.pass("display")))?;
         Ok(())
     }
 

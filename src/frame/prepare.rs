@@ -201,6 +201,7 @@ impl Renderer {
         };
         let live = &self.settings.atmosphere;
         counts.uploads(queue, "sky_view", || self.atmosphere.prepare(queue, &sky, live));
+        counts.uploads(queue, "display", || self.display.prepare(queue, &self.settings.display));
         if let Some(stage) = self.texcells.as_mut() {
             let texcell_view = TexcellView {
                 camera_grid_m: view.grid_m,

@@ -9,7 +9,7 @@ use crate::dataset::{Dataset, IMAGERY_MIPS, LayerPack, LayerSpec};
 use crate::gpu::Gpu;
 use crate::gpu::layout::MAX_LEVELS;
 use crate::passes::seed_select::march::BLOCK_TOPS;
-use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
+use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT, DISPLAY_FORMAT};
 use crate::streaming::loader::imagery_tile;
 use crate::streaming::wants::pinned_tiles;
 use crate::streaming::{Delivery, LayerKind, TileCache};
@@ -23,7 +23,7 @@ use crate::camera::CameraError;
 const MAX_PINNED_TILES: usize = 21;
 
 impl Targets {
-    /// The colour and depth targets of `settings.render`'s size.
+    /// The colour, depth and display targets of `settings.render`'s size.
     pub(super) fn new(device: &wgpu::Device, settings: &Settings) -> Result<Self, RenderError> {
         let (width, height, max) =
             (settings.render.width, settings.render.height, device.limits().max_texture_dimension_2d);
@@ -47,12 +47,13 @@ impl Targets {
                 view_formats,
             })
         };
-        // A window samples the colour's bytes as they are (`Renderer::colour_bytes_view`).
-        let colour = target("colour", COLOUR_FORMAT, &[COLOUR_FORMAT.remove_srgb_suffix()]);
+        let colour = target("colour", COLOUR_FORMAT, &[]);
         let depth = target("depth", DEPTH_FORMAT, &[]);
-        let colour_view = colour.create_view(&Default::default());
-        let depth_view = depth.create_view(&Default::default());
-        Ok(Self { colour, depth, colour_view, depth_view })
+        // A window samples the display's bytes as they are (`Renderer::display_bytes_view`).
+        let display = target("display", DISPLAY_FORMAT, &[DISPLAY_FORMAT.remove_srgb_suffix()]);
+        let [colour_view, depth_view, display_view] =
+            [&colour, &depth, &display].map(|t| t.create_view(&Default::default()));
+        Ok(Self { colour, depth, display, colour_view, depth_view, display_view })
     }
 }
 

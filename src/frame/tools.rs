@@ -121,13 +121,59 @@ impl Renderer {
         [&c.heights, &c.imagery].into_iter().chain(c.landcover.as_ref()).collect()
     }
 
-    /// The last frame's colour, as an sRGB image.
+    /// The last frame as the screen shows it, an sRGB image: its light through the display pass,
+    /// displayed again now so that whatever was drawn over the frame since (the ground truth's
+    /// seeds) is in it.
     pub fn read_colour(&self) -> Result<image::RgbaImage, RenderError> {
-        let colour = &self.targets.colour;
-        let bytes = read_texture(&self.gpu, colour, wgpu::TextureAspect::All, 4)?;
-        let (w, h) = (colour.width(), colour.height());
-        image::RgbaImage::from_raw(w, h, bytes)
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        self.display.encode(&mut encoder, &self.targets.display_view, Counting::OFF);
+        self.gpu.queue.submit([encoder.finish()]);
+        self.read_display(&self.targets.display)
+    }
+
+    /// `light` (a texture of the colour target's format, drawn over a copy of the frame) as this
+    /// renderer's display shows it, an sRGB image.
+    pub(crate) fn display_light(&self, light: &wgpu::Texture) -> Result<image::RgbaImage, RenderError> {
+        let device = &self.gpu.device;
+        let display = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("displayed light"),
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            format: crate::passes::DISPLAY_FORMAT,
+            view_formats: &[],
+            size: light.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        let (light, view) =
+            (light.create_view(&Default::default()), display.create_view(&Default::default()));
+        self.display.encode_light(device, &mut encoder, &light, &view);
+        self.gpu.queue.submit([encoder.finish()]);
+        self.read_display(&display)
+    }
+
+    fn read_display(&self, display: &wgpu::Texture) -> Result<image::RgbaImage, RenderError> {
+        let bytes = read_texture(&self.gpu, display, wgpu::TextureAspect::All, 4)?;
+        image::RgbaImage::from_raw(display.width(), display.height(), bytes)
             .ok_or_else(|| RenderError::Gpu(GpuError::Validation("readback size mismatch".into())))
+    }
+
+    /// The last frame's light before the display exposes it: linear RGB balanced for daylight
+    /// (1 is white ground in daylight; `passes::display`), row by row, top row first.
+    pub fn read_light(&self) -> Result<Vec<[f32; 3]>, RenderError> {
+        let bytes = read_texture(&self.gpu, &self.targets.colour, wgpu::TextureAspect::All, 8)?;
+        let halves: Vec<[u16; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+        Ok(halves.iter().map(|t| [0, 1, 2].map(|c| half::f16::from_bits(t[c]).to_f32())).collect())
+    }
+
+    /// A view of the last frame's display as plain `Rgba8Unorm` (the sRGB-encoded bytes, not
+    /// decoded when sampled): what a window shows them through, byte for byte.
+    pub fn display_bytes_view(&self) -> wgpu::TextureView {
+        self.targets.display.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(crate::passes::DISPLAY_FORMAT.remove_srgb_suffix()),
+            ..Default::default()
+        })
     }
 
     /// The last frame's depth (reversed-Z: 1 at the near plane, 0 for the sky), top row first.

@@ -355,13 +355,12 @@ wgsl_constants! { atmosphere_constants:
     /// Directions per side of the grid the sky-irradiance table gathers over (8 × 8 = 64 over
     /// the upper hemisphere).
     pub const IRRADIANCE_DIRECTIONS_SIDE: u32 = 8;
-    /// The sun's zenith cosine of the daylight the display is balanced for (45°): level white
-    /// ground at sea level under it, sun and sky, shows white (`daylight_balance`).
+    /// The sun's zenith cosine of the daylight the frame's light is balanced for (45°): level
+    /// white ground at sea level under it, sun and sky, is 1 (`daylight_balance`).
     pub const DAYLIGHT_SUN_COS: f32 = 0.70710677;
-    /// The display's tone curve is the identity up to this (linear), then a shoulder that
-    /// approaches 1 with the same slope, so the photograph's colours pass unchanged and the sun's
-    /// glare and snow at noon do not clip (`display`).
-    pub const DISPLAY_KNEE: f32 = 0.8;
+    /// The most balanced light a pass writes (`balanced`): the colour target's f16 holds up to
+    /// 65,504, and the sun's disk is about 70,000 times white ground.
+    pub const SCENE_LIGHT_MAX: f32 = 60000.0;
 }
 
 // --- Wind (`seeds::wind`) ---

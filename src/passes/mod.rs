@@ -11,11 +11,14 @@
 //! 2. `ground`: imagery on the terrain, from the finest resident level, and `texcells`: the far
 //!    forest over it, where the land cover is dense;
 //! 3. `seed_select`: the seeds of the visible near cells, culled and classified;
-//! 4. `compact` and `draw_seeds`: the survivors grouped into indirect draws, and drawn.
+//! 4. `compact` and `draw_seeds`: the survivors grouped into indirect draws, and drawn;
+//!
+//! then `display`: the frame's light, exposed and through a tone curve, as the screen shows it.
 
 pub mod atmosphere;
 pub mod compact;
 pub mod depth_pyramid;
+pub mod display;
 pub mod draw_seeds;
 pub mod ground;
 pub mod seed_select;
@@ -26,8 +29,13 @@ pub mod tile_load_map;
 use crate::gpu::bindings::PipelineBindings;
 use crate::gpu::shaders::WgslSource;
 
-/// The colour target every pass that shades draws into (sRGB: the hardware encodes on store).
-pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// The colour target every pass that shades draws into: light balanced for daylight (1 is white
+/// ground in daylight; `passes::display`), in floating point so the sun, snow and dusk keep their
+/// stops until the display exposes them.
+pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The display target the display pass writes, what is saved and shown (sRGB: the hardware
+/// encodes on store).
+pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 /// The depth target: reversed-Z (1 at the near plane, 0 at infinity), written by the terrain.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -43,6 +51,7 @@ pub const SHADERS: &[&WgslSource] = &[
     &draw_seeds::gpu::SHADER,
     &crate::earth::gpu::SHADER,
     &atmosphere::gpu::SHADER,
+    &display::gpu::SHADER,
 ];
 
 /// Every pipeline's bind group and the shader entry points it serves: what the binding-table test
@@ -95,6 +104,12 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
         entry_points: &["vs_sky", "fs_sky_marched"],
         group: 0,
         bindings: &atmosphere::gpu::SKY_MARCHED_BINDINGS.bindings,
+    },
+    PipelineBindings {
+        shader: &display::gpu::SHADER,
+        entry_points: &["vs_display", "fs_display"],
+        group: 0,
+        bindings: &display::gpu::BINDINGS.bindings,
     },
     PipelineBindings {
         shader: &crate::earth::gpu::SHADER,

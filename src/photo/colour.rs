@@ -6,10 +6,12 @@
 //! data, and mathematical observations", with k_L = k_C = k_H = 1), checked against that paper's
 //! 34 test pairs. Means of colours are taken in linear light (light adds there), never in Lab.
 
+use crate::atmosphere::LUMINANCE_OF_LINEAR_SRGB;
+
 /// Linear sRGB → CIE XYZ, rows X, Y, Z (the sRGB primaries with the D65 white point; Lindbloom's
 /// matrix, seven decimals).
 const XYZ_FROM_LINEAR_SRGB: [[f64; 3]; 3] =
-    [[0.4124564, 0.3575761, 0.1804375], [0.2126729, 0.7151522, 0.0721750], [0.0193339, 0.1191920, 0.9503041]];
+    [[0.4124564, 0.3575761, 0.1804375], LUMINANCE_OF_LINEAR_SRGB, [0.0193339, 0.1191920, 0.9503041]];
 
 /// CIELAB's ε and κ (CIE 15, exact rationals): below ε the cube root becomes a line.
 const LAB_EPSILON: f64 = 216.0 / 24389.0;

@@ -27,7 +27,7 @@ use serde::Serialize;
 
 use super::colour::{delta_e_2000, lab_of_linear, linear_table};
 use super::measure::{BLOCK_PX, NO_TEXEL, PixelKeys, Sums, key_texel, linear_at, texel_key};
-use super::{PhotoError, photograph_settings, pixel_keys};
+use super::{PhotoError, measured_settings, photograph_settings, pixel_keys};
 use crate::camera::Camera;
 use crate::config::Settings;
 use crate::dataset::Dataset;
@@ -131,6 +131,7 @@ pub fn descend(
         r.set_time_s(time_s);
         Ok(r)
     };
+    let settings = &measured_settings(settings);
     let (mut amplified, mut photo) = (renderer(settings.clone())?, renderer(photograph_settings(settings))?);
     let texel_m = dataset.manifest.imagery.as_ref().map_or(1.0, |i| i.texel_m);
     let (mut last, mut pairs): (Option<Frame>, Vec<PairFigures>) = (None, Vec::new());

@@ -7,10 +7,10 @@
 //!   `seeds.density_scale` 0, `texcells.reach_m` 0), which is the ground pass alone: the imagery
 //!   draped on the terrain, lit by the same sun and clouds and seen through the same air.
 //!
-//! Both are settled (`Renderer::render_resolved`) and read straight from the colour target
-//! (`Renderer::read_colour`): the display's tone curve is the identity below `DISPLAY_KNEE` (0.8
-//! linear, where forest and fields lie), so the target's sRGB bytes decode to the linear light the
-//! passes wrote there, and every mean is taken in linear light. The ground's lighting and air are
+//! Both are settled (`Renderer::render_resolved`) and read (`Renderer::read_colour`) through the
+//! display's `linear` curve (`measured_settings`): no exposure and no tone curve, the light the
+//! passes wrote, balanced for daylight and clipped at white (forest and fields lie far below it),
+//! so the sRGB bytes decode to that light and every mean is taken in linear light. The ground's lighting and air are
 //! in both frames alike: where the amplified frame shows its ground they cancel, and where it
 //! shows a tree the tree is lit by the same sun and seen through the same air as the ground it
 //! stands on, so what is left is what the amplification changed.
@@ -34,7 +34,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::camera::{Camera, CameraError};
-use crate::config::Settings;
+use crate::config::{Settings, ToneCurve};
 use crate::dataset::{Dataset, PackError};
 use crate::frame::{RenderError, Renderer};
 use crate::gpu::Gpu;
@@ -94,6 +94,14 @@ pub fn photograph_settings(settings: &Settings) -> Settings {
     s
 }
 
+/// `settings` as the measures render them: the display shows the frame's light itself
+/// (`ToneCurve::Linear`), so colours are compared before any exposure or tone curve.
+pub fn measured_settings(settings: &Settings) -> Settings {
+    let mut s = settings.clone();
+    s.display.tone_curve = ToneCurve::Linear;
+    s
+}
+
 /// One view measured: both frames, what each pixel stands on, the figures.
 pub struct PhotoView {
     /// The frame with the settings as given (sRGB).
@@ -126,9 +134,10 @@ pub struct PhotoReport {
 }
 
 /// Renders the view from `camera` (at `settings.render`'s size) with `settings` and with
-/// `photograph_settings`, both settled at scene time `time_s`, and measures one against the other;
-/// `amplified`, when given, stands for the first (a frame of the same view and size rendered
-/// elsewhere, e.g. by another build), and only the photograph frame is rendered.
+/// `photograph_settings`, both settled at scene time `time_s` and displayed by
+/// `measured_settings`, and measures one against the other; `amplified`, when given, stands for
+/// the first (a frame of the same view and size rendered elsewhere, e.g. by another build, with
+/// `display.tone_curve = "linear"`), and only the photograph frame is rendered.
 pub fn measure_view(
     gpu: &Gpu,
     dataset: Arc<Dataset>,
@@ -137,6 +146,7 @@ pub fn measure_view(
     time_s: f64,
     amplified: Option<RgbaImage>,
 ) -> Result<PhotoView, PhotoError> {
+    let settings = &measured_settings(settings);
     let settle = |settings: Settings| -> Result<(Renderer, RgbaImage), PhotoError> {
         let mut renderer = Renderer::new(gpu.clone(), Arc::clone(&dataset), settings)?;
         renderer.set_time_s(time_s);

@@ -447,10 +447,10 @@ impl Tables<'_> {
         radiance
     }
 
-    /// `fs_sky`'s colour for a direction on the display balanced by `daylight`
+    /// `fs_sky`'s light for a direction as the frame holds it, balanced by `daylight`
     /// (`light::daylight_balance`).
     pub fn sky_colour(&self, sky_view: &Lut, dir: Vec3, daylight: Vec3) -> Vec3 {
-        light::display(self.sky_radiance(sky_view, dir) * PI, daylight, self.model.u.exposure)
+        light::balanced(self.sky_radiance(sky_view, dir) * PI, daylight)
     }
 }
 

@@ -12,6 +12,7 @@ pub mod accuracy;
 pub mod atmosphere;
 pub mod compact;
 pub mod depth_pyramid;
+pub mod display;
 pub mod frame_change;
 pub mod image_metrics;
 pub mod oracle;

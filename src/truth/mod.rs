@@ -293,7 +293,9 @@ fn draw_seeds(
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
+            // Bound too: the display pass shows the colour (`Renderer::display_light`).
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC
                 | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
@@ -385,10 +387,7 @@ fn draw_seeds(
     };
     let seeds = scene.map(|(_, s)| s.seeds).unwrap_or_default();
     let samples = samples_per_seed(&seed_ids, seeds.len());
-    let (w, h) = (colour.width(), colour.height());
-    let samples_image = image::RgbaImage::from_raw(w, h, read(&colour, wgpu::TextureAspect::All)?)
-        .ok_or_else(|| GpuError::Validation("truth colour: readback size mismatch".into()))?;
-    let colour = box_filter(&samples_image, supersample);
+    let colour = box_filter(&renderer.display_light(&colour)?, supersample);
     let ground = box_filter(&renderer.read_colour()?, supersample);
     let depth = bytemuck::pod_collect_to_vec(&read(&depth, wgpu::TextureAspect::DepthOnly)?);
     Ok(Truth {

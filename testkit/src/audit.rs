@@ -256,8 +256,9 @@ pub struct Audit {
     pub depth_not_finite: usize,
     pub depth_out_of_range: usize,
     pub ground_px: usize,
-    /// Pixels whose colour is (0, 0, 0): a NaN written to an 8-bit target reads back as 0, and
-    /// neither the sky, the haze nor lit imagery is black.
+    /// Pixels whose light (`Renderer::read_light`) is not finite or is 0 in every channel:
+    /// a NaN, or a pixel nothing was drawn on; by day neither the sky, the air nor lit imagery
+    /// is without light (the display's tone curve may show very dark light as black).
     pub black_px: usize,
     /// Rays judged, and what they found.
     pub rays: usize,
@@ -314,12 +315,13 @@ pub fn audit(r: &Renderer, camera: &Camera, dem: &Dem, tol: Tolerance, ray_step_
     let lods = Lods::for_view(&r.dataset, &r.settings.terrain, camera, rays.height);
     let fine_within_m = lods.morph_start_m.first().copied().unwrap_or(f64::INFINITY);
     let depth = r.read_depth().unwrap();
-    let colour = r.read_colour().unwrap();
+    let light = r.read_light().unwrap();
     a.pixels = depth.len();
     a.depth_not_finite = depth.iter().filter(|d| !d.is_finite()).count();
     a.depth_out_of_range = depth.iter().filter(|&&d| !(0.0..=1.0).contains(&d)).count();
     a.ground_px = depth.iter().filter(|&&d| d > 0.0).count();
-    a.black_px = colour.pixels().filter(|p| p[0] == 0 && p[1] == 0 && p[2] == 0).count();
+    a.black_px =
+        light.iter().filter(|p| p.iter().any(|c| !c.is_finite()) || p.iter().all(|&c| c == 0.0)).count();
     let at = |x: u32, y: u32| depth[(y * rays.width + x) as usize];
     for y in (ray_step_px / 2..rays.height).step_by(ray_step_px as usize) {
         for x in (ray_step_px / 2..rays.width).step_by(ray_step_px as usize) {

@@ -1,12 +1,13 @@
 //! What docs/atmosphere.md quotes, and where each number is defined.
 
 use terramp::gpu::layout::{
-    DISPLAY_KNEE, FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, IRRADIANCE_DIRECTIONS_SIDE,
+    FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, IRRADIANCE_DIRECTIONS_SIDE, SCENE_LIGHT_MAX,
     SKY_MARCHED_ABOVE_KM,
 };
 use terramp::passes::atmosphere::gpu::air::AIR_GROUP;
+use terramp::passes::display::{SATURATION_CD_M2, SUN_ILLUMINANCE_LX};
 
-use super::claims::{Claim, Source, km, percent, plain, sci, test_const};
+use super::claims::{Claim, Source, grouped, km, percent, plain, sci, test_const};
 
 pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
     Claim {
@@ -81,8 +82,39 @@ pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
     },
     Claim {
         doc: "docs/atmosphere.md",
-        quote: "The tone curve is the identity up to {} (`DISPLAY_KNEE`, linear)",
-        values: &[(Source::Value(DISPLAY_KNEE as f64), plain)],
+        quote: "kept under {} (`SCENE_LIGHT_MAX`), within the f16",
+        values: &[(Source::Value(SCENE_LIGHT_MAX as f64), plain)],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "illuminance constant of the daylighting literature, {} lux (`SUN_ILLUMINANCE_LX`)",
+        values: &[(Source::Value(SUN_ILLUMINANCE_LX), grouped)],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "a factor 1 / ({} × 2^EV100), ISO 12232). The default, {}, is",
+        values: &[
+            (Source::Value(SATURATION_CD_M2), plain),
+            (Source::Setting { preset: None, key: "display.ev100" }, plain),
+        ],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "The tests ask the single scattering within {} % on average and {} % at most (`SINGLE_MEAN`, `SINGLE_MAX`) and the tables' sky within {} % and {} % (`BRUNETON_MEAN`, `BRUNETON_MAX`)",
+        values: &[
+            (test_const("tests/bruneton.rs", "SINGLE_MEAN"), percent),
+            (test_const("tests/bruneton.rs", "SINGLE_MAX"), percent),
+            (test_const("tests/bruneton.rs", "BRUNETON_MEAN"), percent),
+            (test_const("tests/bruneton.rs", "BRUNETON_MAX"), percent),
+        ],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "The GPU's display equals the twin's within {} level of 8 bits over {} light steps",
+        values: &[
+            (test_const("tests/display.rs", "DISPLAY_LEVELS"), plain),
+            (test_const("tests/display.rs", "STEPS"), plain),
+        ],
     },
     Claim {
         doc: "docs/atmosphere.md",

@@ -51,7 +51,8 @@ pub struct PhotoArgs {
     #[arg(long)]
     out: PathBuf,
     /// Measure this PNG as the amplified frame instead of rendering it: a frame of the same view
-    /// and size rendered elsewhere (another build's `terramp render`, say).
+    /// and size rendered elsewhere (another build's `terramp render`, say) with the display's
+    /// `linear` curve (`display.tone_curve = "linear"`), as the measure renders its own.
     #[arg(long, conflicts_with = "descend_to")]
     amplified: Option<PathBuf>,
     /// Also judge the amplified frame against this truth image of the same view and size

@@ -42,11 +42,11 @@ gpu_struct! {
         pub aerial_far_km: f32,
         /// Its slices.
         pub aerial_slices: u32,
-        /// The display's exposure: a factor on every radiance (2^`atmosphere.exposure_ev`).
-        pub exposure: f32,
         /// 1 where the ground, the seeds and the texcells are seen through the air (aerial
         /// perspective), 0 where the air is left out between them and the camera.
         pub aerial_on: u32,
+        /// Unused, to the struct's 16-byte alignment.
+        pub _pad: u32,
 
     }
 }

@@ -6,6 +6,7 @@
 
 mod atmosphere;
 mod compact;
+mod display;
 mod draw_seeds;
 mod earth;
 mod seed_select;
@@ -15,6 +16,7 @@ mod tile_load_map;
 
 pub use atmosphere::AtmosphereUniforms;
 pub use compact::{CompactParams, SeedBlock, SeedDrawArgs};
+pub use display::DisplayUniforms;
 pub use draw_seeds::{DrawSeedsUniforms, SeedMaterial, SeedShape, SeedVertex};
 pub use earth::{EarthNode, EarthProbePoint};
 pub use seed_select::{SeedCell, SeedClass, SeedCounters, SeedRecord, SeedSettle, SeedSpecies, SeedUniforms};
@@ -51,6 +53,7 @@ pub fn layouts() -> Vec<StructLayout> {
         EarthNode::layout(),
         EarthProbePoint::layout(),
         AtmosphereUniforms::layout(),
+        DisplayUniforms::layout(),
     ]
 }
 

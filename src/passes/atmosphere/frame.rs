@@ -61,7 +61,7 @@ pub fn atmosphere_uniforms(settings: &AtmosphereSettings, view: &SkyView) -> Atm
         aerial_size: [settings.aerial_perspective_lut[0], settings.aerial_perspective_lut[1]],
         aerial_far_km: f(aerial_far_km(a, a.bottom_radius_km + altitude_km)),
         aerial_slices: settings.aerial_perspective_lut[2],
-        exposure: f(settings.exposure_ev.exp2()),
         aerial_on: u32::from(settings.aerial_perspective),
+        _pad: 0,
     }
 }

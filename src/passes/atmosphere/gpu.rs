@@ -335,15 +335,11 @@ impl AtmospherePass {
         &self.air
     }
 
-    /// Writes the frame's uniforms for `view`, the display's exposure and aerial perspective as
-    /// `live` has them now (a viewer turns them; the air and the tables' sizes stay the pass's
-    /// own, fixed when it was built).
+    /// Writes the frame's uniforms for `view`, aerial perspective as `live` has it now (a viewer
+    /// turns it; the air and the tables' sizes stay the pass's own, fixed when it was built).
     pub fn prepare(&self, queue: &Queue, view: &SkyView, live: &AtmosphereSettings) {
-        let settings = AtmosphereSettings {
-            exposure_ev: live.exposure_ev,
-            aerial_perspective: live.aerial_perspective,
-            ..self.settings.clone()
-        };
+        let settings =
+            AtmosphereSettings { aerial_perspective: live.aerial_perspective, ..self.settings.clone() };
         let uniforms = atmosphere_uniforms(&settings, view);
         self.air.marched.set(uniforms.up[3] - uniforms.radii[0] > SKY_MARCHED_ABOVE_KM);
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
@@ -413,6 +409,11 @@ impl AtmospherePass {
             self.sky_view.read_back(gpu)?,
             self.irradiance.read_back(gpu)?,
         ])
+    }
+
+    /// The daylight balance every lit pass and the display read: 1 / daylight's light per channel.
+    pub fn daylight(&self) -> &wgpu::Buffer {
+        &self.daylight
     }
 
     /// The display's daylight balance as the GPU made it (rgb), waiting for it: for tests.

@@ -1,6 +1,6 @@
 //! Twin of the light the atmosphere gives the lit passes: the sky-irradiance table
-//! (`irradiance_lut`), the display's daylight balance (`daylight_balance`) and tone curve
-//! (`display`), the light at a point (`light_at`) and the air between it and the camera
+//! (`irradiance_lut`), the frame's daylight balance (`daylight_balance`, `balanced`), the light
+//! at a point (`light_at`) and the air between it and the camera
 //! (`Volume::air_between`, `air_marched` from high up, `through_air`), as `shaders/atmosphere.wgsl` and
 //! `shaders/shared/air.wgsl` compute them, in f32. The volume's filtering is the one place the
 //! twin cannot follow the GPU's arithmetic exactly (the sampler's weights are the adapter's):
@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3, Vec4Swizzles};
 use super::{Lut, Tables, Volume, aerial_distance, grid_direction, mix, ray_segment};
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::{
-    DAYLIGHT_SUN_COS, DISPLAY_KNEE, IRRADIANCE_DIRECTIONS_SIDE, PI, SKY_MARCHED_ABOVE_KM, SKY_VIEW_STEPS,
+    DAYLIGHT_SUN_COS, IRRADIANCE_DIRECTIONS_SIDE, PI, SCENE_LIGHT_MAX, SKY_MARCHED_ABOVE_KM, SKY_VIEW_STEPS,
 };
 
 /// `SunAndSky`: the light at a point per unit of the sun's irradiance above the air.
@@ -96,21 +96,10 @@ impl Tables<'_> {
     }
 }
 
-/// `display`: a radiance times π on the display, balanced by `daylight`, exposed by `exposure`,
-/// through the tone curve (the identity up to `DISPLAY_KNEE`, then a shoulder towards 1).
-pub fn display(radiance_pi: Vec3, daylight: Vec3, exposure: f32) -> Vec3 {
-    let x = (radiance_pi * daylight * exposure).max(Vec3::ZERO);
-    let span = 1.0 - DISPLAY_KNEE;
-    let over = (x - DISPLAY_KNEE).max(Vec3::ZERO);
-    x.min(Vec3::splat(DISPLAY_KNEE)) + span * (Vec3::ONE - (-over / span).exp())
-}
-
-/// The inverse of `display`'s tone curve: the balanced, exposed value a displayed value below 1
-/// came from (for tests that undo a frame's display).
-pub fn undisplayed(shown: Vec3) -> Vec3 {
-    let span = 1.0 - DISPLAY_KNEE;
-    let over = (Vec3::ONE - (shown - DISPLAY_KNEE).max(Vec3::ZERO) / span).max(Vec3::splat(1e-6));
-    shown.min(Vec3::splat(DISPLAY_KNEE)) - span * over.ln()
+/// `balanced`: a radiance times π as the frame holds it, balanced by `daylight` (white ground in
+/// daylight is 1), within the colour target's f16.
+pub fn balanced(radiance_pi: Vec3, daylight: Vec3) -> Vec3 {
+    (radiance_pi * daylight).max(Vec3::ZERO).min(Vec3::splat(SCENE_LIGHT_MAX))
 }
 
 impl Volume {
@@ -157,50 +146,18 @@ impl Volume {
     }
 }
 
-/// `through_air`: a point's light `lit_pi` at `rel_m` on the display, through the air of `volume`
+/// `through_air`: a point's light `lit_pi` at `rel_m` as the frame holds it, through the air of `volume`
 /// or marched with `tables` from high up (unless the uniforms turn aerial perspective off),
 /// balanced by `daylight`.
 pub fn through_air(tables: &Tables, volume: &Volume, daylight: Vec3, lit_pi: Vec3, rel_m: Vec3) -> Vec3 {
     let u = tables.model.u;
     if u.aerial_on == 0 {
-        return display(lit_pi, daylight, u.exposure);
+        return balanced(lit_pi, daylight);
     }
     let (in_scattered, kept) = if u.up[3] - tables.model.bottom() > SKY_MARCHED_ABOVE_KM {
         tables.air_marched(rel_m)
     } else {
         volume.air_between(u, rel_m)
     };
-    display(lit_pi * kept + PI * in_scattered, daylight, u.exposure)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_tone_curve_passes_colours_below_its_knee_and_approaches_white_smoothly() {
-        let daylight = Vec3::ONE;
-        for x in [0.0, 0.1, 0.5, DISPLAY_KNEE] {
-            assert_eq!(display(Vec3::splat(x), daylight, 1.0), Vec3::splat(x));
-        }
-        let mut last = DISPLAY_KNEE;
-        for x in [0.81, 1.0, 1.5, 2.0] {
-            let shown = display(Vec3::splat(x), daylight, 1.0).x;
-            assert!(shown > last && shown < 1.0, "{x}: {shown}");
-            last = shown;
-            let back = undisplayed(Vec3::splat(shown)).x;
-            assert!((back - x).abs() < 1e-3 * x, "{x}: back {back}");
-        }
-        // The glare of the sun's disk: white, never above it.
-        assert_eq!(display(Vec3::splat(1e6), daylight, 1.0), Vec3::ONE);
-        // The slope is 1 on both sides of the knee.
-        let eps = 1e-3;
-        let step = display(Vec3::splat(DISPLAY_KNEE + eps), daylight, 1.0).x - DISPLAY_KNEE;
-        assert!((step / eps - 1.0).abs() < 5e-3, "{step}");
-        // Exposure and balance are factors before the curve.
-        assert_eq!(
-            display(Vec3::new(0.1, 0.2, 0.4), Vec3::new(2.0, 1.0, 0.5), 2.0),
-            Vec3::new(0.4, 0.4, 0.4)
-        );
-    }
+    balanced(lit_pi * kept + PI * in_scattered, daylight)
 }

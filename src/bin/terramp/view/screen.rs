@@ -1,6 +1,6 @@
 //! How it works: the window's side of the viewer. The renderer draws into its own colour target
 //! at the window's size in physical pixels; the screen shows it as egui's background (sampled as
-//! plain bytes, `Renderer::colour_bytes_view`, nearest texel, into a non-sRGB surface, so the
+//! plain bytes, `Renderer::display_bytes_view`, nearest texel, into a non-sRGB surface, so the
 //! window shows the renderer's bytes unchanged) and draws egui's overlay over it, in one render
 //! pass onto the surface's texture, then presents. A lost or outdated surface is configured
 //! again and the frame skipped; HiDPI is egui's pixels per point, from the window's scale factor.
@@ -112,7 +112,7 @@ impl Screen {
         let mut painter = egui_wgpu::Renderer::new(&gpu.device, format, options);
         let frame_texture = painter.register_native_texture(
             &gpu.device,
-            &renderer.colour_bytes_view(),
+            &renderer.display_bytes_view(),
             wgpu::FilterMode::Nearest,
         );
         let timer = PassTimer::new(gpu);
@@ -150,7 +150,7 @@ impl Screen {
     pub fn rebind(&mut self, gpu: &Gpu, renderer: &Renderer) {
         self.painter.update_egui_texture_from_wgpu_texture(
             &gpu.device,
-            &renderer.colour_bytes_view(),
+            &renderer.display_bytes_view(),
             wgpu::FilterMode::Nearest,
             self.frame_texture,
         );

@@ -1,0 +1,167 @@
+//! The display pass's GPU half: one full-screen triangle that reads the frame's colour target and
+//! writes the display target, its pipeline built in `new` for the settings' tone curve (the
+//! curve is a shader constant, so no pipeline holds the other curve's code), the exposure
+//! written by `prepare` each frame (a viewer turns it).
+
+use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension as Dim};
+
+use crate::config::DisplaySettings;
+use crate::gpu::bindings::{Access, Binding, BindingTable};
+use crate::gpu::counter::Counting;
+use crate::gpu::counts::Part;
+use crate::gpu::gpu_types::DisplayUniforms;
+use crate::gpu::resources::{buffer, pipeline_layout};
+use crate::gpu::shaders::WgslSource;
+use crate::gpu::{Gpu, Queue};
+use crate::passes::DISPLAY_FORMAT;
+
+use super::uniforms;
+
+/// The display's shader.
+pub const SHADER: WgslSource =
+    WgslSource { name: "display", parts: &[include_str!("../../../shaders/display.wgsl")] };
+
+/// `vs_display`, `fs_display`.
+pub const BINDINGS: BindingTable<3> = BindingTable {
+    label: "display",
+    bindings: [
+        Binding::storage::<DisplayUniforms>(0, "display", Stage::FRAGMENT, Access::Read),
+        Binding::uniform::<[f32; 4]>(1, "daylight", Stage::FRAGMENT),
+        Binding::texture(
+            2,
+            "scene",
+            Stage::FRAGMENT,
+            TextureSampleType::Float { filterable: false },
+            Dim::D2,
+        ),
+    ],
+};
+
+/// The display on the GPU: its pipeline, its bind group over the frame's colour target and the
+/// atmosphere's daylight balance, and its uniforms.
+pub struct DisplayPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+    uniforms: wgpu::Buffer,
+    daylight: wgpu::Buffer,
+    settings: DisplaySettings,
+}
+
+impl DisplayPass {
+    /// The display of `scene` (the frame's colour target) balanced by `daylight` (the atmosphere
+    /// pass's), through `settings`' tone curve.
+    pub fn new(
+        gpu: &Gpu,
+        settings: &DisplaySettings,
+        scene: &wgpu::TextureView,
+        daylight: &wgpu::Buffer,
+    ) -> Self {
+        let device = &gpu.device;
+        let module = SHADER.module(device);
+        // Storage, as the atmosphere's uniforms: lavapipe keeps a shader variant per value of a
+        // uniform it sees steer code, and the exposure changes while a viewer turns it.
+        let uniforms = buffer(
+            device,
+            "display uniforms",
+            size_of::<DisplayUniforms>() as u64,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&super::uniforms(settings)));
+        let layout = BINDINGS.layout(device);
+        let group = bind(device, &layout, &uniforms, daylight, scene);
+        let constants = [("TONE_CURVE", f64::from(settings.tone_curve.index()))];
+        let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("display"),
+            layout: Some(&pipeline_layout(device, "display", &[&layout])),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_display"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_display"),
+                compilation_options: options,
+                targets: &[Some(DISPLAY_FORMAT.into())],
+            }),
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self { pipeline, layout, group, uniforms, daylight: daylight.clone(), settings: settings.clone() }
+    }
+
+    /// Writes the frame's exposure as `live` has it now (the tone curve stays the pass's own).
+    pub fn prepare(&mut self, queue: &Queue, live: &DisplaySettings) {
+        if live.ev100 != self.settings.ev100 {
+            self.settings.ev100 = live.ev100;
+            queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms(&self.settings)));
+        }
+    }
+
+    /// Records the display of the frame's colour target into `display` (every pixel).
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        display: &wgpu::TextureView,
+        counting: Counting<'_>,
+    ) {
+        self.record(encoder, &self.group, display, counting);
+    }
+
+    /// Records the display of another light texture (`COLOUR_FORMAT`, the frame's size or any)
+    /// into `display`: for tools that draw over a copy of the frame (the ground truth).
+    pub fn encode_light(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        light: &wgpu::TextureView,
+        display: &wgpu::TextureView,
+    ) {
+        let group = bind(device, &self.layout, &self.uniforms, &self.daylight, light);
+        self.record(encoder, &group, display, Counting::OFF);
+    }
+
+    fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        group: &wgpu::BindGroup,
+        display: &wgpu::TextureView,
+        counting: Counting<'_>,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("display"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: display,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        counting.begin(&mut pass, Part::Whole);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        counting.draw(&mut pass, 0..3, 0..1);
+        counting.end(&mut pass);
+    }
+}
+
+fn bind(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    uniforms: &wgpu::Buffer,
+    daylight: &wgpu::Buffer,
+    light: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    let light = wgpu::BindingResource::TextureView(light);
+    BINDINGS.bind_group(device, layout, [uniforms.as_entire_binding(), daylight.as_entire_binding(), light])
+}
