@@ -18,9 +18,12 @@ struct DisplayUniforms {
 @group(0) @binding(1) var<uniform> daylight: vec4<f32>;
 @group(0) @binding(2) var scene: texture_2d<f32>;
 
-// `ToneCurve::index`: 0 AgX, 1 ACES, 2 none (the light itself, clipped at white, unexposed). A
-// pipeline per curve, so none holds another's code.
-override TONE_CURVE: u32 = 0u;
+// The curve this pipeline shows through (`ToneCurve::index`), and the indices of AgX and of the
+// linear display, all set by `DisplayPass::new`: a pipeline per curve, so none holds another's
+// code.
+override TONE_CURVE: u32;
+override AGX: u32;
+override LINEAR: u32;
 
 @vertex
 fn vs_display(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<f32> {
@@ -54,13 +57,13 @@ fn aces(x: vec3<f32>) -> vec3<f32> {
 
 // The displayed linear light of the balanced light `balanced`.
 fn shown(balanced: vec3<f32>) -> vec3<f32> {
-    if TONE_CURVE == 2u {
+    if TONE_CURVE == LINEAR {
         return clamp(balanced, vec3<f32>(0.0), vec3<f32>(1.0));
     }
     let daylight_luminance = dot(display.luminance.xyz, 1.0 / daylight.xyz);
     let exposed = max(balanced, vec3<f32>(0.0)) * (daylight_luminance * display.exposure.x);
     let into = by_rows(display.into_curve, exposed);
-    if TONE_CURVE == 0u {
+    if TONE_CURVE == AGX {
         let encoded = by_rows(display.out_of_curve, agx(into));
         return pow(clamp(encoded, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(display.encoding.z));
     }

@@ -5,7 +5,7 @@
 
 use wgpu::{ShaderStages as Stage, TextureSampleType, TextureViewDimension as Dim};
 
-use crate::config::DisplaySettings;
+use crate::config::{DisplaySettings, ToneCurve};
 use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
@@ -70,7 +70,12 @@ impl DisplayPass {
         gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&super::uniforms(settings)));
         let layout = BINDINGS.layout(device);
         let group = bind(device, &layout, &uniforms, daylight, scene);
-        let constants = [("TONE_CURVE", f64::from(settings.tone_curve.index()))];
+        let index = |curve: ToneCurve| f64::from(curve.index());
+        let constants = [
+            ("TONE_CURVE", index(settings.tone_curve)),
+            ("AGX", index(ToneCurve::Agx)),
+            ("LINEAR", index(ToneCurve::Linear)),
+        ];
         let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("display"),
