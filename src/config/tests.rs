@@ -149,3 +149,17 @@ fn the_demo_settings_name_the_demos_class_table_and_impostors() {
     assert_eq!(Some(s.seeds.class_table.as_str()), crate::classes::ClassTable::generated_for("nc"));
     assert_eq!(s.draw_seeds.impostors, "data/impostors");
 }
+
+#[test]
+fn the_display_takes_ev100_in_range_and_names_its_curves() {
+    let d = Settings::default().display;
+    assert_eq!((d.ev100, d.tone_curve), (15.0, ToneCurve::Agx));
+    let aces = with("[display]\ntone_curve = \"aces\"\nev100 = 9.5\n").unwrap().display;
+    assert_eq!((aces.ev100, aces.tone_curve), (9.5, ToneCurve::Aces));
+    for bad in ["ev100 = 30.0", "ev100 = -11.0", "ev100 = nan"] {
+        let e = with(&format!("[display]\n{bad}\n")).unwrap_err().to_string();
+        assert!(e.contains("display.ev100") && e.contains("-10 to 24"), "{bad}: {e}");
+    }
+    let unknown = with("[display]\ntone_curve = \"filmic\"\n").unwrap_err().to_string();
+    assert!(unknown.contains("filmic") && unknown.contains("agx"), "{unknown}");
+}
