@@ -9,7 +9,7 @@ use crate::classes::ClassTable;
 use crate::gpu::GpuError;
 use crate::gpu::counter::Counting;
 use crate::gpu::gpu_types::{SeedCounters, SeedDrawArgs, SeedRecord, TerrainUniforms, TlmCell};
-use crate::gpu::readback::{read_texture, read_values};
+use crate::gpu::readback::{f16_texels, read_texture, read_values};
 use crate::light::CloudShadowFrame;
 use crate::passes::compact::frame::Compacted;
 use crate::passes::seed_select::frame::{SeedCellRef, SeedOutput};
@@ -163,8 +163,7 @@ impl Renderer {
     /// (1 is white ground in daylight; `passes::display`), row by row, top row first.
     pub fn read_light(&self) -> Result<Vec<[f32; 3]>, RenderError> {
         let bytes = read_texture(&self.gpu, &self.targets.colour, wgpu::TextureAspect::All, 8)?;
-        let halves: Vec<[u16; 4]> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(halves.iter().map(|t| [0, 1, 2].map(|c| half::f16::from_bits(t[c]).to_f32())).collect())
+        Ok(f16_texels(&bytes).into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
     }
 
     /// A view of the last frame's display as plain `Rgba8Unorm` (the sRGB-encoded bytes, not

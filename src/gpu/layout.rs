@@ -359,7 +359,8 @@ wgsl_constants! { atmosphere_constants:
     /// white ground at sea level under it, sun and sky, is 1 (`daylight_balance`).
     pub const DAYLIGHT_SUN_COS: f32 = 0.70710677;
     /// The most balanced light a pass writes (`balanced`): the colour target's f16 holds up to
-    /// 65,504, and the sun's disk is about 70,000 times white ground.
+    /// 65,504, and the sun's disk above the air is about 72,000 times white ground (its
+    /// irradiance over its solid angle, 1 / (π 0.004675²), times π and the daylight balance).
     pub const SCENE_LIGHT_MAX: f32 = 60000.0;
 }
 

@@ -125,3 +125,9 @@ fn read_texture_at(
     gpu.check()?;
     Ok(texels)
 }
+
+/// Texels of an `Rgba16Float` texture read back tightly packed, as f32.
+pub fn f16_texels(bytes: &[u8]) -> Vec<[f32; 4]> {
+    let halves: Vec<[u16; 4]> = bytemuck::pod_collect_to_vec(bytes);
+    halves.iter().map(|t| t.map(|bits| half::f16::from_bits(bits).to_f32())).collect()
+}

@@ -14,7 +14,7 @@ use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::AtmosphereUniforms;
 use crate::gpu::layout::{ATMOSPHERE_WORKGROUP, SKY_MARCHED_ABOVE_KM};
-use crate::gpu::readback::{read_buffer, read_texture_slices};
+use crate::gpu::readback::{f16_texels, read_buffer, read_texture_slices};
 use crate::gpu::resources::{buffer, compute_pipeline, depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
 use crate::gpu::{Gpu, GpuError, Queue};
@@ -394,8 +394,7 @@ impl AtmospherePass {
     /// slice, row by row), waiting for it: for tests and tools.
     pub fn read_back_aerial(&self, gpu: &Gpu) -> Result<[Vec<[f32; 4]>; 2], GpuError> {
         let read = |texture: &wgpu::Texture| -> Result<Vec<[f32; 4]>, GpuError> {
-            let halves: Vec<[u16; 4]> = bytemuck::pod_collect_to_vec(&read_texture_slices(gpu, texture, 8)?);
-            Ok(halves.iter().map(|t| t.map(|bits| half::f16::from_bits(bits).to_f32())).collect())
+            Ok(f16_texels(&read_texture_slices(gpu, texture, 8)?))
         };
         Ok([read(&self.aerial[0])?, read(&self.aerial[1])?])
     }
