@@ -3,14 +3,16 @@
 // - `transmittance_lut`: per (r, μ), the share of light that crosses the air from there to its
 //   top, by quadrature of the extinction (made when the atmosphere changes).
 // - `multiple_scattering_lut`: per (altitude, sun's zenith cosine), the light of every order of
-//   scattering above the first, by Hillaire's approximation: the second order gathered from 64
-//   directions with an isotropic phase, ground included, and the higher orders as the geometric
-//   series of the share the air scatters back, Ψ = L₂ / (1 − f) (made when the atmosphere
-//   changes).
+//   scattering above the first, as six terms of an expansion in the view direction: the light
+//   reaching the point after one scattering, gathered from 256 directions with the true phases
+//   (ground included), projected on the spherical harmonics up to degree 2 and scattered on by
+//   the phases' Legendre moments; the orders above the second as Hillaire's geometric series of
+//   the share the air scatters back, 1 / (1 − f), on the constant term (made when the atmosphere
+//   changes; twin `reference::atmosphere::multiple`, which says why).
 // - `sky_view_lut`: per view direction from the camera's altitude, the light the air scatters
 //   towards it (single scattering with the true phases and the sun's transmittance from the
-//   table, plus Ψ), up to the ground or the top (made each frame: it depends on the camera's
-//   altitude and the sun).
+//   table, plus the higher orders towards it), up to the ground or the top (made each frame: it
+//   depends on the camera's altitude and the sun).
 // - `irradiance_lut`: per (altitude, sun's zenith cosine), the sky's light on a level surface,
 //   gathered from the upper hemisphere (made when the atmosphere changes), which lights the
 //   ground and the plants beside the sun (`shared/air.wgsl`); `daylight_balance` from it and
@@ -62,9 +64,10 @@ fn ray_length(r: f32, mu: f32) -> f32 {
     return distance_to_top(r, mu);
 }
 
-// The second order's light along a ray, gathered with an isotropic phase, the ground's
-// Lambertian light where it ends there (xyz of `radiance`), and the share of light the air
-// scatters along it (`scattered`, Hillaire's f).
+// The light reaching radius r from a direction at zenith cosine μ after one scattering (the true
+// phases, the sun at `mu_sun` and cosine ν with the direction; the ground's Lambertian light
+// where the ray ends on it), and the share of light the air scatters along it (`scattered`,
+// Hillaire's f).
 struct SecondOrder {
     radiance: vec3<f32>,
     scattered: vec3<f32>,
@@ -72,14 +75,16 @@ struct SecondOrder {
 
 fn second_order(r: f32, mu: f32, mu_sun: f32, nu: f32) -> SecondOrder {
     let length = ray_length(r, mu);
+    let rayleigh = rayleigh_phase(nu);
+    let mie = mie_phase(nu);
     var seen = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
     var scattered = vec3<f32>(0.0);
     for (var k = 0u; k < MULTIPLE_STEPS; k++) {
         let s = ray_step(r, mu, mu_sun, nu, k, MULTIPLE_STEPS, length);
-        let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
-        radiance += seen * sun_transmittance(s.r, s.mu_sun) * scattering / (4.0 * PI) * s.kept;
-        scattered += seen * scattering * s.kept;
+        let source = s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie;
+        radiance += seen * sun_transmittance(s.r, s.mu_sun) * source * s.kept;
+        scattered += seen * (s.medium.rayleigh_scattering + s.medium.mie_scattering) * s.kept;
         seen *= s.through;
     }
     if hits_ground(r, mu) {
@@ -90,8 +95,8 @@ fn second_order(r: f32, mu: f32, mu_sun: f32, nu: f32) -> SecondOrder {
     return SecondOrder(radiance, scattered);
 }
 
-// The sky's light along a ray: single scattering with the true phases, plus Ψ, up to the ground
-// or the top.
+// The sky's light along a ray: single scattering with the true phases, plus the higher orders
+// towards the view, up to the ground or the top.
 fn in_scattered(r: f32, mu: f32, mu_sun: f32, nu: f32) -> vec3<f32> {
     let length = ray_length(r, mu);
     let rayleigh = rayleigh_phase(nu);
@@ -100,17 +105,18 @@ fn in_scattered(r: f32, mu: f32, mu_sun: f32, nu: f32) -> vec3<f32> {
     var radiance = vec3<f32>(0.0);
     for (var k = 0u; k < SKY_VIEW_STEPS; k++) {
         let s = ray_step(r, mu, mu_sun, nu, k, SKY_VIEW_STEPS, length);
-        radiance += seen * sky_source(s, rayleigh, mie) * s.kept;
+        radiance += seen * sky_source(s, nu, rayleigh, mie) * s.kept;
         seen *= s.through;
     }
     return radiance;
 }
 
 // (r, μ_sun) of a texel of a table in the multiple-scattering table's parametrisation
-// (`multiple_unit`: x the sun's zenith cosine from −1 to 1, y the altitude).
+// (`multiple_unit`: x the sun's zenith cosine as a signed square root, y the altitude).
 fn multiple_r_mu_sun(texel: vec2<u32>, size: vec2<u32>) -> vec2<f32> {
     let unit = lut_unit(texel, size);
-    return vec2<f32>(bottom_km() + unit.y * (top_km() - bottom_km()), 2.0 * unit.x - 1.0);
+    let s = 2.0 * unit.x - 1.0;
+    return vec2<f32>(bottom_km() + unit.y * (top_km() - bottom_km()), s * abs(s));
 }
 
 // Direction `i` of a `side` × `side` grid even in azimuth and in the zenith cosine, which runs
@@ -120,6 +126,11 @@ fn grid_direction(i: u32, side: u32, mu_from: f32, mu_to: f32) -> vec3<f32> {
     let mu = mu_from + (mu_to - mu_from) * (f32(i / side) + 0.5) / f32(side);
     let sin_theta = sqrt(max(1.0 - mu * mu, 0.0));
     return vec3<f32>(sin_theta * cos(azimuth), sin_theta * sin(azimuth), mu);
+}
+
+// 1 / ∫ b² dω over the sphere of each of the terms' functions (`multiple_basis_of`).
+fn multiple_basis_weight(j: u32) -> f32 {
+    return array<f32, MULTIPLE_TERMS>(1.0 / 4.0, 3.0 / 4.0, 3.0 / 4.0, 5.0 / 16.0, 15.0 / 4.0, 15.0 / 16.0)[j] / PI;
 }
 
 @compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
@@ -132,20 +143,36 @@ fn multiple_scattering_lut(@builtin(global_invocation_id) id: vec3<u32>) {
     let r = r_mu_sun.x;
     let mu_sun = r_mu_sun.y;
     let sun = vec3<f32>(sqrt(max(1.0 - mu_sun * mu_sun, 0.0)), 0.0, mu_sun);
-    var second = vec3<f32>(0.0);
+    var sums: array<vec3<f32>, MULTIPLE_TERMS>;
     var scattered = vec3<f32>(0.0);
     let side = MULTIPLE_DIRECTIONS_SIDE;
     for (var i = 0u; i < side * side; i++) {
-        // Uniform over the sphere.
+        // Uniform over the sphere, each direction 4π / N steradians.
         let dir = grid_direction(i, side, 1.0, -1.0);
         let gathered = second_order(r, dir.z, mu_sun, dot(dir, sun));
-        second += gathered.radiance;
+        let basis = multiple_basis_of(dir);
+        for (var j = 0u; j < MULTIPLE_TERMS; j++) {
+            sums[j] += gathered.radiance * basis[j];
+        }
         scattered += gathered.scattered;
     }
-    // Each direction weighs 4π / N steradians times the isotropic phase 1 / 4π.
     let n = f32(side * side);
-    let psi = (second / n) / (vec3<f32>(1.0) - scattered / n);
-    textureStore(multiple_out, id.xy, vec4<f32>(psi, 1.0));
+    // Each degree scattered on by the phases' moment, mixed by the share of Mie scattering here;
+    // the constant term carries the higher orders' series.
+    let medium = medium_at(r - bottom_km());
+    let mie = vec3<f32>(medium.mie_scattering)
+        / max(medium.rayleigh_scattering + vec3<f32>(medium.mie_scattering), vec3<f32>(1e-12));
+    let moments = atmosphere.phase_moments;
+    let k = array<vec3<f32>, 3>(
+        vec3<f32>(1.0) / (vec3<f32>(1.0) - scattered / n),
+        mie * moments.y,
+        (vec3<f32>(1.0) - mie) * moments.x + mie * moments.z,
+    );
+    let degree = array<u32, MULTIPLE_TERMS>(0u, 1u, 1u, 2u, 2u, 2u);
+    for (var j = 0u; j < MULTIPLE_TERMS; j++) {
+        let term = sums[j] * (4.0 * PI / n) * multiple_basis_weight(j) * k[degree[j]];
+        textureStore(multiple_out, id.xy + vec2<u32>(j * size.x, 0u), vec4<f32>(term, 1.0));
+    }
 }
 
 @compute @workgroup_size(ATMOSPHERE_WORKGROUP, ATMOSPHERE_WORKGROUP)
@@ -191,7 +218,7 @@ fn aerial_perspective_lut(@builtin(global_invocation_id) id: vec3<u32>) {
         let dt = (end - t) / f32(AERIAL_SUBSTEPS);
         for (var k = 0u; k < AERIAL_SUBSTEPS; k++) {
             let s = ray_step_at(r, mu, mu_sun, nu, t + (f32(k) + 0.5) * dt, dt);
-            light += seen * sky_source(s, rayleigh, mie) * s.kept;
+            light += seen * sky_source(s, nu, rayleigh, mie) * s.kept;
             seen *= s.through;
         }
         t = end;

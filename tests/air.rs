@@ -27,7 +27,7 @@ const TABLE_OFF: f32 = 1e-3;
 /// The irradiance table's sky light on level ground at sea level against the brute force's,
 /// relative, per channel (the table gathers the tables' sky from 64 directions; the truth
 /// integrates its own sky over 256).
-const IRRADIANCE_OFF: f64 = 0.08;
+const IRRADIANCE_OFF: f64 = 0.05;
 /// A frame's light through the air against the twin's air over the same frame's light without
 /// it, in levels of 8-bit sRGB: most pixels within `AIR_LEVELS`...
 const AIR_LEVELS: i32 = 2;

@@ -18,9 +18,10 @@ use terramp_testkit::camera::over_fraction;
 use terramp_testkit::{gpu, renderer, small_settings, synth_dataset};
 
 /// The tables' sky against the brute force's, relative luminance: the mean and the largest over
-/// the sample. Hillaire's isotropic multiple scattering is the limit: the single scattering
-/// agrees within 0.3 %, the higher orders by −25 % to +17 % by direction (docs/atmosphere.md).
-const SKY_MEAN_ERROR: f64 = 0.025;
+/// the sample, the bounds (docs/atmosphere.md: 1.1 % and 5.9 % on this sample). The
+/// single scattering agrees within 1 %; the higher orders, expanded to degree 2 in the view
+/// direction, are the rest.
+const SKY_MEAN_ERROR: f64 = 0.02;
 const SKY_MAX_ERROR: f64 = 0.10;
 
 /// Relative errors are taken against at least this luminance, per unit of the sun's irradiance
@@ -30,10 +31,12 @@ const LUMINANCE_FLOOR: f64 = 1e-4;
 
 /// The GPU's tables against the twin's: the transmittance's optical depth, relative...
 const DEPTH_OFF: f32 = 5e-4;
-/// ... the multiple-scattering and sky-view texels, relative...
-const TABLE_OFF: f32 = 1e-3;
-/// ... the sky-view texels, stored as f16: that, and a step of f16 (2⁻¹⁰) where the two round
-/// either side of one...
+/// ... the multiple-scattering texels, relative: each sums 5,120 f32 steps, and with the sun 5° to
+/// 10° below the horizon high in the air the rays to it graze the Earth, where the adapter's
+/// cosine moves which of them it hides (1.3 × 10⁻³ seen on lavapipe, 60 to 100 km up)...
+const MULTIPLE_OFF: f32 = 2e-3;
+/// ... the sky-view texels, relative, stored as f16: 10⁻³ for their f32 sums, and a step of f16
+/// (2⁻¹⁰) where the two round either side of one...
 const SKY_VIEW_OFF: f32 = 3e-3;
 /// ... and the sky-view rows just below the horizon, whose rays graze the ground.
 const GRAZING_OFF: f32 = 2e-2;
@@ -140,11 +143,11 @@ fn the_gpu_makes_the_twins_tables() {
             .map(|c| (twin[texel][c] - gpu[texel][c]).abs() / twin[texel][c].abs().max(floor))
             .fold(0.0f32, f32::max)
     };
-    // The others sum thousands of f32 steps each: 10⁻³ of a texel's value...
+    // The others sum thousands of f32 steps each, relative to each texel...
     let multiple_off = (0..multiple.texels.len())
         .map(|i| off(&multiple.texels, &read[1], i, multiple_floor))
         .fold(0.0, f32::max);
-    assert!(multiple_off < TABLE_OFF, "multiple scattering off the twin by {multiple_off:e}");
+    assert!(multiple_off < MULTIPLE_OFF, "multiple scattering off the twin by {multiple_off:e}");
     // ... except in the sky-view table's rows just below the horizon: their rays graze the
     // ground, and the adapter's cos (Vulkan allows 2⁻¹¹ of absolute error) moves where.
     let [width, height] = sky_view.size.map(|s| s as usize);
@@ -298,6 +301,72 @@ fn the_parts_of_the_sky() {
             format!("{lo:.3} to {hi:.3}")
         };
         println!("| {} km | {sun_deg}° | {} | {} | {} |", altitude_m / 1000.0, range(0), range(1), range(2));
+    }
+}
+
+#[test]
+#[ignore = "minutes: the table of sizes in docs/atmosphere.md"]
+fn what_each_table_size_buys() {
+    // The sky against the brute force as each table's size changes, the others at their defaults:
+    // 48 directions × 6 suns from 0° to 90° × 3 views, 1,024 paths each, the truth computed once.
+    let base = settings();
+    let cases: Vec<(f64, bool, f64)> = [(0.0, true), (10_000.0, false), (100_000.0, false)]
+        .into_iter()
+        .flat_map(|(a, upper)| [0.0, 5.0, 10.0, 20.0, 40.0, 90.0].map(|sun| (a, upper, sun)))
+        .collect();
+    let brute = Brute::new(base.air);
+    let truths: Vec<Vec<(DVec3, f64)>> = cases
+        .iter()
+        .map(|&(altitude_m, upper, sun_deg)| {
+            let u = atmosphere_uniforms(&base, &view(altitude_m, sun_deg));
+            let origin = DVec3::new(0.0, 0.0, f64::from(u.radii[2]));
+            directions(48, upper)
+                .into_par_iter()
+                .enumerate()
+                .filter(|(_, d)| d.dot(sun(sun_deg)) < (4.0 * base.air.sun_angular_radius_rad).cos())
+                .map(|(i, d)| {
+                    (d, luminance(brute.sky(origin, d, sun(sun_deg), 1024, i as u64 * 7919 + 1).radiance()))
+                })
+                .collect()
+        })
+        .collect();
+    type Size = fn(&mut AtmosphereSettings) -> &mut [u32; 2];
+    let tables_of: [(&str, Size, &[[u32; 2]]); 3] = [
+        ("transmittance", |s| &mut s.transmittance_lut, &[[64, 16], [128, 32], [256, 64], [512, 128]]),
+        ("multiple scattering", |s| &mut s.multiple_scattering_lut, &[[8, 8], [16, 16], [32, 32], [64, 64]]),
+        ("sky view", |s| &mut s.sky_view_lut, &[[48, 27], [96, 54], [192, 108], [384, 216]]),
+    ];
+    println!("| table | size | mean | max |");
+    println!("|---|---|---|---|");
+    for (name, size_of, sizes) in tables_of {
+        for &size in sizes {
+            let mut s = base.clone();
+            *size_of(&mut s) = size;
+            let pairs: Vec<(f64, f64, f64)> = cases
+                .iter()
+                .zip(&truths)
+                .flat_map(|(&(altitude_m, _, sun_deg), truth)| {
+                    let u = atmosphere_uniforms(&s, &view(altitude_m, sun_deg));
+                    let (transmittance, multiple, sky_view) = tables(&u);
+                    let lut = Tables {
+                        model: Model::new(&u),
+                        transmittance: &transmittance,
+                        multiple: Some(&multiple),
+                    };
+                    truth
+                        .iter()
+                        .map(|&(d, reference)| {
+                            let table =
+                                luminance(lut.sky_radiance(&sky_view, d.as_vec3()).as_dvec3().to_array());
+                            (reference, table, 0.0)
+                        })
+                        .collect::<Vec<_>>()
+                })
+                .collect();
+            let (mean, max) = errors(&pairs, LUMINANCE_FLOOR);
+            assert!(mean.is_finite() && max.is_finite(), "{name} {size:?}");
+            println!("| {name} | {} × {} | {:.2} % | {:.2} % |", size[0], size[1], mean * 100.0, max * 100.0);
+        }
     }
 }
 

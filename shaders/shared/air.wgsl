@@ -93,7 +93,7 @@ fn air_marched(rel_m: vec3<f32>) -> AirBetween {
     for (var k = 0u; k < SKY_VIEW_STEPS; k++) {
         let segment = ray_segment(k, SKY_VIEW_STEPS, length);
         let s = ray_step_at(r, mu, atmosphere.radii.w, nu, distance_km - segment.x, segment.y);
-        light = sky_source(s, rayleigh, mie) * s.kept + s.through * light;
+        light = sky_source(s, nu, rayleigh, mie) * s.kept + s.through * light;
         seen *= s.through;
     }
     return AirBetween(light, seen);

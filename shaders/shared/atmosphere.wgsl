@@ -6,6 +6,7 @@
 struct AtmosphereUniforms {
     rayleigh: vec4<f32>,
     mie: vec4<f32>,
+    phase_moments: vec4<f32>,
     ozone: vec4<f32>,
     albedo: vec4<f32>,
     radii: vec4<f32>,
@@ -92,18 +93,60 @@ fn sun_transmittance(r: f32, mu_sun: f32) -> vec3<f32> {
     return lut_read(transmittance, atmosphere.transmittance_size, transmittance_unit(r, mu_sun));
 }
 
-// Ψ, the light of every order above the first, at radius r for the sun at zenith cosine
-// `mu_sun`. Reads the includer's `multiple` table.
-fn multiple_scattering(r: f32, mu_sun: f32) -> vec3<f32> {
-    return lut_read(multiple, atmosphere.multiple_size, multiple_unit(r, mu_sun));
+// The multiple-scattering table's terms' functions of a unit direction in the frame whose x
+// points to the sun's azimuth and z up: the real spherical harmonics up to degree 2 that are even
+// across the sun's vertical plane (twin: `reference::atmosphere::multiple`).
+fn multiple_basis_of(d: vec3<f32>) -> array<f32, MULTIPLE_TERMS> {
+    return array<f32, MULTIPLE_TERMS>(1.0, d.z, d.x, 3.0 * d.z * d.z - 1.0, d.x * d.z, d.x * d.x - d.y * d.y);
+}
+
+// The same for a view at zenith cosine μ, the sun at zenith cosine `mu_sun` and cosine ν with it.
+// With the sun at the zenith the frame's x is any horizontal, and the terms that hold it are
+// nought there.
+fn multiple_basis(mu: f32, mu_sun: f32, nu: f32) -> array<f32, MULTIPLE_TERMS> {
+    let sin_sun = sqrt(max(1.0 - mu_sun * mu_sun, 0.0));
+    let ring = sqrt(max(1.0 - mu * mu, 0.0));
+    var x = 0.0;
+    if sin_sun > 1e-4 {
+        x = clamp((nu - mu * mu_sun) / sin_sun, -ring, ring);
+    }
+    return multiple_basis_of(vec3<f32>(x, sqrt(max(ring * ring - x * x, 0.0)), mu));
+}
+
+// The light of every order above the first that the air at radius r scatters towards a view at
+// zenith cosine μ, per unit of scattering, the sun at zenith cosine `mu_sun` and cosine ν with
+// the view: the table's terms at (r, μ_sun) times their functions of the view. Reads the
+// includer's `multiple` table. Written out term by term, the texel and its weights found once:
+// the lit passes march this per fragment from high up, where lavapipe pays for every address.
+fn multiple_scattering(r: f32, mu: f32, mu_sun: f32, nu: f32) -> vec3<f32> {
+    let size = atmosphere.multiple_size;
+    let x = clamp(multiple_unit(r, mu_sun), vec2<f32>(0.0), vec2<f32>(1.0)) * vec2<f32>(size - 1u);
+    let base = min(vec2<u32>(floor(x)), size - 2u);
+    let f = x - vec2<f32>(base);
+    let b = multiple_basis(mu, mu_sun, nu);
+    let psi = multiple_term(base, f, 0u) * b[0] + multiple_term(base, f, 1u) * b[1] + multiple_term(base, f, 2u) * b[2]
+        + multiple_term(base, f, 3u) * b[3] + multiple_term(base, f, 4u) * b[4] + multiple_term(base, f, 5u) * b[5];
+    return max(psi, vec3<f32>(0.0));
+}
+
+// Term `term` of the multiple-scattering table between the texels from `base` on, weighed by `f`
+// (`lut_read`'s reads and weights).
+fn multiple_term(base: vec2<u32>, f: vec2<f32>, term: u32) -> vec3<f32> {
+    let at = base + vec2<u32>(term * atmosphere.multiple_size.x, 0u);
+    let a = textureLoad(multiple, at, 0).rgb;
+    let b = textureLoad(multiple, at + vec2<u32>(1u, 0u), 0).rgb;
+    let c = textureLoad(multiple, at + vec2<u32>(0u, 1u), 0).rgb;
+    let d = textureLoad(multiple, at + vec2<u32>(1u, 1u), 0).rgb;
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
 // One segment of a ray from (r, μ) for the sun at zenith cosine `mu_sun` and cosine `nu` with
-// the ray: the radius and the sun's zenith cosine at its midpoint, the medium there, and the
+// the ray: the radius, the ray's and the sun's zenith cosines at its midpoint, the medium there, and the
 // segment's integral of its own falling transmittance, ∫ e^(−σt) dt = (1 − e^(−σ dt)) / σ
 // (Hillaire's energy-conserving step), with its transmittance e^(−σ dt).
 struct RayStep {
     r: f32,
+    mu: f32,
     mu_sun: f32,
     medium: Medium,
     kept: vec3<f32>,
@@ -118,19 +161,21 @@ fn ray_step(r: f32, mu: f32, mu_sun: f32, nu: f32, k: u32, steps: u32, length: f
 // The segment `dt` long around `t` km along the ray.
 fn ray_step_at(r: f32, mu: f32, mu_sun: f32, nu: f32, t: f32, dt: f32) -> RayStep {
     let r_t = radius_along(r, mu, t);
+    let mu_t = clamp((r * mu + t) / r_t, -1.0, 1.0);
     let mu_sun_t = clamp((r * mu_sun + t * nu) / r_t, -1.0, 1.0);
     let medium = medium_at(r_t - bottom_km());
     let through = exp(-medium.extinction * dt);
     let kept = (vec3<f32>(1.0) - through) / max(medium.extinction, vec3<f32>(1e-12));
-    return RayStep(r_t, mu_sun_t, medium, kept, through);
+    return RayStep(r_t, mu_t, mu_sun_t, medium, kept, through);
 }
 
 // What a segment scatters towards the view per unit length: single scattering with the true
-// phases (`rayleigh`, `mie` at the view's angle to the sun) and Ψ.
-fn sky_source(s: RayStep, rayleigh: f32, mie: f32) -> vec3<f32> {
+// phases (`rayleigh`, `mie` at the view's angle to the sun, whose cosine is ν) and the higher
+// orders towards the view.
+fn sky_source(s: RayStep, nu: f32, rayleigh: f32, mie: f32) -> vec3<f32> {
     let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
     return sun_transmittance(s.r, s.mu_sun) * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
-        + multiple_scattering(s.r, s.mu_sun) * scattering;
+        + multiple_scattering(s.r, s.mu, s.mu_sun, nu) * scattering;
 }
 
 // A radiance times π (what a white Lambertian surface sends under that irradiance) as the frame
@@ -189,9 +234,11 @@ fn transmittance_r_mu(unit: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(r, mu);
 }
 
-// The multiple-scattering table: x the sun's zenith cosine from −1 to 1, y the altitude.
+// The multiple-scattering table: x the sun's zenith cosine from −1 to 1 as the signed square
+// root of its magnitude (fine about the horizon, where twilight falls by orders of magnitude
+// within a few degrees and a linear x would read the chord of that fall), y the altitude.
 fn multiple_unit(r: f32, mu_sun: f32) -> vec2<f32> {
-    return vec2<f32>(0.5 * mu_sun + 0.5, (r - bottom_km()) / (top_km() - bottom_km()));
+    return vec2<f32>(0.5 + 0.5 * sign(mu_sun) * sqrt(abs(mu_sun)), (r - bottom_km()) / (top_km() - bottom_km()));
 }
 
 // The zenith angle of the horizon seen from radius r (90° on the ground, more above it).

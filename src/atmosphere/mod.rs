@@ -166,6 +166,21 @@ pub fn mie_phase(nu: f64, g: f64) -> f64 {
     k * (1.0 + nu * nu) / (1.0 + g * g - 2.0 * g * nu).powf(1.5)
 }
 
+/// The first two Legendre moments of a phase function of the scattering angle's cosine, per
+/// steradian: k₁ = ⟨ν⟩ (the mean cosine) and k₂ = ⟨P₂(ν)⟩ over the sphere. Scattering light
+/// whose angular distribution is a spherical harmonic of degree l multiplies it by k_l (the
+/// Funk–Hecke theorem): what the multiple-scattering table's expansion weighs its degrees by.
+/// Midpoint rule in ν over 4,000 bands (the Mie peak at g = 0.8 is 0.3 wide in ν).
+pub fn legendre_moments(phase: impl Fn(f64) -> f64) -> [f64; 2] {
+    let bands = 4_000;
+    let width = 2.0 / bands as f64;
+    (0..bands).fold([0.0; 2], |[k1, k2], i| {
+        let nu = -1.0 + (i as f64 + 0.5) * width;
+        let weight = phase(nu) * 2.0 * std::f64::consts::PI * width;
+        [k1 + weight * nu, k2 + weight * (1.5 * nu * nu - 0.5)]
+    })
+}
+
 /// The nearest positive distance along the unit `dir` from `origin` to a sphere of `radius`
 /// around the origin, where the ray enters or leaves it ahead.
 pub fn nearest_hit(origin: DVec3, dir: DVec3, radius: f64) -> Option<f64> {
@@ -212,6 +227,22 @@ mod tests {
         };
         assert!((integral(&rayleigh_phase) - 1.0).abs() < 1e-6);
         assert!((integral(&|nu| mie_phase(nu, 0.8)) - 1.0).abs() < 1e-4);
+    }
+
+    /// The moments by quadrature against their closed forms.
+    const PUBLISHED_OFF: f64 = 1e-4;
+
+    #[test]
+    fn the_phase_functions_moments_are_the_published_ones() {
+        // Rayleigh's phase is (1 + ν²) 3/16π: no mean cosine, k₂ = 1/10.
+        let [k1, k2] = legendre_moments(rayleigh_phase);
+        assert!(k1.abs() < PUBLISHED_OFF && (k2 - 0.1).abs() < PUBLISHED_OFF, "{k1} {k2}");
+        // Cornette and Shanks (1992) give their function's mean cosine as 3g(4 + g²) / 5(2 + g²).
+        for g in [0.0, 0.5, 0.8] {
+            let [k1, _] = legendre_moments(|nu| mie_phase(nu, g));
+            let published = 3.0 * g * (4.0 + g * g) / (5.0 * (2.0 + g * g));
+            assert!((k1 - published).abs() < PUBLISHED_OFF, "g {g}: {k1} against {published}");
+        }
     }
 
     #[test]

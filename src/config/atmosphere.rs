@@ -16,7 +16,8 @@ const MAX_TABLE_SIDE: u32 = 4096;
 pub struct AtmosphereSettings {
     /// The transmittance table's width (view zenith) and height (altitude), texels.
     pub transmittance_lut: [u32; 2],
-    /// The multiple-scattering table's width (sun zenith) and height (altitude), texels.
+    /// The multiple-scattering table's width (sun zenith) and height (altitude), texels, per
+    /// term of its expansion in the view direction (six side by side).
     pub multiple_scattering_lut: [u32; 2],
     /// The sky-view table's width (azimuth) and height (zenith), texels.
     pub sky_view_lut: [u32; 2],

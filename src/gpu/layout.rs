@@ -5,8 +5,9 @@
 //! shift or a mask is never written by hand on either side. This module imports nothing of the
 //! crate: anything may depend on it, and it on nothing.
 //!
-//! To add a constant the shaders see: add it to one of the `wgsl_constants!` blocks below. That is
-//! the only file to touch; the shader then names it. The two macros and the types they describe
+//! To add a constant the shaders see: add it to one of the `wgsl_constants!` blocks below (the
+//! atmosphere's are in `layout/atmosphere.rs`, included here). That is the only place to touch;
+//! the shader then names it. The two macros and the types they describe
 //! words with live in `words.rs`, which imports nothing of the crate either.
 
 #[macro_use]
@@ -332,37 +333,8 @@ wgsl_constants! { earth_constants:
     pub const EARTH_PROBE_WORKGROUP: u32 = 64;
 }
 
-// --- The atmosphere (`atmosphere`, `passes::atmosphere`) ---
-wgsl_constants! { atmosphere_constants:
-    /// π in f32, for the phase functions and the sky's angles.
-    pub const PI: f32 = std::f32::consts::PI;
-    /// Texels per side of a workgroup of the atmosphere's tables.
-    pub const ATMOSPHERE_WORKGROUP: u32 = 8;
-    /// Segments of the quadrature from a point to the top of the air (the transmittance table).
-    pub const TRANSMITTANCE_STEPS: u32 = 40;
-    /// Directions per side of the grid the multiple-scattering table gathers over (8 × 8 = 64
-    /// over the sphere, Hillaire's count).
-    pub const MULTIPLE_DIRECTIONS_SIDE: u32 = 8;
-    /// Segments along each of those directions.
-    pub const MULTIPLE_STEPS: u32 = 20;
-    /// Segments along a view ray of the sky-view table (and of the sky marched per pixel).
-    pub const SKY_VIEW_STEPS: u32 = 30;
-    /// Views higher than this above the ground, km, march the sky per pixel: from there the
-    /// limb's rows of the sky-view table span more than the air's scale height (docs/atmosphere.md).
-    pub const SKY_MARCHED_ABOVE_KM: f32 = 30.0;
-    /// Segments per slice of the aerial-perspective volume.
-    pub const AERIAL_SUBSTEPS: u32 = 4;
-    /// Directions per side of the grid the sky-irradiance table gathers over (8 × 8 = 64 over
-    /// the upper hemisphere).
-    pub const IRRADIANCE_DIRECTIONS_SIDE: u32 = 8;
-    /// The sun's zenith cosine of the daylight the frame's light is balanced for (45°): level
-    /// white ground at sea level under it, sun and sky, is 1 (`daylight_balance`).
-    pub const DAYLIGHT_SUN_COS: f32 = 0.70710677;
-    /// The most balanced light a pass writes (`balanced`): the colour target's f16 holds up to
-    /// 65,504, and the sun's disk above the air is about 72,000 times white ground (its
-    /// irradiance over its solid angle, 1 / (π 0.004675²), times π and the daylight balance).
-    pub const SCENE_LIGHT_MAX: f32 = 60000.0;
-}
+// --- The atmosphere (`atmosphere`, `passes::atmosphere`): its block, included ---
+include!("layout/atmosphere.rs");
 
 // --- Wind (`seeds::wind`) ---
 wgsl_constants! { wind_constants:

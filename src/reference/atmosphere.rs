@@ -6,14 +6,12 @@
 //! model (`atmosphere::brute`) judges them both.
 
 pub mod light;
+mod multiple;
 
 use glam::{Vec2, Vec3, Vec4Swizzles};
 
 use crate::gpu::gpu_types::AtmosphereUniforms;
-use crate::gpu::layout::{
-    AERIAL_SUBSTEPS, MULTIPLE_DIRECTIONS_SIDE, MULTIPLE_STEPS, PI, SKY_MARCHED_ABOVE_KM, SKY_VIEW_STEPS,
-    TRANSMITTANCE_STEPS,
-};
+use crate::gpu::layout::{AERIAL_SUBSTEPS, PI, SKY_MARCHED_ABOVE_KM, SKY_VIEW_STEPS, TRANSMITTANCE_STEPS};
 
 /// One table: its size and texels, row by row (rgb used, a = 1).
 #[derive(Debug, Clone, PartialEq)]
@@ -37,17 +35,25 @@ impl Lut {
         Vec3::from_slice(&self.texels[(y * self.size[0] + x) as usize][..3])
     }
 
+    /// `read` within block `j` of `blocks` of equal width side by side (the shaders'
+    /// `multiple_term`).
+    pub fn read_block(&self, j: u32, blocks: u32, unit: Vec2) -> Vec3 {
+        let width = self.size[0] / blocks;
+        let last = Vec2::new((width - 1) as f32, (self.size[1] - 1) as f32);
+        let x = unit.clamp(Vec2::ZERO, Vec2::ONE) * last;
+        let base = [(x.x.floor() as u32).min(width - 2), (x.y.floor() as u32).min(self.size[1] - 2)];
+        let f = x - Vec2::new(base[0] as f32, base[1] as f32);
+        let x0 = j * width + base[0];
+        let a = self.load(x0, base[1]);
+        let b = self.load(x0 + 1, base[1]);
+        let c = self.load(x0, base[1] + 1);
+        let d = self.load(x0 + 1, base[1] + 1);
+        mix(mix(a, b, f.x), mix(c, d, f.x), f.y)
+    }
+
     /// `lut_read`: bilinear between the texels around `unit`, the grid spanning the unit square.
     pub fn read(&self, unit: Vec2) -> Vec3 {
-        let last = Vec2::new((self.size[0] - 1) as f32, (self.size[1] - 1) as f32);
-        let x = unit.clamp(Vec2::ZERO, Vec2::ONE) * last;
-        let base = [(x.x.floor() as u32).min(self.size[0] - 2), (x.y.floor() as u32).min(self.size[1] - 2)];
-        let f = x - Vec2::new(base[0] as f32, base[1] as f32);
-        let a = self.load(base[0], base[1]);
-        let b = self.load(base[0] + 1, base[1]);
-        let c = self.load(base[0], base[1] + 1);
-        let d = self.load(base[0] + 1, base[1] + 1);
-        mix(mix(a, b, f.x), mix(c, d, f.x), f.y)
+        self.read_block(0, 1, unit)
     }
 }
 
@@ -63,6 +69,7 @@ struct Medium {
 
 struct RayStep {
     r: f32,
+    mu: f32,
     mu_sun: f32,
     medium: Medium,
     kept: Vec3,
@@ -147,15 +154,18 @@ impl<'a> Model<'a> {
         (r, mu)
     }
 
+    /// `multiple_unit`: x the sun's zenith cosine as a signed square root, y the altitude.
     fn multiple_unit(&self, r: f32, mu_sun: f32) -> Vec2 {
-        Vec2::new(0.5 * mu_sun + 0.5, (r - self.bottom()) / (self.top() - self.bottom()))
+        let x = 0.5 + 0.5 * mu_sun.signum() * mu_sun.abs().sqrt();
+        Vec2::new(x, (r - self.bottom()) / (self.top() - self.bottom()))
     }
 
     /// `multiple_r_mu_sun`: (r, μ_sun) of a texel of a table in the multiple-scattering table's
     /// parametrisation.
     fn multiple_r_mu_sun(&self, texel: [u32; 2], size: [u32; 2]) -> (f32, f32) {
         let unit = lut_unit(texel, size);
-        (self.bottom() + unit.y * (self.top() - self.bottom()), 2.0 * unit.x - 1.0)
+        let s = 2.0 * unit.x - 1.0;
+        (self.bottom() + unit.y * (self.top() - self.bottom()), s * s.abs())
     }
 
     fn horizon_zenith(&self, r: f32) -> f32 {
@@ -243,10 +253,6 @@ impl Tables<'_> {
         self.transmittance.read(self.model.transmittance_unit(r, mu_sun))
     }
 
-    fn multiple_scattering(&self, r: f32, mu_sun: f32) -> Vec3 {
-        self.multiple.map_or(Vec3::ZERO, |lut| lut.read(self.model.multiple_unit(r, mu_sun)))
-    }
-
     fn ray_length(&self, r: f32, mu: f32) -> f32 {
         let m = &self.model;
         if m.hits_ground(r, mu) { m.distance_to_bottom(r, mu) } else { m.distance_to_top(r, mu) }
@@ -263,40 +269,20 @@ impl Tables<'_> {
     fn ray_step_at(&self, r: f32, mu: f32, mu_sun: f32, nu: f32, t: f32, dt: f32) -> RayStep {
         let m = &self.model;
         let r_t = m.radius_along(r, mu, t);
+        let mu_t = ((r * mu + t) / r_t).clamp(-1.0, 1.0);
         let mu_sun_t = ((r * mu_sun + t * nu) / r_t).clamp(-1.0, 1.0);
         let medium = m.medium(r_t - m.bottom());
         let through = (-medium.extinction * dt).exp();
         let kept = (Vec3::ONE - through) / medium.extinction.max(Vec3::splat(1e-12));
-        RayStep { r: r_t, mu_sun: mu_sun_t, medium, kept, through }
-    }
-
-    /// `second_order`: (radiance, share scattered along the ray).
-    fn second_order(&self, r: f32, mu: f32, mu_sun: f32, nu: f32) -> (Vec3, Vec3) {
-        let m = &self.model;
-        let length = self.ray_length(r, mu);
-        let (mut seen, mut radiance, mut scattered) = (Vec3::ONE, Vec3::ZERO, Vec3::ZERO);
-        for k in 0..MULTIPLE_STEPS {
-            let s = self.ray_step(r, mu, mu_sun, nu, k, MULTIPLE_STEPS, length);
-            let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
-            radiance += seen * self.sun_transmittance(s.r, s.mu_sun) * scattering / (4.0 * PI) * s.kept;
-            scattered += seen * scattering * s.kept;
-            seen *= s.through;
-        }
-        if m.hits_ground(r, mu) {
-            let r_g = m.bottom();
-            let mu_sun_g = ((r * mu_sun + length * nu) / r_g).clamp(-1.0, 1.0);
-            let albedo = Vec3::from_slice(&m.u.albedo[..3]);
-            radiance += seen * self.sun_transmittance(r_g, mu_sun_g) * mu_sun_g.max(0.0) * albedo / PI;
-        }
-        (radiance, scattered)
+        RayStep { r: r_t, mu: mu_t, mu_sun: mu_sun_t, medium, kept, through }
     }
 
     /// `sky_source`.
-    fn sky_source(&self, s: &RayStep, rayleigh: f32, mie: f32) -> Vec3 {
+    fn sky_source(&self, s: &RayStep, nu: f32, rayleigh: f32, mie: f32) -> Vec3 {
         let scattering = s.medium.rayleigh_scattering + s.medium.mie_scattering;
         self.sun_transmittance(s.r, s.mu_sun)
             * (s.medium.rayleigh_scattering * rayleigh + s.medium.mie_scattering * mie)
-            + self.multiple_scattering(s.r, s.mu_sun) * scattering
+            + self.multiple_scattering(s.r, s.mu, s.mu_sun, nu) * scattering
     }
 
     /// `aerial_perspective_lut`, its texels rounded to f16 as the pass stores them.
@@ -331,7 +317,7 @@ impl Tables<'_> {
                     let dt = (end - t) / AERIAL_SUBSTEPS as f32;
                     for k in 0..AERIAL_SUBSTEPS {
                         let s = self.ray_step_at(r, mu, mu_sun, nu, t + (k as f32 + 0.5) * dt, dt);
-                        light += seen * self.sky_source(&s, rayleigh, mie) * s.kept;
+                        light += seen * self.sky_source(&s, nu, rayleigh, mie) * s.kept;
                         seen *= s.through;
                     }
                     t = end;
@@ -353,31 +339,10 @@ impl Tables<'_> {
         let (mut seen, mut radiance) = (Vec3::ONE, Vec3::ZERO);
         for k in 0..SKY_VIEW_STEPS {
             let s = self.ray_step(r, mu, mu_sun, nu, k, SKY_VIEW_STEPS, length);
-            radiance += seen * self.sky_source(&s, rayleigh, mie) * s.kept;
+            radiance += seen * self.sky_source(&s, nu, rayleigh, mie) * s.kept;
             seen *= s.through;
         }
         radiance
-    }
-
-    /// `multiple_scattering_lut` (the tables without one).
-    pub fn multiple_scattering_lut(&self) -> Lut {
-        let m = &self.model;
-        let size = m.u.multiple_size;
-        Lut::made(size, |texel| {
-            let (r, mu_sun) = m.multiple_r_mu_sun(texel, size);
-            let sun = Vec3::new((1.0 - mu_sun * mu_sun).max(0.0).sqrt(), 0.0, mu_sun);
-            let (mut second, mut scattered) = (Vec3::ZERO, Vec3::ZERO);
-            let side = MULTIPLE_DIRECTIONS_SIDE;
-            for i in 0..side * side {
-                // Uniform over the sphere.
-                let dir = grid_direction(i, side, 1.0, -1.0);
-                let (radiance, share) = self.second_order(r, dir.z, mu_sun, dir.dot(sun));
-                second += radiance;
-                scattered += share;
-            }
-            let n = (side * side) as f32;
-            (second / n) / (Vec3::ONE - scattered / n)
-        })
     }
 
     /// `sky_view_lut` (the tables with the multiple-scattering one), its texels rounded to f16

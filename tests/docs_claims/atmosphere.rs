@@ -1,8 +1,8 @@
 //! What docs/atmosphere.md quotes, and where each number is defined.
 
 use terramp::gpu::layout::{
-    FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, IRRADIANCE_DIRECTIONS_SIDE, SCENE_LIGHT_MAX,
-    SKY_MARCHED_ABOVE_KM,
+    FOLIAGE_SKY, FOLIAGE_SUN, FOLIAGE_SUN_WRAP, IRRADIANCE_DIRECTIONS_SIDE, MULTIPLE_DIRECTIONS_SIDE,
+    SCENE_LIGHT_MAX, SKY_MARCHED_ABOVE_KM,
 };
 use terramp::passes::atmosphere::gpu::air::AIR_GROUP;
 use terramp::passes::display::{SATURATION_CD_M2, SUN_ILLUMINANCE_LX};
@@ -10,6 +10,19 @@ use terramp::passes::display::{SATURATION_CD_M2, SUN_ILLUMINANCE_LX};
 use super::claims::{Claim, Source, grouped, km, percent, plain, sci, test_const};
 
 pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "it is gathered from {} × {} directions with the true phases at its first scattering",
+        values: &[
+            (Source::Value(MULTIPLE_DIRECTIONS_SIDE as f64), plain),
+            (Source::Value(MULTIPLE_DIRECTIONS_SIDE as f64), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/atmosphere.md",
+        quote: "whose k₁ is Cornette and Shanks' published mean cosine within {})",
+        values: &[(test_const("src/atmosphere/mod.rs", "PUBLISHED_OFF"), sci)],
+    },
     Claim {
         doc: "docs/atmosphere.md",
         quote: "the sky's light along that ray (the test allows {} % between the two quadratures) and the transmittance table's share (the test allows {} %)",
@@ -36,7 +49,7 @@ pub static ATMOSPHERE_CLAIMS: &[Claim] = &[
         quote: "equal it within {} of each transmittance's optical depth, {} of each multiple-scattering texel, {} of each sky-view texel (stored as f16, whose step is 2⁻¹⁰), and {} in the three",
         values: &[
             (test_const("tests/atmosphere.rs", "DEPTH_OFF"), sci),
-            (test_const("tests/atmosphere.rs", "TABLE_OFF"), sci),
+            (test_const("tests/atmosphere.rs", "MULTIPLE_OFF"), sci),
             (test_const("tests/atmosphere.rs", "SKY_VIEW_OFF"), sci),
             (test_const("tests/atmosphere.rs", "GRAZING_OFF"), sci),
         ],

@@ -13,6 +13,9 @@ gpu_struct! {
         pub rayleigh: [f32; 4],
         /// Mie scattering (x) and extinction (y) at the ground per km, scale height (z), g (w).
         pub mie: [f32; 4],
+        /// The phase functions' Legendre moments (`atmosphere::legendre_moments`): Rayleigh's
+        /// k₂ (x), the aerosols' k₁ and k₂ (y, z); unused (w).
+        pub phase_moments: [f32; 4],
         /// Ozone absorption at its peak per km (xyz), the peak's altitude (w).
         pub ozone: [f32; 4],
         /// The ground's albedo (xyz), the ozone tent's half width (w).

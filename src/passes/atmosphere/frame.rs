@@ -2,7 +2,7 @@
 
 use glam::{DMat4, DVec3};
 
-use crate::atmosphere::Atmosphere;
+use crate::atmosphere::{Atmosphere, legendre_moments, mie_phase, rayleigh_phase};
 use crate::config::AtmosphereSettings;
 use crate::gpu::gpu_types::AtmosphereUniforms;
 
@@ -40,9 +40,12 @@ pub fn atmosphere_uniforms(settings: &AtmosphereSettings, view: &SkyView) -> Atm
     let view_radius_km = a.bottom_radius_km + altitude_km.min(thickness_km);
     let f = |v: f64| v as f32;
     let rgb = |v: [f64; 3], w: f64| [f(v[0]), f(v[1]), f(v[2]), f(w)];
+    let rayleigh = legendre_moments(rayleigh_phase);
+    let mie = legendre_moments(|nu| mie_phase(nu, a.mie_g));
     AtmosphereUniforms {
         rayleigh: rgb(a.rayleigh_scattering_per_km, a.rayleigh_scale_height_km),
         mie: [f(a.mie_scattering_per_km), f(a.mie_extinction_per_km), f(a.mie_scale_height_km), f(a.mie_g)],
+        phase_moments: [f(rayleigh[1]), f(mie[0]), f(mie[1]), 0.0],
         ozone: rgb(a.ozone_absorption_per_km, a.ozone_centre_km),
         albedo: rgb(a.ground_albedo, a.ozone_half_width_km),
         radii: [

@@ -13,7 +13,7 @@ use crate::gpu::bindings::{Access, Binding, BindingTable};
 use crate::gpu::counter::Counting;
 use crate::gpu::counts::Part;
 use crate::gpu::gpu_types::AtmosphereUniforms;
-use crate::gpu::layout::{ATMOSPHERE_WORKGROUP, SKY_MARCHED_ABOVE_KM};
+use crate::gpu::layout::{ATMOSPHERE_WORKGROUP, MULTIPLE_TERMS, SKY_MARCHED_ABOVE_KM};
 use crate::gpu::readback::{f16_texels, read_buffer, read_texture_slices};
 use crate::gpu::resources::{buffer, compute_pipeline, depth_equal, frame_pass, pipeline_layout};
 use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
@@ -176,9 +176,15 @@ impl AtmospherePass {
             size_of::<[f32; 4]>() as u64,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         );
-        let table = |label: &str, size: [u32; 2], format| Table::new(device, label, size, format);
+        let table = |label: &str, size: [u32; 2], format| Table::new(device, label, size, 1, format);
         let transmittance = table("atmosphere transmittance", settings.transmittance_lut, LUT_FORMAT);
-        let multiple = table("atmosphere multiple scattering", settings.multiple_scattering_lut, LUT_FORMAT);
+        let multiple = Table::new(
+            device,
+            "atmosphere multiple scattering",
+            settings.multiple_scattering_lut,
+            MULTIPLE_TERMS,
+            LUT_FORMAT,
+        );
         let sky_view = table("atmosphere sky view", settings.sky_view_lut, SKY_VIEW_FORMAT);
         let irradiance = table("atmosphere sky irradiance", settings.irradiance_lut, LUT_FORMAT);
         use wgpu::BindingResource::TextureView as View;

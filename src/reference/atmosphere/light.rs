@@ -89,7 +89,7 @@ impl Tables<'_> {
         for k in 0..SKY_VIEW_STEPS {
             let (middle, dt) = ray_segment(k, SKY_VIEW_STEPS, length);
             let s = self.ray_step_at(r, mu, u.radii[3], nu, distance_km - middle, dt);
-            light = self.sky_source(&s, rayleigh, mie) * s.kept + s.through * light;
+            light = self.sky_source(&s, nu, rayleigh, mie) * s.kept + s.through * light;
             seen *= s.through;
         }
         (light, seen)

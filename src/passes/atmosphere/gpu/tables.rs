@@ -8,7 +8,8 @@ use crate::gpu::{Gpu, GpuError};
 
 use super::SKY_VIEW_FORMAT;
 
-/// One table on the GPU.
+/// One table on the GPU: `blocks` of `size` texels side by side (the multiple-scattering
+/// table's terms), made by one thread per texel of a block.
 pub(super) struct Table {
     texture: wgpu::Texture,
     pub(super) view: wgpu::TextureView,
@@ -21,11 +22,12 @@ impl Table {
         device: &wgpu::Device,
         label: &str,
         size: [u32; 2],
+        blocks: u32,
         format: wgpu::TextureFormat,
     ) -> Self {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
-            size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+            size: wgpu::Extent3d { width: size[0] * blocks, height: size[1], depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -39,7 +41,7 @@ impl Table {
         Self { texture, view, size, format }
     }
 
-    /// The workgroups that cover it, one thread a texel.
+    /// The workgroups that cover a block, one thread a texel.
     pub(super) fn workgroups(&self) -> [u32; 3] {
         let [w, h] = self.size.map(|side| side.div_ceil(ATMOSPHERE_WORKGROUP));
         [w, h, 1]
