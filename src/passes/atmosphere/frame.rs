@@ -30,22 +30,40 @@ pub fn aerial_far_km(air: &Atmosphere, view_radius_km: f64) -> f64 {
     (view_radius_km.powi(2) - bottom * bottom).max(0.0).sqrt() + (top * top - bottom * bottom).sqrt()
 }
 
-/// The pass's uniforms for `view` over the air of `settings`. The sky-view table is made for the
-/// view's radius within the air (at its top for a view above it, which marches its sky per pixel);
-/// the aerial-perspective volume is marched from the view itself, wherever it is.
+/// The phase functions' Legendre moments as the uniforms carry them, [Rayleigh k₂, Mie k₁, Mie
+/// k₂, 0] (Rayleigh's k₁ is zero): what the multiple-scattering table weighs its degrees by.
+/// Two quadratures of 4,000 bands, so made once per air, not per frame.
+pub fn phase_moments(air: &Atmosphere) -> [f32; 4] {
+    let rayleigh = legendre_moments(rayleigh_phase);
+    let mie = legendre_moments(|nu| mie_phase(nu, air.mie_g));
+    [rayleigh[1] as f32, mie[0] as f32, mie[1] as f32, 0.0]
+}
+
+/// The pass's uniforms for `view` over the air of `settings`, its phase moments computed here
+/// (`frame_uniforms` takes them made once).
 pub fn atmosphere_uniforms(settings: &AtmosphereSettings, view: &SkyView) -> AtmosphereUniforms {
+    frame_uniforms(settings, view, phase_moments(&settings.air))
+}
+
+/// The pass's uniforms for `view` over the air of `settings`, whose phase moments
+/// (`phase_moments`) are given. The sky-view table is made for the view's radius within the air
+/// (at its top for a view above it, which marches its sky per pixel); the aerial-perspective
+/// volume is marched from the view itself, wherever it is.
+pub fn frame_uniforms(
+    settings: &AtmosphereSettings,
+    view: &SkyView,
+    phase_moments: [f32; 4],
+) -> AtmosphereUniforms {
     let a = &settings.air;
     let thickness_km = a.top_radius_km - a.bottom_radius_km;
     let altitude_km = (view.altitude_m / 1000.0).max(LOWEST_VIEW_KM);
     let view_radius_km = a.bottom_radius_km + altitude_km.min(thickness_km);
     let f = |v: f64| v as f32;
     let rgb = |v: [f64; 3], w: f64| [f(v[0]), f(v[1]), f(v[2]), f(w)];
-    let rayleigh = legendre_moments(rayleigh_phase);
-    let mie = legendre_moments(|nu| mie_phase(nu, a.mie_g));
     AtmosphereUniforms {
         rayleigh: rgb(a.rayleigh_scattering_per_km, a.rayleigh_scale_height_km),
         mie: [f(a.mie_scattering_per_km), f(a.mie_extinction_per_km), f(a.mie_scale_height_km), f(a.mie_g)],
-        phase_moments: [f(rayleigh[1]), f(mie[0]), f(mie[1]), 0.0],
+        phase_moments,
         ozone: rgb(a.ozone_absorption_per_km, a.ozone_centre_km),
         albedo: rgb(a.ground_albedo, a.ozone_half_width_km),
         radii: [

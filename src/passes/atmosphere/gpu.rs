@@ -20,7 +20,7 @@ use crate::gpu::shaders::{ATMOSPHERE, WgslSource};
 use crate::gpu::{Gpu, GpuError, Queue};
 use crate::passes::{COLOUR_FORMAT, DEPTH_FORMAT};
 
-use super::frame::{SkyView, atmosphere_uniforms};
+use super::frame::{SkyView, frame_uniforms, phase_moments};
 use air::Air;
 use tables::{Table, aerial_volume};
 
@@ -136,6 +136,8 @@ pub const SKY_MARCHED_BINDINGS: BindingTable<4> = BindingTable {
 /// uniforms `prepare` writes each frame.
 pub struct AtmospherePass {
     settings: AtmosphereSettings,
+    /// The air's phase moments (`frame::phase_moments`), made once with the pass.
+    phase_moments: [f32; 4],
     uniforms: wgpu::Buffer,
     transmittance: Table,
     multiple: Table,
@@ -206,7 +208,12 @@ impl AtmospherePass {
             sun_dir: glam::DVec3::Z,
             altitude_m: 0.0,
         };
-        gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&atmosphere_uniforms(settings, &still)));
+        let phase_moments = phase_moments(&settings.air);
+        gpu.queue.write_buffer(
+            &uniforms,
+            0,
+            bytemuck::bytes_of(&frame_uniforms(settings, &still, phase_moments)),
+        );
         let fixed = [
             {
                 let layout = TRANSMITTANCE_BINDINGS.layout(device);
@@ -320,6 +327,7 @@ impl AtmospherePass {
         );
         Self {
             settings: settings.clone(),
+            phase_moments,
             uniforms,
             transmittance,
             multiple,
@@ -346,7 +354,7 @@ impl AtmospherePass {
     pub fn prepare(&self, queue: &Queue, view: &SkyView, live: &AtmosphereSettings) {
         let settings =
             AtmosphereSettings { aerial_perspective: live.aerial_perspective, ..self.settings.clone() };
-        let uniforms = atmosphere_uniforms(&settings, view);
+        let uniforms = frame_uniforms(&settings, view, self.phase_moments);
         self.air.marched.set(uniforms.up[3] - uniforms.radii[0] > SKY_MARCHED_ABOVE_KM);
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
     }
