@@ -22,6 +22,7 @@ mod faults;
 pub mod knobs;
 mod seeds;
 mod texcells;
+pub mod time;
 mod tlm;
 mod wind;
 

@@ -9,11 +9,12 @@
 //! large dataset the one direction meets each place's own vertical at that place's elevation.
 //! Without a time, `[render] sun_azimuth_deg` and `sun_elevation_deg` place it (`light::sun_dir`).
 
-use chrono::{DateTime, FixedOffset, NaiveDateTime, Utc};
+use chrono::{DateTime, Utc};
 use glam::DVec3;
 use solar_positioning::{Location, SolarPositions, delta_t};
 
 use crate::config::RenderSettings;
+use crate::config::time::parse_instant;
 use crate::dataset::Manifest;
 use crate::earth::EarthFrame;
 use crate::earth::ellipsoid::Ellipsoid;
@@ -47,21 +48,7 @@ pub enum SunError {
 
 /// Reads `text` as an instant: RFC 3339, seconds optional (`2026-06-21T17:30Z`).
 pub fn parse_time(text: &str) -> Result<DateTime<Utc>, SunError> {
-    let fail = || SunError::Time(text.to_owned());
-    let text = text.trim();
-    if let Ok(t) = DateTime::<FixedOffset>::parse_from_rfc3339(text) {
-        return Ok(t.with_timezone(&Utc));
-    }
-    // Minutes only: put the seconds in before the zone.
-    let zone_at =
-        text.rfind(['Z', 'z', '+']).or_else(|| text.get(11..).and_then(|t| t.rfind('-')).map(|i| i + 11));
-    let (clock, zone) = text.split_at(zone_at.ok_or_else(fail)?);
-    if NaiveDateTime::parse_from_str(clock, "%Y-%m-%dT%H:%M").is_err() {
-        return Err(fail());
-    }
-    DateTime::<FixedOffset>::parse_from_rfc3339(&format!("{clock}:00{zone}"))
-        .map(|t| t.with_timezone(&Utc))
-        .map_err(|_| fail())
+    parse_instant(text).ok_or_else(|| SunError::Time(text.to_owned()))
 }
 
 /// The sun's topocentric azimuth (degrees clockwise from true north) and zenith angle (degrees),
@@ -143,12 +130,13 @@ mod tests {
     }
 
     #[test]
-    fn times_read_with_or_without_seconds_and_bad_ones_are_named() {
-        let minutes = parse_time("2026-06-21T17:30Z").unwrap();
-        assert_eq!(minutes, parse_time("2026-06-21T17:30:00Z").unwrap());
-        assert_eq!(minutes, parse_time("2026-06-21T13:30-04:00").unwrap());
-        for bad in ["", "noon", "2026-13-01T00:00Z", "2026-06-21 17:30"] {
-            assert!(matches!(parse_time(bad), Err(SunError::Time(_))), "{bad}");
+    fn a_time_it_cannot_read_is_named() {
+        // How times read is `config::time`'s test; here, that a bad one is named as the setting.
+        assert!(parse_time("2026-06-21T17:30Z").is_ok());
+        for bad in ["", "noon", "2026-06-21 17:30"] {
+            let error = parse_time(bad).unwrap_err();
+            assert!(matches!(&error, SunError::Time(t) if t == bad), "{bad}");
+            assert!(error.to_string().contains("render.sun_time"), "{error}");
         }
     }
 

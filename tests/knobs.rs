@@ -10,10 +10,12 @@
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use terramp::camera::Camera;
-use terramp::config::Settings;
 use terramp::config::knobs::{Apply, KNOBS, Knob};
+use terramp::config::{RenderSettings, Settings};
+use terramp::dataset::Dataset;
 use terramp::frame::{FrameReport, Renderer};
-use terramp_testkit::{camera, psnr, renderer, small_settings, synth_dataset};
+use terramp_testkit::earth::nc_state_plane;
+use terramp_testkit::{camera, gpu, psnr, renderer, small_settings, synth_dataset};
 
 const IMAGE_PX: [u32; 2] = [256, 144];
 
@@ -69,6 +71,7 @@ fn turned(knob: &Knob) -> f64 {
         "cloud cover" => 0.5,
         "sun elevation" => 12.0,
         "sun azimuth" => 200.0,
+        "time of day" => 21.0,
         "exposure" => 13.0,
         "seed occlusion tolerance" => 100.0,
         "seed occlusion tolerance per km" => 100.0,
@@ -89,7 +92,18 @@ fn live_knobs_are_taken_at_the_next_frame_as_a_new_renderer_would_take_them() {
     let Some(impostors) = terramp_testkit::nc_impostors() else { return };
     let dir = synth_dataset(300, 7);
     let base = base_settings(impostors.to_str().unwrap());
-    let mut running = renderer(&dir, base.clone());
+    // Placed on the Earth (drawn flat), so that the time of day can place the sun.
+    let placed = || {
+        let mut dataset = Dataset::open(&dir).unwrap();
+        dataset.manifest.earth = Some(nc_state_plane());
+        dataset
+    };
+    let placed_renderer = |settings: Settings| {
+        let settings =
+            Settings { render: RenderSettings { curved_earth: false, ..settings.render }, ..settings };
+        Renderer::new(gpu(), placed(), settings).unwrap()
+    };
+    let mut running = placed_renderer(base.clone());
     // The wind sways and the clouds drift: a fixed time shows one pose of both.
     running.set_time_s(3.0);
     // Two views: from above over the fields, and low over hills that hide seeds.
@@ -117,7 +131,7 @@ fn live_knobs_are_taken_at_the_next_frame_as_a_new_renderer_would_take_them() {
         );
         before = after;
     }
-    let mut fresh = renderer(&dir, running.settings.clone());
+    let mut fresh = placed_renderer(running.settings.clone());
     fresh.set_time_s(3.0);
     let made = seen(&mut fresh);
     for (running, made) in before.iter().zip(&made) {

@@ -12,7 +12,10 @@ use std::ops::RangeInclusive;
 
 use toml::{Table, Value};
 
-use super::Settings;
+use super::{Settings, time};
+
+/// Where the time-of-day knob rests while no time is set.
+const NO_TIME_SHOWN_H: f64 = 12.0;
 
 /// When a running renderer takes a knob's new value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,6 +49,8 @@ pub struct Knob {
     pub set: fn(&mut Settings, f64),
     /// Its whole field as TOML (an array for one distance of several).
     pub field: fn(&Settings) -> Value,
+    /// What a panel says beside it in `settings`, where its value alone would mislead.
+    pub note: fn(&Settings) -> Option<&'static str>,
 }
 
 fn floats<const N: usize>(values: [f64; N]) -> Value {
@@ -53,9 +58,9 @@ fn floats<const N: usize>(values: [f64; N]) -> Value {
 }
 
 /// A knob over an `f64` field: `$place` is the field (an element of an array, for one distance of
-/// several), `$field` the whole field as TOML.
+/// several), `$field` the whole field as TOML; `then` what setting it also does.
 macro_rules! knob {
-    ($label:literal, $key:literal, $unit:literal, $range:expr, $scale:ident, $apply:ident, |$s:ident| $place:expr, $field:expr) => {
+    ($label:literal, $key:literal, $unit:literal, $range:expr, $scale:ident, $apply:ident, |$s:ident| $place:expr, $field:expr $(, then $then:expr)?) => {
         Knob {
             label: $label,
             key: $key,
@@ -65,8 +70,12 @@ macro_rules! knob {
             integer: false,
             apply: Apply::$apply,
             get: |$s| $place,
-            set: |$s, value| $place = value,
+            set: |$s, value| {
+                $place = value;
+                $($then;)?
+            },
             field: |$s| $field,
+            note: |_| None,
         }
     };
 }
@@ -116,6 +125,7 @@ pub const KNOBS: &[Knob] = &[
         // Even, as the TLM's rings need.
         set: |s, v| s.tlm.cells = (v / 2.0).round() as u32 * 2,
         field: |s| Value::Integer(i64::from(s.tlm.cells)),
+        note: |_| None,
     },
     knob!("terrain triangle size", "terrain.triangle_px", "px", 1.0..=64.0, Log, Live,
         |s| s.terrain.triangle_px, Value::Float(s.terrain.triangle_px)),
@@ -125,11 +135,26 @@ pub const KNOBS: &[Knob] = &[
         |s| s.wind.speed_m_s, Value::Float(s.wind.speed_m_s)),
     knob!("cloud cover", "clouds.coverage", "", 0.0..=1.0, Linear, Live,
         |s| s.clouds.coverage, Value::Float(s.clouds.coverage)),
-    // The time of day as the sun's place (`render.sun_time`, when set, places it instead).
+    // The sun by its two angles, or by the time of day over the dataset's place on the Earth:
+    // turning an angle lets the angles place it again.
     knob!("sun elevation", "render.sun_elevation_deg", "°", -20.0..=90.0, Linear, Live,
-        |s| s.render.sun_elevation_deg, Value::Float(s.render.sun_elevation_deg)),
+        |s| s.render.sun_elevation_deg, Value::Float(s.render.sun_elevation_deg), then s.render.sun_time.clear()),
     knob!("sun azimuth", "render.sun_azimuth_deg", "°", 0.0..=360.0, Linear, Live,
-        |s| s.render.sun_azimuth_deg, Value::Float(s.render.sun_azimuth_deg)),
+        |s| s.render.sun_azimuth_deg, Value::Float(s.render.sun_azimuth_deg), then s.render.sun_time.clear()),
+    Knob {
+        label: "time of day",
+        key: "render.sun_time",
+        unit: "h UTC",
+        // To a quarter to midnight: a day's last instant is the next day's first.
+        range: 0.0..=23.75,
+        logarithmic: false,
+        integer: false,
+        apply: Apply::Live,
+        get: |s| time::time_of_day_h(&s.render.sun_time).unwrap_or(NO_TIME_SHOWN_H),
+        set: |s, hours| s.render.sun_time = time::at_time_of_day(&s.render.sun_time, hours),
+        field: |s| Value::String(s.render.sun_time.clone()),
+        note: |s| time::parse_instant(&s.render.sun_time).is_none().then_some("unset: the angles place the sun"),
+    },
     knob!("exposure", "display.ev100", "EV100", 4.0..=18.0, Linear, Live,
         |s| s.display.ev100, Value::Float(s.display.ev100)),
 ];
@@ -176,6 +201,20 @@ mod tests {
                 settings.validate().unwrap_or_else(|e| panic!("{}: {e}", knob.label));
             }
         }
+    }
+
+    #[test]
+    fn the_time_of_day_places_the_sun_until_an_angle_is_turned() {
+        let knob = |label: &str| KNOBS.iter().find(|k| k.label == label).unwrap();
+        let (time, elevation) = (knob("time of day"), knob("sun elevation"));
+        let mut settings = Settings::default();
+        settings.render.sun_time = "2026-06-21T13:30-04:00".into();
+        assert_eq!(((time.get)(&settings), (time.note)(&settings)), (17.5, None));
+        (time.set)(&mut settings, 6.25);
+        assert_eq!(settings.render.sun_time, "2026-06-21T06:15:00Z");
+        (elevation.set)(&mut settings, 30.0);
+        assert_eq!(settings.render.sun_time, "");
+        assert!((time.note)(&settings).is_some());
     }
 
     #[test]

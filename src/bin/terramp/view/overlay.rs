@@ -266,7 +266,14 @@ impl Overlay {
                         .logarithmic(knob.logarithmic)
                         .integer_if(knob.integer)
                         .suffix(format!(" {}", knob.unit));
-                    let response = ui.add(slider);
+                    let response = ui.horizontal(|ui| {
+                        let response = ui.add(slider);
+                        if let Some(note) = (knob.note)(shown.settings) {
+                            ui.label(RichText::new(note).small());
+                        }
+                        response
+                    });
+                    let response = response.inner;
                     if response.dragged() && remake {
                         self.dragging.insert(index, value);
                     } else if response.changed() || response.drag_stopped() {

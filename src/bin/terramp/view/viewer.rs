@@ -353,7 +353,12 @@ impl Viewer {
                 let knob = &KNOBS[index];
                 let mut settings = self.renderer.settings.clone();
                 (knob.set)(&mut settings, value);
+                // A time of day over a dataset that does not say where on the Earth it lies is
+                // refused here, with the reason, rather than by the next frame.
+                let sun = terramp::sun::check(&settings.render, &self.renderer.dataset.manifest);
                 if let Err(error) = settings.validate() {
+                    self.message = error.to_string();
+                } else if let Err(error) = sun {
                     self.message = error.to_string();
                 } else if knob.apply == Apply::Live {
                     self.renderer.settings = settings;
