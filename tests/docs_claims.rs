@@ -17,6 +17,8 @@
 mod atmosphere;
 #[path = "docs_claims/claims.rs"]
 mod claims;
+#[path = "docs_claims/host.rs"]
+mod host;
 #[path = "docs_claims/presets.rs"]
 mod presets;
 
@@ -24,11 +26,12 @@ use std::path::PathBuf;
 
 use atmosphere::ATMOSPHERE_CLAIMS;
 use claims::{CLAIMS, Claim, Format, Source};
+use host::HOST_CLAIMS;
 use presets::PRESET_ROWS;
 
 /// Every claim, of every page.
 fn all_claims() -> impl Iterator<Item = &'static Claim> {
-    CLAIMS.iter().chain(ATMOSPHERE_CLAIMS)
+    CLAIMS.iter().chain(ATMOSPHERE_CLAIMS).chain(HOST_CLAIMS)
 }
 
 fn root() -> PathBuf {

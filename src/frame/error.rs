@@ -54,6 +54,9 @@ pub enum RenderError {
     /// of LODs, or an adapter without the features it needs.
     #[error(transparent)]
     DrawSeeds(#[from] crate::passes::draw_seeds::DrawSeedsError),
+    /// The device allows less than terramp's passes need (a device the host made).
+    #[error(transparent)]
+    Limits(#[from] crate::passes::limits::LimitShort),
     /// `render.sun_time` cannot place the sun: a time it cannot read, or a dataset that does not
     /// record where it lies on the Earth.
     #[error(transparent)]

@@ -173,8 +173,7 @@ pub struct Renderer {
     load_maps: Option<LoadMaps>,
     last: Option<LastFrame>,
     frame: u64,
-    /// The scene's time of the frames rendered from now on (the wind's sway, the clouds' drift),
-    /// seconds (`set_time_s`).
+    /// The scene's time from now on, seconds (`set_time_s`): the wind's sway, the clouds' drift.
     time_s: f64,
     /// Pass timings of the most recent frame whose timings are in (a frame or two behind).
     last_timings: Vec<PassTiming>,
@@ -189,6 +188,7 @@ impl Renderer {
     /// `dataset`; fails when the viewport, the caches or the seeds do not fit this adapter.
     pub fn new(gpu: Gpu, dataset: impl Into<Arc<Dataset>>, settings: Settings) -> Result<Self, RenderError> {
         let dataset = dataset.into();
+        crate::passes::limits::check_limits(&gpu.device.limits())?;
         // A sun time that cannot be read, or one over a dataset not on the Earth, fails here.
         crate::sun::check(&settings.render, &dataset.manifest)?;
         let targets = Targets::new(&gpu.device, &settings)?;

@@ -206,6 +206,25 @@ impl Gpu {
         Ok((gpu, surface))
     }
 
+    /// terramp on a device the host made (`adapter` the one it was made on): the host's frame and
+    /// terramp's share the device and queue. terramp uses the features the device has (each pass
+    /// that needs one says so when it is made) and `Renderer::new` refuses a device short of
+    /// `passes::limits::needed_limits`, naming the limit. The device's error and loss callbacks
+    /// stay the host's: terramp installs none on it, so its errors reach the host's handler and
+    /// `check` and `lost` report nothing.
+    pub fn from_host(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let has_timestamps = times_inside_encoders(device.features());
+        Self {
+            device,
+            queue: super::Queue::new(queue),
+            info: adapter.get_info(),
+            adapter,
+            has_timestamps,
+            errors: Arc::default(),
+            lost: Arc::default(),
+        }
+    }
+
     /// A device on `adapter` with terramp's features and limits, as far as the adapter has them.
     fn open(adapter: wgpu::Adapter) -> Result<Self, GpuError> {
         let info = adapter.get_info();
@@ -218,8 +237,7 @@ impl Gpu {
             // The foliage passes' fragments counted (`gpu.count_fragments`).
             | wgpu::Features::PIPELINE_STATISTICS_QUERY;
         let features = adapter.features() & wanted;
-        let has_timestamps = features
-            .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+        let has_timestamps = times_inside_encoders(features);
         // Cache texture arrays and seed buffers want what the adapter has, not WebGPU's minimums.
         let adapter_limits = adapter.limits();
         let limits = wgpu::Limits {
@@ -294,6 +312,11 @@ impl Gpu {
         errors.clear();
         Err(GpuError::Validation(joined))
     }
+}
+
+/// Whether a device with `features` can write GPU timestamps inside encoders.
+fn times_inside_encoders(features: wgpu::Features) -> bool {
+    features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
 }
 
 /// The adapter `choice` picks (`AdapterChoice::pick`) among those `instance` sees (those that

@@ -21,6 +21,7 @@ pub mod depth_pyramid;
 pub mod display;
 pub mod draw_seeds;
 pub mod ground;
+pub mod limits;
 pub mod seed_select;
 pub mod terrain;
 pub mod texcells;
