@@ -132,6 +132,23 @@ impl SeedStage {
         }))
     }
 
+    /// Reads `targets`' depth and draws into targets of their size from now on (the frame's
+    /// targets made again at another size); the tables, the pipelines and the records stay.
+    pub fn resize(&mut self, device: &wgpu::Device, caches: &Caches, targets: &Targets) {
+        if let Some(landcover) = &caches.landcover {
+            let sources = SeedSources {
+                heights: &caches.heights,
+                landcover,
+                imagery: &caches.imagery,
+                depth: &targets.depth_view,
+            };
+            self.bind_group = self.pass.bind_group(device, &sources);
+        }
+        if let Some((draw, _)) = self.draw.as_mut() {
+            draw.resize_multisampled(device, &targets.colour, &targets.depth);
+        }
+    }
+
     /// Uploads this frame's cells, and the size of its block table to compaction (each counted as
     /// its pass's).
     pub fn prepare(

@@ -14,8 +14,11 @@ use crate::streaming::loader::imagery_tile;
 use crate::streaming::wants::pinned_tiles;
 use crate::streaming::{Delivery, LayerKind, TileCache};
 
-use super::{Caches, RenderError, Targets};
+use super::{Caches, RenderError, Renderer, Targets};
 use crate::camera::CameraError;
+use crate::gpu::fragments::FragmentCounter;
+use crate::passes::depth_pyramid::gpu::DepthPyramid;
+use crate::passes::tile_load_map::frame::height_tile_ranges;
 
 /// Tiles of the coarsest levels each cache keeps resident from the start, at most: the three
 /// coarsest levels of a square layer (1 + 4 + 16), a fallback everywhere at a quarter of the
@@ -54,6 +57,39 @@ impl Targets {
         let [colour_view, depth_view, display_view] =
             [&colour, &depth, &display].map(|t| t.create_view(&Default::default()));
         Ok(Self { colour, depth, display, colour_view, depth_view, display_view })
+    }
+}
+
+impl Renderer {
+    /// Resizes the frame to `width` × `height` pixels. The targets and what their size shapes
+    /// are made again (the depth pyramid and the Tile Load Map's bindings to it, pass 3's
+    /// binding of the depth, pass 4's multisampled targets, the display's binding of the
+    /// light, the fragment counter); the caches and their tiles, the loader, the tables and the
+    /// pipelines stay, so the next frame streams on from what is resident. A size the adapter
+    /// cannot hold is refused and the renderer left as it was.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        let mut settings = self.settings.clone();
+        (settings.render.width, settings.render.height) = (width, height);
+        let targets = Targets::new(&self.gpu.device, &settings)?;
+        let fragments = match &self.fragments {
+            Some(counter) => {
+                let fresh = FragmentCounter::new(&self.gpu, counter.labels(), &targets.colour);
+                Some(fresh.ok_or(RenderError::NoFragmentCounts)?)
+            }
+            None => None,
+        };
+        let device = &self.gpu.device;
+        self.depth_pyramid = DepthPyramid::new(device, width, height);
+        self.tlm_bindings =
+            self.tlm.bind_group(device, &height_tile_ranges(&self.dataset), &self.depth_pyramid);
+        if let Some(stage) = self.seeds.as_mut() {
+            stage.resize(device, &self.caches, &targets);
+        }
+        self.display.rebind(device, &targets.colour_view);
+        (self.targets, self.fragments, self.settings.render) = (targets, fragments, settings.render);
+        // What the last frame recorded was for the old size.
+        self.last = None;
+        Ok(())
     }
 }
 

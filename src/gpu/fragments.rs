@@ -118,6 +118,11 @@ impl PassFragments {
 }
 
 impl FragmentCounter {
+    /// The passes it counts.
+    pub fn labels(&self) -> &[&'static str] {
+        &self.labels
+    }
+
     /// Counts the passes `labels` over `colour` (a `COPY_SRC` 2D colour target); `None` when the
     /// adapter has no pipeline-statistics queries (the frame's counts then have no invocations).
     pub fn new(gpu: &Gpu, labels: &[&'static str], colour: &wgpu::Texture) -> Option<Self> {

@@ -101,6 +101,11 @@ impl DisplayPass {
         Self { pipeline, layout, group, uniforms, daylight: daylight.clone(), settings: settings.clone() }
     }
 
+    /// Displays `scene` from now on (the frame's light made again at another size).
+    pub fn rebind(&mut self, device: &wgpu::Device, scene: &wgpu::TextureView) {
+        self.group = bind(device, &self.layout, &self.uniforms, &self.daylight, scene);
+    }
+
     /// Writes the frame's exposure as `live` has it now (the tone curve stays the pass's own).
     pub fn prepare(&mut self, queue: &Queue, live: &DisplaySettings) {
         if live.ev100 != self.settings.ev100 {

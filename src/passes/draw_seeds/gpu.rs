@@ -244,6 +244,19 @@ impl DrawSeedsPass {
         self
     }
 
+    /// Draws multisampled into targets of `colour`'s and `depth`'s size from now on, if it does
+    /// (the frame's targets made again at another size); the pipelines stay.
+    pub fn resize_multisampled(
+        &mut self,
+        device: &wgpu::Device,
+        colour: &wgpu::Texture,
+        depth: &wgpu::Texture,
+    ) {
+        if let Some((targets, _)) = self.multisample.as_mut() {
+            *targets = Multisample::new(device, colour, depth);
+        }
+    }
+
     /// The draws' index ranges, for `CompactPass::set_templates` (`SEED_DRAWS` of them).
     pub fn templates(&self) -> &[SeedDrawArgs] {
         &self.templates

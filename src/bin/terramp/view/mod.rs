@@ -3,8 +3,9 @@
 //! the renderer is made at the window's size. Every redraw: the flight (or `--path`) moves the
 //! camera by the time elapsed, the renderer draws a frame as headless commands do, and the screen
 //! shows it under the overlay. Input goes to egui first; what it does not take flies the camera.
-//! Knobs that need new GPU resources, a new preset and a new window size remake the renderer on
-//! the same device, keeping the camera (a resize waits until the size has held still a moment).
+//! Knobs that need new GPU resources and a new preset remake the renderer on the same device,
+//! keeping the camera; a new window size resizes it (`Renderer::resize`: its tiles stay), once
+//! the size has held still a moment.
 //! Every failure is one line and a non-zero exit: no display, no adapter, a dataset that does not
 //! open, a frame that fails. What the window needs (an adapter, then the display) is checked
 //! before the embedded default is synthesized and its trees baked, which takes minutes.

@@ -189,7 +189,7 @@ impl Viewer {
         let now = Instant::now();
         let dt_s = (now - self.last_frame).as_secs_f64();
         self.last_frame = now;
-        self.remake_if_resized()?;
+        self.resize_if_settled()?;
         let dataset = Arc::clone(&self.renderer.dataset);
         let origin = dataset.manifest.origin_m;
         let mut flying_path = false;
@@ -275,7 +275,7 @@ impl Viewer {
         ))
     }
 
-    fn remake_if_resized(&mut self) -> Result<()> {
+    fn resize_if_settled(&mut self) -> Result<()> {
         let Some(since) = self.resize_since else { return Ok(()) };
         if since.elapsed() < RESIZE_SETTLE {
             return Ok(());
@@ -284,9 +284,14 @@ impl Viewer {
         let [w, h] = self.screen.size_px();
         let r = &self.renderer.settings.render;
         if [r.width, r.height] != [w, h] {
-            let mut settings = self.renderer.settings.clone();
-            (settings.render.width, settings.render.height) = (w, h);
-            self.remake(settings, &format!("{w}×{h} px"))?;
+            let start = Instant::now();
+            match self.renderer.resize(w, h) {
+                Ok(()) => {
+                    self.screen.rebind(&self.renderer.gpu, &self.renderer);
+                    self.message = format!("resized to {w}×{h} px in {:.2} s", start.elapsed().as_secs_f64());
+                }
+                Err(error) => self.message = format!("{w}×{h} px: {error}"),
+            }
         }
         Ok(())
     }
