@@ -75,3 +75,16 @@ fn fs_display(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
     let balanced = textureLoad(scene, vec2<i32>(at.xy), 0).rgb;
     return vec4<f32>(shown(min(balanced, vec3<f32>(SCENE_LIGHT_MAX))), 1.0);
 }
+
+// Over the host's colour (`Renderer::render_into`): the light's alpha is how much of the pixel
+// terramp drew (its light premultiplied by it), so the light shown is the light over the alpha,
+// blended over what the host drew by that alpha.
+@fragment
+fn fs_display_over(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
+    let light = textureLoad(scene, vec2<i32>(at.xy), 0);
+    if light.a <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let balanced = min(light.rgb / light.a, vec3<f32>(SCENE_LIGHT_MAX));
+    return vec4<f32>(shown(balanced), light.a);
+}

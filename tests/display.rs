@@ -1,6 +1,7 @@
 //! The display pass (`shaders/display.wgsl`) against its twin (`reference::display`): light from
 //! 12 stops under white ground to the sun's disk, grey and coloured, through every tone curve
-//! and at two exposures, as the GPU shows it and as the twin computes it.
+//! and at two exposures, as the GPU shows it and as the twin computes it; and the same light
+//! shown over a host's colour (`fs_display_over`) at coverages from none to whole.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::Vec3;
@@ -9,9 +10,9 @@ use terramp::gpu::readback::read_texture;
 use terramp::passes::display::gpu::DisplayPass;
 use terramp::passes::display::uniforms;
 use terramp::passes::{COLOUR_FORMAT, DISPLAY_FORMAT};
-use terramp::reference::display::shown;
-use terramp::texcell::pyramid::encode_srgb;
-use terramp_testkit::gpu;
+use terramp::reference::display::{shown, shown_over};
+use terramp::texcell::pyramid::{decode_srgb, encode_srgb};
+use terramp_testkit::{gpu, texture_2d};
 
 /// The GPU's displayed pixels against the twin's, 8-bit levels (the adapter's log2 and pow, and
 /// its rounding to 8 bits).
@@ -24,48 +25,53 @@ const STEPS: u32 = 481;
 const HUES: [[f32; 3]; 5] =
     [[1.0, 1.0, 1.0], [1.0, 0.05, 0.02], [0.03, 1.0, 0.05], [0.02, 0.04, 1.0], [0.25, 0.45, 0.12]];
 
-#[test]
-fn the_gpu_displays_the_twins_light_through_every_curve() {
+/// The light's coverage per row, for the display over a host's colour.
+const COVERAGES: [f32; 5] = [0.0, 0.2, 0.5, 0.8, 1.0];
+
+/// The host's colour under the display, sRGB.
+const UNDER: [u8; 4] = [200, 120, 60, 255];
+
+/// A row per hue of light steps, as the colour target holds it (f16: past 65,504, infinite, as
+/// the sun's disk might be).
+fn light_steps() -> Vec<Vec3> {
+    let f16 = |v: f32| half::f16::from_f32(v).to_f32();
+    (0..HUES.len())
+        .flat_map(|row| {
+            (0..STEPS).map(move |k| Vec3::from_array(HUES[row]) * ((k as f32) / 16.0 - 12.0).exp2())
+        })
+        .map(|l| Vec3::from_array(l.to_array().map(f16)))
+        .collect()
+}
+
+/// A display on the GPU over `light`, premultiplied by its row's coverage where `over` (each row
+/// of `STEPS`), into a display-format target that starts as `UNDER` everywhere; what it shows.
+fn displayed(settings: &DisplaySettings, light: &[Vec3], daylight: Vec3, over: bool) -> Vec<u8> {
     let gpu = gpu();
     let device = &gpu.device;
     let (width, height) = (STEPS, HUES.len() as u32);
-    // As the colour target holds it: f16 (past 65,504, infinite, as the sun's disk might be).
-    let f16 = |v: f32| half::f16::from_f32(v).to_f32();
-    let light: Vec<Vec3> = (0..height)
-        .flat_map(|row| {
-            (0..width).map(move |k| Vec3::from_array(HUES[row as usize]) * ((k as f32) / 16.0 - 12.0).exp2())
+    let texels: Vec<u16> = light
+        .iter()
+        .enumerate()
+        .flat_map(|(i, l)| {
+            let a = if over { COVERAGES[i / STEPS as usize] } else { 1.0 };
+            [l.x * a, l.y * a, l.z * a, a].map(|v| half::f16::from_f32(v).to_bits())
         })
-        .map(|l| Vec3::from_array(l.to_array().map(f16)))
         .collect();
-    let texels: Vec<u16> =
-        light.iter().flat_map(|l| [l.x, l.y, l.z, 1.0].map(|v| half::f16::from_f32(v).to_bits())).collect();
-    let target = |label, format, usage| {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-    };
+    let copy_dst = wgpu::TextureUsages::COPY_DST;
     let scene =
-        target("scene", COLOUR_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST);
-    gpu.queue.write_texture(
-        scene.as_image_copy(),
-        bytemuck::cast_slice(&texels),
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * 8), rows_per_image: None },
-        scene.size(),
-    );
-    let display = target(
-        "display",
-        DISPLAY_FORMAT,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-    );
-    // A daylight balance of the model's order (bluer light is weaker, so blue's gain is larger).
-    let daylight = Vec3::new(1.48, 1.58, 1.67);
+        texture_2d(device, [width, height], COLOUR_FORMAT, wgpu::TextureUsages::TEXTURE_BINDING | copy_dst);
+    let write = |texture: &wgpu::Texture, bytes: &[u8], texel_bytes: u32| {
+        let layout = wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(width * texel_bytes),
+            rows_per_image: None,
+        };
+        gpu.queue.write_texture(texture.as_image_copy(), bytes, layout, texture.size());
+    };
+    write(&scene, bytemuck::cast_slice(&texels), 8);
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC | copy_dst;
+    let display = texture_2d(device, [width, height], DISPLAY_FORMAT, usage);
+    write(&display, &UNDER.repeat(light.len()), 4);
     let daylight_buffer = wgpu::util::DeviceExt::create_buffer_init(
         device,
         &wgpu::util::BufferInitDescriptor {
@@ -74,27 +80,49 @@ fn the_gpu_displays_the_twins_light_through_every_curve() {
             usage: wgpu::BufferUsages::UNIFORM,
         },
     );
-    let scene_view = scene.create_view(&Default::default());
-    let display_view = display.create_view(&Default::default());
+    let mut pass =
+        DisplayPass::new(&gpu, settings, &scene.create_view(&Default::default()), &daylight_buffer);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let (display_view, off) =
+        (display.create_view(&Default::default()), terramp::gpu::counter::Counting::OFF);
+    if over {
+        pass.prepare_over(device, DISPLAY_FORMAT);
+        pass.encode_over(&mut encoder, &display_view, off);
+    } else {
+        pass.encode(&mut encoder, &display_view, off);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    read_texture(&gpu, &display, wgpu::TextureAspect::All, 4).unwrap()
+}
+
+/// The largest difference between `shown_gpu` and the twin's `expected` display light, 8-bit
+/// levels, and the index of the light where it is.
+fn worst(shown_gpu: &[u8], expected: impl Iterator<Item = Vec3>) -> (i32, usize) {
+    let (mut worst, mut at) = (0, 0);
+    for (i, e) in expected.enumerate() {
+        let e = e.to_array().map(encode_srgb);
+        for c in 0..3 {
+            let off = (i32::from(shown_gpu[i * 4 + c]) - i32::from(e[c])).abs();
+            if off > worst {
+                (worst, at) = (off, i);
+            }
+        }
+    }
+    (worst, at)
+}
+
+/// A daylight balance of the model's order (bluer light is weaker, so blue's gain is larger).
+const DAYLIGHT: Vec3 = Vec3::new(1.48, 1.58, 1.67);
+
+#[test]
+fn the_gpu_displays_the_twins_light_through_every_curve() {
+    let light = light_steps();
     for curve in ToneCurve::ALL {
         for ev100 in [15.0, 9.0] {
             let settings = DisplaySettings { ev100, tone_curve: curve };
-            let pass = DisplayPass::new(&gpu, &settings, &scene_view, &daylight_buffer);
-            let mut encoder = device.create_command_encoder(&Default::default());
-            pass.encode(&mut encoder, &display_view, terramp::gpu::counter::Counting::OFF);
-            gpu.queue.submit([encoder.finish()]);
-            let shown_gpu = read_texture(&gpu, &display, wgpu::TextureAspect::All, 4).unwrap();
+            let shown_gpu = displayed(&settings, &light, DAYLIGHT, false);
             let u = uniforms(&settings);
-            let (mut worst, mut at) = (0, 0);
-            for (i, l) in light.iter().enumerate() {
-                let expected = shown(&u, curve, daylight, *l).to_array().map(encode_srgb);
-                for c in 0..3 {
-                    let off = (i32::from(shown_gpu[i * 4 + c]) - i32::from(expected[c])).abs();
-                    if off > worst {
-                        (worst, at) = (off, i);
-                    }
-                }
-            }
+            let (worst, at) = worst(&shown_gpu, light.iter().map(|l| shown(&u, curve, DAYLIGHT, *l)));
             println!("{} at EV100 {ev100}: worst {worst} levels (light {})", curve.name(), light[at]);
             assert!(
                 worst <= DISPLAY_LEVELS,
@@ -103,5 +131,32 @@ fn the_gpu_displays_the_twins_light_through_every_curve() {
                 light[at]
             );
         }
+    }
+}
+
+#[test]
+fn over_a_hosts_colour_the_gpu_shows_the_twins_light_by_its_coverage() {
+    let light = light_steps();
+    let under = Vec3::from_array([UNDER[0], UNDER[1], UNDER[2]].map(decode_srgb));
+    for curve in ToneCurve::ALL {
+        let settings = DisplaySettings { ev100: 15.0, tone_curve: curve };
+        let shown_gpu = displayed(&settings, &light, DAYLIGHT, true);
+        let u = uniforms(&settings);
+        let expected = light.iter().enumerate().map(|(i, l)| {
+            let a = COVERAGES[i / STEPS as usize];
+            let premultiplied =
+                Vec3::from_array((*l * a).to_array().map(|v| half::f16::from_f32(v).to_f32()));
+            shown_over(&u, curve, DAYLIGHT, (premultiplied, half::f16::from_f32(a).to_f32()), under)
+        });
+        let (worst, at) = worst(&shown_gpu, expected);
+        println!(
+            "{} over the host's colour: worst {worst} levels (light {}, row {})",
+            curve.name(),
+            light[at],
+            at / STEPS as usize
+        );
+        assert!(worst <= DISPLAY_LEVELS, "{}: {worst} levels at light {}", curve.name(), light[at]);
+        // Where terramp drew nothing the host's pixel is as it was.
+        assert!(shown_gpu[..STEPS as usize * 4].chunks(4).all(|p| p == UNDER));
     }
 }

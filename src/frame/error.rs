@@ -54,6 +54,9 @@ pub enum RenderError {
     /// of LODs, or an adapter without the features it needs.
     #[error(transparent)]
     DrawSeeds(#[from] crate::passes::draw_seeds::DrawSeedsError),
+    /// A host's targets cannot be drawn over (`Renderer::render_into`).
+    #[error(transparent)]
+    Host(#[from] super::HostTargetError),
     /// The device allows less than terramp's passes need (a device the host made).
     #[error(transparent)]
     Limits(#[from] crate::passes::limits::LimitShort),

@@ -31,11 +31,13 @@ use crate::passes::tile_load_map::frame::{TlmEarth, TlmFrame, height_tile_ranges
 use crate::passes::tile_load_map::gpu::{TileLoadMapPass, TlmBindings};
 use crate::passes::tile_load_map::layout::TlmLayout;
 use crate::seeds::wind::{Wind, WindFrame};
-use crate::streaming::{CacheStats, Delivery, Faults, Loader, LoaderOptions, TileCache};
+use crate::streaming::{Delivery, Faults, Loader, LoaderOptions, TileCache};
 
 mod clearance;
 mod error;
+mod host;
 mod prepare;
+mod report;
 mod seeds;
 mod setup;
 mod texcells;
@@ -44,55 +46,12 @@ mod undrawn;
 
 pub use clearance::GROUND_CLEARANCE_NEAR;
 pub use error::RenderError;
+pub use host::{HostTargetError, HostTargets};
+pub use report::FrameReport;
 pub use seeds::SeedReport;
 pub use texcells::TexcellReport;
 pub use tools::{RESOLVE_GUARD_FRAMES, Replay};
 pub use undrawn::UndrawnSeeds;
-
-/// What one frame did, for logs and tests.
-#[derive(Debug, Clone, Default, serde::Serialize)]
-pub struct FrameReport {
-    /// Index of this frame since the renderer was made, from 0.
-    pub frame: u64,
-    /// Terrain nodes drawn, each one instance over its height tile or a resident ancestor's.
-    pub nodes_drawn: usize,
-    /// Nodes selected but not drawn because their height tile did not fit or could not be read.
-    pub nodes_dropped: usize,
-    /// The height cache's streaming this frame.
-    pub height: CacheStats,
-    /// The imagery cache's streaming this frame (all zero without imagery).
-    pub imagery: CacheStats,
-    /// The land-cover cache's streaming this frame (all zero without land cover).
-    pub landcover: CacheStats,
-    /// The frame whose Tile Load Map drove this frame's streaming (`None` before the first one
-    /// arrives).
-    pub tlm_frame: Option<u64>,
-    /// Cells that Tile Load Map found visible (0 before the first one arrives).
-    pub tlm_visible_cells: usize,
-    /// Distinct seed patterns that Tile Load Map's cells use.
-    pub tlm_patterns: usize,
-    /// TLM readbacks skipped so far because every staging buffer was still in flight.
-    pub tlm_readbacks_skipped: u64,
-    /// Ring-0 cells whose seeds this frame checks.
-    pub seed_cells: usize,
-    /// Near, visible cells left out of pass 3 because they were beyond its dispatch limit.
-    pub seed_cells_dropped: usize,
-    /// Pass 3's counters of the latest frame whose counters have arrived (a frame or two old).
-    pub seeds: Option<SeedReport>,
-    /// Species (each variant counted: each of `ClassTable::species`) drawn with an impostor.
-    pub seed_species_drawn: usize,
-    /// Species selected but not drawn (no `draw_seeds.impostors`, or no model for them).
-    pub seed_species_undrawn: usize,
-    /// Metres the camera was lifted by because it was under the ground (0 when it was not).
-    pub camera_lifted_m: f64,
-    /// The far forest's patches and slices (all zero without texcells).
-    pub texcells: TexcellReport,
-    /// Per foliage pass, fragments shaded and pixels covered (only with `gpu.count_fragments`).
-    pub fragments: Vec<PassFragments>,
-    /// The counts of every frame whose counts arrived during this one (a frame or two old; this
-    /// frame's own with `gpu.count_fragments`, which waits for each frame).
-    pub counts: Vec<FrameCounts>,
-}
 
 /// What a frame's Tile Load Map is read against when it comes back: the frame, its rings and
 /// where the camera was.
@@ -339,6 +298,15 @@ impl Renderer {
 
     /// Renders one frame from `camera`.
     pub fn render(&mut self, camera: &Camera) -> Result<FrameReport, RenderError> {
+        self.render_to(camera, None)
+    }
+
+    /// Renders one frame from `camera`, into its own targets or over `host`'s.
+    fn render_to(
+        &mut self,
+        camera: &Camera,
+        host: Option<&HostTargets<'_>>,
+    ) -> Result<FrameReport, RenderError> {
         if let Some(why) = self.gpu.lost() {
             return Err(GpuError::DeviceLost(why).into());
         }
@@ -348,7 +316,7 @@ impl Renderer {
         self.counts.begin_frame(self.frame);
         let frame = self.prepare(&camera, &mut report).and_then(|plan| {
             let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-            self.encode(&mut encoder, &plan.nodes, &plan.tlm)?;
+            self.encode(&mut encoder, &plan.nodes, &plan.tlm, host)?;
             self.submit(encoder, plan, &mut report)
         });
         // A lost device fails whatever step comes next, each in its own words: say the cause.
@@ -368,8 +336,11 @@ impl Renderer {
         encoder: &mut wgpu::CommandEncoder,
         nodes: &PreparedNodes,
         tlm: &TlmFrame,
+        host: Option<&HostTargets<'_>>,
     ) -> Result<(), RenderError> {
         let (gpu, p, t, c) = (&self.gpu, &mut self.profiler, &self.targets, &self.counts);
+        // Over a host's frame: its geometry's depth first, for every pass to meet.
+        host.inspect(|h| h.copy_depth(encoder, (h.depth, &t.depth)));
         // With `gpu.count_fragments`, the foliage passes count their fragments and pixels.
         let (targets, counter) = ((&t.colour_view, &t.depth_view), self.fragments.as_ref());
         let counted = |label, e: &mut _, record: &dyn Fn(&mut _, Option<CountedPass<'_>>)| {
@@ -378,7 +349,13 @@ impl Renderer {
         let mesh = MeshDraw { terrain: &self.terrain, bind_group: &self.terrain_bindings, nodes };
         // 0. Terrain and depth: the ground every later pass stands on and is occluded by.
         p.pass(gpu, encoder, "terrain", |e| {
-            self.terrain.encode(e, &self.terrain_bindings, &t.depth_view, nodes, c.pass("terrain"))
+            self.terrain.encode(
+                e,
+                &self.terrain_bindings,
+                (&t.depth_view, host.is_some()),
+                nodes,
+                c.pass("terrain"),
+            )
         })?;
         // The depth pyramid: the occluders the Tile Load Map culls against, at every scale.
         p.pass(gpu, encoder, "depth_pyramid", |e| {
@@ -420,7 +397,12 @@ impl Renderer {
             p.pass(gpu, encoder, "draw_seeds", |e| counted("draw_seeds", e, &draw))?;
         }
         // The frame's light as the screen shows it: exposed, through the tone curve.
-        p.pass(gpu, encoder, "display", |e| self.display.encode(e, &t.display_view, c.pass("display")))?;
+        p.pass(gpu, encoder, "display", |e| match host {
+            Some(h) => self.display.encode_over(e, &h.colour_view(), c.pass("display")),
+            None => self.display.encode(e, &t.display_view, c.pass("display")),
+        })?;
+        // The terrain's and the trees' depth back to the host, for what it draws next.
+        host.inspect(|h| h.copy_depth(encoder, (&t.depth, h.depth)));
         Ok(())
     }
 

@@ -296,7 +296,7 @@ impl Renderer {
         });
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         let view = scratch.create_view(&Default::default());
-        self.terrain.encode(&mut encoder, &self.terrain_bindings, &view, &last.nodes, Counting::OFF);
+        self.terrain.encode(&mut encoder, &self.terrain_bindings, (&view, false), &last.nodes, Counting::OFF);
         self.gpu.queue.submit([encoder.finish()]);
         let bytes = read_texture(&self.gpu, &scratch, wgpu::TextureAspect::DepthOnly, 4)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
@@ -359,7 +359,13 @@ impl Renderer {
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         let t = &self.targets;
-        self.terrain.encode(&mut encoder, &self.terrain_bindings, &t.depth_view, &last.nodes, Counting::OFF);
+        self.terrain.encode(
+            &mut encoder,
+            &self.terrain_bindings,
+            (&t.depth_view, false),
+            &last.nodes,
+            Counting::OFF,
+        );
         if through != Replay::Depth {
             stage.encode(&mut encoder, Counting::OFF);
             stage.encode_compact(&mut encoder, Counting::OFF);

@@ -108,7 +108,7 @@ pub const PIPELINE_BINDINGS: &[PipelineBindings] = &[
     },
     PipelineBindings {
         shader: &display::gpu::SHADER,
-        entry_points: &["vs_display", "fs_display"],
+        entry_points: &["vs_display", "fs_display", "fs_display_over"],
         group: 0,
         bindings: &display::gpu::BINDINGS.bindings,
     },

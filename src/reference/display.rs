@@ -53,6 +53,21 @@ pub fn shown(u: &DisplayUniforms, curve: ToneCurve, daylight: Vec3, balanced: Ve
     tone(u, curve, exposed)
 }
 
+/// `fs_display_over` and its blend: the linear display light over a host's pixel whose linear
+/// colour is `under`, the frame's light being `light` premultiplied by its coverage `alpha`.
+pub fn shown_over(
+    u: &DisplayUniforms,
+    curve: ToneCurve,
+    daylight: Vec3,
+    (light, alpha): (Vec3, f32),
+    under: Vec3,
+) -> Vec3 {
+    if alpha <= 0.0 {
+        return under;
+    }
+    shown(u, curve, daylight, light / alpha) * alpha + under * (1.0 - alpha)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

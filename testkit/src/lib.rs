@@ -23,4 +23,6 @@ pub use data::{TempDir, shared_data};
 pub use datasets::{synth_dataset, synth_dataset_with};
 pub use images::{Golden, differing_pixels, psnr};
 pub use impostors::{nc_impostors, nc_sliced_impostors, nc_table_with};
-pub use setup::{command, gpu, ground_settings, lavapipe_only, renderer, settled_colour, small_settings};
+pub use setup::{
+    command, gpu, ground_settings, lavapipe_only, renderer, settled_colour, small_settings, texture_2d,
+};

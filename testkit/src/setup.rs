@@ -88,6 +88,25 @@ pub fn ground_settings(width: u32, height: u32) -> Settings {
     settings
 }
 
+/// A 2D texture of one mip level and one sample, `size` pixels, for a test's own targets.
+pub fn texture_2d(
+    device: &wgpu::Device,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("a test's texture"),
+        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
 /// A renderer over the dataset in `dataset`.
 pub fn renderer(dataset: &Path, settings: Settings) -> Renderer {
     Renderer::new(gpu(), Dataset::open(dataset).unwrap(), settings).unwrap()

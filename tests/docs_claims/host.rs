@@ -13,4 +13,14 @@ pub static HOST_CLAIMS: &[Claim] = &[
         quote: "(the same pixels; the test asks ≥ {} dB PSNR, which half a degree of turn fails",
         values: &[(test_const("tests/resize.rs", "SAME_FRAME_PSNR_DB"), plain)],
     },
+    Claim {
+        doc: "docs/host.md",
+        quote: "the view without the wall (the test asks ≥ {} dB: what streams",
+        values: &[(test_const("tests/host_frame.rs", "BESIDE_WALL_PSNR_DB"), plain)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "through every tone curve, within {} level of 8 bits (the test's bound)",
+        values: &[(test_const("tests/display.rs", "DISPLAY_LEVELS"), plain)],
+    },
 ];

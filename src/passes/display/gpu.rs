@@ -41,6 +41,9 @@ pub const BINDINGS: BindingTable<3> = BindingTable {
 /// atmosphere's daylight balance, and its uniforms.
 pub struct DisplayPass {
     pipeline: wgpu::RenderPipeline,
+    /// The pipeline that shows the light over a host's colour target, for its format
+    /// (`prepare_over`).
+    over: Option<(wgpu::TextureFormat, wgpu::RenderPipeline)>,
     layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
     uniforms: wgpu::Buffer,
@@ -58,7 +61,6 @@ impl DisplayPass {
         daylight: &wgpu::Buffer,
     ) -> Self {
         let device = &gpu.device;
-        let module = SHADER.module(device);
         // Storage, as the atmosphere's uniforms: lavapipe keeps a shader variant per value of a
         // uniform it sees steer code, and the exposure changes while a viewer turns it.
         let uniforms = buffer(
@@ -70,35 +72,16 @@ impl DisplayPass {
         gpu.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&super::uniforms(settings)));
         let layout = BINDINGS.layout(device);
         let group = bind(device, &layout, &uniforms, daylight, scene);
-        let index = |curve: ToneCurve| f64::from(curve.index());
-        let constants = [
-            ("TONE_CURVE", index(settings.tone_curve)),
-            ("AGX", index(ToneCurve::Agx)),
-            ("LINEAR", index(ToneCurve::Linear)),
-        ];
-        let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("display"),
-            layout: Some(&pipeline_layout(device, "display", &[&layout])),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_display"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_display"),
-                compilation_options: options,
-                targets: &[Some(DISPLAY_FORMAT.into())],
-            }),
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
-        Self { pipeline, layout, group, uniforms, daylight: daylight.clone(), settings: settings.clone() }
+        let pipeline = display_pipeline(device, &layout, settings.tone_curve, Shown::Display);
+        Self {
+            pipeline,
+            over: None,
+            layout,
+            group,
+            uniforms,
+            daylight: daylight.clone(),
+            settings: settings.clone(),
+        }
     }
 
     /// Displays `scene` from now on (the frame's light made again at another size).
@@ -121,7 +104,30 @@ impl DisplayPass {
         display: &wgpu::TextureView,
         counting: Counting<'_>,
     ) {
-        self.record(encoder, &self.group, display, counting);
+        self.record(encoder, (&self.pipeline, &self.group), display, counting);
+    }
+
+    /// Makes the pipeline that shows the light over a host's colour target of `format` (an sRGB
+    /// format: the hardware encodes on store), unless it has it.
+    pub fn prepare_over(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) {
+        if self.over.as_ref().is_none_or(|(made, _)| *made != format) {
+            let shown = Shown::Over(format);
+            self.over =
+                Some((format, display_pipeline(device, &self.layout, self.settings.tone_curve, shown)));
+        }
+    }
+
+    /// Records the display of the frame's colour target over `host` by its coverage (the light's
+    /// alpha), through the pipeline `prepare_over` made; records nothing without one.
+    pub fn encode_over(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        host: &wgpu::TextureView,
+        counting: Counting<'_>,
+    ) {
+        if let Some((_, pipeline)) = &self.over {
+            self.record(encoder, (pipeline, &self.group), host, counting);
+        }
     }
 
     /// Records the display of another light texture (`COLOUR_FORMAT`, the frame's size or any)
@@ -134,13 +140,13 @@ impl DisplayPass {
         display: &wgpu::TextureView,
     ) {
         let group = bind(device, &self.layout, &self.uniforms, &self.daylight, light);
-        self.record(encoder, &group, display, Counting::OFF);
+        self.record(encoder, (&self.pipeline, &group), display, Counting::OFF);
     }
 
     fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        group: &wgpu::BindGroup,
+        (pipeline, group): (&wgpu::RenderPipeline, &wgpu::BindGroup),
         display: &wgpu::TextureView,
         counting: Counting<'_>,
     ) {
@@ -158,11 +164,67 @@ impl DisplayPass {
             multiview_mask: None,
         });
         counting.begin(&mut pass, Part::Whole);
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, group, &[]);
         counting.draw(&mut pass, 0..3, 0..1);
         counting.end(&mut pass);
     }
+}
+
+/// Where a display pipeline writes: the display target, or over a host's colour of a format.
+#[derive(Clone, Copy)]
+enum Shown {
+    Display,
+    Over(wgpu::TextureFormat),
+}
+
+/// The display's pipeline for `curve` (a shader constant), writing as `shown` says.
+fn display_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    curve: ToneCurve,
+    shown: Shown,
+) -> wgpu::RenderPipeline {
+    let module = SHADER.module(device);
+    let index = |curve: ToneCurve| f64::from(curve.index());
+    let constants =
+        [("TONE_CURVE", index(curve)), ("AGX", index(ToneCurve::Agx)), ("LINEAR", index(ToneCurve::Linear))];
+    let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+    let (entry_point, target) = match shown {
+        Shown::Display => ("fs_display", DISPLAY_FORMAT.into()),
+        Shown::Over(format) => {
+            // Colour by the coverage over the host's; coverage as premultiplied alpha does.
+            let colour = wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::SrcAlpha,
+                dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+                operation: wgpu::BlendOperation::Add,
+            };
+            let alpha = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, ..colour };
+            let blend = Some(wgpu::BlendState { color: colour, alpha });
+            ("fs_display_over", wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })
+        }
+    };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(entry_point),
+        layout: Some(&pipeline_layout(device, "display", &[layout])),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_display"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some(entry_point),
+            compilation_options: options,
+            targets: &[Some(target)],
+        }),
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 fn bind(

@@ -101,7 +101,11 @@ impl GroundPass {
         air: &Air,
         counting: Counting<'_>,
     ) {
-        let mut pass = frame_pass(encoder, "ground", colour, depth, Some(wgpu::Color::BLACK), None);
+        // Transparent: what the frame's passes draw is opaque or blended over premultiplied, so
+        // the light's alpha is their coverage, by which a host's frame shows it
+        // (`Renderer::render_into`); the sky covers every pixel nothing else drew.
+        let clear = Some(wgpu::Color::TRANSPARENT);
+        let mut pass = frame_pass(encoder, "ground", colour, depth, clear, None);
         pass.set_pipeline(self.pipelines.get(air));
         pass.set_bind_group(AIR_GROUP, air.group(), &[]);
         counting.begin(&mut pass, Part::Whole);

@@ -207,25 +207,24 @@ impl TerrainPass {
         &self.layout
     }
 
-    /// Pass 0: the mesh into a cleared depth target, nothing else; counted through `counting`.
+    /// Pass 0: the mesh into the depth target, cleared unless `keep_depth` (a host's geometry is
+    /// in it), nothing else; counted through `counting`.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
-        depth: &wgpu::TextureView,
+        (depth, keep_depth): (&wgpu::TextureView, bool),
         nodes: &PreparedNodes,
         counting: Counting<'_>,
     ) {
+        // Reversed-Z: 0 is infinitely far. Kept where a host's geometry is in it already.
+        let load = if keep_depth { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(0.0) };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("terrain"),
             color_attachments: &[],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
-                // Reversed-Z: 0 is infinitely far.
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
+                depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,
