@@ -6,7 +6,8 @@
 //! - with it, the left half is the wall's colour in every pixel, the right half terramp's view
 //!   within a stated PSNR, and pass 3 culls the seeds behind the wall (fewer selected, more
 //!   culled by occlusion): the host's depth is in the culling, not only in the drawing;
-//! - afterwards the host's depth holds the wall on the left and terramp's depth on the right;
+//! - afterwards the host's depth holds the wall on the left and terramp's depth on the right
+//!   (the terrain's: multisampled trees keep theirs in their own target);
 //! - targets of another size, a non-sRGB colour or a depth that cannot be copied are refused,
 //!   naming the target.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]

@@ -8,7 +8,8 @@
 //! blended over premultiplied (the texcells, the trees' resolved samples), so the light's alpha
 //! is how much of each pixel terramp drew. The display shows that light over the host's colour
 //! by it (the host's pixels in front stay as the host drew them), and the depth goes back to
-//! the host's target, so what the host draws afterwards meets the terrain and the trees.
+//! the host's target, so what the host draws afterwards meets the terrain and the trees drawn
+//! single-sampled (multisampled trees keep their depth in their own target).
 
 use super::{FrameReport, RenderError, Renderer};
 use crate::camera::Camera;
