@@ -91,13 +91,14 @@ impl HostTargets<'_> {
         self.colour.create_view(&Default::default())
     }
 
-    /// Records a copy of the whole depth of `from` into `to` (the two of one size).
-    pub(super) fn copy_depth(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        (from, to): (&wgpu::Texture, &wgpu::Texture),
-    ) {
-        encoder.copy_texture_to_texture(from.as_image_copy(), to.as_image_copy(), from.size());
+    /// Records a copy of the host's depth into `own` (terramp's depth target, of its size).
+    pub(super) fn copy_depth_in(&self, encoder: &mut wgpu::CommandEncoder, own: &wgpu::Texture) {
+        encoder.copy_texture_to_texture(self.depth.as_image_copy(), own.as_image_copy(), own.size());
+    }
+
+    /// Records a copy of `own` (terramp's depth target) back into the host's depth.
+    pub(super) fn copy_depth_back(&self, encoder: &mut wgpu::CommandEncoder, own: &wgpu::Texture) {
+        encoder.copy_texture_to_texture(own.as_image_copy(), self.depth.as_image_copy(), own.size());
     }
 }
 

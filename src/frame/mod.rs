@@ -340,7 +340,7 @@ impl Renderer {
     ) -> Result<(), RenderError> {
         let (gpu, p, t, c) = (&self.gpu, &mut self.profiler, &self.targets, &self.counts);
         // Over a host's frame: its geometry's depth first, for every pass to meet.
-        host.inspect(|h| h.copy_depth(encoder, (h.depth, &t.depth)));
+        host.inspect(|h| h.copy_depth_in(encoder, &t.depth));
         // With `gpu.count_fragments`, the foliage passes count their fragments and pixels.
         let (targets, counter) = ((&t.colour_view, &t.depth_view), self.fragments.as_ref());
         let counted = |label, e: &mut _, record: &dyn Fn(&mut _, Option<CountedPass<'_>>)| {
@@ -402,7 +402,7 @@ impl Renderer {
             None => self.display.encode(e, &t.display_view, c.pass("display")),
         })?;
         // The terrain's and the trees' depth back to the host, for what it draws next.
-        host.inspect(|h| h.copy_depth(encoder, (&t.depth, h.depth)));
+        host.inspect(|h| h.copy_depth_back(encoder, &t.depth));
         Ok(())
     }
 

@@ -32,6 +32,7 @@ use crate::passes::seed_select::march::height_tile_max_m;
 use crate::seeds::SeedTables;
 use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::wind::WindFrame;
+use crate::streaming::TileCache;
 
 use super::{Caches, RenderError, Targets, UndrawnSeeds};
 
@@ -92,18 +93,12 @@ impl SeedStage {
         else {
             return Ok(None);
         };
-        let sources = SeedSources {
-            heights: &caches.heights,
-            landcover: landcover_cache,
-            imagery: &caches.imagery,
-            depth: &targets.depth_view,
-        };
         let device = &gpu.device;
         check_capacity(device, settings.seeds.capacity)?;
         let (table, tables, patterns) = seeded_world(settings, landcover)?;
         let undrawn = UndrawnSeeds::find(class_table_name(settings, landcover), &table, settings);
         let pass = SeedSelectPass::new(device, settings, &patterns, &tables, &height_tile_max_m(dataset));
-        let bind_group = pass.bind_group(device, &sources);
+        let bind_group = bind_sources(device, &pass, (caches, landcover_cache), targets);
         let mut compact = CompactPass::new(device, CompactLimits::from(settings))?;
         let compact_bind_group =
             compact.bind_group(device, &CompactInputs { blocks: pass.blocks(), keys: pass.keys() });
@@ -136,13 +131,7 @@ impl SeedStage {
     /// targets made again at another size); the tables, the pipelines and the records stay.
     pub fn resize(&mut self, device: &wgpu::Device, caches: &Caches, targets: &Targets) {
         if let Some(landcover) = &caches.landcover {
-            let sources = SeedSources {
-                heights: &caches.heights,
-                landcover,
-                imagery: &caches.imagery,
-                depth: &targets.depth_view,
-            };
-            self.bind_group = self.pass.bind_group(device, &sources);
+            self.bind_group = bind_sources(device, &self.pass, (caches, landcover), targets);
         }
         if let Some((draw, _)) = self.draw.as_mut() {
             draw.resize_multisampled(device, &targets.colour, &targets.depth);
@@ -289,6 +278,22 @@ fn seeded_world(
     let patterns =
         SeedPatterns::generate(settings.tlm.corner_colours(), seeds.seeds_per_pattern, settings.tlm.seed);
     Ok((table, tables, patterns))
+}
+
+/// Pass 3's bind group over the caches (`landcover` the land cover's) and the frame's depth.
+fn bind_sources(
+    device: &wgpu::Device,
+    pass: &SeedSelectPass,
+    (caches, landcover): (&Caches, &TileCache),
+    targets: &Targets,
+) -> wgpu::BindGroup {
+    let sources = SeedSources {
+        heights: &caches.heights,
+        landcover,
+        imagery: &caches.imagery,
+        depth: &targets.depth_view,
+    };
+    pass.bind_group(device, &sources)
 }
 
 /// Pass 4 over the impostors in `dir` of `table`'s species, bound to pass 3's records and
