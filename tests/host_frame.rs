@@ -14,6 +14,7 @@
 
 use terramp::camera::Camera;
 use terramp::frame::{FrameReport, HostTargetError, HostTargets, RenderError, Renderer};
+use terramp::gpu::TimeSource;
 use terramp::gpu::readback::read_texture;
 use terramp::passes::DEPTH_FORMAT;
 use terramp_testkit::{
@@ -40,6 +41,17 @@ fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
 @fragment
 fn fs() -> @location(0) vec4<f32> { return vec4<f32>(1.0, 0.0, 1.0, 1.0); }
 ";
+
+/// Who submits terramp's frame.
+#[derive(Clone, Copy)]
+enum Submit {
+    /// terramp, after the host's (`render_into`).
+    Terramp,
+    /// The host, with its own geometry in one encoder (`encode_frame`), saying so (`submitted`).
+    Host,
+    /// As `Host`, never saying so: each frame's readbacks start at the next frame.
+    HostUnsaid,
+}
 
 /// The host: its targets and the pipeline of its wall.
 struct Host {
@@ -91,9 +103,30 @@ impl Host {
         Self { colour, depth, wall }
     }
 
-    /// The host's frame (cleared, the wall drawn or not), submitted, then terramp's over it.
-    fn frame(&self, r: &mut Renderer, pose: &Camera, wall: bool) -> FrameReport {
+    /// The host's frame (cleared, the wall drawn or not), then terramp's over it: submitted by
+    /// terramp after the host's, or recorded into the host's encoder and submitted with it.
+    fn frame(&self, r: &mut Renderer, pose: &Camera, wall: bool, submit: Submit) -> FrameReport {
         let mut encoder = r.gpu.device.create_command_encoder(&Default::default());
+        self.record(&mut encoder, wall);
+        let targets = HostTargets { colour: &self.colour, depth: &self.depth };
+        match submit {
+            Submit::Terramp => {
+                r.gpu.queue.submit([encoder.finish()]);
+                r.render_into(pose, &targets).unwrap()
+            }
+            Submit::Host | Submit::HostUnsaid => {
+                let report = r.encode_frame(pose, &mut encoder, &targets).unwrap();
+                r.gpu.queue.submit([encoder.finish()]);
+                if matches!(submit, Submit::Host) {
+                    r.submitted();
+                }
+                report
+            }
+        }
+    }
+
+    /// Records the host's geometry: its targets cleared, the wall drawn or not.
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, wall: bool) {
         {
             let (colour, depth) =
                 (self.colour.create_view(&Default::default()), self.depth.create_view(&Default::default()));
@@ -125,14 +158,18 @@ impl Host {
                 pass.draw(0..6, 0..1);
             }
         }
-        r.gpu.queue.submit([encoder.finish()]);
-        r.render_into(pose, &HostTargets { colour: &self.colour, depth: &self.depth }).unwrap()
     }
 
     /// The host's frame settled: every tile it asks for resident, and pass 3's counters (a frame
     /// or two late) the same two frames running.
-    fn settled(&self, r: &mut Renderer, pose: &Camera, wall: bool) -> (FrameReport, image::RgbaImage) {
-        let mut report = self.frame(r, pose, wall);
+    fn settled(
+        &self,
+        r: &mut Renderer,
+        pose: &Camera,
+        wall: bool,
+        submit: Submit,
+    ) -> (FrameReport, image::RgbaImage) {
+        let mut report = self.frame(r, pose, wall, submit);
         // Counters of this call's frames only: the view before it may have had other ones.
         let first = report.frame;
         let counters = |report: &FrameReport| {
@@ -143,13 +180,17 @@ impl Host {
             let arrived = report.height.needed_resident == report.height.needed
                 && report.imagery.needed_resident == report.imagery.needed;
             if arrived && counters(&report).is_some() && counters(&report) == last {
-                let bytes = read_texture(&r.gpu, &self.colour, wgpu::TextureAspect::All, 4).unwrap();
-                return (report, image::RgbaImage::from_raw(SIZE[0], SIZE[1], bytes).unwrap());
+                return (report, self.colour(r));
             }
             last = counters(&report);
-            report = self.frame(r, pose, wall);
+            report = self.frame(r, pose, wall, submit);
         }
         panic!("the view did not settle in {SETTLE_FRAMES} frames")
+    }
+
+    fn colour(&self, r: &Renderer) -> image::RgbaImage {
+        let bytes = read_texture(&r.gpu, &self.colour, wgpu::TextureAspect::All, 4).unwrap();
+        image::RgbaImage::from_raw(SIZE[0], SIZE[1], bytes).unwrap()
     }
 
     fn depth(&self, r: &Renderer) -> Vec<f32> {
@@ -175,7 +216,7 @@ fn terramp_over_a_hosts_frame_meets_its_geometry_in_depth_and_in_culling() {
     let pose = camera::over_fraction(&r, [0.45, 0.35], 25.0, 20.0, -10.0);
     let host = Host::new(&r.gpu.device);
 
-    let (plain, plain_image) = host.settled(&mut r, &pose, false);
+    let (plain, plain_image) = host.settled(&mut r, &pose, false, Submit::Terramp);
     r.render(&pose).unwrap();
     let own = r.read_colour().unwrap();
     let plain_db = psnr(&plain_image, &own);
@@ -184,7 +225,7 @@ fn terramp_over_a_hosts_frame_meets_its_geometry_in_depth_and_in_culling() {
         assert_eq!(differing_pixels(&plain_image, &own), 0);
     }
 
-    let (walled, walled_image) = host.settled(&mut r, &pose, true);
+    let (walled, walled_image) = host.settled(&mut r, &pose, true, Submit::Terramp);
     let left = half(&walled_image, false);
     assert!(left.pixels().all(|p| p.0 == WALL), "the wall is covered somewhere");
     let beside_db = psnr(&half(&walled_image, true), &half(&plain_image, true));
@@ -234,4 +275,87 @@ fn targets_terramp_cannot_draw_over_are_refused_naming_them() {
     }
     // Refusals draw nothing and leave the renderer working.
     r.render_into(&pose, &HostTargets { colour: &good.colour, depth: &good.depth }).unwrap();
+}
+
+#[test]
+fn a_frame_recorded_into_the_hosts_encoder_is_the_frame_terramp_submits() {
+    let Some(impostors) = terramp_testkit::nc_impostors() else { return };
+    let dir = synth_dataset(300, 7);
+    let mut settings = small_settings(SIZE[0], SIZE[1]);
+    settings.draw_seeds.impostors = impostors.to_str().unwrap().to_owned();
+    settings.draw_seeds.samples = 4;
+    let [mut own, mut hosted] = [(); 2].map(|()| renderer(&dir, settings.clone()));
+    let pose = camera::over_fraction(&own, [0.45, 0.35], 25.0, 20.0, -10.0);
+    // Each renderer has a device of its own (`renderer`), and each host its targets on it.
+    let [own_host, hosted_host] = [&own, &hosted].map(|r| Host::new(&r.gpu.device));
+
+    let (submitted, submitted_image) = own_host.settled(&mut own, &pose, true, Submit::Terramp);
+    let (recorded, recorded_image) = hosted_host.settled(&mut hosted, &pose, true, Submit::Host);
+    let db = psnr(&recorded_image, &submitted_image);
+    let [a, b] = [submitted, recorded].map(|r| r.seeds.unwrap().counters);
+    println!(
+        "recorded by the host against submitted by terramp: {db:.1} dB; seeds selected {} and {}",
+        a.selected, b.selected
+    );
+    assert_eq!(a, b, "pass 3's counters");
+    if lavapipe_only(&hosted.gpu, "the recorded frame pixel for pixel") {
+        assert_eq!(differing_pixels(&recorded_image, &submitted_image), 0);
+    }
+    // The passes were timed inside the host's encoder, where the adapter has timestamps.
+    if hosted.profiler.uses_gpu_timestamps() {
+        let timed = hosted
+            .last_timings()
+            .iter()
+            .any(|t| t.label == "draw_seeds" && t.source == TimeSource::GpuTimestamps);
+        assert!(timed, "{:?}", hosted.last_timings());
+    }
+}
+
+#[test]
+fn a_frame_in_the_hosts_encoder_reaches_the_gpu_with_the_hosts_submit() {
+    let dir = synth_dataset(300, 7);
+    let mut settings = small_settings(SIZE[0], SIZE[1]);
+    // Without timestamps terramp would time each pass by submitting it: not in a host's encoder.
+    settings.gpu.timestamps = false;
+    let mut r = renderer(&dir, settings);
+    let pose = camera::over_fraction(&r, [0.45, 0.35], 25.0, 20.0, -10.0);
+    let host = Host::new(&r.gpu.device);
+    // The host never says it submitted: each frame's readbacks start at the next one.
+    let (report, walled) = host.settled(&mut r, &pose, true, Submit::HostUnsaid);
+    assert!(report.tlm_frame.is_some() && report.seeds.is_some(), "no readback came back");
+    assert!(half(&walled, false).pixels().all(|p| p.0 == WALL), "the wall is covered somewhere");
+    assert!(
+        half(&walled, true).pixels().any(|p| p.0 != WALL && p.0 != [0, 0, 255, 255]),
+        "terramp drew nothing"
+    );
+    let untimed = r.last_timings().iter().all(|t| t.source == TimeSource::Cpu);
+    assert!(untimed, "a pass was timed by submitting it: {:?}", r.last_timings());
+
+    // A frame without the wall, recorded: until the host submits it, the GPU has none of it.
+    let mut encoder = r.gpu.device.create_command_encoder(&Default::default());
+    host.record(&mut encoder, false);
+    r.encode_frame(&pose, &mut encoder, &HostTargets { colour: &host.colour, depth: &host.depth }).unwrap();
+    assert_eq!(differing_pixels(&host.colour(&r), &walled), 0, "drawn before the host's submit");
+    r.gpu.queue.submit([encoder.finish()]);
+    r.submitted();
+    let unwalled = host.colour(&r);
+    assert!(half(&unwalled, false).pixels().any(|p| p.0 != WALL), "the host's submit drew nothing");
+}
+
+#[test]
+fn counting_fragments_is_refused_in_the_hosts_encoder() {
+    let dir = synth_dataset(64, 3);
+    let mut settings = small_settings(SIZE[0], SIZE[1]);
+    settings.gpu.count_fragments = true;
+    let mut r = renderer(&dir, settings);
+    let pose = camera::over_fraction(&r, [0.5, 0.5], 50.0, 0.0, -10.0);
+    let host = Host::new(&r.gpu.device);
+    let mut encoder = r.gpu.device.create_command_encoder(&Default::default());
+    let targets = HostTargets { colour: &host.colour, depth: &host.depth };
+    let refused = r.encode_frame(&pose, &mut encoder, &targets).unwrap_err();
+    println!("{refused}");
+    assert!(matches!(refused, RenderError::FragmentsWait), "{refused}");
+    // Nothing was recorded, and terramp's own submit still draws over the host's frame.
+    r.gpu.queue.submit([encoder.finish()]);
+    r.render_into(&pose, &targets).unwrap();
 }

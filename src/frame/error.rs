@@ -64,6 +64,12 @@ pub enum RenderError {
     /// record where it lies on the Earth.
     #[error(transparent)]
     Sun(#[from] crate::sun::SunError),
+    /// `gpu.count_fragments` is on and a frame was to be recorded into a host's encoder: the
+    /// counter waits for each frame, and a frame the host submits cannot be waited for.
+    #[error(
+        "gpu.count_fragments waits for each frame: turn it off to record into the host's encoder, or draw with render_into"
+    )]
+    FragmentsWait,
     /// `gpu.count_fragments` is on, and the adapter has no pipeline-statistics queries.
     #[error("gpu.count_fragments: this adapter cannot count fragments (no pipeline-statistics queries)")]
     NoFragmentCounts,

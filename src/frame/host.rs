@@ -10,6 +10,11 @@
 //! by it (the host's pixels in front stay as the host drew them), and the depth goes back to
 //! the host's target, so what the host draws afterwards meets the terrain and the trees drawn
 //! single-sampled (multisampled trees keep their depth in their own target).
+//!
+//! `render_into` submits the frame itself; `encode_frame` records the same frame into the host's
+//! encoder, after the host's geometry, and leaves the submit to the host: the readbacks (which
+//! map buffers, and a buffer mapped before the submit would fail it) start when the host says it
+//! submitted, or at the next frame.
 
 use super::{FrameReport, RenderError, Renderer};
 use crate::camera::Camera;
@@ -107,7 +112,8 @@ impl Renderer {
     /// (and submitted before this call) occludes and is occluded by the terrain and the trees,
     /// and the host's depth holds theirs afterwards. terramp's own targets still hold the frame's
     /// light and depth (`read_light`, `read_depth`); its display target is not drawn. Targets it
-    /// cannot use are refused with the reason, and nothing is drawn.
+    /// cannot use are refused with the reason, and nothing is drawn. terramp submits the frame
+    /// itself; `encode_frame` records it into the host's encoder instead.
     pub fn render_into(
         &mut self,
         camera: &Camera,
@@ -116,5 +122,53 @@ impl Renderer {
         host.check([self.settings.render.width, self.settings.render.height])?;
         self.display.prepare_over(&self.gpu.device, host.colour.format());
         self.render_to(camera, Some(host))
+    }
+
+    /// Records one frame from `camera` over the host's targets into the host's `encoder`, after
+    /// whatever the host recorded there before (its geometry), and submits nothing: the host
+    /// submits the encoder, then may say so with `submitted`, and must before its next call to
+    /// this renderer. The frame's CPU work (the LOD, the streaming, the uploads, which reach the
+    /// GPU with the host's submit) runs here and waits for nothing; the readbacks of earlier
+    /// frames that have arrived are taken first, so the report's `seeds` and `counts` are a frame
+    /// or two older than in `render_into`'s. Without GPU timestamps the passes go untimed (timing
+    /// them would mean submitting the host's encoder). `gpu.count_fragments`, which waits for each
+    /// frame, is refused.
+    pub fn encode_frame(
+        &mut self,
+        camera: &Camera,
+        encoder: &mut wgpu::CommandEncoder,
+        host: &HostTargets<'_>,
+    ) -> Result<FrameReport, RenderError> {
+        if self.fragments.is_some() {
+            return Err(RenderError::FragmentsWait);
+        }
+        host.check([self.settings.render.width, self.settings.render.height])?;
+        self.display.prepare_over(&self.gpu.device, host.colour.format());
+        let (camera, mut report) = self.start_frame(camera)?;
+        let frame = self.take_arrived(&mut report).and_then(|()| {
+            let plan = self.prepare(&camera, &mut report)?;
+            self.profiler.set_may_submit(false);
+            let encoded = self.encode(encoder, &plan.nodes, &plan.tlm, Some(host));
+            self.profiler.set_may_submit(true);
+            encoded?;
+            self.record_readbacks(encoder, plan);
+            self.hosted_unsubmitted = true;
+            Ok(())
+        });
+        self.conclude(frame, report)
+    }
+
+    /// Says that the encoder the last `encode_frame` recorded into is on the queue, so its
+    /// readbacks start now instead of at the next frame. Calling it before the submit fails the
+    /// submit (the readbacks' buffers would be mapped); calling it again does nothing.
+    pub fn submitted(&mut self) {
+        self.mark_hosted_submitted();
+    }
+
+    /// Starts the readbacks of a frame recorded into a host's encoder, if one waits.
+    pub(super) fn mark_hosted_submitted(&mut self) {
+        if std::mem::take(&mut self.hosted_unsubmitted) {
+            self.mark_submitted();
+        }
     }
 }

@@ -1,8 +1,9 @@
 //! How it works: `Renderer` owns the GPU resources of one dataset (caches, loader threads, passes,
 //! targets) and `render` runs one frame in three steps: `prepare` does the frame's CPU work (the
 //! terrain's LOD selection, the streaming the latest Tile Load Map asked for, every upload of the
-//! frame), `encode` records the paper's passes, one line each, and `submit` sends them with the
-//! non-blocking readbacks and takes whatever earlier readbacks have arrived. Nothing in a frame
+//! frame), `encode` records the paper's passes, one line each, and the frame's readbacks are
+//! recorded after them, sent, and whatever earlier readbacks have arrived is taken (`submit`).
+//! Over a host's frame the same steps record into the host's encoder (`host`). Nothing in a frame
 //! waits for the disk or the GPU: tiles stream in over the following frames, and until they do
 //! their ancestors stand in; the Tile Load Map and pass 3's counters come back a frame or two late.
 
@@ -16,7 +17,7 @@ use crate::dataset::{Dataset, TileId};
 use crate::earth::placing::{EarthPlacing, ExactPlacing};
 use crate::gpu::counter::Counter;
 use crate::gpu::counts::FrameCounts;
-use crate::gpu::fragments::{CountedPass, FragmentCounter, PassFragments, with_counts};
+use crate::gpu::fragments::{CountedPass, FragmentCounter};
 use crate::gpu::gpu_types::TerrainUniforms;
 use crate::gpu::readback_ring::{DEFAULT_SLOTS, ReadbackRing};
 use crate::gpu::{Gpu, GpuError, PassTiming, Profiler};
@@ -26,7 +27,7 @@ use crate::passes::display::gpu::DisplayPass;
 use crate::passes::ground::gpu::GroundPass;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
 use crate::passes::terrain::select::NodeBounds;
-use crate::passes::tile_load_map::analysis::{LoadMaps, analyse};
+use crate::passes::tile_load_map::analysis::LoadMaps;
 use crate::passes::tile_load_map::frame::{TlmEarth, TlmFrame, height_tile_ranges};
 use crate::passes::tile_load_map::gpu::{TileLoadMapPass, TlmBindings};
 use crate::passes::tile_load_map::layout::TlmLayout;
@@ -40,6 +41,7 @@ mod prepare;
 mod report;
 mod seeds;
 mod setup;
+mod submit;
 mod texcells;
 mod tools;
 mod undrawn;
@@ -140,6 +142,9 @@ pub struct Renderer {
     fragments: Option<FragmentCounter>,
     /// Counts what each pass asks of the GPU, every frame.
     counts: Counter,
+    /// A frame was recorded into a host's encoder (`encode_frame`) and its readbacks have not
+    /// been started: they start once the host says it submitted it, or at the next frame.
+    hosted_unsubmitted: bool,
 }
 
 impl Renderer {
@@ -228,6 +233,7 @@ impl Renderer {
             last_timings: Vec::new(),
             fragments,
             counts,
+            hosted_unsubmitted: false,
         })
     }
 
@@ -307,18 +313,37 @@ impl Renderer {
         camera: &Camera,
         host: Option<&HostTargets<'_>>,
     ) -> Result<FrameReport, RenderError> {
+        let (camera, mut report) = self.start_frame(camera)?;
+        let frame = self.prepare(&camera, &mut report).and_then(|plan| {
+            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+            self.encode(&mut encoder, &plan.nodes, &plan.tlm, host)?;
+            self.record_readbacks(&mut encoder, plan);
+            self.gpu.queue.submit([encoder.finish()]);
+            self.after_submit(report.frame, &mut report)
+        });
+        self.conclude(frame, report)
+    }
+
+    /// A frame's start: the device alive, the camera valid (and lifted above the ground), the
+    /// readbacks of a frame the host recorded and has submitted since started, the counts begun.
+    fn start_frame(&mut self, camera: &Camera) -> Result<(Camera, FrameReport), RenderError> {
         if let Some(why) = self.gpu.lost() {
             return Err(GpuError::DeviceLost(why).into());
         }
         camera.validate()?;
         let (camera, camera_lifted_m) = self.above_ground(camera);
-        let mut report = FrameReport { frame: self.frame, camera_lifted_m, ..Default::default() };
+        let report = FrameReport { frame: self.frame, camera_lifted_m, ..Default::default() };
+        self.mark_hosted_submitted();
         self.counts.begin_frame(self.frame);
-        let frame = self.prepare(&camera, &mut report).and_then(|plan| {
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-            self.encode(&mut encoder, &plan.nodes, &plan.tlm, host)?;
-            self.submit(encoder, plan, &mut report)
-        });
+        Ok((camera, report))
+    }
+
+    /// The frame's report, or why it failed; a lost device is named as the cause.
+    fn conclude(
+        &self,
+        frame: Result<(), RenderError>,
+        report: FrameReport,
+    ) -> Result<FrameReport, RenderError> {
         // A lost device fails whatever step comes next, each in its own words: say the cause.
         // wgpu tells of a loss once the queue has drained, so a frame the GPU failed waits for it.
         if matches!(frame, Err(RenderError::Gpu(_))) && self.gpu.lost().is_none() {
@@ -403,80 +428,6 @@ impl Renderer {
         })?;
         // The terrain's and the trees' depth back to the host, for what it draws next.
         host.inspect(|h| h.copy_depth_back(encoder, &t.depth));
-        Ok(())
-    }
-
-    /// Records the frame's readbacks (after the last timed pass: the CPU-timing fallback submits
-    /// each pass's encoder on its own), submits, and takes every readback that has arrived.
-    fn submit(
-        &mut self,
-        mut encoder: wgpu::CommandEncoder,
-        plan: prepare::FramePlan,
-        report: &mut FrameReport,
-    ) -> Result<(), RenderError> {
-        let prepare::FramePlan { layout, camera_grid_m, tlm, nodes, terrain } = plan;
-        let tag = TlmTag { frame: self.frame, layout, camera_grid_m };
-        let before = self.tlm_readback.copied_bytes();
-        self.tlm_readback.encode_copy(&mut encoder, self.tlm.output(), tlm.output_bytes(), tag);
-        self.counts.read_back("tile_load_map", self.tlm_readback.copied_bytes() - before);
-        if let Some(stage) = self.seeds.as_mut() {
-            stage.encode_readback(&mut encoder, self.frame, &self.counts);
-        }
-        self.profiler.resolve(&mut encoder);
-        self.fragments.iter().for_each(|counter| counter.resolve(&mut encoder));
-        self.counts.resolve(&mut encoder);
-        self.gpu.queue.submit([encoder.finish()]);
-        self.counts.submitted();
-        self.tlm_readback.submitted();
-        if let Some(stage) = self.seeds.as_mut() {
-            stage.submitted();
-        }
-        if self.fragments.is_some() {
-            report.fragments = self.read_fragments(report)?;
-        }
-        self.profiler.end_frame();
-        self.gpu.device.poll(wgpu::PollType::Poll).map_err(GpuError::from)?;
-        self.analyse_arrived_tlms()?;
-        report.tlm_readbacks_skipped = self.tlm_readback.skipped();
-        if let Some(stage) = self.seeds.as_mut() {
-            stage.collect(&self.gpu.device)?;
-            report.seeds = stage.latest;
-        }
-        report.counts.extend(self.counts.collect(&self.gpu.device)?);
-        while let Some(timings) = self.profiler.finished_frame(&self.gpu) {
-            self.last_timings = timings;
-        }
-        self.gpu.check()?;
-        self.last = Some(LastFrame { tlm, nodes, terrain });
-        self.frame += 1;
-        Ok(())
-    }
-
-    /// With `gpu.count_fragments`: waits for the frame, reads the pixels its foliage passes
-    /// covered, and takes its counts (and any older ones still in flight) for their invocations.
-    fn read_fragments(&mut self, report: &mut FrameReport) -> Result<Vec<PassFragments>, RenderError> {
-        let Some(counter) = &self.fragments else { return Ok(Vec::new()) };
-        let before = self.gpu.queue.read_back_bytes();
-        let passes = counter.read(&self.gpu)?;
-        self.counts.read_back_late(self.frame, "fragments", self.gpu.queue.read_back_bytes() - before);
-        report.counts.extend(self.counts.collect(&self.gpu.device)?);
-        let counts = report.counts.iter().find(|c| c.frame == self.frame).ok_or_else(|| {
-            GpuError::Validation("a frame's counts did not arrive after waiting for it".into())
-        })?;
-        Ok(with_counts(passes, counts))
-    }
-
-    /// Turns every TLM that has arrived into load maps, keeping the newest.
-    fn analyse_arrived_tlms(&mut self) -> Result<(), RenderError> {
-        while let Some(readback) = self.tlm_readback.try_take(&self.gpu.device)? {
-            let TlmTag { frame, layout, camera_grid_m } = &readback.tag;
-            let cells = readback.cast();
-            let dataset = &self.dataset;
-            let maps = self
-                .profiler
-                .cpu("tlm_analysis", || analyse(*frame, layout, &cells, *camera_grid_m, dataset));
-            self.load_maps = Some(maps);
-        }
         Ok(())
     }
 }

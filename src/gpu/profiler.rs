@@ -4,8 +4,9 @@
 //!
 //! Without timestamps the profiler falls back to CPU timing: it submits what was recorded before
 //! the pass, waits, then records, submits and waits for the pass alone. That serialises the frame
-//! (so it is slower), but each figure is still the pass's own wall time. CPU work (TLM analysis,
-//! uploads) is timed with `cpu` scopes either way. Timings are in milliseconds.
+//! (so it is slower), but each figure is still the pass's own wall time; into an encoder it may
+//! not submit (a host's), passes go untimed. CPU work (TLM analysis, uploads) is timed with `cpu`
+//! scopes either way. Timings are in milliseconds.
 //!
 //! Each frame is numbered by the `end_frame` calls before it. `keep_history` makes the profiler
 //! also keep every finished frame with its number and each scope's start (on the GPU's timestamp
@@ -82,6 +83,8 @@ pub struct Profiler {
     pending: std::collections::VecDeque<FrameTimings>,
     /// Finished frames, kept while `keep_history` is on.
     history: Option<Vec<FrameTimings>>,
+    /// Whether `pass` may submit the encoder it is given: not one a host will submit itself.
+    may_submit: bool,
 }
 
 impl Profiler {
@@ -108,6 +111,7 @@ impl Profiler {
             cpu: FrameTimings::default(),
             pending: Default::default(),
             history: None,
+            may_submit: true,
         }
     }
 
@@ -148,6 +152,9 @@ impl Profiler {
             let mut scope = profiler.scope(label, encoder);
             return Ok(record(&mut scope));
         }
+        if !self.may_submit {
+            return Ok(record(encoder));
+        }
         let new_encoder = || gpu.device.create_command_encoder(&Default::default());
         gpu.queue.submit([std::mem::replace(encoder, new_encoder()).finish()]);
         gpu.wait()?;
@@ -157,6 +164,13 @@ impl Profiler {
         gpu.wait()?;
         self.push_cpu(label, start, TimeSource::CpuWait);
         Ok(result)
+    }
+
+    /// Whether `pass` may submit the encoders it is given (true unless set). Without timestamps a
+    /// pass is timed by submitting and waiting; into an encoder the host submits, passes are
+    /// recorded untimed instead.
+    pub fn set_may_submit(&mut self, may_submit: bool) {
+        self.may_submit = may_submit;
     }
 
     /// Times CPU work of the frame being recorded.
