@@ -219,6 +219,12 @@ impl Dataset {
     /// clamped to the dataset. Reads at most four tiles; for camera placement and tests, not the
     /// per-frame path.
     pub fn height_at(&self, x_m: f64, y_m: f64, level: u32) -> Result<f64, PackError> {
+        Ok(self.ground_at(x_m, y_m, level)?.0)
+    }
+
+    /// `height_at`'s height and the slopes of the triangle holding the point, metres of height per
+    /// cell of `level` along x and y (`surface::drawn_height`).
+    pub fn ground_at(&self, x_m: f64, y_m: f64, level: u32) -> Result<(f64, [f64; 2]), PackError> {
         let pyramid = &self.height.pyramid;
         let level = level.min(pyramid.levels - 1);
         let spacing = self.manifest.height.spacing_m * f64::from(1u32 << level);
@@ -232,7 +238,7 @@ impl Dataset {
         let ((ix, fx), (iy, fy)) = (axis(x_m, size[0]), axis(y_m, size[1]));
         let sample = |x: u32, y: u32| self.height_sample(level, x.min(size[0] - 1), y.min(size[1] - 1));
         let corners = [sample(ix, iy)?, sample(ix + 1, iy)?, sample(ix, iy + 1)?, sample(ix + 1, iy + 1)?];
-        Ok(surface::drawn_height([ix, iy], corners, [fx, fy]).0)
+        Ok(surface::drawn_height([ix, iy], corners, [fx, fy]))
     }
 
     /// The land cover's LCC coding, if the dataset has land cover.

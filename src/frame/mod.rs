@@ -25,6 +25,7 @@ use crate::passes::atmosphere::gpu::AtmospherePass;
 use crate::passes::depth_pyramid::gpu::DepthPyramid;
 use crate::passes::display::gpu::DisplayPass;
 use crate::passes::ground::gpu::GroundPass;
+use crate::passes::terrain::frame::NodeBatches;
 use crate::passes::terrain::gpu::{MeshDraw, PreparedNodes, TerrainPass};
 use crate::passes::terrain::select::NodeBounds;
 use crate::passes::tile_load_map::analysis::LoadMaps;
@@ -38,6 +39,7 @@ mod clearance;
 mod error;
 mod host;
 mod prepare;
+mod query;
 mod report;
 mod seeds;
 mod setup;
@@ -49,6 +51,7 @@ mod undrawn;
 pub use clearance::GROUND_CLEARANCE_NEAR;
 pub use error::RenderError;
 pub use host::{HostTargetError, HostTargets};
+pub use query::GroundAt;
 pub use report::FrameReport;
 pub use seeds::SeedReport;
 pub use texcells::TexcellReport;
@@ -68,6 +71,11 @@ struct LastFrame {
     tlm: TlmFrame,
     nodes: PreparedNodes,
     terrain: TerrainUniforms,
+    /// The node instances drawn, the camera's grid position and the frame's f64 matrix
+    /// (camera-relative metres to clip), for `drawn_ground`.
+    batches: NodeBatches,
+    camera_grid_m: DVec3,
+    clip_from_rel_m: glam::DMat4,
 }
 
 /// The three tile caches, with the tiles each keeps resident for good.

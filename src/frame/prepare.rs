@@ -5,14 +5,14 @@
 //! and pass 4's constants, each step's bytes counted as its pass's (the caches' as `streaming`).
 //! `encode` then only records commands over what this left.
 
-use glam::DVec3;
+use glam::{DMat4, DVec3};
 
 use crate::camera::{Camera, Frustum};
 use crate::earth::horizon::fall_per_m2;
 use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::{EarthNode, TerrainUniforms};
 use crate::passes::atmosphere::frame::SkyView;
-use crate::passes::terrain::frame::{FrameLight, height_tiles, node_batches, terrain_uniforms};
+use crate::passes::terrain::frame::{FrameLight, NodeBatches, height_tiles, node_batches, terrain_uniforms};
 use crate::passes::terrain::gpu::PreparedNodes;
 use crate::passes::terrain::select::{Lods, Selected, select};
 use crate::passes::tile_load_map::analysis::LoadMaps;
@@ -34,6 +34,10 @@ pub(super) struct FramePlan {
     pub nodes: PreparedNodes,
     /// The terrain's uniforms: its matrix, sun and clouds, which everything drawn over it shares.
     pub terrain: TerrainUniforms,
+    /// The node instances drawn, kept for the CPU's rebuild of the drawn ground, and the f64
+    /// matrix they were drawn with (camera-relative metres to clip).
+    pub batches: NodeBatches,
+    pub clip_from_rel_m: DMat4,
 }
 
 /// The camera, as this frame's passes see it.
@@ -79,9 +83,10 @@ impl Renderer {
         let selected = self.select_nodes(&view);
         self.stream(&view, &selected, report);
         let (layout, tlm) = self.prepare_tlm(&view)?;
-        let (nodes, terrain) = self.prepare_terrain(&view, &selected, report);
+        let (nodes, terrain, batches) = self.prepare_terrain(&view, &selected, report);
         self.prepare_seeds(&view, &terrain, report)?;
-        Ok(FramePlan { layout, camera_grid_m: view.grid_m, tlm, nodes, terrain })
+        let clip_from_rel_m = view.clip_from_view_world;
+        Ok(FramePlan { layout, camera_grid_m: view.grid_m, tlm, nodes, terrain, batches, clip_from_rel_m })
     }
 
     /// Terrain LOD: the nodes whose triangles keep their target size on screen.
@@ -175,7 +180,7 @@ impl Renderer {
         view: &View,
         selected: &[Selected],
         report: &mut FrameReport,
-    ) -> (PreparedNodes, TerrainUniforms) {
+    ) -> (PreparedNodes, TerrainUniforms, NodeBatches) {
         let (dataset, bounds) = (&self.dataset, &mut self.bounds);
         let floor_m = dataset.manifest.height.min_m;
         let mut placed = self.placing.view(&view.placing);
@@ -213,7 +218,7 @@ impl Renderer {
                 })
             });
         }
-        (nodes, uniforms)
+        (nodes, uniforms, batches)
     }
 
     /// Pass 3's cells (those the latest TLM found near and visible), and pass 4's constants (the

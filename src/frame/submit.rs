@@ -17,7 +17,8 @@ impl Renderer {
     /// CPU-timing fallback submits each pass's encoder on its own), keeps what tools read of the
     /// frame, and numbers the next one.
     pub(super) fn record_readbacks(&mut self, encoder: &mut wgpu::CommandEncoder, plan: prepare::FramePlan) {
-        let prepare::FramePlan { layout, camera_grid_m, tlm, nodes, terrain } = plan;
+        let prepare::FramePlan { layout, camera_grid_m, tlm, nodes, terrain, batches, clip_from_rel_m } =
+            plan;
         let tag = TlmTag { frame: self.frame, layout, camera_grid_m };
         let before = self.tlm_readback.copied_bytes();
         self.tlm_readback.encode_copy(encoder, self.tlm.output(), tlm.output_bytes(), tag);
@@ -28,7 +29,7 @@ impl Renderer {
         self.profiler.resolve(encoder);
         self.fragments.iter().for_each(|counter| counter.resolve(encoder));
         self.counts.resolve(encoder);
-        self.last = Some(LastFrame { tlm, nodes, terrain });
+        self.last = Some(LastFrame { tlm, nodes, terrain, batches, camera_grid_m, clip_from_rel_m });
         self.frame += 1;
     }
 

@@ -6,7 +6,8 @@
 //! ground truth) and `frame_change` (popping: 4 × 4 block changes between consecutive frames,
 //! against the truth's along the same flight) are what the speed trade (`sweep`) reports; `worst`
 //! takes error maxima that never drop a NaN; `slicing` measures the slicings' stochastic blend
-//! against the paper's sorted one.
+//! against the paper's sorted one; `terrain` rebuilds the ground a frame drew, for the host's
+//! picks and heights.
 
 pub mod accuracy;
 pub mod atmosphere;
@@ -18,6 +19,7 @@ pub mod image_metrics;
 pub mod oracle;
 pub mod seed_select;
 pub mod slicing;
+pub mod terrain;
 pub mod texcells;
 pub mod tile_load_map;
 pub mod worst;

@@ -73,6 +73,11 @@ pub fn mm(v: f64) -> String {
     plain(v * 1000.0)
 }
 
+/// Metres as centimetres.
+pub fn cm(v: f64) -> String {
+    plain(v * 100.0)
+}
+
 /// Metres as kilometres.
 pub fn km(v: f64) -> String {
     plain(v / 1000.0)

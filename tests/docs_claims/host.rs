@@ -1,6 +1,6 @@
 //! What docs/host.md quotes, and where each number is defined.
 
-use super::claims::{Claim, plain, test_const};
+use super::claims::{Claim, cm, grouped, mm, plain, test_const};
 
 pub static HOST_CLAIMS: &[Claim] = &[
     Claim {
@@ -22,5 +22,28 @@ pub static HOST_CLAIMS: &[Claim] = &[
         doc: "docs/host.md",
         quote: "through every tone curve, within {} level of 8 bits (the test's bound)",
         values: &[(test_const("tests/display.rs", "DISPLAY_LEVELS"), plain)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "`tests/query.rs` picks {} pixels of each of",
+        values: &[(test_const("tests/query.rs", "PICKS"), grouped)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "depth buffer gives for that pixel: within {} cm, or within the",
+        values: &[(test_const("tests/query.rs", "PICK_FLOOR_M"), cm)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "up to 2^-{} pixel ({} subpixel bits, the fewest Vulkan allows;",
+        values: &[
+            (test_const("tests/query.rs", "SUBPIXEL_BITS"), plain),
+            (test_const("tests/query.rs", "SUBPIXEL_BITS"), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "grid point is the pick's within {} mm (the test's",
+        values: &[(test_const("tests/query.rs", "HEIGHT_M"), mm)],
     },
 ];

@@ -28,6 +28,19 @@ pub struct NodeBatches {
     pub earth: [Vec<EarthNode>; 4],
     /// The box each of those instances draws (its quadrant of the node), in the same order.
     pub boxes: [Vec<QuadrantBox>; 4],
+    /// Where each of those instances' node lies and the height tile it reads, in the same order:
+    /// what the CPU needs to rebuild the drawn ground (`reference::terrain`).
+    pub sources: [Vec<NodeSource>; 4],
+}
+
+/// A drawn node's south-west corner in the grid and the height tile it reads (its own, or its
+/// finest resident ancestor).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeSource {
+    /// The corner, metres (the GPU sees it camera-relative, in f32).
+    pub origin_grid_m: glam::DVec2,
+    /// The tile.
+    pub tile: TileId,
 }
 
 /// The grid-space box of one node quadrant's ground, metres: what the texcells over it stand in.
@@ -181,6 +194,7 @@ pub fn node_batches(
             }
             batches.by_quadrant[q].push(node);
             batches.earth[q].push(earth);
+            batches.sources[q].push(NodeSource { origin_grid_m: origin.into(), tile: source });
             // The quadrant's cells, cut to the node's cells inside the dataset.
             let first = [(q & 1) as f64 * half_cells, (q >> 1) as f64 * half_cells];
             let last = [0, 1].map(|a| (first[a] + half_cells).min(f64::from(inside[a])).max(first[a]));
