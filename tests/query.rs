@@ -5,8 +5,9 @@
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use terramp::camera::Camera;
-use terramp::frame::Renderer;
+use terramp::frame::{Plants, Renderer};
 use terramp::gpu::Gpu;
+use terramp::gpu::layout::SpeciesLod;
 use terramp_testkit::earth::synth_on_nc;
 use terramp_testkit::{camera, gpu, renderer, small_settings, synth_dataset};
 
@@ -146,4 +147,75 @@ fn the_finest_grounds_height_is_the_datasets() {
     let east = r.ground_at(100.75 * spacing_m, 40.25 * spacing_m).unwrap();
     let rise = east.height_m - at.height_m;
     assert!(rise == 0.0 || (at.normal.x < 0.0) == (rise > 0.0), "{at:?} {rise}");
+}
+
+/// Radius of the plants asked for around each point, metres.
+const PLANTS_RADIUS_M: f64 = 15.0;
+/// Points asked about.
+const PLANT_POINTS: usize = 100;
+/// Most seeds, as a share of those near the points, on which the exact oracle and pass 3 (f32,
+/// its occlusion against the depth) may disagree: seeds on a cull's very edge.
+const PLANTS_DISAGREEING: f64 = 0.01;
+
+#[test]
+fn the_plants_near_a_point_are_the_seeds_pass_3_selected_there() {
+    let dir = synth_dataset(300, 7);
+    let mut r = renderer(&dir, small_settings(SIZE[0], SIZE[1]));
+    let pose = camera::over_fraction(&r, [0.45, 0.35], 25.0, 20.0, -10.0);
+    r.render_resolved(&pose).unwrap();
+    // Pass 3 runs on the cells of a Tile Load Map a frame or two old: let the latest arrive.
+    for _ in 0..3 {
+        r.render(&pose).unwrap();
+    }
+    let (records, _) = r.read_seeds().unwrap().unwrap();
+    let camera_grid_m = pose.position_m
+        - glam::DVec3::new(r.dataset.manifest.origin_m[0], r.dataset.manifest.origin_m[1], 0.0);
+    let drawn: Vec<([i64; 2], u32, u32, glam::DVec2)> = records
+        .iter()
+        .map(|s| {
+            let grid = camera_grid_m.truncate()
+                + glam::Vec2::new(s.position_rel_m[0], s.position_rel_m[1]).as_dvec2();
+            (s.address.map(i64::from), s.rank, SpeciesLod::unpack(s.species_lod).species, grid)
+        })
+        .collect();
+    let ground = r.drawn_ground().unwrap().unwrap();
+    let mut pixels = Pixels(3);
+    let (mut points, mut near, mut disagree, mut grown_total) = (0, 0, 0, 0);
+    while points < PLANT_POINTS {
+        let Some(hit) = ground.pick_pixel(pixels.next()) else { continue };
+        let centre = [hit.grid_m.x, hit.grid_m.y];
+        points += 1;
+        let selected = r.plants_near(&pose, centre, PLANTS_RADIUS_M, Plants::Selected).unwrap().unwrap();
+        let grown = r.plants_near(&pose, centre, PLANTS_RADIUS_M, Plants::Grown).unwrap().unwrap();
+        grown_total += grown.len();
+        // Seeds within a millimetre of the circle may fall either side of it in f32.
+        let off_edge =
+            |p: glam::DVec2| (p.distance(glam::DVec2::from(centre)) - PLANTS_RADIUS_M).abs() > 1e-3;
+        let by_gpu: Vec<_> = drawn
+            .iter()
+            .filter(|d| d.3.distance(glam::DVec2::from(centre)) <= PLANTS_RADIUS_M && off_edge(d.3))
+            .map(|d| (d.0, d.1, d.2))
+            .collect();
+        let by_oracle: Vec<_> = selected
+            .iter()
+            .filter(|p| off_edge(p.position_grid_m.truncate()))
+            .map(|p| (p.address, p.rank, p.species))
+            .collect();
+        near += by_gpu.len().max(by_oracle.len());
+        disagree += by_gpu.iter().filter(|d| !by_oracle.contains(d)).count();
+        disagree += by_oracle.iter().filter(|o| !by_gpu.contains(o)).count();
+        // Every selected plant is grown there, and every grown one stands within the radius.
+        for p in &selected {
+            assert!(grown.iter().any(|g| g.address == p.address && g.rank == p.rank), "{p:?} not grown");
+        }
+        for g in &grown {
+            assert!(g.position_grid_m.truncate().distance(glam::DVec2::from(centre)) <= PLANTS_RADIUS_M);
+            assert!(g.radius_m > 0.0 && g.height_m > 0.0);
+        }
+    }
+    println!(
+        "{points} points, {PLANTS_RADIUS_M} m around each: {near} seeds selected near them, {disagree} on which the oracle and pass 3 disagree; {grown_total} grown"
+    );
+    assert!(near > 0, "no seed near any point");
+    assert!(disagree as f64 <= PLANTS_DISAGREEING * near as f64, "{disagree} of {near}");
 }

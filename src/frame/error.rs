@@ -54,6 +54,10 @@ pub enum RenderError {
     /// of LODs, or an adapter without the features it needs.
     #[error(transparent)]
     DrawSeeds(#[from] crate::passes::draw_seeds::DrawSeedsError),
+    /// The exact oracle could not judge the plants near a point (`Renderer::plants_near`): a
+    /// camera it cannot project, a pack it cannot read.
+    #[error(transparent)]
+    Oracle(#[from] crate::reference::oracle::OracleError),
     /// A host's targets cannot be drawn over (`Renderer::render_into`).
     #[error(transparent)]
     Host(#[from] super::HostTargetError),

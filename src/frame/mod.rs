@@ -51,7 +51,7 @@ mod undrawn;
 pub use clearance::GROUND_CLEARANCE_NEAR;
 pub use error::RenderError;
 pub use host::{HostTargetError, HostTargets};
-pub use query::GroundAt;
+pub use query::{GroundAt, Plant, Plants};
 pub use report::FrameReport;
 pub use seeds::SeedReport;
 pub use texcells::TexcellReport;

@@ -4,15 +4,20 @@
 //! a camera is lifted above), and the one the last frame drew (`drawn_ground`: each drawn node
 //! rebuilt from the instance and the height tile its vertex shader read, morph and Earth placing
 //! included; what a pick must meet, and what a camera should not sink through at the current
-//! level of detail). The land cover at a point is its source texel's class.
+//! level of detail). The land cover at a point is its source texel's class. The plants near a
+//! point are the seeded world's, judged by the exact oracle from the host's camera (the same
+//! patterns, classes, rules and reach as pass 3): every plant the view grows there, or only
+//! those pass 3 keeps.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::{RenderError, Renderer};
+use crate::camera::Camera;
 use crate::dataset::lcc::LCC_SOURCE_LEVEL;
+use crate::reference::oracle::{Culls, OracleSeed, seeds_within};
 use crate::reference::terrain::{DrawnGround, DrawnQuadrant};
 
 /// The finest data's ground at a grid point.
@@ -22,6 +27,37 @@ pub struct GroundAt {
     pub height_m: f64,
     /// The unit normal of the finest mesh's triangle there, in grid axes (z up).
     pub normal: DVec3,
+}
+
+/// A plant standing near a point (`Renderer::plants_near`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plant {
+    /// Its ring-0 cell: with its rank, its identity, as pass 3's records name it
+    /// (`SeedRecord::address`, `rank`).
+    pub address: [i64; 2],
+    /// Its rank in the cell's pattern.
+    pub rank: u32,
+    /// Its species' variant: an index into `ClassTable::species` (its model).
+    pub species: u32,
+    /// Where it stands: grid x and y, and the drawn ground's height there (its trunk sinks below
+    /// it by `seeds.sink_fraction` of its height), metres.
+    pub position_grid_m: DVec3,
+    /// Its height, metres.
+    pub height_m: f64,
+    /// The radius of its bounding sphere (crown and trunk), metres: its species' radius per metre
+    /// of height, times its height.
+    pub radius_m: f64,
+    /// Its draw LOD from this camera (0 nearest: meshes).
+    pub lod: u32,
+}
+
+/// Which plants `plants_near` answers with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Plants {
+    /// Every plant the view grows there, seen or not (for collision): class, rules and reach.
+    Grown,
+    /// Those pass 3 keeps from this camera: also inside the view and not hidden by the ground.
+    Selected,
 }
 
 impl Renderer {
@@ -78,5 +114,42 @@ impl Renderer {
         let placing = self.placing.exact(last.camera_grid_m);
         let viewport = [self.settings.render.width, self.settings.render.height];
         Ok(Some(DrawnGround::new(&quadrants, &last.terrain, placing, (last.clip_from_rel_m, viewport))))
+    }
+
+    /// The plants within `radius_m` of grid point `centre_grid_m` as the view from `camera` grows
+    /// them (its density, classes and reach by size; a seed fading out at the end of its reach
+    /// counts while it is drawn at all), or only those pass 3 keeps; sorted by (address, rank).
+    /// Judged exactly on the CPU (f64), from the dataset's packs: no GPU round trip. `None`
+    /// without land cover.
+    pub fn plants_near(
+        &self,
+        camera: &Camera,
+        centre_grid_m: [f64; 2],
+        radius_m: f64,
+        plants: Plants,
+    ) -> Result<Option<Vec<Plant>>, RenderError> {
+        let Some(inputs) = self.oracle_inputs(camera) else { return Ok(None) };
+        let culls = match plants {
+            Plants::Grown => Culls::GROWN,
+            Plants::Selected => Culls::SELECTION,
+        };
+        let seeds = seeds_within(&inputs, culls, DVec2::from(centre_grid_m), radius_m)?;
+        let radius_per_height = |s: &OracleSeed| {
+            inputs.tables.species.get(s.species as usize).map_or(0.0, |k| f64::from(k.radius_per_height))
+        };
+        Ok(Some(
+            seeds
+                .iter()
+                .map(|s| Plant {
+                    address: s.address,
+                    rank: s.rank,
+                    species: s.species,
+                    position_grid_m: DVec2::from(s.position_grid_m).extend(s.ground_m),
+                    height_m: s.height_m,
+                    radius_m: s.height_m * radius_per_height(s),
+                    lod: s.lod,
+                })
+                .collect(),
+        ))
     }
 }

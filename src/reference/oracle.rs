@@ -34,6 +34,7 @@
 
 mod frame;
 mod ground;
+mod near;
 mod vegetation;
 
 use glam::{DVec2, DVec3, DVec4};
@@ -50,6 +51,7 @@ use crate::seeds::patterns::SeedPatterns;
 use crate::seeds::{SeedTables, cell_pattern, seed_hash, seed_height_m, seed_variant, species_of_rank};
 use frame::ViewFrame;
 use ground::{DemWindow, LandcoverTiles};
+pub use near::seeds_within;
 use vegetation::Vegetation;
 
 /// How much farther than their reach, on the grid, the cells judged on the Earth reach.
@@ -166,11 +168,16 @@ pub struct Culls {
     /// Whether a seed whose eye→summit segment passes below the terrain is culled. The ground
     /// truth keeps it: whether any part of it shows is for its image to say.
     pub occlusion: bool,
+    /// Whether a seed whose bounding sphere lies outside the view is culled: always for what is
+    /// drawn; not for the plants standing near a point (`seeds_within`), seen or not.
+    pub frustum: bool,
 }
 
 impl Culls {
     /// Pass 3's culls, exact: reach by size, frustum (bounding sphere), occlusion (summit).
-    pub const SELECTION: Self = Self { reach_m: None, occlusion: true };
+    pub const SELECTION: Self = Self { reach_m: None, occlusion: true, frustum: true };
+    /// The plants the view grows, seen or not: class, rules and reach by size, no view cull.
+    pub const GROWN: Self = Self { reach_m: None, occlusion: false, frustum: false };
 }
 
 /// The visible seeds of the view, sorted by (address, rank), and the counts of every fate.
@@ -178,8 +185,8 @@ pub fn visible_seeds(inputs: &OracleInputs) -> Result<(Vec<OracleSeed>, OracleCo
     judge_seeds(inputs, Culls::SELECTION)
 }
 
-/// The seeds of the view that survive `culls` (the frustum cull always applies: a bounding sphere
-/// outside the view has no pixel in it), sorted by (address, rank), and the counts of every fate.
+/// The seeds of the view that survive `culls`, sorted by (address, rank), and the counts of every
+/// fate.
 pub fn judge_seeds(
     inputs: &OracleInputs,
     culls: Culls,
@@ -400,7 +407,7 @@ impl View<'_> {
         // The sphere's centre half-way up the sunk trunk, along the local vertical.
         let centre_m = ground_m + height_m * (0.5 - seeds.sink_fraction);
         let centre = self.placing.position_rel_m(DVec3::new(p.x, p.y, centre_m));
-        if !self.in_frustum(species, centre, height_m, sway_m) {
+        if self.culls.frustum && !self.in_frustum(species, centre, height_m, sway_m) {
             return Ok(Fate::Frustum);
         }
         // Pass 3's rule: swaying, the summit may rise into view by as far as the wind moves it.

@@ -213,9 +213,10 @@ impl TruthRenderer {
         let renderer = &mut self.renderer;
         renderer.render_resolved(camera)?;
         let (seeds, counts) = match renderer.oracle_inputs(camera) {
-            Some(inputs) => {
-                judge_seeds(&inputs, Culls { reach_m: Some(self.options.reach_m), occlusion: false })?
-            }
+            Some(inputs) => judge_seeds(
+                &inputs,
+                Culls { reach_m: Some(self.options.reach_m), occlusion: false, frustum: true },
+            )?,
             None => (Vec::new(), OracleCounts::default()),
         };
         let mut truth = draw_seeds(renderer, camera, seeds, &mut self.meshes, self.options.supersample)?;

@@ -1,6 +1,6 @@
 //! What docs/host.md quotes, and where each number is defined.
 
-use super::claims::{Claim, cm, grouped, mm, plain, test_const};
+use super::claims::{Claim, cm, grouped, mm, percent, plain, test_const};
 
 pub static HOST_CLAIMS: &[Claim] = &[
     Claim {
@@ -45,5 +45,18 @@ pub static HOST_CLAIMS: &[Claim] = &[
         doc: "docs/host.md",
         quote: "grid point is the pick's within {} mm (the test's",
         values: &[(test_const("tests/query.rs", "HEIGHT_M"), mm)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "asks for the plants within {} m of {} picked points of a settled synthetic",
+        values: &[
+            (test_const("tests/query.rs", "PLANTS_RADIUS_M"), plain),
+            (test_const("tests/query.rs", "PLANT_POINTS"), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "disagreement on at most {} % of them is allowed",
+        values: &[(test_const("tests/query.rs", "PLANTS_DISAGREEING"), percent)],
     },
 ];

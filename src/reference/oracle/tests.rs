@@ -350,7 +350,7 @@ fn fates_seed_by_seed_agree_with_the_judge() {
     with_inputs(&ds, pose, [400, 250], |inputs| {
         // Every seed in view out to beyond the draw reaches, occluded or not, judged again by pass
         // 3's rule: the visible ones are exactly the judge's, the others beyond reach or hidden.
-        let wide = Culls { reach_m: Some(5000.0), occlusion: false };
+        let wide = Culls { reach_m: Some(5000.0), occlusion: false, frustum: true };
         let (all, _) = judge_seeds(inputs, wide).unwrap();
         let (visible, counts) = visible_seeds(inputs).unwrap();
         let fates = fates_of(inputs, Culls::SELECTION, &all).unwrap();
