@@ -18,6 +18,7 @@ pub mod dataset;
 pub mod earth;
 pub mod frame;
 pub mod gpu;
+pub mod host;
 pub mod impostor;
 pub mod light;
 pub mod passes;

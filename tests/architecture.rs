@@ -106,7 +106,7 @@ const LAYERS: &[&[&str]] = &[
     &["passes", "bake", "sun"],
     &["reference"],
     &["frame"],
-    &["profile", "truth", "photo"],
+    &["profile", "truth", "photo", "host"],
     &["sweep"],
 ];
 
