@@ -53,6 +53,7 @@ fn renderer() -> Renderer {
         position_m: DVec3::new(m.origin_m[0] + grid[0], m.origin_m[1] + grid[1], ground + 120.0),
         yaw_deg: 45.0,
         pitch_deg: -12.0,
+        roll_deg: 0.0,
         fov_deg: renderer.settings.render.fov_deg,
         near_m: renderer.settings.render.near_m,
     };

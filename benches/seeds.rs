@@ -83,6 +83,7 @@ fn main() {
         position_m: DVec3::new(m.origin_m[0] + centre[0], m.origin_m[1] + centre[1], ground + above_m),
         yaw_deg: 30.0,
         pitch_deg: -20.0,
+        roll_deg: 0.0,
         fov_deg: 60.0,
         near_m: 0.1,
     };

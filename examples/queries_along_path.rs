@@ -91,6 +91,7 @@ fn walk(dir: &Path, points: usize, radius_m: f64) -> Result<()> {
             position_m: (origin + grid).extend(ground.height_m + EYE_M),
             yaw_deg: heading_deg,
             pitch_deg: 0.0,
+            roll_deg: 0.0,
             fov_deg: 60.0,
             near_m: 0.5,
         };

@@ -5,13 +5,20 @@
 //! 0.1 m to hundreds of kilometres share one Depth32Float buffer without z-fighting.
 //!
 //! Angles: `yaw_deg` is the compass heading (0 = north, 90 = east), `pitch_deg` the elevation of
-//! the view direction above the horizon (negative looks down).
+//! the view direction above the horizon (negative looks down), `roll_deg` the turn of the camera
+//! about its view direction (positive lowers its right side, as an aircraft banking right: the
+//! world in the image turns counter-clockwise).
+//! The view's rotation is built from them in closed form, so every pose has one, straight up and
+//! down included; a host's own rotation or matrices become a camera in `camera::from_host`.
 //!
 //! `validate` refuses what the f32 GPU side cannot carry, with a typed error rather than a frame
 //! of garbage: non-finite numbers, a near plane that is not positive, a field of view outside
 //! [`MIN_FOV_DEG`, 180°), coordinates beyond `MAX_COORDINATE_M`.
 
-use glam::{DMat4, DVec3, DVec4, Mat4};
+use glam::{DMat3, DMat4, DVec3, DVec4, Mat4};
+
+mod from_host;
+pub use from_host::HostCameraError;
 use thiserror::Error;
 
 /// Narrowest vertical field of view, degrees. The GPU computes clip coordinates in f32 from
@@ -46,8 +53,10 @@ pub enum CameraError {
     /// A projection was asked for a viewport (width × height, pixels) with no pixels.
     #[error("camera: viewport {0}×{1} has no area")]
     Viewport(u32, u32),
-    /// A pose given as text is not five comma-separated numbers.
-    #[error("camera: `{0}` is not X,Y,Z,YAW,PITCH (five numbers: metres, metres, metres, degrees, degrees)")]
+    /// A pose given as text is not five or six comma-separated numbers.
+    #[error(
+        "camera: `{0}` is not X,Y,Z,YAW,PITCH[,ROLL] (five or six numbers: metres, metres, metres, degrees, degrees, degrees)"
+    )]
     Parse(String),
 }
 
@@ -60,6 +69,9 @@ pub struct Camera {
     pub yaw_deg: f64,
     /// Elevation of the view direction above the horizon, degrees (negative looks down).
     pub pitch_deg: f64,
+    /// Turn of the camera about its view direction, degrees: positive lowers its right side (the
+    /// world in the image turns counter-clockwise).
+    pub roll_deg: f64,
     /// Vertical field of view, degrees.
     pub fov_deg: f64,
     /// Near plane, metres (at least `MIN_NEAR_M`); the far plane is at infinity.
@@ -67,17 +79,19 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// Parses `X,Y,Z,YAW,PITCH` as given on the command line.
+    /// Parses `X,Y,Z,YAW,PITCH` or `X,Y,Z,YAW,PITCH,ROLL` as given on the command line.
     pub fn parse_pose(text: &str, fov_deg: f64, near_m: f64) -> Result<Self, CameraError> {
         let values: Vec<f64> = text
             .split(',')
             .map(|v| v.trim().parse::<f64>())
             .collect::<Result<_, _>>()
             .map_err(|_| CameraError::Parse(text.into()))?;
-        let [x, y, z, yaw_deg, pitch_deg] = values[..] else {
-            return Err(CameraError::Parse(text.into()));
+        let (x, y, z, yaw_deg, pitch_deg, roll_deg) = match values[..] {
+            [x, y, z, yaw, pitch] => (x, y, z, yaw, pitch, 0.0),
+            [x, y, z, yaw, pitch, roll] => (x, y, z, yaw, pitch, roll),
+            _ => return Err(CameraError::Parse(text.into())),
         };
-        let camera = Self { position_m: DVec3::new(x, y, z), yaw_deg, pitch_deg, fov_deg, near_m };
+        let camera = Self { position_m: DVec3::new(x, y, z), yaw_deg, pitch_deg, roll_deg, fov_deg, near_m };
         camera.validate()?;
         Ok(camera)
     }
@@ -91,6 +105,7 @@ impl Camera {
             ("z", self.position_m.z),
             ("yaw", self.yaw_deg),
             ("pitch", self.pitch_deg),
+            ("roll", self.roll_deg),
             ("fov", self.fov_deg),
             ("near", self.near_m),
         ];
@@ -109,16 +124,31 @@ impl Camera {
         Ok(())
     }
 
-    /// Unit view direction (x east, y north, z up). Pitch is clamped just short of ±90° so the
-    /// view always has a defined "up".
+    /// Unit view direction (x east, y north, z up).
     pub fn forward(&self) -> DVec3 {
-        let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.clamp(-89.99, 89.99).to_radians());
+        let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.to_radians());
         DVec3::new(yaw.sin() * pitch.cos(), yaw.cos() * pitch.cos(), pitch.sin())
+    }
+
+    /// The view's axes in camera-relative world space, as columns: the image's right, its up, and
+    /// backwards (the view looks along −z, as in wgpu's right-handed view space). Unrolled, right
+    /// is level (the heading turned 90° clockwise) and up is the forward direction pitched up by
+    /// 90°; the roll turns both about the forward direction. Defined for every pose: straight
+    /// down, right is still the heading's right.
+    pub fn world_from_view_rotation(&self) -> DMat3 {
+        let (sin_yaw, cos_yaw) = self.yaw_deg.to_radians().sin_cos();
+        let (sin_pitch, cos_pitch) = self.pitch_deg.to_radians().sin_cos();
+        let (sin_roll, cos_roll) = self.roll_deg.to_radians().sin_cos();
+        let level_right = DVec3::new(cos_yaw, -sin_yaw, 0.0);
+        let level_up = DVec3::new(-sin_yaw * sin_pitch, -cos_yaw * sin_pitch, cos_pitch);
+        let right = level_right * cos_roll - level_up * sin_roll;
+        let up = level_up * cos_roll + level_right * sin_roll;
+        DMat3::from_cols(right, up, -self.forward())
     }
 
     /// View-from-world for camera-relative world space.
     pub fn view_from_world(&self) -> DMat4 {
-        glam::dcamera::rh::view::look_to_mat4(DVec3::ZERO, self.forward(), DVec3::Z)
+        DMat4::from_mat3(self.world_from_view_rotation().transpose())
     }
 
     /// Reversed-Z, infinite-far projection.
@@ -219,6 +249,12 @@ mod tests {
     #[test]
     fn bad_poses_are_errors() {
         assert!(matches!(Camera::parse_pose("1,2,3", 60.0, 0.1), Err(CameraError::Parse(_))));
+        assert!(matches!(Camera::parse_pose("1,2,3,4,5,6,7", 60.0, 0.1), Err(CameraError::Parse(_))));
+        assert_eq!(Camera::parse_pose("1,2,3,4,5,6", 60.0, 0.1).map(|c| c.roll_deg), Ok(6.0));
+        assert!(matches!(
+            Camera::parse_pose("1,2,3,4,5,nan", 60.0, 0.1),
+            Err(CameraError::NotFinite("roll"))
+        ));
         assert!(matches!(Camera::parse_pose("1,2,3,4,x", 60.0, 0.1), Err(CameraError::Parse(_))));
         assert!(matches!(Camera::parse_pose("1,2,3,4,5", 180.0, 0.1), Err(CameraError::Fov(_))));
         assert!(matches!(Camera::parse_pose("1,2,inf,4,5", 60.0, 0.1), Err(CameraError::NotFinite("z"))));

@@ -11,8 +11,9 @@
 pub use glam;
 pub use wgpu;
 
-/// The camera: an f64 position in the dataset's CRS, heading, pitch, field of view and near plane.
-pub use crate::camera::Camera;
+/// The camera: an f64 position in the dataset's CRS, heading, pitch, roll, field of view and near
+/// plane; made from a host's rotation or matrices (`Camera::from_matrices`).
+pub use crate::camera::{Camera, CameraError, HostCameraError};
 /// The settings (`config/default.toml` and its presets), and the error reading them.
 pub use crate::config::{Settings, SettingsError};
 /// A built dataset, opened; a camera placed in it from the Earth or from text, and why not.

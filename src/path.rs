@@ -198,6 +198,7 @@ impl CameraPath {
             position_m: position,
             yaw_deg: (k1.yaw_deg + turn * f).rem_euclid(360.0),
             pitch_deg: k1.pitch_deg + (k2.pitch_deg - k1.pitch_deg) * f,
+            roll_deg: 0.0,
             fov_deg,
             near_m,
         }

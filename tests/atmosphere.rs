@@ -411,6 +411,7 @@ fn the_gpu_makes_the_twins_aerial_perspective_and_its_far_slice_is_the_sky() {
         position_m: DVec3::new(0.0, 0.0, 1500.0),
         yaw_deg: 90.0,
         pitch_deg: 10.0,
+        roll_deg: 0.0,
         fov_deg: 60.0,
         near_m: 0.1,
     };

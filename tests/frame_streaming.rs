@@ -156,6 +156,7 @@ fn a_corrupt_tile_is_reported_and_the_frame_still_renders() {
             ),
             yaw_deg: 45.0,
             pitch_deg: -30.0,
+            roll_deg: 0.0,
             fov_deg: 60.0,
             near_m: 0.1,
         };

@@ -79,6 +79,7 @@ fn cameras_outside_the_dataset_look_in() {
         position_m: DVec3::new(corner[0] - 500.0, corner[1] - 500.0, f64::from(m.height.max_m) + 800.0),
         yaw_deg: 45.0,
         pitch_deg: -25.0,
+        roll_deg: 0.0,
         fov_deg: 60.0,
         near_m: 0.1,
     };

@@ -106,7 +106,7 @@ impl LoneOak {
         let (sin, cos) = yaw_deg.to_radians().sin_cos();
         let position_m =
             DVec3::new(self.foot_m.x - distance_m * sin, self.foot_m.y - distance_m * cos, self.middle_m);
-        Camera { position_m, yaw_deg, pitch_deg: 0.0, fov_deg, near_m: 0.1 }
+        Camera { position_m, yaw_deg, pitch_deg: 0.0, roll_deg: 0.0, fov_deg, near_m: 0.1 }
     }
 
     /// Looking at the oak's middle from `distance_m` along `eye_model` (a direction from its
@@ -115,7 +115,7 @@ impl LoneOak {
         let eye = model_to_world(eye_model.as_dvec3().normalize(), self.turn_rad);
         let position_m = DVec3::new(self.foot_m.x, self.foot_m.y, self.middle_m) + eye * distance_m;
         let (yaw_deg, pitch_deg) = ((-eye.x).atan2(-eye.y).to_degrees(), (-eye.z).asin().to_degrees());
-        Camera { position_m, yaw_deg, pitch_deg, fov_deg, near_m: 0.1 }
+        Camera { position_m, yaw_deg, pitch_deg, roll_deg: 0.0, fov_deg, near_m: 0.1 }
     }
 }
 

@@ -80,6 +80,7 @@ fn camera(height_m: f64) -> Camera {
         position_m: DVec3::new(0.0, 0.0, height_m),
         yaw_deg: 180.0,
         pitch_deg: 0.0,
+        roll_deg: 0.0,
         fov_deg: FOV_DEG,
         near_m: 0.1,
     }

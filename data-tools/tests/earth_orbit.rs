@@ -121,6 +121,7 @@ fn from_orbit_the_sea_lies_on_the_ellipsoid() {
             position_m: DVec3::new(0.0, 0.0, height_m),
             yaw_deg: 0.0,
             pitch_deg,
+            roll_deg: 0.0,
             fov_deg: FOV_DEG,
             near_m: 0.1,
         };

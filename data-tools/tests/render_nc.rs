@@ -37,6 +37,7 @@ fn nc_renders_like_its_reference() {
         position_m: DVec3::new(631_000.0, 216_000.0, 1500.0),
         yaw_deg: 40.0,
         pitch_deg: -25.0,
+        roll_deg: 0.0,
         fov_deg: 60.0,
         near_m: 0.1,
     };

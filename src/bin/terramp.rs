@@ -72,9 +72,9 @@ impl SettingsArgs {
 struct ViewArgs {
     #[arg(long)]
     dataset: PathBuf,
-    /// X,Y,Z,YAW,PITCH: position in the dataset CRS (metres; Z above the datum), compass
-    /// heading from the grid's north and pitch above the horizon (degrees). E.g. `--camera
-    /// 636000,214000,900,0,-20`. Or on the Earth (datasets whose manifest records where they
+    /// X,Y,Z,YAW,PITCH[,ROLL]: position in the dataset CRS (metres; Z above the datum), compass
+    /// heading from the grid's north, pitch above the horizon and roll (right side down; 0 if
+    /// left out) (degrees). E.g. `--camera 636000,214000,900,0,-20`. Or on the Earth (datasets whose manifest records where they
     /// lie): `lonlat:LON,LAT,H,HEADING,PITCH` (WGS 84 degrees, H metres above its ellipsoid,
     /// heading from true north), `lonlat-ground:LON,LAT,H,HEADING,PITCH` (H above the ground).
     #[arg(long, allow_hyphen_values = true)]

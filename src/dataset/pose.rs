@@ -1,6 +1,6 @@
 //! How it works: a camera as a user writes it, placed in a dataset. Three forms:
-//! - `X,Y,Z,YAW,PITCH`: the dataset's CRS (metres, Z above its datum), heading from the grid's
-//!   north and pitch (degrees), as `Camera::parse_pose` reads it;
+//! - `X,Y,Z,YAW,PITCH[,ROLL]`: the dataset's CRS (metres, Z above its datum), heading from the
+//!   grid's north, pitch and roll (degrees), as `Camera::parse_pose` reads it;
 //! - `lonlat:LON,LAT,H,HEADING,PITCH`: WGS 84 degrees, H metres above WGS 84's ellipsoid, heading
 //!   from true north (`earth::pose::GeoPose`, through the manifest's `[earth]`);
 //! - `lonlat-ground:LON,LAT,H,HEADING,PITCH`: the same, H metres above the dataset's ground there
@@ -18,7 +18,7 @@ use crate::earth::pose::{CrsPose, GeoPose, PoseError};
 pub enum CameraPoseError {
     /// Not one of the three forms.
     #[error(
-        "camera {0:?}: expected X,Y,Z,YAW,PITCH, lonlat:LON,LAT,H,HEADING,PITCH or lonlat-ground:LON,LAT,H,HEADING,PITCH"
+        "camera {0:?}: expected X,Y,Z,YAW,PITCH[,ROLL], lonlat:LON,LAT,H,HEADING,PITCH or lonlat-ground:LON,LAT,H,HEADING,PITCH"
     )]
     Parse(String),
     /// A pose on the Earth for a dataset whose manifest does not say where it lies.
@@ -67,6 +67,7 @@ impl Dataset {
             position_m: crs.position_m,
             yaw_deg: crs.yaw_deg,
             pitch_deg: crs.pitch_deg,
+            roll_deg: 0.0,
             fov_deg,
             near_m,
         };

@@ -275,7 +275,8 @@ mod tests {
         let o = dataset.manifest.origin_m;
         let ground_m = dataset.height_at(0.0, 0.0, 0).unwrap();
         let position_m = DVec3::new(o[0], o[1], ground_m + 1000.0);
-        let top = Camera { position_m, yaw_deg: 0.0, pitch_deg: -89.0, fov_deg: 60.0, near_m: 0.1 };
+        let top =
+            Camera { position_m, yaw_deg: 0.0, pitch_deg: -89.0, roll_deg: 0.0, fov_deg: 60.0, near_m: 0.1 };
         let cameras = Descent { top, bottom_m: 500.0, step: 0.1 }.cameras(&dataset).unwrap();
         let heights: Vec<f64> = cameras.iter().map(|(h, _)| *h).collect();
         assert_eq!(heights.len(), 7, "1000 m to 531 m by 10 %: {heights:?}");

@@ -454,6 +454,7 @@ pub fn camera_at(
         position_m: DVec3::new(o[0] + grid_m[0], o[1] + grid_m[1], ground + above_m),
         yaw_deg,
         pitch_deg,
+        roll_deg: 0.0,
         fov_deg: 60.0,
         near_m: 0.1,
     }

@@ -9,7 +9,7 @@ use terramp::frame::Renderer;
 
 /// A camera at CRS position `position_m`.
 pub fn looking(position_m: DVec3, yaw_deg: f64, pitch_deg: f64) -> Camera {
-    Camera { position_m, yaw_deg, pitch_deg, fov_deg: 60.0, near_m: 0.1 }
+    Camera { position_m, yaw_deg, pitch_deg, roll_deg: 0.0, fov_deg: 60.0, near_m: 0.1 }
 }
 
 /// A camera at grid-space position `grid_m` (height included).

@@ -1,6 +1,6 @@
 //! What docs/host.md quotes, and where each number is defined.
 
-use super::claims::{Claim, cm, grouped, mm, percent, plain, test_const};
+use super::claims::{Claim, cm, grouped, mm, percent, plain, pow10, test_const};
 
 pub static HOST_CLAIMS: &[Claim] = &[
     Claim {
@@ -58,5 +58,38 @@ pub static HOST_CLAIMS: &[Claim] = &[
         doc: "docs/host.md",
         quote: "disagreement on at most {} % of them is allowed",
         values: &[(test_const("tests/query.rs", "PLANTS_DISAGREEING"), percent)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "a rotation that is not orthonormal within {})",
+        values: &[(test_const("src/camera/from_host.rs", "HOST_MATRIX_TOLERANCE"), pow10)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "back from the camera within {} per element;",
+        values: &[(test_const("src/camera/from_host_tests.rs", "ROUND_TRIP_OFF"), pow10)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "`tests/host_camera.rs` draws, on a {} × {} view",
+        values: &[
+            (test_const("tests/host_camera.rs", "SIDE"), plain),
+            (test_const("tests/host_camera.rs", "SIDE"), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "the test allows {} % apart, for seeds on the frustum's edge",
+        values: &[(test_const("tests/host_camera.rs", "SELECTION_DIFFERENCE"), percent)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "at 81.7 dB PSNR on lavapipe (the test asks ≥ {} dB)",
+        values: &[(test_const("tests/host_camera.rs", "TURNED_PSNR_DB"), plain)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "13.5 dB (the test asks it to stay ≤ {} dB)",
+        values: &[(test_const("tests/host_camera.rs", "CONTROL_PSNR_DB"), plain)],
     },
 ];

@@ -31,6 +31,7 @@ fn cameras_outside_every_corner_and_edge_look_in() {
                 position_m: DVec3::new(o[0] + edge[0] + out.x * away_m, o[1] + edge[1] + out.y * away_m, z_m),
                 yaw_deg: yaw_in,
                 pitch_deg: pitch,
+                roll_deg: 0.0,
                 fov_deg: 60.0,
                 near_m: 0.1,
             };

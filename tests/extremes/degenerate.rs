@@ -99,7 +99,14 @@ fn fields_of_view_near_0_and_180_render_or_are_refused() {
 /// How far (pixels) the GPU's f32 projection puts points 1 km away on the rays through pixel
 /// centres of a 1920×1080 frame from where they belong, at `fov_deg`.
 fn worst_f32_misplacement_px(fov_deg: f64) -> f64 {
-    let camera = Camera { position_m: DVec3::ZERO, yaw_deg: 30.0, pitch_deg: -5.0, fov_deg, near_m: 0.1 };
+    let camera = Camera {
+        position_m: DVec3::ZERO,
+        yaw_deg: 30.0,
+        pitch_deg: -5.0,
+        roll_deg: 0.0,
+        fov_deg,
+        near_m: 0.1,
+    };
     let clip = camera.clip_from_view(1920, 1080).unwrap() * camera.view_from_world();
     let (inverse, clip_f32) = (clip.inverse(), clip.as_mat4());
     let mut worst_px = 0.0f64;

@@ -23,7 +23,14 @@ const FAR_M: f64 = 500_000.0;
 const GAP: f64 = 1e-5;
 
 fn level_camera() -> Camera {
-    Camera { position_m: DVec3::ZERO, yaw_deg: 0.0, pitch_deg: 0.0, fov_deg: 60.0, near_m: NEAR_M }
+    Camera {
+        position_m: DVec3::ZERO,
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+        roll_deg: 0.0,
+        fov_deg: 60.0,
+        near_m: NEAR_M,
+    }
 }
 
 /// Depth of a point `distance_m` straight ahead, as the GPU computes it: the f32 matrix times
@@ -299,6 +306,7 @@ fn high_oblique(r: &terramp::frame::Renderer, dem: &Dem, target: [f64; 2], dista
         position_m: DVec3::new(o[0] + target[0], o[1] + target[1] - back, ground + distance_m * down.sin()),
         yaw_deg: yaw,
         pitch_deg: -60.0,
+        roll_deg: 0.0,
         fov_deg: 60.0,
         near_m: NEAR_M,
     }

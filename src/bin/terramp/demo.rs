@@ -222,6 +222,7 @@ impl DemoPath {
             position_m: DVec3::new(position.x, position.y, ground_m + 120.0),
             yaw_deg,
             pitch_deg: -12.0,
+            roll_deg: 0.0,
             fov_deg: r.fov_deg,
             near_m: r.near_m,
         })

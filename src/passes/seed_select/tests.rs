@@ -55,6 +55,7 @@ fn seed_frame(
         position_m: DVec3::new(origin_m[0], origin_m[1], 0.0) + camera_grid_m,
         yaw_deg: 30.0,
         pitch_deg: -10.0,
+        roll_deg: 0.0,
         fov_deg: 60.0,
         near_m: 0.1,
     };

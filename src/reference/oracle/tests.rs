@@ -326,7 +326,7 @@ fn with_inputs<R>(
     let origin = dataset.manifest.origin_m;
     let z = dataset.height_at(x, y, 0).unwrap() + above_m;
     let position_m = DVec3::new(origin[0] + x, origin[1] + y, z);
-    let camera = Camera { position_m, yaw_deg, pitch_deg, fov_deg: 60.0, near_m: 0.1 };
+    let camera = Camera { position_m, yaw_deg, pitch_deg, roll_deg: 0.0, fov_deg: 60.0, near_m: 0.1 };
     judge(&OracleInputs {
         dataset,
         settings: &settings,

@@ -162,6 +162,7 @@ mod tests {
             position_m: DVec3::new(x, 2.0, 300.0),
             yaw_deg,
             pitch_deg: -10.0,
+            roll_deg: 0.0,
             fov_deg: 60.0,
             near_m: 0.1,
         }

@@ -193,6 +193,7 @@ mod tests {
             position_m: DVec3::new(1000.0, 2000.0, 500.0),
             yaw_deg: 90.0,
             pitch_deg: 0.0,
+            roll_deg: 0.0,
             fov_deg: 60.0,
             near_m: 0.1,
         };

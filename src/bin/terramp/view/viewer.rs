@@ -88,6 +88,7 @@ fn overview(dataset: &Dataset, settings: &Settings) -> Camera {
         ),
         yaw_deg: 0.0,
         pitch_deg: -35.0,
+        roll_deg: 0.0,
         fov_deg: settings.render.fov_deg,
         near_m: settings.render.near_m,
     }
