@@ -7,7 +7,8 @@
 //! triangles it draws), give all planes of the LOD one texel density and shelf-pack their
 //! rectangles (`pack`), render every plane's triangles orthographically into its rectangle on the
 //! GPU (`render`), read the atlas back and build its coverage-preserving mips
-//! ([`build_mip_chain`], per plane). The impostor is then saved atomically.
+//! ([`build_mip_chain`](crate::impostor::mips::build_mip_chain), per plane). The impostor is
+//! then saved atomically.
 //!
 //! Mips: an atlas of 2^k texels keeps k − 5 levels (at most 5: 1024 → 64 texels), so rectangles
 //! aligned to 2^(mips−1) texels never share a box with a neighbour at any level.
