@@ -3,7 +3,8 @@
 // (`luminance(1 / daylight)` is daylight's own, in units of the sun's irradiance, which
 // `exposure.x` takes to cd/m² and exposes at EV100), then through the tone curve `TONE_CURVE`
 // picks, a matrix, a curve per channel, a matrix back. The target is sRGB: the hardware encodes
-// on store. Twin: `reference::display`.
+// on store. Over a host's linear HDR target the exposed light is written instead, for the host's
+// own tone curve. Twin: `reference::display`.
 
 struct DisplayUniforms {
     into_curve: array<vec4<f32>, 3>,
@@ -55,14 +56,19 @@ fn aces(x: vec3<f32>) -> vec3<f32> {
     return (x * (x + c.x) - c.y) / (x * (c.z * x + c.w) + e);
 }
 
+// The balanced light `balanced` exposed: scene-referred linear light (sRGB primaries) that a tone
+// curve takes, 0.18 mid grey at the exposure.
+fn exposed(balanced: vec3<f32>) -> vec3<f32> {
+    let daylight_luminance = dot(display.luminance.xyz, 1.0 / daylight.xyz);
+    return max(balanced, vec3<f32>(0.0)) * (daylight_luminance * display.exposure.x);
+}
+
 // The displayed linear light of the balanced light `balanced`.
 fn shown(balanced: vec3<f32>) -> vec3<f32> {
     if TONE_CURVE == LINEAR {
         return clamp(balanced, vec3<f32>(0.0), vec3<f32>(1.0));
     }
-    let daylight_luminance = dot(display.luminance.xyz, 1.0 / daylight.xyz);
-    let exposed = max(balanced, vec3<f32>(0.0)) * (daylight_luminance * display.exposure.x);
-    let into = by_rows(display.into_curve, exposed);
+    let into = by_rows(display.into_curve, exposed(balanced));
     if TONE_CURVE == AGX {
         let encoded = by_rows(display.out_of_curve, agx(into));
         return pow(clamp(encoded, vec3<f32>(0.0), vec3<f32>(1.0)), vec3<f32>(display.encoding.z));
@@ -87,4 +93,16 @@ fn fs_display_over(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
     }
     let balanced = min(light.rgb / light.a, vec3<f32>(SCENE_LIGHT_MAX));
     return vec4<f32>(shown(balanced), light.a);
+}
+
+// Over a host's linear HDR colour (a float target the host tone-maps itself): the light exposed,
+// through no curve, blended over what the host drew by the coverage as `fs_display_over` does.
+@fragment
+fn fs_display_over_linear(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
+    let light = textureLoad(scene, vec2<i32>(at.xy), 0);
+    if light.a <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let balanced = min(light.rgb / light.a, vec3<f32>(SCENE_LIGHT_MAX));
+    return vec4<f32>(min(exposed(balanced), vec3<f32>(HOST_HDR_MAX)), light.a);
 }

@@ -30,6 +30,9 @@ pub use crate::frame::{
 pub use crate::gpu::{AdapterChoice, Gpu, GpuError};
 /// The limits a host's device must allow for terramp's passes.
 pub use crate::passes::limits::needed_limits;
+/// The host's depth format, and the format of a linear HDR host colour (sRGB formats take the
+/// frame display-ready).
+pub use crate::passes::{DEPTH_FORMAT, HOST_HDR_FORMAT};
 /// The ground the last frame drew (`Renderer::drawn_ground`): picks and heights on it.
 pub use crate::reference::terrain::{DrawnGround, GroundPoint};
 /// A synthetic dataset, for a host to try terramp without data of its own.

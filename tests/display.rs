@@ -1,7 +1,8 @@
 //! The display pass (`shaders/display.wgsl`) against its twin (`reference::display`): light from
 //! 12 stops under white ground to the sun's disk, grey and coloured, through every tone curve
 //! and at two exposures, as the GPU shows it and as the twin computes it; and the same light
-//! shown over a host's colour (`fs_display_over`) at coverages from none to whole.
+//! shown over a host's colour (`fs_display_over`) at coverages from none to whole, and written
+//! exposed over a host's linear HDR colour (`fs_display_over_linear`).
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use glam::Vec3;
@@ -9,8 +10,8 @@ use terramp::config::{DisplaySettings, ToneCurve};
 use terramp::gpu::readback::read_texture;
 use terramp::passes::display::gpu::DisplayPass;
 use terramp::passes::display::uniforms;
-use terramp::passes::{COLOUR_FORMAT, DISPLAY_FORMAT};
-use terramp::reference::display::{shown, shown_over};
+use terramp::passes::{COLOUR_FORMAT, DISPLAY_FORMAT, HOST_HDR_FORMAT};
+use terramp::reference::display::{exposed_over, shown, shown_over, tone};
 use terramp::texcell::pyramid::{decode_srgb, encode_srgb};
 use terramp_testkit::{gpu, texture_2d};
 
@@ -31,6 +32,18 @@ const COVERAGES: [f32; 5] = [0.0, 0.2, 0.5, 0.8, 1.0];
 /// The host's colour under the display, sRGB.
 const UNDER: [u8; 4] = [200, 120, 60, 255];
 
+/// The GPU's exposed light over a host's linear HDR colour against the twin's, both rounded to
+/// half floats, relative to it, in f16's relative steps of 2^-11 (the blend's own rounding).
+const HDR_STEPS: f32 = 4.0;
+
+/// Where `displayed` draws: the display target, or over a host's colour of `DISPLAY_FORMAT` or
+/// `HOST_HDR_FORMAT` that starts as `UNDER`.
+#[derive(Clone, Copy, PartialEq)]
+enum Target {
+    Display,
+    Over(wgpu::TextureFormat),
+}
+
 /// A row per hue of light steps, as the colour target holds it (f16: past 65,504, infinite, as
 /// the sun's disk might be).
 fn light_steps() -> Vec<Vec3> {
@@ -43,9 +56,14 @@ fn light_steps() -> Vec<Vec3> {
         .collect()
 }
 
-/// A display on the GPU over `light`, premultiplied by its row's coverage where `over` (each row
-/// of `STEPS`), into a display-format target that starts as `UNDER` everywhere; what it shows.
-fn displayed(settings: &DisplaySettings, light: &[Vec3], daylight: Vec3, over: bool) -> Vec<u8> {
+/// A display on the GPU over `light`, premultiplied by its row's coverage when over a host's
+/// colour (each row of `STEPS`), into a target that starts as `UNDER` everywhere; its bytes.
+fn displayed(settings: &DisplaySettings, light: &[Vec3], daylight: Vec3, target: Target) -> Vec<u8> {
+    let over = target != Target::Display;
+    let format = match target {
+        Target::Display => DISPLAY_FORMAT,
+        Target::Over(format) => format,
+    };
     let gpu = gpu();
     let device = &gpu.device;
     let (width, height) = (STEPS, HUES.len() as u32);
@@ -70,8 +88,15 @@ fn displayed(settings: &DisplaySettings, light: &[Vec3], daylight: Vec3, over: b
     };
     write(&scene, bytemuck::cast_slice(&texels), 8);
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC | copy_dst;
-    let display = texture_2d(device, [width, height], DISPLAY_FORMAT, usage);
-    write(&display, &UNDER.repeat(light.len()), 4);
+    let display = texture_2d(device, [width, height], format, usage);
+    let texel_bytes = format.block_copy_size(None).unwrap();
+    if format == HOST_HDR_FORMAT {
+        let under = UNDER.map(decode_srgb).map(|v| half::f16::from_f32(v).to_bits());
+        let under = [under[0], under[1], under[2], half::f16::ONE.to_bits()];
+        write(&display, bytemuck::cast_slice(&under.repeat(light.len())), texel_bytes);
+    } else {
+        write(&display, &UNDER.repeat(light.len()), texel_bytes);
+    }
     let daylight_buffer = wgpu::util::DeviceExt::create_buffer_init(
         device,
         &wgpu::util::BufferInitDescriptor {
@@ -86,13 +111,13 @@ fn displayed(settings: &DisplaySettings, light: &[Vec3], daylight: Vec3, over: b
     let (display_view, off) =
         (display.create_view(&Default::default()), terramp::gpu::counter::Counting::OFF);
     if over {
-        pass.prepare_over(device, DISPLAY_FORMAT);
+        pass.prepare_over(device, format);
         pass.encode_over(&mut encoder, &display_view, off);
     } else {
         pass.encode(&mut encoder, &display_view, off);
     }
     gpu.queue.submit([encoder.finish()]);
-    read_texture(&gpu, &display, wgpu::TextureAspect::All, 4).unwrap()
+    read_texture(&gpu, &display, wgpu::TextureAspect::All, texel_bytes).unwrap()
 }
 
 /// The largest difference between `shown_gpu` and the twin's `expected` display light, 8-bit
@@ -120,7 +145,7 @@ fn the_gpu_displays_the_twins_light_through_every_curve() {
     for curve in ToneCurve::ALL {
         for ev100 in [15.0, 9.0] {
             let settings = DisplaySettings { ev100, tone_curve: curve };
-            let shown_gpu = displayed(&settings, &light, DAYLIGHT, false);
+            let shown_gpu = displayed(&settings, &light, DAYLIGHT, Target::Display);
             let u = uniforms(&settings);
             let (worst, at) = worst(&shown_gpu, light.iter().map(|l| shown(&u, curve, DAYLIGHT, *l)));
             println!("{} at EV100 {ev100}: worst {worst} levels (light {})", curve.name(), light[at]);
@@ -140,14 +165,9 @@ fn over_a_hosts_colour_the_gpu_shows_the_twins_light_by_its_coverage() {
     let under = Vec3::from_array([UNDER[0], UNDER[1], UNDER[2]].map(decode_srgb));
     for curve in ToneCurve::ALL {
         let settings = DisplaySettings { ev100: 15.0, tone_curve: curve };
-        let shown_gpu = displayed(&settings, &light, DAYLIGHT, true);
+        let shown_gpu = displayed(&settings, &light, DAYLIGHT, Target::Over(DISPLAY_FORMAT));
         let u = uniforms(&settings);
-        let expected = light.iter().enumerate().map(|(i, l)| {
-            let a = COVERAGES[i / STEPS as usize];
-            let premultiplied =
-                Vec3::from_array((*l * a).to_array().map(|v| half::f16::from_f32(v).to_f32()));
-            shown_over(&u, curve, DAYLIGHT, (premultiplied, half::f16::from_f32(a).to_f32()), under)
-        });
+        let expected = premultiplied(&light).map(|lit| shown_over(&u, curve, DAYLIGHT, lit, under));
         let (worst, at) = worst(&shown_gpu, expected);
         println!(
             "{} over the host's colour: worst {worst} levels (light {}, row {})",
@@ -158,5 +178,88 @@ fn over_a_hosts_colour_the_gpu_shows_the_twins_light_by_its_coverage() {
         assert!(worst <= DISPLAY_LEVELS, "{}: {worst} levels at light {}", curve.name(), light[at]);
         // Where terramp drew nothing the host's pixel is as it was.
         assert!(shown_gpu[..STEPS as usize * 4].chunks(4).all(|p| p == UNDER));
+    }
+}
+
+/// The light premultiplied by its row's coverage as the colour target holds it, and the coverage.
+fn premultiplied(light: &[Vec3]) -> impl Iterator<Item = (Vec3, f32)> + '_ {
+    let f16 = |v: f32| half::f16::from_f32(v).to_f32();
+    light.iter().enumerate().map(move |(i, l)| {
+        let a = COVERAGES[i / STEPS as usize];
+        (Vec3::from_array((*l * a).to_array().map(f16)), f16(a))
+    })
+}
+
+#[test]
+fn over_a_hosts_linear_hdr_colour_the_gpu_writes_the_twins_exposed_light() {
+    let light = light_steps();
+    let under = Vec3::from_array([UNDER[0], UNDER[1], UNDER[2]].map(decode_srgb));
+    let f16 = |v: f32| half::f16::from_f32(v).to_f32();
+    for curve in ToneCurve::ALL {
+        for ev100 in [15.0, 9.0] {
+            let settings = DisplaySettings { ev100, tone_curve: curve };
+            let bytes = displayed(&settings, &light, DAYLIGHT, Target::Over(HOST_HDR_FORMAT));
+            let hdr: Vec<f32> = bytemuck::cast_slice::<u8, u16>(&bytes)
+                .iter()
+                .map(|&b| half::f16::from_bits(b).to_f32())
+                .collect();
+            let u = uniforms(&settings);
+            let (mut worst, mut at) = (0.0f32, 0);
+            for (i, lit) in premultiplied(&light).enumerate() {
+                let expected = exposed_over(&u, DAYLIGHT, lit, under).to_array().map(f16);
+                for c in 0..3 {
+                    let (gpu, twin) = (hdr[i * 4 + c], expected[c]);
+                    let off = if gpu == twin { 0.0 } else { (gpu - twin).abs() / twin.abs().max(1e-4) };
+                    if off > worst || off.is_nan() {
+                        (worst, at) = (off, i);
+                    }
+                }
+            }
+            println!(
+                "{} at EV100 {ev100}, linear HDR: worst {worst:.2e} relative (light {})",
+                curve.name(),
+                light[at]
+            );
+            assert!(
+                worst <= HDR_STEPS / 2048.0,
+                "{} at EV100 {ev100}: {worst} at light {}",
+                curve.name(),
+                light[at]
+            );
+            assert!(hdr.iter().all(|v| v.is_finite()), "the host gets infinity or NaN");
+            // Where terramp drew nothing the host's pixel is as it was; the tone curve changes nothing.
+            assert!(hdr[..STEPS as usize * 4].chunks(4).all(|p| p[..3] == under.to_array().map(f16)));
+        }
+    }
+}
+
+#[test]
+fn the_linear_hdr_light_through_the_twins_curve_is_what_the_display_ready_target_shows() {
+    // Where terramp covers the pixel whole, the host's curve over the exposed light (here the
+    // twin's) and terramp's display-ready output must agree: the two targets, one frame's light.
+    let light = light_steps();
+    let whole = (COVERAGES.len() - 1) * STEPS as usize;
+    for curve in [ToneCurve::Agx, ToneCurve::Aces] {
+        let settings = DisplaySettings { ev100: 15.0, tone_curve: curve };
+        let u = uniforms(&settings);
+        let ready = displayed(&settings, &light, DAYLIGHT, Target::Over(DISPLAY_FORMAT));
+        let bytes = displayed(&settings, &light, DAYLIGHT, Target::Over(HOST_HDR_FORMAT));
+        let hdr: Vec<f32> = bytemuck::cast_slice::<u8, u16>(&bytes)
+            .iter()
+            .map(|&b| half::f16::from_bits(b).to_f32())
+            .collect();
+        let toned = (whole..light.len())
+            .map(|i| tone(&u, curve, Vec3::new(hdr[i * 4], hdr[i * 4 + 1], hdr[i * 4 + 2])));
+        let (worst, at) = worst(&ready[whole * 4..], toned);
+        println!(
+            "{}: the HDR light through the curve against the display-ready target: worst {worst} levels",
+            curve.name()
+        );
+        assert!(
+            worst <= DISPLAY_LEVELS + 1,
+            "{}: {worst} levels at light {}",
+            curve.name(),
+            light[whole + at]
+        );
     }
 }

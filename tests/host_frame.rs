@@ -8,8 +8,8 @@
 //!   culled by occlusion): the host's depth is in the culling, not only in the drawing;
 //! - afterwards the host's depth holds the wall on the left and terramp's depth on the right
 //!   (the terrain's: multisampled trees keep theirs in their own target);
-//! - targets of another size, a non-sRGB colour or a depth that cannot be copied are refused,
-//!   naming the target.
+//! - targets of another size, a linear 8-bit colour or a depth that cannot be copied are
+//!   refused, naming the target (a linear HDR colour is `tests/host_hdr.rs`'s).
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use terramp::camera::Camera;

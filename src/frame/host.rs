@@ -18,12 +18,13 @@
 
 use super::{FrameReport, RenderError, Renderer};
 use crate::camera::Camera;
-use crate::passes::DEPTH_FORMAT;
+use crate::passes::{DEPTH_FORMAT, HOST_HDR_FORMAT};
 
 /// The host's colour and depth targets, of the renderer's size (`render.width` × `height`).
 pub struct HostTargets<'a> {
-    /// Display-ready colour: an sRGB format (the hardware encodes on store), usable as a render
-    /// attachment, one sample.
+    /// Colour, usable as a render attachment, one sample: display-ready in an sRGB format
+    /// (exposed at `display.ev100`, through the tone curve; the hardware encodes on store), or
+    /// linear HDR in `HOST_HDR_FORMAT` (exposed, through no curve: the host tone-maps).
     pub colour: &'a wgpu::Texture,
     /// Depth in `DEPTH_FORMAT` (32-bit float, reversed-Z: 1 at the near plane, 0 at infinity),
     /// copied from and back (`COPY_SRC | COPY_DST`), one sample.
@@ -71,9 +72,10 @@ impl HostTargets<'_> {
         }
         let unusable = |target, why: String| Err(HostTargetError::Unusable { target, why });
         let (colour, depth) = (self.colour, self.depth);
-        if !colour.format().is_srgb() || !colour.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
+        let format_ok = colour.format().is_srgb() || colour.format() == HOST_HDR_FORMAT;
+        if !format_ok || !colour.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
             let why = format!(
-                "{:?} with {:?}: needs an sRGB format usable as a render attachment",
+                "{:?} with {:?}: needs an sRGB format (display-ready) or {HOST_HDR_FORMAT:?} (linear HDR) usable as a render attachment",
                 colour.format(),
                 colour.usage()
             );

@@ -37,6 +37,9 @@ pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The display target the display pass writes, what is saved and shown (sRGB: the hardware
 /// encodes on store).
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// A host's linear HDR colour target, which takes the light exposed and through no tone curve,
+/// for the host's own (`frame::HostTargets`): half floats, blendable on every adapter.
+pub const HOST_HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The depth target: reversed-Z (1 at the near plane, 0 at infinity), written by the terrain.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 

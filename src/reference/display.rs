@@ -6,7 +6,7 @@ use glam::Vec3;
 
 use crate::config::ToneCurve;
 use crate::gpu::gpu_types::DisplayUniforms;
-use crate::gpu::layout::SCENE_LIGHT_MAX;
+use crate::gpu::layout::{HOST_HDR_MAX, SCENE_LIGHT_MAX};
 
 fn by_rows(rows: &[[f32; 4]; 3], v: Vec3) -> Vec3 {
     let row = |r: &[f32; 4]| Vec3::new(r[0], r[1], r[2]).dot(v);
@@ -46,11 +46,25 @@ pub fn shown(u: &DisplayUniforms, curve: ToneCurve, daylight: Vec3, balanced: Ve
     if curve == ToneCurve::Linear {
         return balanced.clamp(Vec3::ZERO, Vec3::ONE);
     }
+    tone(u, curve, exposed(u, daylight, balanced))
+}
+
+/// The frame's balanced light `balanced` exposed: scene-referred linear light (sRGB primaries)
+/// that a tone curve takes, mid grey 0.18 at the exposure (`display.ev100`).
+pub fn exposed(u: &DisplayUniforms, daylight: Vec3, balanced: Vec3) -> Vec3 {
     let weights = Vec3::new(u.luminance[0], u.luminance[1], u.luminance[2]);
     let daylight_luminance = weights.dot(Vec3::ONE / daylight);
-    let exposed =
-        balanced.min(Vec3::splat(SCENE_LIGHT_MAX)).max(Vec3::ZERO) * (daylight_luminance * u.exposure[0]);
-    tone(u, curve, exposed)
+    balanced.min(Vec3::splat(SCENE_LIGHT_MAX)).max(Vec3::ZERO) * (daylight_luminance * u.exposure[0])
+}
+
+/// `fs_display_over_linear` and its blend: the exposed light (at most `HOST_HDR_MAX`) over a
+/// host's linear HDR pixel `under`, the frame's light being `light` premultiplied by its coverage
+/// `alpha`.
+pub fn exposed_over(u: &DisplayUniforms, daylight: Vec3, (light, alpha): (Vec3, f32), under: Vec3) -> Vec3 {
+    if alpha <= 0.0 {
+        return under;
+    }
+    exposed(u, daylight, light / alpha).min(Vec3::splat(HOST_HDR_MAX)) * alpha + under * (1.0 - alpha)
 }
 
 /// `fs_display_over` and its blend: the linear display light over a host's pixel whose linear

@@ -92,4 +92,14 @@ pub static HOST_CLAIMS: &[Claim] = &[
         quote: "13.5 dB (the test asks it to stay ≤ {} dB)",
         values: &[(test_const("tests/host_camera.rs", "CONTROL_PSNR_DB"), plain)],
     },
+    Claim {
+        doc: "docs/host.md",
+        quote: "relative steps of 2^-11; the test allows {}),",
+        values: &[(test_const("tests/display.rs", "HDR_STEPS"), plain)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "one of its 36,864 pixels (the test allows {});",
+        values: &[(test_const("tests/host_hdr.rs", "TONED_LEVELS"), plain)],
+    },
 ];

@@ -36,4 +36,8 @@ wgsl_constants! { atmosphere_constants:
     /// 65,504, and the sun's disk above the air is about 72,000 times white ground (its
     /// irradiance over its solid angle, 1 / (π 0.004675²), times π and the daylight balance).
     pub const SCENE_LIGHT_MAX: f32 = 60000.0;
+    /// The most exposed light the display writes over a host's linear HDR colour: f16's largest,
+    /// so that an exposure low enough to take the sun's disk past it leaves the host a bright
+    /// pixel, not infinity.
+    pub const HOST_HDR_MAX: f32 = 65504.0;
 }

@@ -108,7 +108,8 @@ impl DisplayPass {
     }
 
     /// Makes the pipeline that shows the light over a host's colour target of `format` (an sRGB
-    /// format: the hardware encodes on store), unless it has it.
+    /// format, the hardware encoding on store; or a float format, which takes the light exposed
+    /// and through no curve: `HOST_HDR_FORMAT`), unless it has it.
     pub fn prepare_over(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) {
         if self.over.as_ref().is_none_or(|(made, _)| *made != format) {
             let shown = Shown::Over(format);
@@ -201,7 +202,8 @@ fn display_pipeline(
             };
             let alpha = wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, ..colour };
             let blend = Some(wgpu::BlendState { color: colour, alpha });
-            ("fs_display_over", wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })
+            let entry_point = if format.is_srgb() { "fs_display_over" } else { "fs_display_over_linear" };
+            (entry_point, wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })
         }
     };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
