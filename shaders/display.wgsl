@@ -84,25 +84,27 @@ fn fs_display(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
 
 // Over the host's colour (`Renderer::render_into`): the light's alpha is how much of the pixel
 // terramp drew (its light premultiplied by it), so the light shown is the light over the alpha,
-// blended over what the host drew by that alpha.
-@fragment
-fn fs_display_over(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
+// blended over what the host drew by that alpha. This is that light, balanced, and the alpha (0
+// where terramp drew nothing: the host's pixel stays).
+fn covering(at: vec4<f32>) -> vec4<f32> {
     let light = textureLoad(scene, vec2<i32>(at.xy), 0);
     if light.a <= 0.0 {
         return vec4<f32>(0.0);
     }
-    let balanced = min(light.rgb / light.a, vec3<f32>(SCENE_LIGHT_MAX));
-    return vec4<f32>(shown(balanced), light.a);
+    return vec4<f32>(min(light.rgb / light.a, vec3<f32>(SCENE_LIGHT_MAX)), light.a);
+}
+
+// Over a display-ready (sRGB) host colour: the light shown.
+@fragment
+fn fs_display_over(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
+    let light = covering(at);
+    return vec4<f32>(shown(light.rgb), light.a);
 }
 
 // Over a host's linear HDR colour (a float target the host tone-maps itself): the light exposed,
-// through no curve, blended over what the host drew by the coverage as `fs_display_over` does.
+// through no curve.
 @fragment
 fn fs_display_over_linear(@builtin(position) at: vec4<f32>) -> @location(0) vec4<f32> {
-    let light = textureLoad(scene, vec2<i32>(at.xy), 0);
-    if light.a <= 0.0 {
-        return vec4<f32>(0.0);
-    }
-    let balanced = min(light.rgb / light.a, vec3<f32>(SCENE_LIGHT_MAX));
-    return vec4<f32>(min(exposed(balanced), vec3<f32>(HOST_HDR_MAX)), light.a);
+    let light = covering(at);
+    return vec4<f32>(min(exposed(light.rgb), vec3<f32>(HOST_HDR_MAX)), light.a);
 }
