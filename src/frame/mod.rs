@@ -71,10 +71,9 @@ struct LastFrame {
     tlm: TlmFrame,
     nodes: PreparedNodes,
     terrain: TerrainUniforms,
-    /// The node instances drawn, the camera's grid position and the frame's f64 matrix
-    /// (camera-relative metres to clip), for `drawn_ground`.
+    /// The node instances drawn and the frame's f64 matrix (camera-relative metres to clip), for
+    /// `drawn_ground`.
     batches: NodeBatches,
-    camera_grid_m: DVec3,
     clip_from_rel_m: glam::DMat4,
 }
 

@@ -111,9 +111,8 @@ impl Renderer {
                 });
             }
         }
-        let placing = self.placing.exact(last.camera_grid_m);
         let viewport = [self.settings.render.width, self.settings.render.height];
-        Ok(Some(DrawnGround::new(&quadrants, &last.terrain, placing, (last.clip_from_rel_m, viewport))))
+        Ok(Some(DrawnGround::new(&quadrants, &last.terrain, (last.clip_from_rel_m, viewport))))
     }
 
     /// The plants within `radius_m` of grid point `centre_grid_m` as the view from `camera` grows

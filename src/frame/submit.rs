@@ -29,7 +29,7 @@ impl Renderer {
         self.profiler.resolve(encoder);
         self.fragments.iter().for_each(|counter| counter.resolve(encoder));
         self.counts.resolve(encoder);
-        self.last = Some(LastFrame { tlm, nodes, terrain, batches, camera_grid_m, clip_from_rel_m });
+        self.last = Some(LastFrame { tlm, nodes, terrain, batches, clip_from_rel_m });
         self.frame += 1;
     }
 

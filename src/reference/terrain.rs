@@ -15,7 +15,6 @@ use glam::{DMat4, DVec2, DVec3, Vec2, Vec3};
 
 use crate::dataset::surface::diagonal_rises;
 use crate::earth::local::NodeMapping;
-use crate::earth::placing::ExactPlacing;
 use crate::gpu::gpu_types::{EarthNode, TerrainNode, TerrainUniforms};
 use crate::gpu::layout::HEIGHT_TILE_EXTENT;
 
@@ -39,7 +38,9 @@ pub struct DrawnQuadrant {
 pub struct GroundPoint {
     /// Where it is relative to the camera, in the frame's world axes, metres.
     pub rel_m: DVec3,
-    /// The grid point placed there: x, y and a height, metres (exact inverse of the placing).
+    /// The grid point the drawn ground holds there: x, y and a height, metres, blended from its
+    /// triangle's vertices as they were drawn (on the Earth it differs from the placing's exact
+    /// inverse of `rel_m` by the node mapping's error).
     pub grid_m: DVec3,
     /// Its height above the datum, metres.
     pub height_m: f64,
@@ -70,8 +71,6 @@ struct Patch {
 /// The ground a frame drew, rebuilt on the CPU.
 pub struct DrawnGround {
     patches: Vec<Patch>,
-    /// How the frame placed the grid, exact: camera-relative points back to grid points.
-    placing: ExactPlacing,
     /// The frame's matrix, camera-relative metres to clip, and its viewport, pixels.
     clip_from_rel_m: DMat4,
     viewport_px: [u32; 2],
@@ -79,15 +78,14 @@ pub struct DrawnGround {
 
 impl DrawnGround {
     /// The ground of `quadrants`, drawn with `uniforms` (the frame's node cells and camera),
-    /// placed by `placing`, seen through `clip_from_rel_m` in a `viewport_px` frame.
+    /// seen through `clip_from_rel_m` in a `viewport_px` frame.
     pub fn new(
         quadrants: &[DrawnQuadrant],
         uniforms: &TerrainUniforms,
-        placing: ExactPlacing,
         (clip_from_rel_m, viewport_px): (DMat4, [u32; 2]),
     ) -> Self {
         let patches = quadrants.iter().map(|q| patch(q, uniforms)).collect();
-        Self { patches, placing, clip_from_rel_m, viewport_px }
+        Self { patches, clip_from_rel_m, viewport_px }
     }
 
     /// The direction from the camera through the centre of pixel (`x`, `y`) (from the top left),
@@ -143,13 +141,16 @@ impl DrawnGround {
         }
         let (distance, patch, t, [u, v]) = best?;
         let [a, b, c] = t.map(|i| patch.vertices[i]);
-        let height_m =
-            f64::from(a.height_m) * (1.0 - u - v) + f64::from(b.height_m) * u + f64::from(c.height_m) * v;
-        let rel_m = direction * distance;
+        // The triangle's own grid point, blended as its height is (what `at_grid` gives back),
+        // not the exact inverse of the placing, which differs by the node mapping's error.
+        let weights = [1.0 - u - v, u, v];
+        let blend = |f: fn(&Vertex) -> DVec3| f(&a) * weights[0] + f(&b) * weights[1] + f(&c) * weights[2];
+        let offset_m = blend(|v| v.offset_m.as_dvec2().extend(f64::from(v.height_m)));
+        let grid_m = patch.origin_grid_m.extend(0.0) + offset_m;
         Some(GroundPoint {
-            rel_m,
-            grid_m: self.placing.grid_m(rel_m),
-            height_m,
+            rel_m: direction * distance,
+            grid_m,
+            height_m: grid_m.z,
             normal: sheet_normal([a, b, c]),
         })
     }

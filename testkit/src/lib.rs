@@ -16,6 +16,7 @@ pub mod earth;
 pub mod images;
 pub mod impostors;
 pub mod memory;
+pub mod query;
 pub mod setup;
 pub mod tlm;
 

@@ -25,39 +25,47 @@ pub static HOST_CLAIMS: &[Claim] = &[
     },
     Claim {
         doc: "docs/host.md",
-        quote: "`tests/query.rs` picks {} pixels of each of",
-        values: &[(test_const("tests/query.rs", "PICKS"), grouped)],
+        quote: "Each picks {} pixels of a settled 320 × 180 view",
+        values: &[(test_const("testkit/src/query.rs", "PICKS"), grouped)],
     },
     Claim {
         doc: "docs/host.md",
         quote: "depth buffer gives for that pixel: within {} cm, or within the",
-        values: &[(test_const("tests/query.rs", "PICK_FLOOR_M"), cm)],
+        values: &[(test_const("testkit/src/query.rs", "PICK_FLOOR_M"), cm)],
     },
     Claim {
         doc: "docs/host.md",
         quote: "up to 2^-{} pixel ({} subpixel bits, the fewest Vulkan allows;",
         values: &[
-            (test_const("tests/query.rs", "SUBPIXEL_BITS"), plain),
-            (test_const("tests/query.rs", "SUBPIXEL_BITS"), plain),
+            (test_const("testkit/src/query.rs", "SUBPIXEL_BITS"), plain),
+            (test_const("testkit/src/query.rs", "SUBPIXEL_BITS"), plain),
         ],
     },
     Claim {
         doc: "docs/host.md",
-        quote: "grid point is the pick's within {} mm (the test's",
-        values: &[(test_const("tests/query.rs", "HEIGHT_M"), mm)],
-    },
-    Claim {
-        doc: "docs/host.md",
-        quote: "asks for the plants within {} m of {} picked points of a settled synthetic",
+        quote: "point is the pick's within {} mm (the test's bound), and of the pixels showing sky at most {} %",
         values: &[
-            (test_const("tests/query.rs", "PLANTS_RADIUS_M"), plain),
-            (test_const("tests/query.rs", "PLANT_POINTS"), plain),
+            (test_const("testkit/src/query.rs", "HEIGHT_M"), mm),
+            (test_const("testkit/src/query.rs", "SKY_PICKED"), percent),
         ],
     },
     Claim {
         doc: "docs/host.md",
-        quote: "disagreement on at most {} % of them is allowed",
-        values: &[(test_const("tests/query.rs", "PLANTS_DISAGREEING"), percent)],
+        quote: "ask for the plants within {} m of {} picked points of a low view",
+        values: &[
+            (test_const("testkit/src/query.rs", "PLANTS_RADIUS_M"), plain),
+            (test_const("testkit/src/query.rs", "PLANT_POINTS"), plain),
+        ],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "{} % of the seeds near the points kept by the oracle and dropped by pass 3",
+        values: &[(test_const("testkit/src/query.rs", "PLANTS_DROPPED"), percent)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "at most {} % kept by pass 3 and dropped by the oracle",
+        values: &[(test_const("testkit/src/query.rs", "PLANTS_KEPT"), percent)],
     },
     Claim {
         doc: "docs/host.md",
