@@ -8,6 +8,7 @@
 //! an item a host needs and this module lacks shows up as a failing example, and a change to this
 //! list is a change to the host API, seen in review.
 
+pub use bytemuck;
 pub use glam;
 pub use wgpu;
 
@@ -26,6 +27,8 @@ pub use crate::earth::pose::{CrsPose, GeoPose};
 pub use crate::frame::{
     FrameReport, GroundAt, HostTargetError, HostTargets, Plant, Plants, RenderError, Renderer,
 };
+/// A texture's texels read back (waits for the GPU): for a host saving its frame.
+pub use crate::gpu::readback::read_texture;
 /// The device: terramp's own (`Gpu::new`) or the host's (`Gpu::from_host`).
 pub use crate::gpu::{AdapterChoice, Gpu, GpuError};
 /// The limits a host's device must allow for terramp's passes.

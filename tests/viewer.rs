@@ -16,11 +16,11 @@
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
 use std::io::{BufRead, BufReader};
-use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
+use terramp_testkit::xvfb::Xvfb;
 use terramp_testkit::{TempDir, psnr, synth_dataset};
 
 /// Least PSNR between the window's 3D frame and the same view rendered headless, dB.
@@ -38,10 +38,6 @@ impl Drop for Killed {
         let _ = self.0.kill();
         let _ = self.0.wait();
     }
-}
-
-fn have(tool: &str) -> bool {
-    Command::new("sh").args(["-c", &format!("command -v {tool}")]).output().is_ok_and(|o| o.status.success())
 }
 
 /// Runs an X client against `display`, checking that it succeeded; its standard output.
@@ -94,36 +90,14 @@ fn changed(a: &image::RgbaImage, b: &image::RgbaImage) -> Vec<(u32, u32)> {
 
 #[test]
 fn the_viewer_flies_in_a_real_window_and_shows_what_render_renders() {
-    if !["Xvfb", "xdotool", "xwd"].iter().all(|t| have(t)) {
-        assert!(std::env::var("CI").is_err(), "CI needs Xvfb, xdotool and xwd (.ci/run installs them)");
-        eprintln!("SKIPPED: Xvfb, xdotool or xwd missing (apt-get install xvfb xdotool x11-apps)");
-        return;
-    }
+    let Some(server) = Xvfb::start(&["Xvfb", "xdotool", "xwd"]) else { return };
+    let display = server.display.clone();
     let Some(impostors) = terramp_testkit::nc_impostors() else { return };
     let dataset = synth_dataset(300, 7);
     let tmp = TempDir::new("viewer");
     let settings = tmp.path().join("trees.toml");
     std::fs::write(&settings, format!("[draw_seeds]\nimpostors = {:?}\n", impostors.display().to_string()))
         .unwrap();
-
-    // A display number of its own: the lowest free one above 90.
-    let n = (90..200).find(|n| !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()).unwrap();
-    let display = format!(":{n}");
-    let _server = Killed(
-        Command::new("Xvfb")
-            .args([display.as_str(), "-screen", "0", "800x600x24", "-nolisten", "tcp"])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap(),
-    );
-    let socket = format!("/tmp/.X11-unix/X{n}");
-    for _ in 0..100 {
-        if Path::new(&socket).exists() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    }
 
     let [w, h] = WINDOW_PX.map(|v| v.to_string());
     let out = tmp.path().join("view");

@@ -19,6 +19,7 @@ pub mod memory;
 pub mod query;
 pub mod setup;
 pub mod tlm;
+pub mod xvfb;
 
 pub use data::{TempDir, shared_data};
 pub use datasets::{synth_dataset, synth_dataset_with};

@@ -110,4 +110,24 @@ pub static HOST_CLAIMS: &[Claim] = &[
         quote: "one of its 36,864 pixels (the test allows {});",
         values: &[(test_const("tests/host_hdr.rs", "TONED_LEVELS"), plain)],
     },
+    Claim {
+        doc: "docs/host.md",
+        quote: "each run drawing {} frames at 320 × 180",
+        values: &[(test_const("tests/winit_host.rs", "FRAMES"), plain)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "frame is terramp's own (the test asks ≥ {} dB;",
+        values: &[(test_const("tests/winit_host.rs", "OWN_VIEW_PSNR_DB"), plain)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "a {} m cube floating 2.6 km away",
+        values: &[(test_const("tests/winit_host.rs", "CUBE_M"), plain)],
+    },
+    Claim {
+        doc: "docs/host.md",
+        quote: "changes 70 (the test asks at least {});",
+        values: &[(test_const("tests/winit_host.rs", "SHOWN_PIXELS"), plain)],
+    },
 ];
