@@ -2,25 +2,11 @@
 //! (`target/<profile>/examples/`), and these tests run the binaries and read what they print.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
-use std::path::PathBuf;
 use std::process::Output;
 
 use terramp::dataset::Dataset;
 use terramp_testkit::datasets::synth_dataset;
-use terramp_testkit::setup::command;
-
-/// A built example, as `cargo test` left it beside the test binaries.
-fn example(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let profile_dir = exe.parent().and_then(|deps| deps.parent()).unwrap();
-    let path = profile_dir.join("examples").join(name);
-    assert!(
-        path.is_file(),
-        "{} is not built: `cargo test` builds the examples (or `cargo build --example {name}`)",
-        path.display()
-    );
-    path
-}
+use terramp_testkit::setup::{command, example};
 
 fn run(name: &str, args: &[&str]) -> Output {
     command(example(name)).args(args).output().unwrap()

@@ -11,13 +11,14 @@
 //! saying so, elsewhere.
 #![allow(clippy::unwrap_used, reason = "a test fails by panicking, and says where")]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::DVec3;
 use terramp::camera::Camera;
 use terramp::config::Settings;
 use terramp::frame::Renderer;
 use terramp::reference::terrain::DrawnGround;
+use terramp_testkit::setup::example;
 use terramp_testkit::xvfb::Xvfb;
 use terramp_testkit::{TempDir, camera, command, differing_pixels, gpu, psnr, synth_dataset};
 
@@ -31,14 +32,6 @@ const SHOWN_PIXELS: usize = 20;
 /// The cubes' side, metres.
 const CUBE_M: f64 = 4.0;
 
-/// The example, as `cargo test` builds it beside the tests.
-fn example() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let path = exe.parent().and_then(Path::parent).unwrap().join("examples").join("winit_host");
-    assert!(path.is_file(), "{} is not built: `cargo test` builds the examples", path.display());
-    path
-}
-
 /// The example's saved frame of `pose` with `cubes` (CRS x, y, z and side, metres).
 fn host_frame(
     x: &Xvfb,
@@ -51,7 +44,7 @@ fn host_frame(
     let p = pose.position_m;
     let camera = format!("{},{},{},{},{}", p.x, p.y, p.z, pose.yaw_deg, pose.pitch_deg);
     let out = dir.join(format!("{name}.png"));
-    let mut run = command(example());
+    let mut run = command(example("winit_host"));
     run.arg(dir.join("dataset")).args(["--settings", settings.to_str().unwrap(), "--camera", &camera]);
     run.args(["--size", &format!("{}x{}", SIZE[0], SIZE[1]), "--frames", &FRAMES.to_string()]);
     // The software adapter, as the view rendered here (`WGPU_ADAPTER_NAME`, wgpu's own choice).

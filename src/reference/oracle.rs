@@ -199,13 +199,7 @@ pub fn judge_seeds(
         .unwrap_or_else(|| inputs.settings.draw_seeds.reach_m.iter().fold(0.0f64, |a, &b| a.max(b)));
 
     // Ring-0 cells overlapping the height rectangle whose square comes within reach.
-    let range = |c: f64, a: usize| {
-        let last = (extent_m[a] / cell_m).floor();
-        let lo = ((c - reach_m) / cell_m).floor().max(0.0);
-        let hi = ((c + reach_m) / cell_m).floor().min(last);
-        (lo as i64, hi as i64)
-    };
-    let ((x0, x1), (y0, y1)) = (range(eye.x, 0), range(eye.y, 1));
+    let [(x0, x1), (y0, y1)] = cell_span(extent_m, cell_m, eye.truncate(), reach_m);
     // On the Earth reach is measured placed, and a projection may shrink distances by its scale
     // factor (UTM's by up to 0.04 % at a zone's edge): cells a little beyond reach on the grid
     // are judged too.
@@ -222,10 +216,8 @@ pub fn judge_seeds(
     if cells.is_empty() {
         return Ok((Vec::new(), OracleCounts::default()));
     }
-    let region_min = [x0 as f64 * cell_m, y0 as f64 * cell_m];
-    let region_max =
-        [((x1 + 1) as f64 * cell_m).min(extent_m[0]), ((y1 + 1) as f64 * cell_m).min(extent_m[1])];
-    let view = frame.view(inputs, culls, region_min, region_max)?;
+    let (region_min, region_max) = span_region(extent_m, cell_m, [(x0, x1), (y0, y1)]);
+    let view = frame.view(inputs, culls, region_min.to_array(), region_max.to_array())?;
     let judged: Vec<(Vec<OracleSeed>, OracleCounts)> =
         cells.par_iter().map(|&address| view.cell(address)).collect::<Result<_, _>>()?;
     let mut counts = OracleCounts::default();
@@ -236,6 +228,24 @@ pub fn judge_seeds(
     }
     seeds.sort_by_key(|s| (s.address, s.rank));
     Ok((seeds, counts))
+}
+
+/// The first and last ring-0 cell along x and y whose squares a disc of `radius_m` around grid
+/// point `centre_m` may overlap, clamped to the dataset's `extent_m` (empty where first > last).
+fn cell_span(extent_m: [f64; 2], cell_m: f64, centre_m: DVec2, radius_m: f64) -> [(i64, i64); 2] {
+    [0, 1].map(|a| {
+        let last = (extent_m[a] / cell_m).floor();
+        let lo = ((centre_m[a] - radius_m) / cell_m).floor().max(0.0);
+        let hi = ((centre_m[a] + radius_m) / cell_m).floor().min(last);
+        (lo as i64, hi as i64)
+    })
+}
+
+/// The grid rectangle the cells of `span` cover, clamped to the dataset's `extent_m`.
+fn span_region(extent_m: [f64; 2], cell_m: f64, [(x0, x1), (y0, y1)]: [(i64, i64); 2]) -> (DVec2, DVec2) {
+    let min = DVec2::new(x0 as f64 * cell_m, y0 as f64 * cell_m);
+    let max = DVec2::new((x1 + 1) as f64 * cell_m, (y1 + 1) as f64 * cell_m).min(DVec2::from(extent_m));
+    (min, max)
 }
 
 /// How each of `seeds` (named by address and rank; judged before in a view of the same dataset,

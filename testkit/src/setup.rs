@@ -45,6 +45,19 @@ pub fn command(program: impl AsRef<OsStr>) -> Command {
 }
 
 /// Whether `info` is Mesa's lavapipe: llvmpipe, its CPU rasteriser, on Vulkan.
+/// A built example of the crate, as `cargo test` leaves it beside the test binaries
+/// (`target/<profile>/examples/`); fails, saying how to build it, where it is not.
+pub fn example(name: &str) -> std::path::PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let path = exe.parent().and_then(Path::parent).unwrap().join("examples").join(name);
+    assert!(
+        path.is_file(),
+        "{} is not built: `cargo test` builds the examples (or `cargo build --example {name}`)",
+        path.display()
+    );
+    path
+}
+
 pub fn is_lavapipe(info: &wgpu::AdapterInfo) -> bool {
     let llvmpipe = info.name.contains("llvmpipe") || info.driver.contains("llvmpipe");
     info.device_type == wgpu::DeviceType::Cpu && info.backend == wgpu::Backend::Vulkan && llvmpipe

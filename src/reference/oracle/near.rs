@@ -8,7 +8,7 @@ use glam::DVec2;
 use rayon::prelude::*;
 
 use super::frame::ViewFrame;
-use super::{Culls, OracleError, OracleInputs, OracleSeed};
+use super::{Culls, OracleError, OracleInputs, OracleSeed, cell_span, span_region};
 
 /// The seeds of the view of `inputs` standing within `radius_m` of grid point `centre_m` that
 /// survive `culls`, sorted by (address, rank).
@@ -20,23 +20,15 @@ pub fn seeds_within(
 ) -> Result<Vec<OracleSeed>, OracleError> {
     let frame = ViewFrame::new(inputs)?;
     let (cell_m, extent_m) = (inputs.settings.tlm.cell_m, frame.extent_m);
-    let range = |a: usize| {
-        let last = (extent_m[a] / cell_m).floor();
-        let lo = ((centre_m[a] - radius_m) / cell_m).floor().max(0.0);
-        let hi = ((centre_m[a] + radius_m) / cell_m).floor().min(last);
-        (lo as i64, hi as i64)
-    };
-    let ((x0, x1), (y0, y1)) = (range(0), range(1));
+    let [(x0, x1), (y0, y1)] = cell_span(extent_m, cell_m, centre_m, radius_m);
     if x0 > x1 || y0 > y1 || radius_m < 0.0 {
         return Ok(Vec::new());
     }
     let cells: Vec<[i64; 2]> = (y0..=y1).flat_map(|gy| (x0..=x1).map(move |gx| [gx, gy])).collect();
     // The region holds the eye too: the occlusion test walks the ground from the eye to a seed.
     let eye = frame.eye.truncate();
-    let region_min = DVec2::new(x0 as f64 * cell_m, y0 as f64 * cell_m).min(eye);
-    let region_max =
-        DVec2::new(((x1 + 1) as f64 * cell_m).min(extent_m[0]), ((y1 + 1) as f64 * cell_m).min(extent_m[1]))
-            .max(eye);
+    let (region_min, region_max) = span_region(extent_m, cell_m, [(x0, x1), (y0, y1)]);
+    let (region_min, region_max) = (region_min.min(eye), region_max.max(eye));
     let view = frame.view(inputs, culls, region_min.to_array(), region_max.to_array())?;
     let judged: Vec<Vec<OracleSeed>> =
         cells.par_iter().map(|&address| Ok(view.cell(address)?.0)).collect::<Result<_, OracleError>>()?;
